@@ -1,0 +1,14 @@
+// The isolink subcommands. Each add_*_command registers one CLI11 subcommand on app; its callback
+// runs the command and stores the process exit status in *exit_code
+// (0 pass / done, 1 the link fails its rules, 2 bad input or internal error).
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace isolink::cli {
+
+void add_sim_command(CLI::App& app, int* exit_code);
+void add_check_command(CLI::App& app, int* exit_code);
+void add_frame_command(CLI::App& app, int* exit_code);
+
+}  // namespace isolink::cli

@@ -1,0 +1,49 @@
+// Card: one flattened element instance as the netlist layer hands it to the solver.
+//
+// The SPICE reader (netlists/) resolves includes, parameters, expressions and subcircuits, then
+// gives each element as a Card: names and nodes already hierarchical ("x1.r3", "x1.mid"), every
+// value already a number. Element kinds (solver/elements/) turn a Card into an Element, checking
+// their own values. Nothing here knows SPICE syntax.
+//   R1 a b 49              -> letter 'r', nodes {a, b}, args {49}
+//   V1 p 0 PULSE(0 5 1n)   -> letter 'v', args {Call "pulse" [0, 5, 1e-9]}
+//   V2 p 0 DC 2.5          -> args {Word "dc", 2.5}
+//   K1 L1 L2 0.99          -> refs {l1, l2}, args {0.99}
+//   C1 a b 1n ic=0         -> args {1e-9}, params {ic: 0}
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "solver/source_loc.h"
+
+namespace isolink {
+
+struct CardArg {
+  enum class Kind { Number, Word, Call };
+  Kind kind = Kind::Number;
+  double number = 0.0;       // Kind::Number
+  std::string word;          // Kind::Word (lower case), or the function name of Kind::Call
+  std::vector<double> call;  // Kind::Call arguments, e.g. pwl(t1 v1 t2 v2 ...)
+  SourceLoc loc;
+};
+
+struct Card {
+  char letter = 0;                     // element kind letter, lower case ('r', 'c', ...)
+  std::string name;                    // full hierarchical name, lower case ("x1.r3")
+  SourceLoc loc;                       // where the element's name starts
+  std::vector<std::string> nodes;      // node names, lower case, "0" is ground
+  std::vector<SourceLoc> node_locs;    // one per node
+  std::vector<std::string> refs;       // other elements named by this one (K: two inductors)
+  std::vector<SourceLoc> ref_locs;     // one per ref
+  std::vector<CardArg> args;           // positional values after nodes and refs
+  std::vector<std::pair<std::string, CardArg>> params;  // key=value pairs, keys lower case
+
+  const CardArg* param(const std::string& key) const {
+    for (const auto& [k, v] : params)
+      if (k == key) return &v;
+    return nullptr;
+  }
+};
+
+}  // namespace isolink

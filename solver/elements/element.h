@@ -1,0 +1,102 @@
+// Element: one circuit element kind's behaviour in modified nodal analysis (MNA).
+//
+// Lifecycle (driven by Circuit and the engines, never by users of a kind):
+//   1. parse:   ElementKind::parse(card) -> Element, values checked, nodes still names.
+//   2. connect: Circuit maps node names to unknown indices (0 = ground) and hands out branch
+//               unknowns (branch_count()); link() resolves references to other elements (K -> L).
+//   3. declare: declare(pattern) asks for every matrix entry it will touch, once, and keeps the
+//               slot handles. Entries in the ground row or column come back as the write-only
+//               trash slot, so stamps never test for ground.
+//   4. stamp:   stamp(g, c) adds constant values into G (conductance) and C (d/dt) once;
+//               stamp_rhs(t, b) adds the excitation at time t into b on every step.
+// The circuits isolink targets are linear and time-invariant: G and C never change during a run.
+#pragma once
+
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "solver/card.h"
+#include "solver/source_loc.h"
+#include "solver/status.h"
+
+namespace isolink {
+
+class Circuit;
+class MnaPattern;
+
+using Slot = int;  // index into a matrix value array; MnaPattern::kTrash for ground entries
+
+// How an element joins two nodes at DC, for the topology checks before the operating point.
+enum class DcLink { Conductive, VoltageDefining, CurrentSource };
+struct DcEdge {
+  int a, b;
+  DcLink link;
+};
+
+class Element {
+ public:
+  Element(std::string name, SourceLoc loc) : name_(std::move(name)), loc_(std::move(loc)) {}
+  virtual ~Element() = default;
+
+  const std::string& name() const { return name_; }
+  const SourceLoc& loc() const { return loc_; }
+  const std::vector<std::string>& node_names() const { return node_names_; }
+  const std::vector<int>& nodes() const { return nodes_; }
+  const std::vector<int>& branches() const { return branches_; }
+
+  // Number of branch-current unknowns this element adds (V and L: 1).
+  virtual int branch_count() const { return 0; }
+  // True when the branch current is a state (inductor): the step control watches its error.
+  virtual bool branch_is_state() const { return false; }
+  // Resolves references to other elements once every element is connected.
+  virtual Status link(const Circuit& circuit) { return Status::Ok(); }
+  virtual void declare(MnaPattern& pattern) = 0;
+  // Constant values into G and C (value arrays over the declared pattern).
+  virtual void stamp(double* g, double* c) const = 0;
+  // Excitation at time t into b (b[0] is the ground trash entry).
+  virtual void stamp_rhs(double t, double* b) const {}
+  // Times in (0, tstop] where the excitation has a corner.
+  virtual void breakpoints(double tstop, std::vector<double>& out) const {}
+  // DC connectivity for the topology checks.
+  virtual void dc_edges(std::vector<DcEdge>& out) const {}
+
+  // Called by Circuit while connecting.
+  void set_node_names(std::vector<std::string> names) { node_names_ = std::move(names); }
+  void set_nodes(std::vector<int> nodes) { nodes_ = std::move(nodes); }
+  void set_branches(std::vector<int> branches) { branches_ = std::move(branches); }
+
+ protected:
+  std::string name_;
+  SourceLoc loc_;
+  std::vector<std::string> node_names_;
+  std::vector<int> nodes_;
+  std::vector<int> branches_;
+};
+
+// One row of an element kind's parameter table: feeds the parser, --help and the README.
+struct ParamSpec {
+  const char* name;       // lower case, as written in key=value or as the positional value
+  double default_value;   // NaN when required
+  const char* unit;       // SI unit symbol, "" when dimensionless
+  const char* doc;        // one line
+};
+
+// One element kind: the registry in elements/registry.cpp lists them all explicitly.
+struct ElementKind {
+  char letter;                     // SPICE letter, lower case
+  const char* name;                // "resistor"
+  const char* usage;               // "Rname n+ n- value [key=value...]"
+  int node_count;                  // node tokens after the name
+  int ref_count;                   // element-name tokens after the nodes (K: 2)
+  std::span<const ParamSpec> params;
+  StatusOr<std::unique_ptr<Element>> (*parse)(const Card& card);
+};
+
+// All element kinds, in letter order.
+std::span<const ElementKind> element_kinds();
+// nullptr when no kind has that letter (any case).
+const ElementKind* find_element_kind(char letter);
+
+}  // namespace isolink
