@@ -1,0 +1,63 @@
+#include "cli/simulate.h"
+
+#include <chrono>
+
+#include "solver/circuit.h"
+
+namespace isolink::cli {
+
+StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const SimulationRequest& req) {
+  SimulationResult result;
+  result.warnings = netlist.warnings;
+
+  TransientOptions opt;
+  if (netlist.tran) {
+    opt.tstep = netlist.tran->tstep;
+    opt.tstop = netlist.tran->tstop;
+    opt.tstart = netlist.tran->tstart;
+    opt.tmax = netlist.tran->tmax;
+    opt.uic = netlist.tran->uic;
+  }
+  for (const auto& o : netlist.options) {
+    bool known = true;
+    if (Status s = opt.set_option(o.key, o.value, &known); !s.ok()) return s;
+    if (!known)
+      result.warnings.push_back(
+          format_diagnostic(o.loc, "warning", "option '" + o.key + "' is not used by isolink; ignored"));
+  }
+  if (req.tstop) opt.tstop = *req.tstop;
+  if (req.tstep) opt.tstep = *req.tstep;
+  if (req.tmax) opt.tmax = *req.tmax;
+  if (req.method) opt.method = *req.method;
+  if (req.reltol) opt.reltol = *req.reltol;
+  if (!netlist.tran && !req.tstop)
+    return Status::Error("no .tran card in the netlist and no --tstop given: nothing to simulate");
+  if (opt.tstep <= 0 && opt.tstop > 0) opt.tstep = opt.tstop / 1000;
+  if (Status s = opt.validate(); !s.ok()) return s;
+
+  Circuit circuit;
+  for (const Card& card : netlist.cards)
+    if (Status s = circuit.add(card); !s.ok()) return s;
+  if (Status s = circuit.finalize(); !s.ok()) return s;
+  for (const auto& w : circuit.warnings()) result.warnings.push_back(w);
+
+  std::vector<Probe> probes;
+  for (const auto& text : req.probes) {
+    StatusOr<Probe> p = parse_probe(circuit, text);
+    if (!p) return p.status();
+    probes.push_back(*p);
+  }
+  if (probes.empty()) return Status::Error("no --probe given: say what to record, e.g. --probe 'v(rxp,rxn)'");
+
+  const auto start = std::chrono::steady_clock::now();
+  StatusOr<Waveform> wave = run_transient(circuit, opt, probes, &result.stats);
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!wave) return wave.status();
+  result.wave = std::move(*wave);
+  result.nodes = circuit.node_count() - 1;
+  result.unknowns = circuit.unknown_count();
+  result.elements = static_cast<int>(circuit.elements().size());
+  return result;
+}
+
+}  // namespace isolink::cli

@@ -1,0 +1,53 @@
+// I: independent current source; the current flows from n+ through the source to n-.
+#include <cmath>
+
+#include "solver/elements/card_values.h"
+#include "solver/elements/kinds.h"
+#include "solver/elements/source_function.h"
+#include "solver/mna.h"
+
+namespace isolink {
+namespace {
+
+constexpr ParamSpec kParams[] = {
+    {"dc", 0.0, "A", "DC value, or PULSE(...) | PWL(...) | SIN(...) as for V"},
+};
+
+class CurrentSource final : public Element {
+ public:
+  CurrentSource(const Card& card, SourceFunction f) : Element(card.name, card.loc), f_(std::move(f)) {}
+  void declare(MnaPattern&) override {}
+  void stamp(double*, double*) const override {}
+  void stamp_rhs(double t, double* b) const override {
+    const double i = f_.value(t);
+    b[nodes_[0]] -= i, b[nodes_[1]] += i;
+  }
+  void bind_time(double tstep, double tstop) override { f_.bind_time(tstep, tstop); }
+  void breakpoints(double tstop, std::vector<double>& out) const override {
+    f_.breakpoints(tstop, out);
+  }
+  void dc_edges(std::vector<DcEdge>& out) const override {
+    out.push_back({nodes_[0], nodes_[1], DcLink::CurrentSource});
+  }
+
+ private:
+  SourceFunction f_;
+};
+
+StatusOr<std::unique_ptr<Element>> parse(const Card& card) {
+  if (Status s = check_params(card, kParams); !s.ok()) return s;
+  StatusOr<SourceFunction> f = SourceFunction::Parse(card);
+  if (!f) return f.status();
+  return std::unique_ptr<Element>(std::make_unique<CurrentSource>(card, std::move(*f)));
+}
+
+}  // namespace
+
+const ElementKind& current_source_kind() {
+  static const ElementKind kind{'i', "current source",
+                                "Iname n+ n- [DC] value | PULSE(...) | PWL(...) | SIN(...)", 2, 0,
+                                kParams, parse};
+  return kind;
+}
+
+}  // namespace isolink

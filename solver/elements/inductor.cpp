@@ -1,0 +1,48 @@
+// Branch equation: V(a) - V(b) - L di/dt = 0; KCL: +i leaves a, enters b.
+#include "solver/elements/inductor.h"
+
+#include <cmath>
+
+#include "solver/elements/card_values.h"
+#include "solver/elements/kinds.h"
+#include "solver/mna.h"
+
+namespace isolink {
+namespace {
+
+constexpr ParamSpec kParams[] = {
+    {"l", NAN, "H", "inductance, positive"},
+    {"ic", 0.0, "A", "initial current (accepted, used only with uic: the DC point sets it)"},
+};
+
+StatusOr<std::unique_ptr<Element>> parse(const Card& card) {
+  if (Status s = check_params(card, kParams); !s.ok()) return s;
+  StatusOr<double> l = card_value(card, kParams, "l", 0);
+  if (!l) return l.status();
+  if (Status s = require_positive(card, "l", 0, *l, "inductance"); !s.ok()) return s;
+  return std::unique_ptr<Element>(std::make_unique<Inductor>(card, *l));
+}
+
+}  // namespace
+
+void Inductor::declare(MnaPattern& p) {
+  const int a = nodes_[0], b = nodes_[1], br = branches_[0];
+  a_br_ = p.slot(a, br), b_br_ = p.slot(b, br), br_a_ = p.slot(br, a), br_b_ = p.slot(br, b);
+  br_br_ = p.slot(br, br);
+}
+
+void Inductor::stamp(double* g, double* c) const {
+  g[a_br_] += 1, g[b_br_] -= 1, g[br_a_] += 1, g[br_b_] -= 1;
+  c[br_br_] -= l_;
+}
+
+void Inductor::dc_edges(std::vector<DcEdge>& out) const {
+  out.push_back({nodes_[0], nodes_[1], DcLink::VoltageDefining});
+}
+
+const ElementKind& inductor_kind() {
+  static const ElementKind kind{'l', "inductor", "Lname n+ n- value", 2, 0, kParams, parse};
+  return kind;
+}
+
+}  // namespace isolink

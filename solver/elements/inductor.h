@@ -1,0 +1,26 @@
+// L: a linear inductor; its branch current is an MNA unknown (and a state for step control).
+// Exposed so that mutual inductance (K) can couple two of them.
+#pragma once
+
+#include "solver/elements/element.h"
+
+namespace isolink {
+
+class Inductor final : public Element {
+ public:
+  Inductor(const Card& card, double l) : Element(card.name, card.loc), l_(l) {}
+  double inductance() const { return l_; }
+  int branch() const { return branches_[0]; }
+
+  int branch_count() const override { return 1; }
+  bool branch_is_state() const override { return true; }
+  void declare(MnaPattern& p) override;
+  void stamp(double* g, double* c) const override;
+  void dc_edges(std::vector<DcEdge>& out) const override;
+
+ private:
+  double l_;
+  Slot a_br_ = 0, b_br_ = 0, br_a_ = 0, br_b_ = 0, br_br_ = 0;
+};
+
+}  // namespace isolink

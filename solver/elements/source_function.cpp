@@ -1,0 +1,160 @@
+#include "solver/elements/source_function.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include <fmt/format.h>
+
+namespace isolink {
+
+namespace {
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+double or_default(const std::vector<double>& p, size_t i, double d) {
+  return i < p.size() && !std::isnan(p[i]) ? p[i] : d;
+}
+}  // namespace
+
+StatusOr<SourceFunction> SourceFunction::Parse(const Card& card) {
+  SourceFunction f;
+  bool have_value = false;
+  const auto& args = card.args;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const CardArg& a = args[i];
+    if (a.kind == CardArg::Kind::Number) {
+      if (have_value) return error_at(a.loc, "unexpected extra value for source '" + card.name + "'");
+      f.dc_ = a.number;
+      have_value = true;
+    } else if (a.kind == CardArg::Kind::Word) {
+      if (a.word == "dc") {
+        if (i + 1 >= args.size() || args[i + 1].kind != CardArg::Kind::Number)
+          return error_at(a.loc, "expected a number after DC");
+        f.dc_ = args[++i].number;
+        have_value = true;
+      } else if (a.word == "ac") {
+        // AC magnitude/phase: no small-signal analysis here; skip its numbers.
+        while (i + 1 < args.size() && args[i + 1].kind == CardArg::Kind::Number) ++i;
+      } else {
+        return error_at(a.loc, "expected DC, PULSE, PWL or SIN in source '" + card.name +
+                                   "', found '" + a.word + "'");
+      }
+    } else {  // Call
+      if (a.word == "pulse") {
+        if (a.call.size() < 2 || a.call.size() > 8)
+          return error_at(a.loc, "PULSE takes 2 to 8 values (V1 V2 TD TR TF PW PER NP), got " +
+                                     std::to_string(a.call.size()));
+        f.kind_ = Kind::Pulse;
+        f.p_ = a.call;
+        for (size_t k = 2; k < a.call.size(); ++k)
+          if (a.call[k] < 0) return error_at(a.loc, "PULSE timing values must not be negative");
+      } else if (a.word == "sin") {
+        if (a.call.size() < 3 || a.call.size() > 6)
+          return error_at(a.loc, "SIN takes 3 to 6 values (VO VA FREQ TD THETA PHASE), got " +
+                                     std::to_string(a.call.size()));
+        f.kind_ = Kind::Sin;
+        f.p_ = a.call;
+      } else if (a.word == "pwl") {
+        if (a.call.size() < 2 || a.call.size() % 2 != 0)
+          return error_at(a.loc, "PWL takes time/value pairs, got " +
+                                     std::to_string(a.call.size()) + " values");
+        f.kind_ = Kind::Pwl;
+        for (size_t k = 0; k < a.call.size(); k += 2) {
+          double t = a.call[k];
+          if (t < 0) return error_at(a.loc, fmt::format("PWL time {:g} s is negative", t));
+          if (!f.pwl_t_.empty() && t <= f.pwl_t_.back())
+            return error_at(a.loc, fmt::format("PWL times must increase: point {} has t={:g} s "
+                                               "after t={:g} s",
+                                               k / 2 + 1, t, f.pwl_t_.back()));
+          f.pwl_t_.push_back(t);
+          f.pwl_v_.push_back(a.call[k + 1]);
+        }
+      } else {
+        return error_at(a.loc, "unknown source function '" + a.word +
+                                   "' (expected PULSE, PWL or SIN)");
+      }
+      have_value = true;
+    }
+  }
+  f.bind_time(0.0, 0.0);
+  return f;
+}
+
+void SourceFunction::bind_time(double tstep, double tstop) {
+  if (kind_ != Kind::Pulse) return;
+  v1_ = or_default(p_, 0, 0.0);
+  v2_ = or_default(p_, 1, 0.0);
+  td_ = or_default(p_, 2, 0.0);
+  // ngspice: TR and TF default to TSTEP, PW and PER to TSTOP.
+  tr_ = or_default(p_, 3, 0.0);
+  tf_ = or_default(p_, 4, 0.0);
+  if (tr_ <= 0) tr_ = tstep > 0 ? tstep : 1e-12;
+  if (tf_ <= 0) tf_ = tstep > 0 ? tstep : 1e-12;
+  pw_ = or_default(p_, 5, tstop > 0 ? tstop : 1.0);
+  per_ = or_default(p_, 6, tstop > 0 ? tstop : 1.0);
+  np_ = or_default(p_, 7, 0.0);
+  if (per_ < tr_ + pw_ + tf_) per_ = tr_ + pw_ + tf_;
+}
+
+double SourceFunction::value(double t) const {
+  switch (kind_) {
+    case Kind::Dc:
+      return dc_;
+    case Kind::Pulse: {
+      if (t <= td_) return v1_;
+      double tt = t - td_;
+      double k = std::floor(tt / per_);
+      if (np_ > 0 && k >= np_) return v1_;
+      tt -= k * per_;
+      if (tt < tr_) return v1_ + (v2_ - v1_) * tt / tr_;
+      if (tt <= tr_ + pw_) return v2_;
+      if (tt < tr_ + pw_ + tf_) return v2_ + (v1_ - v2_) * (tt - tr_ - pw_) / tf_;
+      return v1_;
+    }
+    case Kind::Pwl: {
+      if (t <= pwl_t_.front()) return pwl_v_.front();
+      if (t >= pwl_t_.back()) return pwl_v_.back();
+      size_t i = std::upper_bound(pwl_t_.begin(), pwl_t_.end(), t) - pwl_t_.begin();
+      double f = (t - pwl_t_[i - 1]) / (pwl_t_[i] - pwl_t_[i - 1]);
+      return pwl_v_[i - 1] + f * (pwl_v_[i] - pwl_v_[i - 1]);
+    }
+    case Kind::Sin: {
+      double vo = or_default(p_, 0, 0), va = or_default(p_, 1, 0), freq = or_default(p_, 2, 0);
+      double td = or_default(p_, 3, 0), theta = or_default(p_, 4, 0), ph = or_default(p_, 5, 0);
+      double phase = ph * std::numbers::pi / 180.0;
+      if (t <= td) return vo + va * std::sin(phase);
+      double tt = t - td;
+      return vo + va * std::exp(-tt * theta) * std::sin(2 * std::numbers::pi * freq * tt + phase);
+    }
+  }
+  return 0.0;
+}
+
+void SourceFunction::breakpoints(double tstop, std::vector<double>& out) const {
+  switch (kind_) {
+    case Kind::Dc:
+      return;
+    case Kind::Pulse: {
+      for (long k = 0;; ++k) {
+        if (np_ > 0 && k >= np_) break;
+        double base = td_ + static_cast<double>(k) * per_;
+        if (base > tstop) break;
+        for (double c : {base, base + tr_, base + tr_ + pw_, base + tr_ + pw_ + tf_})
+          if (c > 0 && c <= tstop) out.push_back(c);
+        if (per_ <= 0) break;
+      }
+      return;
+    }
+    case Kind::Pwl:
+      for (double t : pwl_t_)
+        if (t > 0 && t <= tstop) out.push_back(t);
+      return;
+    case Kind::Sin: {
+      double td = or_default(p_, 3, 0);
+      if (td > 0 && td <= tstop) out.push_back(td);
+      return;
+    }
+  }
+}
+
+}  // namespace isolink

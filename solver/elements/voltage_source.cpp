@@ -1,0 +1,58 @@
+// V: independent voltage source, V(n+) - V(n-) = f(t); branch current flows n+ -> source -> n-.
+#include <cmath>
+
+#include "solver/elements/card_values.h"
+#include "solver/elements/kinds.h"
+#include "solver/elements/source_function.h"
+#include "solver/mna.h"
+
+namespace isolink {
+namespace {
+
+constexpr ParamSpec kParams[] = {
+    {"dc", 0.0, "V", "DC value, or PULSE(V1 V2 TD TR TF PW PER NP) | PWL(t v ...) | "
+                     "SIN(VO VA F TD THETA PHASE)"},
+};
+
+class VoltageSource final : public Element {
+ public:
+  VoltageSource(const Card& card, SourceFunction f) : Element(card.name, card.loc), f_(std::move(f)) {}
+  int branch_count() const override { return 1; }
+  void declare(MnaPattern& p) override {
+    const int a = nodes_[0], b = nodes_[1], br = branches_[0];
+    a_br_ = p.slot(a, br), b_br_ = p.slot(b, br), br_a_ = p.slot(br, a), br_b_ = p.slot(br, b);
+  }
+  void stamp(double* g, double*) const override {
+    g[a_br_] += 1, g[b_br_] -= 1, g[br_a_] += 1, g[br_b_] -= 1;
+  }
+  void stamp_rhs(double t, double* b) const override { b[branches_[0]] += f_.value(t); }
+  void bind_time(double tstep, double tstop) override { f_.bind_time(tstep, tstop); }
+  void breakpoints(double tstop, std::vector<double>& out) const override {
+    f_.breakpoints(tstop, out);
+  }
+  void dc_edges(std::vector<DcEdge>& out) const override {
+    out.push_back({nodes_[0], nodes_[1], DcLink::VoltageDefining});
+  }
+
+ private:
+  SourceFunction f_;
+  Slot a_br_ = 0, b_br_ = 0, br_a_ = 0, br_b_ = 0;
+};
+
+StatusOr<std::unique_ptr<Element>> parse(const Card& card) {
+  if (Status s = check_params(card, kParams); !s.ok()) return s;
+  StatusOr<SourceFunction> f = SourceFunction::Parse(card);
+  if (!f) return f.status();
+  return std::unique_ptr<Element>(std::make_unique<VoltageSource>(card, std::move(*f)));
+}
+
+}  // namespace
+
+const ElementKind& voltage_source_kind() {
+  static const ElementKind kind{'v', "voltage source",
+                                "Vname n+ n- [DC] value | PULSE(...) | PWL(...) | SIN(...)", 2, 0,
+                                kParams, parse};
+  return kind;
+}
+
+}  // namespace isolink

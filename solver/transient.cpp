@@ -1,0 +1,315 @@
+#include "solver/transient.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "solver/klu_solver.h"
+#include "solver/mna.h"
+
+namespace isolink {
+
+double TransientOptions::effective_tmax() const {
+  if (tmax > 0) return tmax;
+  return std::min(tstep, (tstop - tstart) / 50.0);
+}
+
+Status TransientOptions::validate() const {
+  auto bad = [](const char* field, double v, const char* rule) {
+    return Status::Error(fmt::format("transient option {} = {:g}: {}", field, v, rule));
+  };
+  if (!(tstep > 0)) return bad("tstep", tstep, "must be positive");
+  if (!(tstart >= 0)) return bad("tstart", tstart, "must not be negative");
+  if (!(tstop > tstart)) return bad("tstop", tstop, "must be greater than tstart");
+  if (!(tmax >= 0)) return bad("tmax", tmax, "must not be negative");
+  if (!(reltol > 0 && reltol < 1)) return bad("reltol", reltol, "must be in (0, 1)");
+  if (!(vntol > 0)) return bad("vntol", vntol, "must be positive");
+  if (!(abstol > 0)) return bad("abstol", abstol, "must be positive");
+  if (!(trtol > 0)) return bad("trtol", trtol, "must be positive");
+  if (max_steps <= 0) return bad("max_steps", static_cast<double>(max_steps), "must be positive");
+  return Status::Ok();
+}
+
+Status TransientOptions::set_option(const std::string& key, const CardArg& value, bool* known) {
+  *known = true;
+  auto number = [&](double* field) -> Status {
+    if (value.kind != CardArg::Kind::Number)
+      return error_at(value.loc, "option " + key + " expects a number");
+    *field = value.number;
+    return Status::Ok();
+  };
+  if (key == "reltol") return number(&reltol);
+  if (key == "vntol") return number(&vntol);
+  if (key == "abstol") return number(&abstol);
+  if (key == "trtol") return number(&trtol);
+  if (key == "method") {
+    if (value.kind == CardArg::Kind::Word && (value.word == "trap" || value.word == "trapezoidal"))
+      method = IntegrationMethod::Trapezoidal;
+    else if (value.kind == CardArg::Kind::Word && value.word == "gear")
+      method = IntegrationMethod::Gear2;
+    else
+      return error_at(value.loc, "option method expects trap or gear");
+    return Status::Ok();
+  }
+  if (key == "maxord") return Status::Ok();  // Gear-2 is the only Gear order; accepted
+  *known = false;
+  return Status::Ok();
+}
+
+namespace {
+
+// The assembled linear system of a circuit.
+struct System {
+  MnaPattern pattern{0};
+  std::vector<double> g, c;  // value arrays (+ trash)
+  KluSolver klu;
+  int n = 0;                 // unknowns without ground
+
+  Status build(const Circuit& circuit) {
+    n = circuit.unknown_count();
+    pattern = MnaPattern(n);
+    auto& elements = const_cast<Circuit&>(circuit).elements();
+    for (auto& e : elements) e->declare(pattern);
+    pattern.finalize();
+    for (auto& e : elements) e->declare(pattern);
+    g.assign(pattern.value_count(), 0.0);
+    c.assign(pattern.value_count(), 0.0);
+    for (auto& e : elements) e->stamp(g.data(), c.data());
+    for (int node : circuit.floating_nodes()) g[pattern.slot(node, node)] += Circuit::kFloatingTie;
+    return klu.analyze(pattern);
+  }
+
+  // y += C * v over unknowns 1..n (index 0 ignored).
+  void add_c_times(const std::vector<double>& v, double scale, std::vector<double>& y) const {
+    const auto& cp = pattern.col_start();
+    const auto& ri = pattern.row_index();
+    for (int col = 0; col < n; ++col) {
+      const double vc = v[col + 1] * scale;
+      if (vc == 0.0) continue;
+      for (int k = cp[col]; k < cp[col + 1]; ++k) y[ri[k] + 1] += c[k] * vc;
+    }
+  }
+
+  void rhs(const Circuit& circuit, double t, std::vector<double>& b) const {
+    std::fill(b.begin(), b.end(), 0.0);
+    for (const auto& e : circuit.elements()) e->stamp_rhs(t, b.data());
+    b[0] = 0.0;
+  }
+
+  Status select_or_factor(const Circuit& circuit, double alpha) {
+    if (klu.select(alpha)) return Status::Ok();
+    std::vector<double> a(pattern.nonzeros());
+    for (int k = 0; k < pattern.nonzeros(); ++k) a[k] = g[k] + alpha * c[k];
+    Status s = klu.factor(alpha, a.data());
+    if (!s.ok() && klu.singular_column() >= 0)
+      return Status::Error(fmt::format("singular matrix: {} is not determined by the circuit",
+                                       circuit.unknown_name(klu.singular_column() + 1)));
+    return s;
+  }
+
+  // Solves in place: b holds the right-hand side (index 0 ignored), then x.
+  Status solve(std::vector<double>& b) {
+    Status s = klu.solve(b.data() + 1);
+    b[0] = 0.0;
+    return s;
+  }
+};
+
+}  // namespace
+
+StatusOr<std::vector<double>> dc_operating_point(const Circuit& circuit) {
+  System sys;
+  if (Status s = sys.build(circuit); !s.ok()) return s;
+  if (Status s = sys.select_or_factor(circuit, 0.0); !s.ok()) return s.with_context("DC operating point");
+  std::vector<double> x(sys.n + 1);
+  sys.rhs(circuit, 0.0, x);
+  if (Status s = sys.solve(x); !s.ok()) return s.with_context("DC operating point");
+  return x;
+}
+
+StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions& opt,
+                                 const std::vector<Probe>& probes, TransientStats* stats_out) {
+  if (Status s = opt.validate(); !s.ok()) return s;
+  TransientStats stats;
+  for (const auto& e : circuit.elements()) const_cast<Element&>(*e).bind_time(opt.tstep, opt.tstop);
+
+  System sys;
+  if (Status s = sys.build(circuit); !s.ok()) return s;
+  const int n = sys.n;
+  const double tstop = opt.tstop;
+  const double hmax = opt.effective_tmax();
+  const double hmin = std::max(1e-18, tstop * 1e-13);
+  const double tiny = tstop * 1e-12;  // breakpoints closer than this merge
+
+  // Breakpoints: every source corner, and tstop.
+  std::vector<double> bps;
+  for (const auto& e : circuit.elements()) e->breakpoints(tstop, bps);
+  bps.push_back(tstop);
+  std::sort(bps.begin(), bps.end());
+  std::vector<double> merged;
+  for (double t : bps)
+    if (t > tiny && (merged.empty() || t - merged.back() > tiny)) merged.push_back(t);
+  bps.swap(merged);
+  stats.breakpoints = static_cast<int>(bps.size());
+
+  // Initial state.
+  std::vector<double> x(n + 1, 0.0), xdot(n + 1, 0.0), b(n + 1), rhs(n + 1), xnew(n + 1);
+  if (!opt.uic) {
+    if (Status s = sys.select_or_factor(circuit, 0.0); !s.ok()) return s.with_context("DC operating point");
+    sys.rhs(circuit, 0.0, x);
+    if (Status s = sys.solve(x); !s.ok()) return s.with_context("DC operating point");
+    ++stats.solves;
+  }
+
+  Waveform w;
+  for (const auto& p : probes) w.add_column(p.label, {});
+  auto record = [&](double t, const std::vector<double>& v) {
+    if (t < opt.tstart - tiny) return;
+    w.time.push_back(t);
+    for (size_t k = 0; k < probes.size(); ++k) w.columns[k].push_back(probes[k].value(v.data()));
+  };
+  record(0.0, x);
+
+  // Which unknowns the error control watches, and their absolute tolerances.
+  std::vector<int> watched;
+  std::vector<double> abs_tol;
+  // As SPICE does, only states count: nodes with capacitance (C diagonal) and inductor currents;
+  // a node without capacitance is algebraic and follows the states.
+  std::vector<bool> has_c(n + 1, false);
+  for (int u = 1; u <= n; ++u) has_c[u] = sys.c[sys.pattern.slot(u, u)] != 0.0;
+  for (int u = 1; u <= n; ++u) {
+    if ((circuit.unknown_is_node(u) && has_c[u]) || circuit.unknown_is_state(u)) {
+      watched.push_back(u);
+      abs_tol.push_back(circuit.unknown_is_node(u) ? opt.vntol : opt.abstol);
+    }
+  }
+
+  // History since the last breakpoint: times and states, newest last (at most 3 kept).
+  std::vector<double> hist_t{0.0};
+  std::vector<std::vector<double>> hist_x{x};
+  auto ladder = [&](double h) {  // largest hmax / 2^k not above h (up to rounding)
+    if (h >= hmax) return hmax;
+    const int k = static_cast<int>(std::ceil(std::log2(hmax / h) - 1e-9));
+    return std::ldexp(hmax, -k);
+  };
+
+  double t = 0.0;
+  size_t next_bp = 0;
+  double h = ladder(0.1 * std::min(hmax, bps[0]));
+  double last_regular_h = hmax;
+  bool after_bp = true;  // the next step is the first after a breakpoint (or t = 0)
+  int worst_unknown = 0;
+
+  while (t < tstop - tiny) {
+    if (stats.accepted + stats.rejected >= opt.max_steps)
+      return Status::Error(fmt::format("transient gave up at t={:g} s after {} steps (max_steps)",
+                                       t, opt.max_steps));
+    while (next_bp < bps.size() && bps[next_bp] <= t + tiny) ++next_bp;
+    const double bp = next_bp < bps.size() ? bps[next_bp] : tstop;
+    double step = std::min(h, hmax);
+    bool lands = false;
+    if (t + step >= bp - tiny) {
+      step = bp - t;
+      lands = true;
+    } else if (t + 1.5 * step > bp) {
+      step = 0.5 * (bp - t);  // avoid a sliver before the breakpoint
+    }
+
+    // Integration formula: x1' = a0 x1 + hist; system (G + a0 C) x1 = b1 - C hist.
+    const bool euler = after_bp || hist_t.size() < 2;
+    const bool gear = !euler && opt.method == IntegrationMethod::Gear2;
+    double a0;
+    std::fill(rhs.begin(), rhs.end(), 0.0);  // rhs <- hist (the x1-independent part of x1')
+    if (euler) {
+      a0 = 1.0 / step;
+      for (int u = 1; u <= n; ++u) rhs[u] = -x[u] / step;
+    } else if (gear) {
+      const double h0 = t - hist_t[hist_t.size() - 2];
+      const double rho = step / h0;
+      a0 = (1 + 2 * rho) / (step * (1 + rho));
+      const double a1 = -(1 + rho) / step, a2 = rho * rho / (step * (1 + rho));
+      const auto& xm1 = hist_x[hist_x.size() - 2];
+      for (int u = 1; u <= n; ++u) rhs[u] = a1 * x[u] + a2 * xm1[u];
+    } else {
+      a0 = 2.0 / step;
+      for (int u = 1; u <= n; ++u) rhs[u] = -2.0 * x[u] / step - xdot[u];
+    }
+    sys.rhs(circuit, t + step, b);
+    sys.add_c_times(rhs, -1.0, b);
+    if (Status s = sys.select_or_factor(circuit, a0); !s.ok())
+      return s.with_context(fmt::format("transient at t={:g} s", t + step));
+    xnew = b;
+    if (Status s = sys.solve(xnew); !s.ok()) return s.with_context(fmt::format("t={:g} s", t + step));
+    ++stats.solves;
+
+    // Truncation error from the third divided difference over the last four points.
+    double ratio = 0.0;
+    if (hist_t.size() >= 3) {
+      const double t1 = t + step, t0 = hist_t[2], tm1 = hist_t[1], tm2 = hist_t[0];
+      const auto &x0 = hist_x[2], &xm1 = hist_x[1], &xm2 = hist_x[0];
+      const double coef = gear ? (2.0 / 9.0) * 6.0 : (1.0 / 12.0) * 6.0;
+      const double h3 = step * step * step * coef;
+      for (size_t k = 0; k < watched.size(); ++k) {
+        const int u = watched[k];
+        const double d10 = (xnew[u] - x0[u]) / (t1 - t0);
+        const double d0m = (x0[u] - xm1[u]) / (t0 - tm1);
+        const double dm2 = (xm1[u] - xm2[u]) / (tm1 - tm2);
+        const double dd2a = (d10 - d0m) / (t1 - tm1);
+        const double dd2b = (d0m - dm2) / (t0 - tm2);
+        const double dd3 = (dd2a - dd2b) / (t1 - tm2);
+        const double err = h3 * std::fabs(dd3);
+        const double tol =
+            opt.trtol * (opt.reltol * std::max(std::fabs(xnew[u]), std::fabs(x0[u])) + abs_tol[k]);
+        if (err / tol > ratio) {
+          ratio = err / tol;
+          worst_unknown = u;
+        }
+      }
+    }
+
+    if (ratio > 1.0) {
+      ++stats.rejected;
+      h = step * std::max(0.25, 0.9 * std::cbrt(1.0 / ratio));
+      if (h < hmin)
+        return Status::Error(fmt::format(
+            "time step too small at t={:g} s (h={:g} s): the truncation error of {} does not "
+            "converge",
+            t, h, circuit.unknown_name(worst_unknown)));
+      h = ladder(h);
+      continue;
+    }
+
+    // Accept.
+    ++stats.accepted;
+    for (int u = 1; u <= n; ++u) xdot[u] = a0 * xnew[u] + rhs[u];
+    t = lands ? bp : t + step;
+    std::swap(x, xnew);
+    hist_t.push_back(t);
+    hist_x.push_back(x);
+    if (hist_t.size() > 3) {
+      hist_t.erase(hist_t.begin());
+      hist_x.erase(hist_x.begin());
+    }
+    record(t, x);
+
+    const double grow = ratio > 0 ? std::min(2.0, 0.9 * std::cbrt(1.0 / ratio)) : 2.0;
+    if (!lands) last_regular_h = step;
+    h = ladder(std::max(step * std::max(grow, 0.5), hmin));
+    after_bp = false;
+    if (lands) {
+      // Restart the formula at the corner: small Euler step, fresh history.
+      after_bp = true;
+      h = ladder(0.1 * std::min(last_regular_h, (next_bp + 1 < bps.size() ? bps[next_bp + 1] : tstop) - t));
+      hist_t.assign(1, t);
+      hist_x.assign(1, x);
+    }
+  }
+
+  stats.factorizations = sys.klu.factorizations();
+  stats.reuses = sys.klu.reuses();
+  if (stats_out) *stats_out = stats;
+  return w;
+}
+
+}  // namespace isolink

@@ -1,0 +1,66 @@
+// Transient analysis of a linear circuit: DC operating point, then trapezoidal or Gear-2 steps
+// under local-truncation-error control, with breakpoints at every source corner.
+//
+//   TransientOptions opt{.tstep = 1e-9, .tstop = 20e-6};
+//   if (Status s = opt.validate(); !s.ok()) ...          // before any work
+//   TransientStats stats;
+//   StatusOr<Waveform> w = run_transient(circuit, opt, probes, &stats);
+// One Waveform row per accepted step with t >= tstart. The circuit must be finalized.
+//
+// Method, in short (details in the README "Solver" section):
+//   C x' + G x = b(t). G and C are stamped once; each step solves (G + alpha C) x1 = rhs with a
+//   KLU factorization cached by alpha, so a step size that comes back costs one solve.
+//   Backward Euler takes the first step after every breakpoint; then trapezoidal
+//   (x1' = 2 (x1 - x0) / h - x0') or variable-step BDF2. The error estimate is the trapezoidal /
+//   BDF2 truncation term from the third divided difference of node voltages and inductor
+//   currents; steps come from a ladder tmax / 2^k so factorizations are reused.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "solver/card.h"
+#include "solver/circuit.h"
+#include "solver/probe.h"
+#include "solver/waveform.h"
+
+namespace isolink {
+
+enum class IntegrationMethod { Trapezoidal, Gear2 };
+
+struct TransientOptions {
+  double tstep = 0.0;   // s, output/step hint (> 0)
+  double tstop = 0.0;   // s, end time (> tstart)
+  double tstart = 0.0;  // s, first time written out
+  double tmax = 0.0;    // s, largest step; 0 = min(tstep, (tstop - tstart) / 50) as ngspice
+  IntegrationMethod method = IntegrationMethod::Trapezoidal;
+  double reltol = 1e-3;  // relative tolerance of the truncation error
+  double vntol = 1e-6;   // V, absolute tolerance on node voltages
+  double abstol = 1e-12; // A, absolute tolerance on inductor currents
+  double trtol = 1.0;    // multiplies the truncation tolerance (ngspice's default is 7)
+  bool uic = false;      // skip the DC operating point, start from zero
+  long max_steps = 20'000'000;  // accepted + rejected steps before giving up
+
+  double effective_tmax() const;
+  // Errors name the field, its value and the rule it breaks.
+  Status validate() const;
+  // Applies one ".options key=value"; *known = false for options isolink does not use.
+  Status set_option(const std::string& key, const CardArg& value, bool* known);
+};
+
+struct TransientStats {
+  long accepted = 0;
+  long rejected = 0;
+  int factorizations = 0;
+  int reuses = 0;
+  long solves = 0;
+  int breakpoints = 0;
+};
+
+// DC operating point: the full unknown vector (index 0 = ground). Errors name the node.
+StatusOr<std::vector<double>> dc_operating_point(const Circuit& circuit);
+
+StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions& options,
+                                 const std::vector<Probe>& probes, TransientStats* stats = nullptr);
+
+}  // namespace isolink

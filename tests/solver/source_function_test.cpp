@@ -1,0 +1,72 @@
+#include "solver/elements/source_function.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "test_cards.h"
+
+namespace isolink {
+namespace {
+using namespace isolink::testing;
+
+SourceFunction parse(std::vector<CardArg> args) {
+  auto f = SourceFunction::Parse(card("v1", {"a", "0"}, std::move(args)));
+  EXPECT_TRUE(f.ok()) << f.status().message();
+  return *f;
+}
+
+TEST(SourceFunction, PulseShapeAndCorners) {
+  SourceFunction f = parse({call("pulse", {0, 5, 10e-9, 2e-9, 4e-9, 20e-9, 50e-9})});
+  f.bind_time(1e-9, 100e-9);
+  EXPECT_DOUBLE_EQ(f.value(5e-9), 0.0);
+  EXPECT_NEAR(f.value(11e-9), 2.5, 1e-12);   // half way up the 2 ns rise
+  EXPECT_DOUBLE_EQ(f.value(20e-9), 5.0);
+  EXPECT_NEAR(f.value(34e-9), 2.5, 1e-12);  // half way down: 10+2+20 = 32, +2 of 4 ns
+  EXPECT_NEAR(f.value(61e-9), 2.5, 1e-9);   // second period
+  std::vector<double> bp;
+  f.breakpoints(100e-9, bp);
+  std::vector<double> want{10e-9, 12e-9, 32e-9, 36e-9, 60e-9, 62e-9, 82e-9, 86e-9};
+  ASSERT_EQ(bp.size(), want.size());
+  for (size_t i = 0; i < bp.size(); ++i) EXPECT_NEAR(bp[i], want[i], 1e-18);
+}
+
+TEST(SourceFunction, PulseDefaultsFollowNgspice) {
+  SourceFunction f = parse({call("pulse", {1, 2})});
+  f.bind_time(1e-9, 1e-6);  // TR = TF = TSTEP, PW = PER = TSTOP
+  EXPECT_DOUBLE_EQ(f.value(0.5e-9), 1.5);
+  EXPECT_DOUBLE_EQ(f.value(0.5e-6), 2.0);
+}
+
+TEST(SourceFunction, PwlInterpolatesAndHoldsEnds) {
+  SourceFunction f = parse({call("pwl", {1e-9, 1, 3e-9, 5})});
+  EXPECT_DOUBLE_EQ(f.value(0), 1.0);
+  EXPECT_DOUBLE_EQ(f.value(2e-9), 3.0);
+  EXPECT_DOUBLE_EQ(f.value(1), 5.0);
+}
+
+TEST(SourceFunction, SinWithDelayDampingAndPhase) {
+  SourceFunction f = parse({call("sin", {1, 2, 1e6, 1e-6, 1e5, 90})});
+  EXPECT_DOUBLE_EQ(f.value(0), 3.0);  // before TD: VO + VA sin(phase)
+  const double t = 1.3e-6, tt = 0.3e-6;
+  EXPECT_NEAR(f.value(t), 1 + 2 * std::exp(-tt * 1e5) * std::sin(2 * M_PI * 1e6 * tt + M_PI / 2), 1e-12);
+}
+
+TEST(SourceFunction, DcForms) {
+  EXPECT_DOUBLE_EQ(parse({num(2.5)}).value(1.0), 2.5);
+  EXPECT_DOUBLE_EQ(parse({word("dc"), num(-1)}).value(1.0), -1.0);
+  EXPECT_DOUBLE_EQ(parse({word("dc"), num(0), word("ac"), num(1), call("pwl", {0, 0, 1, 4})}).value(0.5), 2.0);
+}
+
+TEST(SourceFunction, BadFormsAreErrors) {
+  auto bad = [](std::vector<CardArg> args) {
+    return SourceFunction::Parse(card("v1", {"a", "0"}, std::move(args))).status().message();
+  };
+  EXPECT_NE(bad({call("pwl", {0, 1, 1e-9})}).find("PWL takes time/value pairs"), std::string::npos);
+  EXPECT_NE(bad({call("pulse", {0})}).find("PULSE takes 2 to 8 values"), std::string::npos);
+  EXPECT_NE(bad({call("exp", {0, 1})}).find("unknown source function 'exp'"), std::string::npos);
+  EXPECT_NE(bad({word("dc")}).find("expected a number after DC"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace isolink
