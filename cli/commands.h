@@ -10,5 +10,9 @@ namespace isolink::cli {
 void add_sim_command(CLI::App& app, int* exit_code);
 void add_check_command(CLI::App& app, int* exit_code);
 void add_frame_command(CLI::App& app, int* exit_code);
+void add_elements_command(CLI::App& app, int* exit_code);
+
+// The element table of the README (`isolink elements --markdown`).
+std::string element_reference_markdown();
 
 }  // namespace isolink::cli

@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   isolink::cli::add_sim_command(app, &exit_code);
   isolink::cli::add_check_command(app, &exit_code);
   isolink::cli::add_frame_command(app, &exit_code);
+  isolink::cli::add_elements_command(app, &exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

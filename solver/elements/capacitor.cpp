@@ -10,7 +10,7 @@ namespace {
 
 constexpr ParamSpec kParams[] = {
     {"c", NAN, "F", "capacitance, positive"},
-    {"ic", 0.0, "V", "initial voltage (accepted, used only with uic: the DC point sets it)"},
+    {"ic", 0.0, "V", "initial voltage: accepted for ngspice compatibility, ignored (the DC point sets the state)"},
     {"m", 1.0, "", "parallel multiplier"},
 };
 

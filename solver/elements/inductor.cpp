@@ -12,7 +12,7 @@ namespace {
 
 constexpr ParamSpec kParams[] = {
     {"l", NAN, "H", "inductance, positive"},
-    {"ic", 0.0, "A", "initial current (accepted, used only with uic: the DC point sets it)"},
+    {"ic", 0.0, "A", "initial current: accepted for ngspice compatibility, ignored (the DC point sets the state)"},
 };
 
 StatusOr<std::unique_ptr<Element>> parse(const Card& card) {

@@ -1,0 +1,121 @@
+// `isolink sim` end to end: the CSV contract, exit codes, and nothing written on bad input.
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kBinary = ISOLINK_BINARY;
+const std::string kExamples = ISOLINK_EXAMPLES_DIR;
+
+struct Result {
+  int code;
+  std::string err;
+};
+
+Result run(const std::string& args) {
+  const std::string err_file = ::testing::TempDir() + "/sim_stderr.txt";
+  const std::string cmd = kBinary + " " + args + " >/dev/null 2>" + err_file;
+  int status = std::system(cmd.c_str());
+  std::ifstream in(err_file);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return {WEXITSTATUS(status), ss.str()};
+}
+
+std::string write_temp(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(SimCommand, WritesHeaderAndStrictlyIncreasingTimes) {
+  const std::string out = ::testing::TempDir() + "/wave.csv";
+  fs::remove(out);
+  Result r = run("sim " + kExamples + "/cap_link_2m.cir --probe 'v(rxp,rxn)' --probe 'v(txp)' -o " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(out);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "time,v(rxp,rxn),v(txp)");
+  double prev = -1;
+  int rows = 0;
+  while (std::getline(in, line)) {
+    double t = std::stod(line.substr(0, line.find(',')));
+    EXPECT_GT(t, prev);
+    prev = t;
+    ++rows;
+  }
+  EXPECT_GT(rows, 100);
+  EXPECT_NEAR(prev, 3e-6, 1e-15);
+  EXPECT_NE(r.err.find("tied to it with 1e-12 S"), std::string::npos) << r.err;  // floating cable
+}
+
+TEST(SimCommand, StepResamplesOnAUniformGrid) {
+  const std::string out = ::testing::TempDir() + "/wave_step.csv";
+  Result r = run("sim " + kExamples + "/cap_link_2m.cir -p 'v(rxp,rxn)' --step 10n -q -o " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(out);
+  std::string line;
+  std::getline(in, line);
+  int rows = 0;
+  double t = 0;
+  while (std::getline(in, line)) {
+    t = std::stod(line.substr(0, line.find(',')));
+    EXPECT_NEAR(t, rows * 10e-9, 1e-15);
+    ++rows;
+  }
+  EXPECT_EQ(rows, 301);  // 0 .. 3 us
+}
+
+TEST(SimCommand, BadNetlistExitsTwoAndWritesNothing) {
+  const std::string out = ::testing::TempDir() + "/never.csv";
+  fs::remove(out);
+  std::string path = write_temp("bad_r.cir", "bad value\nV1 a 0 1\nR1 a 0 -5\n.tran 1n 10n\n.end\n");
+  Result r = run("sim " + path + " -p 'v(a)' -o " + out);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("bad_r.cir:3:8: error: resistance of r1 must be positive, got -5"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find(" R1 a 0 -5\n        ^"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(SimCommand, SingularCircuitNamesTheNodes) {
+  std::string path =
+      write_temp("loop.cir", "loop\nV1 a 0 1\nV2 a 0 2\nR1 a 0 1\n.tran 1n 10n\n.end\n");
+  Result r = run("sim " + path + " -p 'v(a)'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("loop.cir:3:1: error: singular circuit: voltage sources / inductors form a "
+                       "loop (v1, v2) through nodes a and 0"),
+            std::string::npos)
+      << r.err;
+}
+
+TEST(SimCommand, UnknownProbeAndMissingTranAreErrors) {
+  std::string path = write_temp("rc.cir", "rc\nV1 a 0 PULSE(0 1 0 1n)\nR1 a b 1k\nC1 b 0 1n\n.end\n");
+  Result r = run("sim " + path + " -p 'v(zz)' --tstop 1u");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("no node named 'zz'"), std::string::npos) << r.err;
+  r = run("sim " + path + " -p 'v(b)'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("no .tran card"), std::string::npos) << r.err;
+  EXPECT_EQ(run("sim " + path + " -p 'v(b)' --tstop 1u -o " + ::testing::TempDir() + "/rc.csv").code, 0);
+}
+
+TEST(SimCommand, UnknownOptionIsWarnedAndIgnored) {
+  std::string path = write_temp("opt.cir", "opt\nV1 a 0 1\nR1 a 0 1k\n.options foo=3 reltol=1e-4\n"
+                                           ".tran 1n 10n\n.end\n");
+  Result r = run("sim " + path + " -p 'v(a)' -o " + ::testing::TempDir() + "/opt.csv");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("opt.cir:4:10: warning: option 'foo' is not used by isolink; ignored"),
+            std::string::npos)
+      << r.err;
+}
+
+}  // namespace
