@@ -30,17 +30,18 @@ std::string SourceLoc::str() const {
 
 std::string format_diagnostic(const SourceLoc& loc, const std::string& severity,
                               const std::string& message) {
-  std::string out = loc.str() + ": " + severity + ": " + message;
+  std::string out = loc.str();
+  out.append(": ").append(severity).append(": ").append(message);
   if (loc.file && loc.line > 0 && loc.line <= static_cast<int>(loc.file->lines.size())) {
     const std::string& text = loc.file->lines[loc.line - 1];
-    out += "\n " + text + "\n ";
+    out.append("\n ").append(text).append("\n ");
     for (int i = 1; i < loc.col && i <= static_cast<int>(text.size()); ++i)
       out += text[i - 1] == '\t' ? '\t' : ' ';
     out += "^";
   }
   for (auto from = loc.file ? loc.file->included_from : nullptr; from;
        from = from->file ? from->file->included_from : nullptr) {
-    out += "\n (included from " + from->str() + ")";
+    out.append("\n (included from ").append(from->str()).append(")");
   }
   return out;
 }

@@ -1,0 +1,41 @@
+// Parameter expressions as ngspice writes them inside {...} or '...' and after .param NAME=.
+//
+//   ParamLookup lookup = [&](const std::string& name) -> std::optional<double> { ... };
+//   StatusOr<double> v = evaluate_expression("sqrt(rx*2) + 1k", lookup,
+//                                            [&](std::size_t off) { return line.loc(base + off);
+//                                            });
+//
+// Grammar (lowest precedence first):
+//   expr    := term (('+' | '-') term)*
+//   term    := unary (('*' | '/') unary)*
+//   unary   := ('-' | '+') unary | power
+//   power   := primary (('^' | '**') unary)?          right-associative, -2^2 = -4
+//   primary := NUMBER (SPICE suffixes: 1k, 2.2n, 10meg) | NAME | NAME '(' expr (',' expr)* ')'
+//            | '(' expr ')'
+// Names are case-insensitive; parameters shadow the constant pi. Functions: sqrt exp log ln
+// (natural) log10 sin cos tan atan sinh cosh tanh abs min max pow floor ceil.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "solver/source_loc.h"
+#include "solver/status.h"
+
+namespace isolink::spice {
+
+// Value of a parameter by lower-case name, nullopt when undefined.
+using ParamLookup = std::function<std::optional<double>(const std::string& name)>;
+// Source location of an offset in the expression text (for error carets).
+using OffsetLoc = std::function<SourceLoc(std::size_t offset)>;
+
+// Errors: syntax (unexpected character, unbalanced parentheses, missing operand), undefined
+// parameter, unknown function or wrong argument count, division by zero, non-finite result;
+// each at the offending character.
+StatusOr<double> evaluate_expression(std::string_view text, const ParamLookup& lookup,
+                                     const OffsetLoc& where);
+
+}  // namespace isolink::spice

@@ -1,0 +1,690 @@
+#include "netlists/spice_reader.h"
+
+#include <cctype>
+#include <cmath>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <numbers>
+#include <sstream>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "netlists/expression.h"
+#include "netlists/lexer.h"
+#include "solver/elements/element.h"
+
+namespace isolink {
+namespace {
+
+namespace fs = std::filesystem;
+using spice::LogicalLine;
+using spice::lower;
+using spice::Token;
+using spice::TokenKind;
+
+bool is_blank(char c) {
+  return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v';
+}
+bool is_ident_start(char c) {
+  return std::isalpha(static_cast<unsigned char>(c)) || c == '_';
+}
+bool is_ident_char(char c) {
+  return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+}
+bool is_identifier(std::string_view s) {
+  if (s.empty() || !is_ident_start(s[0])) return false;
+  for (char c : s)
+    if (!is_ident_char(c)) return false;
+  return true;
+}
+
+std::string trim(std::string_view s) {
+  std::size_t a = 0, b = s.size();
+  while (a < b && is_blank(s[a])) ++a;
+  while (b > a && is_blank(s[b - 1])) --b;
+  return std::string(s.substr(a, b - a));
+}
+
+std::string describe(const Token& t) {
+  if (t.kind == TokenKind::Expr) return "{" + std::string(t.text) + "}";
+  return std::string(t.text);
+}
+
+// A logical line with its tokens; lives in a deque so the token views stay valid.
+struct Line {
+  LogicalLine ll;
+  std::vector<Token> toks;
+
+  SourceLoc at(std::size_t k) const { return ll.loc(toks[k].offset); }
+  // Just past the last token (where a missing token was expected).
+  SourceLoc end() const { return ll.loc(toks.empty() ? 0 : toks.back().end()); }
+  SourceLoc at_or_end(std::size_t k) const { return k < toks.size() ? at(k) : end(); }
+  bool word(std::size_t k) const { return k < toks.size() && toks[k].kind == TokenKind::Word; }
+  bool kind(std::size_t k, TokenKind kd) const { return k < toks.size() && toks[k].kind == kd; }
+  // key=value starts at k
+  bool assignment(std::size_t k) const { return word(k) && kind(k + 1, TokenKind::Equals); }
+  std::string key() const { return toks.empty() ? std::string() : lower(toks[0].text); }
+};
+
+struct SubcktDef {
+  std::string name;
+  SourceLoc loc;       // the name token
+  SourceLoc card_loc;  // the .subckt keyword
+  const Line* header = nullptr;
+  std::vector<std::string> ports;
+  std::vector<std::pair<std::string, std::size_t>> params;  // key, value token index in header
+  std::vector<const Line*> body;
+};
+
+struct Scope {
+  std::unordered_map<std::string, double> values;
+  const Scope* parent = nullptr;
+  std::optional<double> find(const std::string& name) const {
+    for (const Scope* s = this; s; s = s->parent) {
+      auto it = s->values.find(name);
+      if (it != s->values.end()) return it->second;
+    }
+    return std::nullopt;
+  }
+};
+
+struct Ctx {
+  std::string prefix;                                                   // "" or "x1.x2."
+  const std::unordered_map<std::string, std::string>* ports = nullptr;  // port -> outer node
+  Scope* scope = nullptr;
+  std::vector<const SubcktDef*> stack;
+};
+
+StatusOr<std::string> read_whole_file(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  if (!in) return Status::Error("cannot open");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::string canonical_key(const std::string& path) {
+  std::error_code ec;
+  fs::path c = fs::weakly_canonical(fs::path(path), ec);
+  return ec ? fs::path(path).lexically_normal().string() : c.string();
+}
+
+class Reader {
+ public:
+  Status read(const std::shared_ptr<const SourceFile>& top) {
+    if (!top->lines.empty()) out_.title = trim(top->lines[0]);
+    if (top->path != "<string>") include_stack_.push_back(canonical_key(top->path));
+    if (Status s = collect(top, 2); !s.ok()) return s;
+    if (!open_.empty())
+      return error_at(open_.back()->card_loc,
+                      "missing '.ends' for subcircuit '" + open_.back()->name + "'");
+    Ctx ctx;
+    ctx.scope = &globals_;
+    return elaborate(top_, ctx);
+  }
+  Netlist take() { return std::move(out_); }
+
+ private:
+  // ---- pass 1: lines, includes, subcircuit bodies ----
+  Status collect(const std::shared_ptr<const SourceFile>& file, int first_line) {
+    auto lines = spice::join_lines(file, first_line);
+    if (!lines) return lines.status();
+    for (LogicalLine& ll : *lines) {
+      std::size_t a = 0;
+      while (a < ll.text.size() && is_blank(ll.text[a])) ++a;
+      std::size_t b = a;
+      while (b < ll.text.size() && !is_blank(ll.text[b])) ++b;
+      const std::string key = lower(std::string_view(ll.text).substr(a, b - a));
+      if (in_control_) {
+        if (key == ".endc") in_control_ = false;
+        continue;
+      }
+      if (key == ".control") {
+        warn_once(".control", ll.loc(a), "'.control' ... '.endc' block ignored");
+        in_control_ = true;
+        continue;
+      }
+      if (key == ".end") return Status::Ok();
+      if (key == ".include" || key == ".inc") {
+        if (Status s = include(ll, b); !s.ok()) return s;
+        continue;
+      }
+      Line& line = lines_.emplace_back();
+      line.ll = std::move(ll);
+      auto toks = spice::tokenize(line.ll);
+      if (!toks) return toks.status();
+      line.toks = std::move(*toks);
+      if (key == ".subckt") {
+        if (Status s = define_subckt(line); !s.ok()) return s;
+      } else if (key == ".ends") {
+        if (open_.empty()) return error_at(line.at(0), "'.ends' without '.subckt'");
+        open_.pop_back();
+      } else {
+        (open_.empty() ? top_ : open_.back()->body).push_back(&line);
+      }
+    }
+    return Status::Ok();
+  }
+
+  Status include(const LogicalLine& ll, std::size_t after_key) {
+    std::size_t a = after_key;
+    while (a < ll.text.size() && is_blank(ll.text[a])) ++a;
+    if (a >= ll.text.size()) return error_at(ll.loc(a), "expected a file name after .include");
+    std::string name;
+    const char q = ll.text[a];
+    if (q == '"' || q == '\'') {
+      const std::size_t e = ll.text.find(q, a + 1);
+      if (e == std::string::npos)
+        return error_at(ll.loc(a), std::string("unterminated file name: missing closing ") + q);
+      name = ll.text.substr(a + 1, e - a - 1);
+    } else {
+      std::size_t e = a;
+      while (e < ll.text.size() && !is_blank(ll.text[e])) ++e;
+      name = ll.text.substr(a, e - a);
+    }
+    const SourceLoc where = ll.loc(a);
+    fs::path p(name);
+    if (p.is_relative()) {
+      const std::string& from = ll.file->path;
+      const fs::path base =
+          from.empty() || from[0] == '<' ? fs::path() : fs::path(from).parent_path();
+      p = (base / p).lexically_normal();
+    }
+    const std::string key = canonical_key(p.string());
+    for (std::size_t k = 0; k < include_stack_.size(); ++k) {
+      if (include_stack_[k] != key) continue;
+      return error_at(where, "recursive include of '" + p.string() + "'");
+    }
+    auto text = read_whole_file(p);
+    if (!text)
+      return error_at(where,
+                      "cannot open include file '" + name + "' (looked for '" + p.string() + "')");
+    auto file = SourceFile::FromText(p.string(), *text, std::make_shared<const SourceLoc>(where));
+    include_stack_.push_back(key);
+    Status s = collect(file, 1);
+    include_stack_.pop_back();
+    return s;
+  }
+
+  Status define_subckt(const Line& line) {
+    if (!line.word(1))
+      return error_at(line.at_or_end(1), "expected a subcircuit name after .subckt");
+    auto def = std::make_unique<SubcktDef>();
+    def->name = lower(line.toks[1].text);
+    def->loc = line.at(1);
+    def->card_loc = line.at(0);
+    def->header = &line;
+    std::size_t i = 2;
+    const std::size_t n = line.toks.size();
+    for (; i < n; ++i) {
+      if (line.assignment(i)) break;
+      if (!line.word(i))
+        return error_at(line.at(i), "unexpected '" + describe(line.toks[i]) + "' in .subckt ports");
+      const std::string w = lower(line.toks[i].text);
+      if (w == "params:") {
+        ++i;
+        break;
+      }
+      def->ports.push_back(w);
+    }
+    for (; i < n; i += 3) {
+      if (!line.assignment(i))
+        return error_at(line.at(i), "expected NAME=VALUE in .subckt parameters, got '" +
+                                        describe(line.toks[i]) + "'");
+      if (i + 2 >= n ||
+          (line.toks[i + 2].kind != TokenKind::Word && line.toks[i + 2].kind != TokenKind::Expr))
+        return error_at(line.at_or_end(i + 2), "missing value for subcircuit parameter '" +
+                                                   lower(line.toks[i].text) + "'");
+      def->params.emplace_back(lower(line.toks[i].text), i + 2);
+    }
+    if (subckts_.count(def->name))
+      return error_at(def->loc, "subcircuit '" + def->name + "' defined twice (first at " +
+                                    subckts_[def->name]->loc.str() + ")");
+    open_.push_back(def.get());
+    subckts_[def->name] = std::move(def);
+    return Status::Ok();
+  }
+
+  // ---- values ----
+  StatusOr<double> number(const Line& line, const Token& t, const Scope& scope) {
+    const auto lookup = [&](const std::string& name) { return scope.find(name); };
+    if (t.kind == TokenKind::Expr) {
+      const std::size_t base = t.offset + 1;
+      return spice::evaluate_expression(t.text, lookup,
+                                        [&](std::size_t o) { return line.ll.loc(base + o); });
+    }
+    if (t.kind != TokenKind::Word)
+      return error_at(line.ll.loc(t.offset), "expected a number, got '" + describe(t) + "'");
+    double v = 0;
+    if (spice::parse_number(t.text, v)) return v;
+    std::string_view body = t.text;
+    if (!body.empty() && (body[0] == '+' || body[0] == '-')) body.remove_prefix(1);
+    if (body.empty() || std::isdigit(static_cast<unsigned char>(body[0])) || body[0] == '.')
+      return error_at(line.ll.loc(t.offset), "malformed number '" + std::string(t.text) + "'");
+    if (is_identifier(t.text)) {
+      const std::string name = lower(t.text);
+      if (auto p = scope.find(name)) return *p;
+      if (name == "pi") return std::numbers::pi;
+      return error_at(line.ll.loc(t.offset), "expected a number, got '" + std::string(t.text) +
+                                                 "' (no parameter of that name is defined)");
+    }
+    return spice::evaluate_expression(t.text, lookup,
+                                      [&](std::size_t o) { return line.ll.loc(t.offset + o); });
+  }
+
+  // NAME ( values... ) starting at toks[i] (NAME), toks[i+1] == '('. Advances i past ')'.
+  StatusOr<CardArg> call(const Line& line, std::size_t& i, const Scope& scope) {
+    CardArg arg;
+    arg.kind = CardArg::Kind::Call;
+    arg.word = lower(line.toks[i].text);
+    arg.loc = line.at(i);
+    std::size_t j = i + 2;
+    const std::size_t n = line.toks.size();
+    for (; j < n; ++j) {
+      const Token& t = line.toks[j];
+      if (t.kind == TokenKind::RParen) break;
+      if (t.kind == TokenKind::Comma) continue;
+      if (t.kind == TokenKind::LParen || t.kind == TokenKind::Equals)
+        return error_at(line.at(j), "unexpected '" + describe(t) + "' inside " + arg.word +
+                                        "(...); write expressions in {braces}");
+      if (t.kind == TokenKind::Word && line.kind(j + 1, TokenKind::LParen))
+        return error_at(line.at(j), "unexpected call '" + std::string(t.text) + "(' inside " +
+                                        arg.word + "(...); write expressions in {braces}");
+      auto v = number(line, t, scope);
+      if (!v) return v.status();
+      arg.call.push_back(*v);
+    }
+    i = j + 1;  // the tokenizer guarantees the ')'
+    return arg;
+  }
+
+  // One value token (or NAME(...)) at toks[i]; advances i.
+  StatusOr<CardArg> value(const Line& line, std::size_t& i, const Scope& scope, bool allow_word) {
+    const Token& t = line.toks[i];
+    if (t.kind == TokenKind::Word && line.kind(i + 1, TokenKind::LParen))
+      return call(line, i, scope);
+    CardArg arg;
+    arg.loc = line.at(i);
+    if (allow_word && t.kind == TokenKind::Word && is_identifier(t.text)) {
+      const std::string w = lower(t.text);
+      if (!scope.find(w) && w != "pi") {
+        arg.kind = CardArg::Kind::Word;
+        arg.word = w;
+        ++i;
+        return arg;
+      }
+    }
+    auto v = number(line, t, scope);
+    if (!v) return v.status();
+    arg.number = *v;
+    ++i;
+    return arg;
+  }
+
+  // ---- pass 2: parameters, elements, instances, analysis cards ----
+  Status elaborate(const std::vector<const Line*>& body, Ctx& ctx) {
+    for (const Line* l : body)
+      if (l->key() == ".param")
+        if (Status s = param_card(*l, *ctx.scope); !s.ok()) return s;
+    for (const Line* l : body) {
+      const std::string key = l->key();
+      if (key.empty() || key == ".param") continue;
+      if (!l->word(0))
+        return error_at(
+            l->at(0), "expected an element name or a dot card, got '" + describe(l->toks[0]) + "'");
+      Status s = Status::Ok();
+      if (key[0] == '.')
+        s = dot_card(*l, key, ctx);
+      else if (key[0] == 'x')
+        s = instance(*l, ctx);
+      else
+        s = element(*l, ctx);
+      if (!s.ok()) return s;
+    }
+    return Status::Ok();
+  }
+
+  Status param_card(const Line& line, Scope& scope) {
+    const std::size_t n = line.toks.size();
+    if (n == 1) return error_at(line.end(), "expected NAME=VALUE after .param");
+    std::size_t i = 1;
+    while (i < n) {
+      if (!line.assignment(i))
+        return error_at(line.at(i),
+                        "expected NAME=VALUE in .param, got '" + describe(line.toks[i]) + "'");
+      const std::string name = lower(line.toks[i].text);
+      if (!is_identifier(name))
+        return error_at(line.at(i), "invalid parameter name '" + name + "'");
+      std::size_t j = i + 2;
+      while (j < n && !line.assignment(j)) ++j;
+      if (j == i + 2)
+        return error_at(line.at_or_end(i + 2), "missing value for parameter '" + name + "'");
+      StatusOr<double> v = 0.0;
+      if (j == i + 3) {
+        v = number(line, line.toks[i + 2], scope);
+      } else {  // an unbraced expression spread over several tokens: "a = 2 * b"
+        const std::size_t from = line.toks[i + 2].offset, to = line.toks[j - 1].end();
+        v = spice::evaluate_expression(
+            std::string_view(line.ll.text).substr(from, to - from),
+            [&](const std::string& nm) { return scope.find(nm); },
+            [&](std::size_t o) { return line.ll.loc(from + o); });
+      }
+      if (!v) return v.status();
+      scope.values[name] = *v;
+      i = j;
+    }
+    return Status::Ok();
+  }
+
+  std::string node(std::string_view text, const Ctx& ctx) const {
+    std::string n = lower(text);
+    if (n == "0" || n == "gnd") return "0";
+    if (ctx.ports) {
+      auto it = ctx.ports->find(n);
+      if (it != ctx.ports->end()) return it->second;
+    }
+    return ctx.prefix + n;
+  }
+
+  Status claim_name(const std::string& name, const SourceLoc& loc) {
+    auto [it, fresh] = names_.emplace(name, loc);
+    if (!fresh)
+      return error_at(
+          loc, "duplicate element name '" + name + "' (first defined at " + it->second.str() + ")");
+    return Status::Ok();
+  }
+
+  Status element(const Line& line, const Ctx& ctx) {
+    if (!line.word(0))
+      return error_at(line.at(0), "expected an element name, got '" + describe(line.toks[0]) + "'");
+    std::string local = lower(line.toks[0].text);
+    const char letter = local[0];
+    const ElementKind* kind = find_element_kind(letter);
+    if (!kind) {
+      std::string known;
+      for (const ElementKind& k : element_kinds()) known += std::string(1, k.letter) + " ";
+      return error_at(line.at(0), "unknown element letter '" + std::string(1, letter) + "' in '" +
+                                      local + "' (known: " + known + "x)");
+    }
+    // ngspice's flattened names: "r.x1.r3" is element "x1.r3" of kind r.
+    if (local.size() > 2 && local[1] == '.') {
+      const std::string rest = local.substr(2);
+      const std::size_t dot = rest.rfind('.');
+      if (dot != std::string::npos && dot + 1 < rest.size() && rest[dot + 1] == letter)
+        local = rest;
+    }
+    Card card;
+    card.letter = letter;
+    card.name = ctx.prefix + local;
+    card.loc = line.at(0);
+    const std::size_t n = line.toks.size();
+    std::size_t i = 1;
+    auto plain_word = [&](std::size_t k) {
+      return line.word(k) && !line.kind(k + 1, TokenKind::Equals) &&
+             !line.kind(k + 1, TokenKind::LParen);
+    };
+    for (int k = 0; k < kind->node_count; ++k, ++i) {
+      if (!plain_word(i))
+        return error_at(line.at_or_end(i), "too few nodes: " + std::string(kind->name) + " '" +
+                                               local + "' needs " +
+                                               std::to_string(kind->node_count) +
+                                               " nodes (usage: " + kind->usage + ")");
+      card.nodes.push_back(node(line.toks[i].text, ctx));
+      card.node_locs.push_back(line.at(i));
+    }
+    for (int k = 0; k < kind->ref_count; ++k, ++i) {
+      if (!plain_word(i))
+        return error_at(line.at_or_end(i), "too few element names: " + std::string(kind->name) +
+                                               " '" + local + "' needs " +
+                                               std::to_string(kind->ref_count) +
+                                               " (usage: " + kind->usage + ")");
+      card.refs.push_back(ctx.prefix + lower(line.toks[i].text));
+      card.ref_locs.push_back(line.at(i));
+    }
+    while (i < n && !line.assignment(i)) {
+      const Token& t = line.toks[i];
+      if (t.kind != TokenKind::Word && t.kind != TokenKind::Expr)
+        return error_at(line.at(i), "unexpected '" + describe(t) + "'");
+      if (t.kind == TokenKind::Word && !line.kind(i + 1, TokenKind::LParen)) {
+        const std::string w = lower(t.text);
+        if (w == "dc") {
+          CardArg a;
+          a.kind = CardArg::Kind::Word;
+          a.word = w;
+          a.loc = line.at(i++);
+          card.args.push_back(std::move(a));
+          continue;
+        }
+        if (w == "ac") {
+          warn_once("ac", line.at(i), "AC specification ignored (isolink runs transient analyses)");
+          ++i;
+          for (int k = 0; k < 2 && i < n && !line.assignment(i) &&
+                          (line.kind(i, TokenKind::Expr) ||
+                           (line.word(i) && !line.kind(i + 1, TokenKind::LParen) &&
+                            number(line, line.toks[i], *ctx.scope)));
+               ++k)
+            ++i;
+          continue;
+        }
+      }
+      auto a = value(line, i, *ctx.scope, false);
+      if (!a) return a.status();
+      card.args.push_back(std::move(*a));
+    }
+    if (Status s = key_values(line, i, *ctx.scope, card.params); !s.ok()) return s;
+    if (Status s = claim_name(card.name, card.loc); !s.ok()) return s;
+    out_.cards.push_back(std::move(card));
+    return Status::Ok();
+  }
+
+  Status key_values(const Line& line, std::size_t i, const Scope& scope,
+                    std::vector<std::pair<std::string, CardArg>>& out) {
+    const std::size_t n = line.toks.size();
+    while (i < n) {
+      if (!line.assignment(i))
+        return error_at(line.at(i),
+                        "unexpected '" + describe(line.toks[i]) + "' after key=value parameters");
+      const std::string key = lower(line.toks[i].text);
+      i += 2;
+      if (i >= n || (line.toks[i].kind != TokenKind::Word && line.toks[i].kind != TokenKind::Expr))
+        return error_at(line.at_or_end(i), "missing value for '" + key + "'");
+      auto a = value(line, i, scope, false);
+      if (!a) return a.status();
+      out.emplace_back(key, std::move(*a));
+    }
+    return Status::Ok();
+  }
+
+  Status instance(const Line& line, Ctx& ctx) {
+    const std::string local = lower(line.toks[0].text);
+    const std::string full = ctx.prefix + local;
+    const std::size_t n = line.toks.size();
+    std::size_t i = 1;
+    std::vector<std::size_t> words;
+    while (i < n && line.word(i) && !line.assignment(i) && lower(line.toks[i].text) != "params:")
+      words.push_back(i++);
+    if (i < n && !line.word(i))
+      return error_at(line.at(i),
+                      "unexpected '" + describe(line.toks[i]) + "' in instance '" + local + "'");
+    if (words.empty())
+      return error_at(line.at_or_end(1),
+                      "expected nodes and a subcircuit name after '" + local + "'");
+    const std::size_t name_tok = words.back();
+    words.pop_back();
+    const std::string sub = lower(line.toks[name_tok].text);
+    auto it = subckts_.find(sub);
+    if (it == subckts_.end())
+      return error_at(line.at(name_tok), "unknown subcircuit '" + sub + "'");
+    const SubcktDef* def = it->second.get();
+    for (const SubcktDef* d : ctx.stack) {
+      if (d != def) continue;
+      std::string chain;
+      for (const SubcktDef* e : ctx.stack) chain += e->name + " -> ";
+      return error_at(line.at(name_tok), "recursive subcircuit: " + chain + sub);
+    }
+    if (words.size() != def->ports.size()) {
+      std::string ports;
+      for (const auto& p : def->ports) ports += (ports.empty() ? "" : " ") + p;
+      const std::string msg = "'" + local + "': subcircuit '" + sub + "' has " +
+                              std::to_string(def->ports.size()) + " ports (" + ports + "), " +
+                              std::to_string(words.size()) + " nodes given";
+      return error_at(
+          line.at(words.size() > def->ports.size() ? words[def->ports.size()] : name_tok), msg);
+    }
+    if (i < n && lower(line.toks[i].text) == "params:") ++i;
+    std::vector<std::pair<std::string, CardArg>> overrides;
+    const std::size_t first_override = i;
+    if (Status s = key_values(line, i, *ctx.scope, overrides); !s.ok()) return s;
+    for (std::size_t k = 0; k < overrides.size(); ++k) {
+      if (overrides[k].second.kind != CardArg::Kind::Number)
+        return error_at(overrides[k].second.loc,
+                        "subcircuit parameter '" + overrides[k].first + "' needs a number");
+      bool known = false;
+      for (const auto& p : def->params) known = known || p.first == overrides[k].first;
+      if (!known)
+        return error_at(line.at(first_override + 3 * k),
+                        "subcircuit '" + sub + "' has no parameter '" + overrides[k].first + "'");
+    }
+    if (Status s = claim_name(full, line.at(0)); !s.ok()) return s;
+
+    Scope scope;
+    scope.parent = ctx.scope;
+    for (const auto& [key, tok] : def->params) {
+      bool set = false;
+      for (const auto& [k, v] : overrides)
+        if (k == key) scope.values[key] = v.number, set = true;
+      if (set) continue;
+      auto v = number(*def->header, def->header->toks[tok], scope);
+      if (!v) return v.status();
+      scope.values[key] = *v;
+    }
+    std::unordered_map<std::string, std::string> ports;
+    for (std::size_t k = 0; k < words.size(); ++k)
+      ports[def->ports[k]] = node(line.toks[words[k]].text, ctx);
+    Ctx inner;
+    inner.prefix = full + ".";
+    inner.ports = &ports;
+    inner.scope = &scope;
+    inner.stack = ctx.stack;
+    inner.stack.push_back(def);
+    Status s = elaborate(def->body, inner);
+    if (!s.ok())
+      return Status::Error(s.message() + "\n (in subcircuit instance '" + full + "' of '" + sub +
+                           "' at " + line.at(0).str() + ")");
+    return Status::Ok();
+  }
+
+  Status dot_card(const Line& line, const std::string& key, Ctx& ctx) {
+    if (key == ".tran") return tran(line, *ctx.scope);
+    if (key == ".options" || key == ".option" || key == ".opt" || key == ".opts")
+      return options(line, *ctx.scope);
+    if (key == ".temp") {
+      warn_once(key, line.at(0),
+                "'.temp' ignored: isolink's elements do not depend on temperature");
+      return Status::Ok();
+    }
+    warn_once(key, line.at(0), "unsupported card '" + key + "' ignored");
+    return Status::Ok();
+  }
+
+  Status tran(const Line& line, const Scope& scope) {
+    TranSpec spec;
+    spec.loc = line.at(0);
+    std::vector<double> v;
+    const std::size_t n = line.toks.size();
+    for (std::size_t i = 1; i < n; ++i) {
+      const Token& t = line.toks[i];
+      if (t.kind == TokenKind::Word && lower(t.text) == "uic") {
+        spec.uic = true;
+        continue;
+      }
+      if (v.size() == 4)
+        return error_at(line.at(i),
+                        "too many values: expected .tran TSTEP TSTOP [TSTART [TMAX]] "
+                        "[UIC]");
+      auto x = number(line, t, scope);
+      if (!x) return x.status();
+      v.push_back(*x);
+    }
+    if (v.size() < 2)
+      return error_at(line.end(), "expected .tran TSTEP TSTOP [TSTART [TMAX]] [UIC]");
+    spec.tstep = v[0], spec.tstop = v[1];
+    if (v.size() > 2) spec.tstart = v[2];
+    if (v.size() > 3) spec.tmax = v[3];
+    if (out_.tran)
+      out_.warnings.push_back(format_diagnostic(
+          spec.loc, "warning", "second .tran card replaces the one at " + out_.tran->loc.str()));
+    out_.tran = spec;
+    return Status::Ok();
+  }
+
+  Status options(const Line& line, const Scope& scope) {
+    const std::size_t n = line.toks.size();
+    std::size_t i = 1;
+    while (i < n) {
+      const Token& t = line.toks[i];
+      if (t.kind == TokenKind::Comma) {
+        ++i;
+        continue;
+      }
+      if (t.kind != TokenKind::Word)
+        return error_at(line.at(i), "expected an option name, got '" + describe(t) + "'");
+      NetlistOption opt;
+      opt.key = lower(t.text);
+      opt.loc = line.at(i);
+      if (line.kind(i + 1, TokenKind::Equals)) {
+        i += 2;
+        if (i >= n ||
+            (line.toks[i].kind != TokenKind::Word && line.toks[i].kind != TokenKind::Expr))
+          return error_at(line.at_or_end(i), "missing value for option '" + opt.key + "'");
+        auto a = value(line, i, scope, true);
+        if (!a) return a.status();
+        opt.value = std::move(*a);
+      } else {
+        opt.value.kind = CardArg::Kind::Word;
+        opt.value.loc = opt.loc;
+        ++i;
+      }
+      out_.options.push_back(std::move(opt));
+    }
+    return Status::Ok();
+  }
+
+  void warn_once(const std::string& kind, const SourceLoc& loc, const std::string& msg) {
+    if (warned_.insert(kind).second)
+      out_.warnings.push_back(format_diagnostic(loc, "warning", msg));
+  }
+
+  Netlist out_;
+  std::deque<Line> lines_;
+  std::vector<const Line*> top_;
+  std::unordered_map<std::string, std::unique_ptr<SubcktDef>> subckts_;
+  std::vector<SubcktDef*> open_;
+  std::vector<std::string> include_stack_;
+  bool in_control_ = false;
+  std::unordered_set<std::string> warned_;
+  std::unordered_map<std::string, SourceLoc> names_;
+  Scope globals_;
+};
+
+StatusOr<Netlist> read(const std::shared_ptr<const SourceFile>& file) {
+  Reader r;
+  if (Status s = r.read(file); !s.ok()) return s;
+  return r.take();
+}
+
+}  // namespace
+
+StatusOr<Netlist> read_spice_file(const std::string& path) {
+  auto text = read_whole_file(path);
+  if (!text) return Status::Error("cannot open netlist '" + path + "'");
+  return read(SourceFile::FromText(path, *text));
+}
+
+StatusOr<Netlist> read_spice_text(const std::string& text, const std::string& name) {
+  return read(SourceFile::FromText(name, text));
+}
+
+}  // namespace isolink

@@ -1,0 +1,65 @@
+#include "netlists/link/pins.h"
+
+#include <gtest/gtest.h>
+
+#include "solver/transient.h"
+
+namespace isolink::link {
+namespace {
+
+traffic::Drive couplet_drive() {  // idle 1 us, + 250 ns, - 250 ns, idle 1 us
+  traffic::Drive d;
+  d.segments = {{0, 1e-6, 0}, {1e-6, 1.25e-6, +1}, {1.25e-6, 1.5e-6, -1}, {1.5e-6, 2.5e-6, 0}};
+  return d;
+}
+
+TEST(Pins, DrivePwlHasEdgesAtEverySegmentBoundary) {
+  const auto p = drive_pwl(couplet_drive(), TxDriverModel{}, +1);
+  const std::vector<double> want{0,       2.5, 1e-6,     2.5, 1.01e-6, 5, 1.25e-6, 5,
+                                 1.26e-6, 0,   1.5e-6,   0,   1.51e-6, 2.5};
+  ASSERT_EQ(p.size(), want.size());
+  for (size_t i = 0; i < p.size(); ++i) EXPECT_NEAR(p[i], want[i], 1e-15) << i;
+  const auto n = drive_pwl(couplet_drive(), TxDriverModel{}, -1);
+  EXPECT_NEAR(n[5], 0.0, 1e-15);  // N low while P is high
+  EXPECT_NEAR(n[9], 5.0, 1e-15);
+}
+
+TEST(Pins, EdgeIsClippedToHalfTheShorterSegment) {
+  traffic::Drive d;
+  d.segments = {{0, 1e-6, 0}, {1e-6, 1.004e-6, +1}, {1.004e-6, 2e-6, 0}};
+  const auto p = drive_pwl(d, TxDriverModel{}, +1);
+  EXPECT_NEAR(p[4], 1.002e-6, 1e-15);  // 4 ns pulse: 2 ns edge instead of 10 ns
+}
+
+TEST(Pins, DriverIntoTerminatedReceiverGivesTheResistiveDivider) {
+  Circuit c;
+  ASSERT_TRUE(add_tx_driver(c, "tx", "p", "n", couplet_drive(), TxDriverModel{}).ok());
+  ASSERT_TRUE(add_rx_load(c, "rx", "p", "n", RxLoadModel{}).ok());
+  Card term;
+  term.letter = 'r';
+  term.name = "rterm";
+  term.nodes = {"p", "n"};
+  term.node_locs.resize(2);
+  term.args.resize(1);
+  term.args[0].number = 1e3;
+  ASSERT_TRUE(c.add(term).ok());
+  ASSERT_TRUE(c.finalize().ok());
+  auto probe = parse_probe(c, "v(p,n)");
+  ASSERT_TRUE(probe.ok());
+  auto w = run_transient(c, {.tstep = 1e-9, .tstop = 2.5e-6}, {*probe});
+  ASSERT_TRUE(w.ok()) << w.status().message();
+  const double rload = 1.0 / (1.0 / 1e3 + 1.0 / 20e3);  // termination || two 10 k pins
+  const double vplus = 5.0 * rload / (rload + 20.0);      // 4.8972 V
+  EXPECT_NEAR(w->value_at(0, 1.24e-6), vplus, 1e-3);
+  EXPECT_NEAR(w->value_at(0, 1.49e-6), -vplus, 1e-3);
+  EXPECT_NEAR(w->value_at(0, 2.4e-6), 0.0, 1e-6);  // idle: both lines at 2.5 V
+  EXPECT_NEAR(w->value_at(0, 0.5e-6), 0.0, 1e-9);
+}
+
+TEST(Pins, ModelsValidateTheirFields) {
+  EXPECT_EQ((TxDriverModel{.edge = 0}).validate().message(), "tx_driver.edge = 0: must be positive");
+  EXPECT_EQ((RxLoadModel{.r_in = -1}).validate().message(), "rx_load.r_in = -1: must be positive");
+}
+
+}  // namespace
+}  // namespace isolink::link
