@@ -1,11 +1,13 @@
 // isolink sim NETLIST.cir --probe 'v(rxp,rxn)' [-o wave.csv]: plain transient of a SPICE netlist.
 #include <cstdio>
 #include <iostream>
+#include <optional>
 
 #include <fmt/format.h>
 
 #include "cli/commands.h"
 #include "cli/simulate.h"
+#include "netlists/lexer.h"
 
 namespace isolink::cli {
 
@@ -14,14 +16,31 @@ struct SimArgs {
   std::string netlist;
   std::vector<std::string> probes;
   std::string output;
-  double step = 0;
-  double tstop = 0, tmax = 0;
+  std::string step, tstop, tmax;  // SPICE numbers: 10n, 1u
   std::string method;
   double reltol = 0;
   bool quiet = false;
 };
 
+// A positive SPICE number from an option ("10n"), or an error naming the option.
+std::optional<double> si_option(const char* flag, const std::string& text, bool* bad) {
+  if (text.empty()) return std::nullopt;
+  double v = 0;
+  if (!spice::parse_number(text, v) || !(v > 0)) {
+    std::cerr << "isolink sim: error: " << flag << " expects a positive time such as 10n, got '"
+              << text << "'\n";
+    *bad = true;
+    return std::nullopt;
+  }
+  return v;
+}
+
 int run_sim(const SimArgs& a) {
+  bool bad = false;
+  std::optional<double> step = si_option("--step", a.step, &bad);
+  std::optional<double> tstop = si_option("--tstop", a.tstop, &bad);
+  std::optional<double> tmax = si_option("--tmax", a.tmax, &bad);
+  if (bad) return 2;
   StatusOr<Netlist> netlist = read_spice_file(a.netlist);
   if (!netlist) {
     std::cerr << netlist.status().message() << "\n";
@@ -29,18 +48,19 @@ int run_sim(const SimArgs& a) {
   }
   SimulationRequest req;
   req.probes = a.probes;
-  if (a.tstop > 0) req.tstop = a.tstop;
-  if (a.tmax > 0) req.tmax = a.tmax;
+  req.tstop = tstop;
+  req.tmax = tmax;
   if (a.reltol > 0) req.reltol = a.reltol;
   if (a.method == "trap") req.method = IntegrationMethod::Trapezoidal;
   if (a.method == "gear") req.method = IntegrationMethod::Gear2;
   StatusOr<SimulationResult> r = simulate_netlist(*netlist, req);
   if (!r) {
-    std::cerr << a.netlist << ": error: " << r.status().message() << "\n";
+    const std::string& m = r.status().message();  // diagnostics already say file:line:col
+    std::cerr << (m.find(": error: ") == std::string::npos ? "isolink sim: error: " : "") << m << "\n";
     return 2;
   }
   for (const auto& w : r->warnings) std::cerr << w << "\n";
-  const Waveform out = a.step > 0 ? r->wave.resampled(a.step) : r->wave;
+  const Waveform out = step ? r->wave.resampled(*step) : r->wave;
   if (a.output.empty() || a.output == "-") {
     std::printf("time");
     for (const auto& n : out.names) std::printf(",%s", n.c_str());
@@ -73,12 +93,9 @@ void add_sim_command(CLI::App& app, int* exit_code) {
                   "signal to record: v(node), v(node,node) or i(Vname|Lname); repeatable")
       ->required();
   cmd->add_option("-o,--output", args->output, "CSV file to write (default: stdout)");
-  cmd->add_option("--step", args->step, "resample the output on a uniform grid of DT seconds")
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--tstop", args->tstop, "end time in seconds (overrides .tran)")
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--tmax", args->tmax, "largest time step in seconds (overrides .tran)")
-      ->check(CLI::PositiveNumber);
+  cmd->add_option("--step", args->step, "resample the output on a uniform grid of DT seconds (10n)");
+  cmd->add_option("--tstop", args->tstop, "end time in seconds (overrides .tran)");
+  cmd->add_option("--tmax", args->tmax, "largest time step in seconds (overrides .tran)");
   cmd->add_option("--method", args->method, "integration method (overrides .options method)")
       ->check(CLI::IsMember({"trap", "gear"}));
   cmd->add_option("--reltol", args->reltol, "relative truncation-error tolerance (default 1e-3)")
