@@ -1,6 +1,7 @@
 #include "solver/transient.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -116,6 +117,31 @@ struct System {
   }
 };
 
+// The last accepted points since a breakpoint, oldest first, in rotating fixed storage.
+struct History {
+  std::array<double, 3> times{};
+  std::array<std::vector<double>, 3> states;
+  int first = 0, count = 0;
+
+  History(int n, const std::vector<double>& x0) {
+    for (auto& s : states) s.resize(n + 1);
+    reset(0.0, x0);
+  }
+  double t(int i) const { return times[(first + i) % 3]; }
+  const std::vector<double>& x(int i) const { return states[(first + i) % 3]; }
+  void reset(double t0, const std::vector<double>& x0) {
+    first = 0, count = 1, times[0] = t0;
+    states[0] = x0;
+  }
+  void push(double t1, const std::vector<double>& x1) {
+    if (count == 3) first = (first + 1) % 3, --count;
+    const int slot = (first + count) % 3;
+    times[slot] = t1;
+    std::copy(x1.begin(), x1.end(), states[slot].begin());
+    ++count;
+  }
+};
+
 }  // namespace
 
 StatusOr<std::vector<double>> dc_operating_point(const Circuit& circuit) {
@@ -185,9 +211,9 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
     }
   }
 
-  // History since the last breakpoint: times and states, newest last (at most 3 kept).
-  std::vector<double> hist_t{0.0};
-  std::vector<std::vector<double>> hist_x{x};
+  // History since the last breakpoint: up to 3 points, oldest first (fixed storage).
+  History hist(n, x);
+
   auto ladder = [&](double h) {  // largest hmax / 2^k not above h (up to rounding)
     if (h >= hmax) return hmax;
     const int k = static_cast<int>(std::ceil(std::log2(hmax / h) - 1e-9));
@@ -217,7 +243,7 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
     }
 
     // Integration formula: x1' = a0 x1 + hist; system (G + a0 C) x1 = b1 - C hist.
-    const bool euler = after_bp || hist_t.size() < 2;
+    const bool euler = after_bp || hist.count < 2;
     const bool gear = !euler && opt.method == IntegrationMethod::Gear2;
     double a0;
     std::fill(rhs.begin(), rhs.end(), 0.0);  // rhs <- hist (the x1-independent part of x1')
@@ -225,11 +251,11 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
       a0 = 1.0 / step;
       for (int u = 1; u <= n; ++u) rhs[u] = -x[u] / step;
     } else if (gear) {
-      const double h0 = t - hist_t[hist_t.size() - 2];
+      const double h0 = t - hist.t(hist.count - 2);
       const double rho = step / h0;
       a0 = (1 + 2 * rho) / (step * (1 + rho));
       const double a1 = -(1 + rho) / step, a2 = rho * rho / (step * (1 + rho));
-      const auto& xm1 = hist_x[hist_x.size() - 2];
+      const auto& xm1 = hist.x(hist.count - 2);
       for (int u = 1; u <= n; ++u) rhs[u] = a1 * x[u] + a2 * xm1[u];
     } else {
       a0 = 2.0 / step;
@@ -245,9 +271,9 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
 
     // Truncation error from the third divided difference over the last four points.
     double ratio = 0.0;
-    if (hist_t.size() >= 3) {
-      const double t1 = t + step, t0 = hist_t[2], tm1 = hist_t[1], tm2 = hist_t[0];
-      const auto &x0 = hist_x[2], &xm1 = hist_x[1], &xm2 = hist_x[0];
+    if (hist.count == 3) {
+      const double t1 = t + step, t0 = hist.t(2), tm1 = hist.t(1), tm2 = hist.t(0);
+      const auto &x0 = hist.x(2), &xm1 = hist.x(1), &xm2 = hist.x(0);
       const double coef = gear ? (2.0 / 9.0) * 6.0 : (1.0 / 12.0) * 6.0;
       const double h3 = step * step * step * coef;
       for (size_t k = 0; k < watched.size(); ++k) {
@@ -285,12 +311,7 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
     for (int u = 1; u <= n; ++u) xdot[u] = a0 * xnew[u] + rhs[u];
     t = lands ? bp : t + step;
     std::swap(x, xnew);
-    hist_t.push_back(t);
-    hist_x.push_back(x);
-    if (hist_t.size() > 3) {
-      hist_t.erase(hist_t.begin());
-      hist_x.erase(hist_x.begin());
-    }
+    hist.push(t, x);
     record(t, x);
 
     const double grow = ratio > 0 ? std::min(2.0, 0.9 * std::cbrt(1.0 / ratio)) : 2.0;
@@ -301,8 +322,7 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
       // Restart the formula at the corner: small Euler step, fresh history.
       after_bp = true;
       h = ladder(0.1 * std::min(last_regular_h, (next_bp + 1 < bps.size() ? bps[next_bp + 1] : tstop) - t));
-      hist_t.assign(1, t);
-      hist_x.assign(1, x);
+      hist.reset(t, x);
     }
   }
 

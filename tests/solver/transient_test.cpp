@@ -113,6 +113,67 @@ TEST(Transient, CoupledInductorsInduceMTimesDiDt) {
   EXPECT_LT(worst, 0.565 * 5e-3);  // 0.5 % of the 0.565 V amplitude
 }
 
+TEST(Transient, TransformerVoltageRatioIsKTimesTurnsRatio) {
+  // Open secondary (10 Mohm), L2 = 4 L1 (n = 2), k = 0.95: v2 / v1 = M / L1 = k n = 1.9.
+  const double l1 = 100e-6, k = 0.95, f = 1e6;
+  TransientOptions opt{.tstep = 2e-9, .tstop = 2e-6, .reltol = 1e-5};
+  SimResult run = simulate({card("v1", {"in", "0"}, {call("sin", {0, 1, f})}),
+                            card("r1", {"in", "p"}, {num(1)}),  // v(p): the primary's own voltage
+                            card("l1", {"p", "0"}, {num(l1)}), card("l2", {"s", "0"}, {num(4 * l1)}),
+                            card("k1", {}, {num(k)}, {"l1", "l2"}), card("r2", {"s", "0"}, {num(1e7)})},
+                           opt, {"v(s)", "v(p)"});
+  double worst = 0;
+  for (size_t i = 0; i < run.w.samples(); ++i)
+    if (run.w.time[i] > 0.5e-6)
+      worst = std::max(worst, std::fabs(run.w.columns[0][i] - 1.9 * run.w.columns[1][i]));
+  EXPECT_LT(worst, 1.9 * 2e-3);  // 0.2 % of the secondary amplitude (the 10 Mohm load: 1e-4)
+}
+
+TEST(Transient, ShortedSecondaryLeavesTheLeakageInductance) {
+  // Secondary shorted: the primary sees L1 (1 - k^2), the leakage; v1 = Llk di1/dt.
+  const double l1 = 260e-6, k = 0.99, f = 1e6, w = 2 * M_PI * f, amp = 1e-3;
+  const double leak = l1 * (1 - k * k);  // 5.17 uH
+  TransientOptions opt{.tstep = 1e-9, .tstop = 2e-6, .reltol = 1e-5};
+  SimResult run = simulate({card("i1", {"0", "p"}, {call("sin", {0, amp, f})}),
+                            card("l1", {"p", "0"}, {num(l1)}), card("l2", {"s", "0"}, {num(l1)}),
+                            card("k1", {}, {num(k)}, {"l1", "l2"}), card("r2", {"s", "0"}, {num(1e-3)})},
+                           opt, {"v(p)"});
+  double worst = 0;
+  for (size_t i = 0; i < run.w.samples(); ++i) {
+    const double t = run.w.time[i];
+    if (t < 0.5e-6) continue;
+    worst = std::max(worst, std::fabs(run.w.columns[0][i] - leak * amp * w * std::cos(w * t)));
+  }
+  const double peak = leak * amp * w;  // 32.5 mV
+  EXPECT_LT(worst, 0.01 * peak);       // the 1 mohm short adds 3e-5 relative; the rest is numerics
+}
+
+TEST(Transient, LosslessLcLadderDelaysByNSqrtLC) {
+  // 40 sections of 10 nH / 4 pF: Z0 = 50 ohm, 0.2 ns per section, 8 ns in all; matched ends.
+  const int sections = 40;
+  const double l = 10e-9, c = 4e-12, z0 = 50, tr = 1e-9, td = 1e-9;
+  std::vector<Card> cards{card("v1", {"src", "0"}, {call("pulse", {0, 2, td, tr, tr, 1, 2})}),
+                          card("rs", {"src", "n0"}, {num(z0)})};
+  for (int i = 0; i < sections; ++i) {
+    const std::string a = "n" + std::to_string(i), b = "n" + std::to_string(i + 1);
+    cards.push_back(card("l" + std::to_string(i), {a, b}, {num(l)}));
+    cards.push_back(card("c" + std::to_string(i), {b, "0"}, {num(c)}));
+  }
+  const std::string out = "n" + std::to_string(sections);
+  cards.push_back(card("rl", {out, "0"}, {num(z0)}));
+  TransientOptions opt{.tstep = 0.05e-9, .tstop = 20e-9, .reltol = 1e-4};
+  SimResult run = simulate(cards, opt, {"v(" + out + ")"});
+  // 50 % crossing (0.5 V of the 1 V that reaches the matched load) against td + tr/2 + N sqrt(LC).
+  double crossing = 0;
+  const auto& v = run.w.columns[0];
+  for (size_t i = 1; i < v.size() && crossing == 0; ++i)
+    if (v[i - 1] < 0.5 && v[i] >= 0.5)
+      crossing = run.w.time[i - 1] + (0.5 - v[i - 1]) / (v[i] - v[i - 1]) * (run.w.time[i] - run.w.time[i - 1]);
+  const double delay = crossing - td - tr / 2;
+  EXPECT_NEAR(delay, sections * std::sqrt(l * c), 0.02 * sections * std::sqrt(l * c));
+  EXPECT_NEAR(v.back(), 1.0, 0.01);  // matched: half the 2 V source
+}
+
 TEST(Transient, RepeatedStepSizesReuseFactorizations) {
   // A square wave: the same step sizes recur every period.
   TransientOptions opt{.tstep = 5e-9, .tstop = 20e-6};
