@@ -1,42 +1,78 @@
 #!/usr/bin/env bash
-# Times `isolink sim` and ngspice on the same netlists in the same run (wall time, best of N).
-#   bash bench/sim_vs_ngspice.sh [build/cli/isolink] [N]
-# Both simulators write the same probes to a file; ngspice gets `.options rshunt=1e12` (it cannot
-# solve the floating cable nodes otherwise) and its defaults otherwise (reltol 1e-3, trtol 7).
+# isolink sim against ngspice on the example link netlists, all in one run:
+#   bash bench/sim_vs_ngspice.sh [ISOLINK_BINARY] [N] [EXAMPLE...]
+# (defaults: build/cli/isolink, N=5, every netlists/examples/*.cir). For each example:
+#   - `isolink sim` with its default options, wall time best of N;
+#   - ngspice with its default options plus `.options rshunt=1e12` (it cannot solve the floating
+#     nodes otherwise), wall time best of N;
+#   - ngspice once at tight tolerances (reltol 1e-6, abstol 1e-12, vntol 1e-9) as the reference;
+#   - max |v(rxp,rxn) - reference| over the reference's time points (the other waveform
+#     interpolated linearly), in mV, for isolink and for default ngspice.
+# Prints a Markdown table (for bench/README.md). Both programs write v(rxp,rxn) to a file, so the
+# wall times include parsing and output on both sides.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ISOLINK=${1:-build/cli/isolink}
 N=${2:-5}
+shift $(($# < 2 ? $# : 2))
+if (($# > 0)); then examples=("$@"); else examples=(netlists/examples/*.cir); fi
+PROBE='v(rxp,rxn)'
+TIGHT='.options reltol=1e-6 abstol=1e-12 vntol=1e-9 rshunt=1e12'
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
 best() {  # best wall time in ms of N runs of "$@"
-  local b=999999
+  local b=999999999 s e ms
   for _ in $(seq "$N"); do
-    local s e
     s=$(date +%s%N)
     "$@" >/dev/null 2>&1 || true
     e=$(date +%s%N)
-    local ms=$(((e - s) / 1000000))
+    ms=$(((e - s) / 1000000))
     ((ms < b)) && b=$ms
   done
   echo "$b"
 }
 
-printf '| netlist | probes | isolink ms | isolink steps | ngspice ms | ngspice points |\n|---|---|---|---|---|---|\n'
-for spec in "netlists/examples/cap_link_2m.cir:v(rxp,rxn) v(txp,txn)" \
-            "tests/cli/data/transformer.cir:v(s1,s2)" \
-            "tests/cli/data/rlc_ladder.cir:v(b) v(d)"; do
-  file=${spec%%:*}
-  probes=${spec#*:}
-  args=()
-  for p in $probes; do args+=(--probe "$p"); done
-  t_iso=$(best "$ISOLINK" sim "$file" "${args[@]}" -q -o "$work/iso.csv")
-  steps=$(("$(wc -l <"$work/iso.csv")" - 1))
-  deck="$work/deck.cir"
-  sed '/^\.[eE][nN][dD]\s*$/d' "$file" >"$deck"
-  printf '.options rshunt=1e12\n.control\nset wr_singlescale\nrun\nwrdata %s %s\n.endc\n.end\n' "$work/ng.txt" "$probes" >>"$deck"
-  t_ng=$(best ngspice -b "$deck")
-  points=$(("$(wc -l <"$work/ng.txt")"))
-  printf '| %s | %s | %s | %s | %s | %s |\n' "$file" "$probes" "$t_iso" "$steps" "$t_ng" "$points"
+ngdeck() {  # netlist options deck data: the netlist without .end, options, a .control block
+  sed '/^\.[eE][nN][dD]\s*$/d' "$1" >"$3"
+  printf '%s\n.control\nset wr_singlescale\noption numdgt=12\nrun\nwrdata %s %s\n.endc\n.end\n' \
+    "$2" "$4" "$PROBE" >>"$3"
+}
+
+# max |test - ref| in mV over ref's time points, test interpolated linearly (col 1 time, col 2
+# value; CSV or whitespace; non-numeric lines skipped; times must increase)
+maxdev() {
+  awk '
+    function num(s) { return s ~ /^[-+0-9.eE]+$/ }
+    { sub(/^[ \t]+/, ""); n = split($0, f, /[ ,\t]+/); if (n < 2 || !num(f[1]) || !num(f[2])) next }
+    FNR == NR { if (m > 0 && f[1] + 0 <= t[m - 1]) next; t[m] = f[1] + 0; v[m] = f[2] + 0; m++; next }
+    { x = f[1] + 0; if (m < 2 || x < t[0] || x > t[m - 1]) next
+      while (j < m - 2 && t[j + 1] < x) j++
+      y = v[j] + (v[j + 1] - v[j]) * (x - t[j]) / (t[j + 1] - t[j])
+      d = y - (f[2] + 0); if (d < 0) d = -d; if (d > worst) worst = d }
+    END { printf "%.1f", worst * 1000 }' "$1" "$2"
+}
+
+rows() { awk 'NF && $1 ~ /^[-+0-9.eE]+,?/' "$1" | wc -l; }
+
+echo "<!-- $(date -u +%Y-%m-%d), $(nproc) cores, $(uname -m), load $(cut -d' ' -f1-3 /proc/loadavg), N=$N -->"
+printf '| example | unknowns | isolink ms | ngspice ms | speed ratio (ngspice/isolink) | isolink max dev (mV) | ngspice max dev (mV) | isolink steps | ngspice points | reference points |\n'
+printf '|---|---|---|---|---|---|---|---|---|---|\n'
+for file in "${examples[@]}"; do
+  name=$(basename "$file" .cir)
+  summary=$("$ISOLINK" sim "$file" --probe "$PROBE" -o "$work/iso.csv" 2>&1 >/dev/null || true)
+  unknowns=$(sed -n 's/.* \([0-9]*\) unknowns.*/\1/p' <<<"$summary" | head -1)
+  t_iso=$(best "$ISOLINK" sim "$file" --probe "$PROBE" -q -o "$work/iso.csv")
+  ngdeck "$file" '.options rshunt=1e12' "$work/ng.cir" "$work/ng.txt"
+  t_ng=$(best ngspice -b "$work/ng.cir")
+  ngdeck "$file" "$TIGHT" "$work/ref.cir" "$work/ref.txt"
+  ngspice -b "$work/ref.cir" >"$work/ref.log" 2>&1 || true
+  if [[ ! -s "$work/ref.txt" || ! -s "$work/ng.txt" || ! -s "$work/iso.csv" ]]; then
+    printf '| %s | run failed | | | | | | | | |\n' "$name"
+    continue
+  fi
+  ratio=$(awk -v a="$t_ng" -v b="$t_iso" 'BEGIN { printf "%.2f", (b > 0 ? a / b : 0) }')
+  printf '| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n' "$name" "$unknowns" "$t_iso" "$t_ng" \
+    "$ratio" "$(maxdev "$work/iso.csv" "$work/ref.txt")" "$(maxdev "$work/ng.txt" "$work/ref.txt")" \
+    "$(($(rows "$work/iso.csv") - 1))" "$(($(rows "$work/ng.txt") - 1))" "$(($(rows "$work/ref.txt") - 1))"
 done

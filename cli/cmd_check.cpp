@@ -1,9 +1,99 @@
-// placeholder until the check command lands
+// isolink check WAVE.csv: score a waveform (simulated or a scope capture) against a rule set.
+// The work is in eye/check.h; this file maps flags and prints.
+#include <cstdio>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
 #include "cli/commands.h"
+#include "eye/check.h"
+#include "eye/decode.h"
+#include "eye/rules.h"
+#include "eye/waveform_csv.h"
 
 namespace isolink::cli {
-void add_check_command(CLI::App& app, int* exit_code) {
-  auto* cmd = app.add_subcommand("check", "(not built yet)");
-  cmd->callback([exit_code] { std::fputs("isolink check: not available in this build\n", stderr); *exit_code = 2; });
+namespace {
+
+struct CheckArgs {
+  std::string wave;
+  std::string rules = "bq7961x";
+  eye::CsvColumns cols;
+  bool json = false;
+  std::string pulses_csv;
+  std::string expect;
+  std::optional<bool> sof;
+  std::optional<int> sof_value;
+  bool msb_first = false;
+  bool lsb_first = false;
+};
+
+int fail_input(const std::string& message) {
+  std::fprintf(stderr, "isolink check: %s\n", message.c_str());
+  return 2;
 }
+
+int run_check(const CheckArgs& a) {
+  StatusOr<eye::Rules> rules = eye::load_rules(a.rules);
+  if (!rules) return fail_input(rules.status().message());
+  eye::CheckOptions opt;
+  if (a.sof) opt.sof = *a.sof;
+  if (a.sof_value) opt.sof_value = *a.sof_value;
+  if (a.msb_first) opt.bit_order = eye::BitOrder::kMsbFirst;
+  if (a.lsb_first) opt.bit_order = eye::BitOrder::kLsbFirst;
+  if (!a.expect.empty()) {
+    StatusOr<std::vector<uint8_t>> e = eye::parse_hex_bytes(a.expect);
+    if (!e) return fail_input("--expect: error: " + e.status().message());
+    opt.expect = *e;
+  }
+  StatusOr<Waveform> w = eye::read_differential_csv(a.wave, a.cols);
+  if (!w) return fail_input(w.status().message());
+  StatusOr<eye::CheckResult> r = eye::check_waveform(*w, *rules, opt);
+  if (!r) return fail_input(a.wave + ": error: " + r.status().message());
+  if (!a.pulses_csv.empty())
+    if (Status s = eye::write_pulses_csv(*r, a.pulses_csv); !s.ok()) return fail_input(s.message());
+  if (a.json)
+    std::printf("%s\n", eye::to_json(*r).dump(2).c_str());
+  else
+    std::fputs(eye::summary_text(*r, a.wave).c_str(), stdout);
+  return r->pass ? 0 : 1;
+}
+
+}  // namespace
+
+void add_check_command(CLI::App& app, int* exit_code) {
+  auto args = std::make_shared<CheckArgs>();
+  auto* cmd = app.add_subcommand(
+      "check",
+      "Score a waveform CSV against the receiver rules (exit 0 pass, 1 fail, 2 bad input)");
+  cmd->add_option("wave", args->wave,
+                  "WAVE.csv: time column and a differential (or P and N) column")
+      ->required();
+  cmd->add_option("--rules", args->rules,
+                  "a shipped rule set (bq7961x, bq79600, tone) or a YAML rule file")
+      ->capture_default_str();
+  cmd->add_option("--time", args->cols.time, "time column (name or 1-based index; default first)");
+  cmd->add_option("--diff", args->cols.diff,
+                  "differential column (name or 1-based index; default second)");
+  auto* p = cmd->add_option("--p", args->cols.p, "P column: the differential is P - N");
+  auto* n = cmd->add_option("--n", args->cols.n, "N column");
+  p->needs(n);
+  n->needs(p);
+  cmd->get_option("--diff")->excludes(p)->excludes(n);
+  cmd->add_flag("--json", args->json, "print one JSON object instead of the summary");
+  cmd->add_option("--pulses-csv", args->pulses_csv, "write the per-pulse table to this CSV file");
+  cmd->add_option("--expect", args->expect,
+                  "bytes expected, e.g. \"80 00 02 15 0B CB 49\": fails on a mismatch");
+  cmd->add_flag_function(
+      "--sof,!--no-sof", [args](int64_t count) { args->sof = count > 0; },
+      "frames carry (or lack) a start-of-frame bit after the sync pair (default: the rules')");
+  cmd->add_option_function<int>(
+         "--sof-value", [args](const int& v) { args->sof_value = v; }, "the SOF bit's value")
+      ->check(CLI::Range(0, 1));
+  auto* msb = cmd->add_flag("--msb-first", args->msb_first, "data bits most significant first");
+  auto* lsb = cmd->add_flag("--lsb-first", args->lsb_first, "data bits least significant first");
+  msb->excludes(lsb);
+  cmd->callback([args, exit_code] { *exit_code = run_check(*args); });
+}
+
 }  // namespace isolink::cli

@@ -37,7 +37,7 @@ struct TransientOptions {
   double reltol = 1e-3;  // relative tolerance of the truncation error
   double vntol = 1e-6;   // V, absolute tolerance on node voltages
   double abstol = 1e-12; // A, absolute tolerance on inductor currents
-  double trtol = 7.0;    // multiplies the truncation tolerance (as ngspice)
+  double trtol = 1.0;    // multiplies the truncation tolerance (ngspice: 7, looser)
   bool uic = false;      // skip the DC operating point, start from zero
   long max_steps = 20'000'000;  // accepted + rejected steps before giving up
 

@@ -41,30 +41,6 @@ Status RxLoadModel::validate() const {
   return positive("rx_load", "c_in", c_in);
 }
 
-std::vector<double> drive_pwl(const traffic::Drive& drive, const TxDriverModel& model,
-                              int line_sign) {
-  // Line voltage for a level: P follows the level, N its complement; idle = vdd / 2.
-  auto volts = [&](int level) { return model.vdd * (0.5 + 0.5 * line_sign * level); };
-  std::vector<double> pwl;
-  pwl.reserve(4 * drive.segments.size() + 2);
-  auto point = [&pwl](double t, double v) {
-    pwl.push_back(t);
-    pwl.push_back(v);
-  };
-  point(0.0, volts(drive.segments.empty() ? 0 : drive.segments.front().level));
-  for (size_t i = 1; i < drive.segments.size(); ++i) {
-    const double t = drive.segments[i].start;
-    // The edge starts at the boundary and takes `edge` (clipped to half the shorter neighbour).
-    const double room = std::min(drive.segments[i - 1].end - drive.segments[i - 1].start,
-                                 drive.segments[i].end - drive.segments[i].start);
-    const double e = std::min(model.edge, 0.5 * room);
-    const double prev_t = pwl[pwl.size() - 2];
-    if (t > prev_t) point(t, volts(drive.segments[i - 1].level));
-    point(t + e, volts(drive.segments[i].level));
-  }
-  return pwl;
-}
-
 Status add_tx_driver(Circuit& circuit, const std::string& prefix, const std::string& p,
                      const std::string& n, const traffic::Drive& drive, const TxDriverModel& model) {
   if (Status s = model.validate(); !s.ok()) return s;
@@ -74,7 +50,9 @@ Status add_tx_driver(Circuit& circuit, const std::string& prefix, const std::str
     CardArg pwl;
     pwl.kind = CardArg::Kind::Call;
     pwl.word = "pwl";
-    pwl.call = drive_pwl(drive, model, sign);
+    StatusOr<std::vector<double>> points = traffic::line_pwl(drive, sign, model.edge, model.vdd);
+    if (!points) return points.status().with_context("tx driver");
+    pwl.call = std::move(*points);
     if (Status s = circuit.add(make_card('v', "v" + prefix + side, {internal, "0"}, {pwl})); !s.ok())
       return s;
     if (Status s = circuit.add(make_card('r', "r" + prefix + side, {internal, sign > 0 ? p : n},

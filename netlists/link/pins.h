@@ -9,7 +9,8 @@
 //
 // Defaults (our assumptions where the data sheets are silent; netlists/link/README.md):
 //   TX: CVDD 5 V, lines driven 0 / 5 V complementary, 2.5 V when idle (actively held), 10 ns
-//       linear edges (0-100 %), 10 ohm output resistance per line.
+//       linear edges (0-100 %) centred on each corner (traffic::line_pwl, as `isolink frame
+//       --pwl`), 10 ohm output resistance per line.
 //   RX: 10 kohm per pin to a 2.5 V bias, 5 pF per pin to ground.
 #pragma once
 
@@ -44,8 +45,5 @@ Status add_tx_driver(Circuit& circuit, const std::string& prefix, const std::str
 // Adds the receiver input network at pins p and n (bias source "v<prefix>bias").
 Status add_rx_load(Circuit& circuit, const std::string& prefix, const std::string& p,
                    const std::string& n, const RxLoadModel& model);
-
-// The line voltages (P, N) of a drive as PWL points: t0 v0 t1 v1 ... (exposed for tests).
-std::vector<double> drive_pwl(const traffic::Drive& drive, const TxDriverModel& model, int line_sign);
 
 }  // namespace isolink::link

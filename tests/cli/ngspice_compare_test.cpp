@@ -1,7 +1,8 @@
 // isolink's transient against ngspice on the same netlists (ngspice run with tight tolerances).
-#include <filesystem>
-
 #include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
 
 #include "cli/simulate.h"
 #include "ngspice_runner.h"
@@ -25,9 +26,10 @@ void compare(const Case& c, IntegrationMethod method) {
   auto mine = cli::simulate_netlist(*netlist, req);
   ASSERT_TRUE(mine.ok()) << mine.status().message();
   const std::string work = ::testing::TempDir() + "/ngspice_compare";
-  auto ng = testing::run_ngspice(c.netlist, c.probes, work,
-                                 ".options reltol=1e-6 abstol=1e-12 vntol=1e-9 rshunt=1e12 method=" +
-                                     std::string(method == IntegrationMethod::Gear2 ? "gear" : "trap"));
+  auto ng = testing::run_ngspice(
+      c.netlist, c.probes, work,
+      std::string(testing::kNgspiceTight) +
+          " method=" + std::string(method == IntegrationMethod::Gear2 ? "gear" : "trap"));
   ASSERT_TRUE(ng.ok()) << ng.status().message();
   ASSERT_GT(ng->samples(), 100u);
   for (size_t k = 0; k < c.probes.size(); ++k) {
@@ -50,7 +52,55 @@ TEST_P(NgspiceCompare, CapacitorIsolatedLinkExample) {
 }
 
 INSTANTIATE_TEST_SUITE_P(TrapAndGear, NgspiceCompare,
-                         ::testing::Values(IntegrationMethod::Trapezoidal, IntegrationMethod::Gear2));
+                         ::testing::Values(IntegrationMethod::Trapezoidal,
+                                           IntegrationMethod::Gear2));
+
+// Every example link netlist, isolink with its DEFAULT options (what a user gets from
+// `isolink sim`) against ngspice at tight tolerances: v(rxp,rxn) within 10 mV over the run.
+// `tstop` (if > 0) shortens both runs, for the largest example only (ngspice-tight on its full
+// 52 us takes ~8 s; its error is per edge, not accumulated: the first two frames show it).
+void compare_example(const std::string& name, double tstop = 0) {
+  const std::string path = kExamples + "/" + name + ".cir";
+  const std::vector<std::string> probes = {"v(rxp,rxn)"};
+  auto netlist = read_spice_file(path);
+  ASSERT_TRUE(netlist.ok()) << netlist.status().message();
+  cli::SimulationRequest req{.probes = probes};
+  std::string tran;
+  if (tstop > 0) {
+    req.tstop = tstop;
+    char card[64];
+    std::snprintf(card, sizeof card, ".tran %.9g %.9g", netlist->tran->tstep, tstop);
+    tran = card;
+  }
+  auto mine = cli::simulate_netlist(*netlist, req);
+  ASSERT_TRUE(mine.ok()) << mine.status().message();
+  const std::string work = ::testing::TempDir() + "/ngspice_examples";
+  auto ng = testing::run_ngspice(path, probes, work, testing::kNgspiceTight, tran);
+  ASSERT_TRUE(ng.ok()) << ng.status().message();
+  ASSERT_GT(ng->samples(), 1000u);
+  if (tstop > 0) {
+    ASSERT_NEAR(ng->time.back(), tstop, 1e-12);
+  }
+  ASSERT_NEAR(mine->wave.time.back(), ng->time.back(), 1e-12);
+  const double d = testing::max_abs_difference(mine->wave, 0, *ng, 0);
+  EXPECT_LE(d, 10e-3) << name << ": max |isolink - ngspice tight| of v(rxp,rxn)";
+  ::testing::Test::RecordProperty("max_dev_mV", std::to_string(d * 1e3));
+  std::printf("%s: max |dev| %.2f mV over %zu reference points, %zu isolink steps\n", name.c_str(),
+              d * 1e3, ng->samples(), mine->wave.samples());
+}
+
+TEST(NgspiceExamples, CapLink2m) {
+  compare_example("cap_link_2m");
+}
+TEST(NgspiceExamples, CmcLink5m) {
+  compare_example("cmc_link_5m");
+}
+TEST(NgspiceExamples, HybridXfmrCap3m) {
+  compare_example("hybrid_xfmr_cap_3m");
+}
+TEST(NgspiceExamples, XfmrLink15mFirstTwoFrames) {
+  compare_example("xfmr_link_15m", 20.7e-6);
+}
 
 }  // namespace
 }  // namespace isolink

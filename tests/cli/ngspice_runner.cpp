@@ -1,5 +1,6 @@
 #include "ngspice_runner.h"
 
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -9,7 +10,8 @@
 namespace isolink::testing {
 
 StatusOr<Waveform> run_ngspice(const std::string& netlist, const std::vector<std::string>& probes,
-                               const std::string& work_dir, const std::string& extra) {
+                               const std::string& work_dir, const std::string& extra,
+                               const std::string& tran) {
   namespace fs = std::filesystem;
   fs::create_directories(work_dir);
   const std::string stem = fs::path(netlist).stem().string();
@@ -24,8 +26,16 @@ StatusOr<Waveform> run_ngspice(const std::string& netlist, const std::vector<std
   while (std::getline(in, line)) {
     std::string l = line;
     for (auto& ch : l) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-    if (l.rfind(".end", 0) == 0 && (l.size() == 4 || std::isspace(static_cast<unsigned char>(l[4]))))
+    if (l.rfind(".end", 0) == 0 &&
+        (l.size() == 4 || std::isspace(static_cast<unsigned char>(l[4]))))
       continue;
+    if (!tran.empty() && l.rfind(".tran", 0) == 0 &&
+        (l.size() == 5 || std::isspace(static_cast<unsigned char>(l[5])))) {
+      line = "* (replaced) " +
+             line;  // a + continuation of it would be an error: keep .tran on one line
+      out << line << "\n" << tran << "\n";
+      continue;
+    }
     if (l.rfind(".include", 0) == 0) {  // make includes absolute
       std::string path = line.substr(8);
       path.erase(0, path.find_first_not_of(" \t\""));
@@ -47,8 +57,7 @@ StatusOr<Waveform> run_ngspice(const std::string& netlist, const std::vector<std
   fs::remove(data);
   const std::string cmd = "ngspice -b " + deck + " > " + dir + "/" + stem + ".ngspice.log 2>&1";
   (void)std::system(cmd.c_str());  // ngspice -b exits 1 even after a good run
-  if (!fs::exists(data))
-    return Status::Error("ngspice failed on " + deck + " (see its .log)");
+  if (!fs::exists(data)) return Status::Error("ngspice failed on " + deck + " (see its .log)");
   std::ifstream din(data);
   std::getline(din, line);  // header
   Waveform w;
@@ -68,7 +77,8 @@ StatusOr<Waveform> run_ngspice(const std::string& netlist, const std::vector<std
   return w;
 }
 
-double max_abs_difference(const Waveform& a, size_t ka, const Waveform& b, size_t kb, double t_from) {
+double max_abs_difference(const Waveform& a, size_t ka, const Waveform& b, size_t kb,
+                          double t_from) {
   double worst = 0;
   for (size_t i = 0; i < b.samples(); ++i) {
     if (b.time[i] < t_from || b.time[i] > a.time.back()) continue;

@@ -12,6 +12,7 @@ namespace {
 namespace fs = std::filesystem;
 const std::string kBinary = ISOLINK_BINARY;
 const std::string kExamples = ISOLINK_EXAMPLES_DIR;
+const std::string kData = ISOLINK_TEST_DATA_DIR;
 
 struct Result {
   int code;
@@ -37,7 +38,7 @@ std::string write_temp(const std::string& name, const std::string& text) {
 TEST(SimCommand, WritesHeaderAndStrictlyIncreasingTimes) {
   const std::string out = ::testing::TempDir() + "/wave.csv";
   fs::remove(out);
-  Result r = run("sim " + kExamples + "/cap_link_2m.cir --probe 'v(rxp,rxn)' --probe 'v(txp)' -o " + out);
+  Result r = run("sim " + kData + "/floating_cable.cir --probe 'v(rxp,rxn)' --probe 'v(txp)' -o " + out);
   ASSERT_EQ(r.code, 0) << r.err;
   std::ifstream in(out);
   std::string line;

@@ -13,22 +13,10 @@ traffic::Drive couplet_drive() {  // idle 1 us, + 250 ns, - 250 ns, idle 1 us
   return d;
 }
 
-TEST(Pins, DrivePwlHasEdgesAtEverySegmentBoundary) {
-  const auto p = drive_pwl(couplet_drive(), TxDriverModel{}, +1);
-  const std::vector<double> want{0,       2.5, 1e-6,     2.5, 1.01e-6, 5, 1.25e-6, 5,
-                                 1.26e-6, 0,   1.5e-6,   0,   1.51e-6, 2.5};
-  ASSERT_EQ(p.size(), want.size());
-  for (size_t i = 0; i < p.size(); ++i) EXPECT_NEAR(p[i], want[i], 1e-15) << i;
-  const auto n = drive_pwl(couplet_drive(), TxDriverModel{}, -1);
-  EXPECT_NEAR(n[5], 0.0, 1e-15);  // N low while P is high
-  EXPECT_NEAR(n[9], 5.0, 1e-15);
-}
-
-TEST(Pins, EdgeIsClippedToHalfTheShorterSegment) {
-  traffic::Drive d;
-  d.segments = {{0, 1e-6, 0}, {1e-6, 1.004e-6, +1}, {1.004e-6, 2e-6, 0}};
-  const auto p = drive_pwl(d, TxDriverModel{}, +1);
-  EXPECT_NEAR(p[4], 1.002e-6, 1e-15);  // 4 ns pulse: 2 ns edge instead of 10 ns
+TEST(Pins, TooLongAnEdgeIsAnError) {
+  Circuit c;
+  Status s = add_tx_driver(c, "tx", "p", "n", couplet_drive(), TxDriverModel{.edge = 300e-9});
+  EXPECT_NE(s.message().find("edge time 3e-07 s is too long"), std::string::npos) << s.message();
 }
 
 TEST(Pins, DriverIntoTerminatedReceiverGivesTheResistiveDivider) {
@@ -52,6 +40,7 @@ TEST(Pins, DriverIntoTerminatedReceiverGivesTheResistiveDivider) {
   const double vplus = 5.0 * rload / (rload + 20.0);      // 4.8972 V
   EXPECT_NEAR(w->value_at(0, 1.24e-6), vplus, 1e-3);
   EXPECT_NEAR(w->value_at(0, 1.49e-6), -vplus, 1e-3);
+  EXPECT_NEAR(w->value_at(0, 1.25e-6), 0.0, 0.05);  // edges centred on the corners
   EXPECT_NEAR(w->value_at(0, 2.4e-6), 0.0, 1e-6);  // idle: both lines at 2.5 V
   EXPECT_NEAR(w->value_at(0, 0.5e-6), 0.0, 1e-9);
 }

@@ -1,0 +1,464 @@
+#include "eye/check.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+namespace isolink::eye {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+json num(double x) {
+  return std::isnan(x) ? json(nullptr) : json(x);
+}
+json opt_num(const std::optional<double>& x, double scale = 1) {
+  return x ? json(*x * scale) : json(nullptr);
+}
+double ns(double s) {
+  return s * 1e9;
+}
+const char* sign_str(int s) {
+  return s > 0 ? "+" : "-";
+}
+
+std::string byte_hex(uint8_t b) {
+  return to_hex(std::span<const uint8_t>(&b, 1));
+}
+
+template <class F>
+std::optional<double> fold(const std::vector<PulseMetrics>& ps, F pick, bool want_min) {
+  std::optional<double> r;
+  for (const PulseMetrics& p : ps) {
+    std::optional<double> x = pick(p);
+    if (!x) continue;
+    if (!r || (want_min ? *x < *r : *x > *r)) r = *x;
+  }
+  return r;
+}
+
+bool is_time_metric(const std::string& m) {
+  return m == "width" || m == "edge";
+}
+
+std::string place(const PulseMetrics& p) {
+  std::string s = fmt::format("pulse {} ({} at {:.4f} us", p.index, sign_str(p.sign), p.a * 1e6);
+  if (p.frame >= 0) s += fmt::format(", frame {}", p.frame);
+  if (!p.role.empty()) s += ", " + p.role;
+  return s + ")";
+}
+
+}  // namespace
+
+size_t CheckResult::failing() const {
+  return static_cast<size_t>(std::count_if(pulses.begin(), pulses.end(),
+                                           [](const PulseMetrics& p) { return p.failing(); }));
+}
+std::optional<double> CheckResult::vstart_min() const {
+  return fold(
+      pulses,
+      [](const PulseMetrics& p) {
+        return p.vstart.measured() ? std::optional(p.vstart.value) : std::nullopt;
+      },
+      true);
+}
+std::optional<double> CheckResult::vend_min() const {
+  return fold(
+      pulses,
+      [](const PulseMetrics& p) {
+        return p.vend.measured() ? std::optional(p.vend.value) : std::nullopt;
+      },
+      true);
+}
+std::optional<double> CheckResult::width_min() const {
+  return fold(
+      pulses,
+      [](const PulseMetrics& p) {
+        return !p.idle && p.width.measured() ? std::optional(p.width.value) : std::nullopt;
+      },
+      true);
+}
+std::optional<double> CheckResult::width_max() const {
+  return fold(
+      pulses,
+      [](const PulseMetrics& p) {
+        return !p.idle && p.width.measured() ? std::optional(p.width.value) : std::nullopt;
+      },
+      false);
+}
+std::optional<double> CheckResult::edge_max() const {
+  return fold(
+      pulses,
+      [](const PulseMetrics& p) {
+        return p.edge.measured() ? std::optional(p.edge.value) : std::nullopt;
+      },
+      false);
+}
+
+StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const double> v,
+                                    const Rules& rules, const CheckOptions& opt) {
+  if (t.size() != v.size())
+    return Status::Error(fmt::format("{} time samples but {} values", t.size(), v.size()));
+  if (t.size() < 2) return Status::Error("a waveform needs at least two samples");
+  for (size_t i = 0; i < t.size(); ++i) {
+    if (!std::isfinite(t[i]) || !std::isfinite(v[i]))
+      return Status::Error(fmt::format("sample {} is not a finite number", i));
+    if (i > 0 && !(t[i] > t[i - 1]))
+      return Status::Error(fmt::format("time does not increase at sample {} ({:g} s after {:g} s)",
+                                       i, t[i], t[i - 1]));
+  }
+  if (Status s = validate_rules(rules); !s.ok()) return s;
+
+  CheckResult r;
+  r.rules = rules.name;
+  r.rules_source = rules.source;
+  r.tone = rules.tone;
+  r.frame_format = rules.frame;
+  if (opt.sof) r.frame_format.sof = *opt.sof;
+  if (opt.sof_value) r.frame_format.sof_value = *opt.sof_value;
+  if (opt.bit_order) r.frame_format.bit_order = *opt.bit_order;
+  if (r.frame_format.sof_value != 0 && r.frame_format.sof_value != 1)
+    return Status::Error(fmt::format("SOF value {} is neither 0 nor 1", r.frame_format.sof_value));
+  r.samples = t.size();
+  r.t_begin = t.front();
+  r.t_end = t.back();
+
+  const Segmentation seg = segment(t, v, segment_params(rules));
+  r.pulses = measure_pulses(t, v, seg, rules);
+  r.ringing = seg.ringing;
+  r.idle = find_idle_undershoots(t, v, seg, rules);
+  const FrameFormat& fmt_ = r.frame_format;
+
+  // Item 12: decode each run of joined pulses.
+  for (const FrameSpan& fs : seg.frames) {
+    std::vector<int> hb;
+    std::vector<size_t> hb_pulse;
+    std::vector<int> hb_off;
+    for (size_t p = fs.first; p <= fs.last; ++p)
+      for (int k = 0; k < r.pulses[p].half_bits; ++k) {
+        hb.push_back(r.pulses[p].sign);
+        hb_pulse.push_back(p);
+        hb_off.push_back(k);
+      }
+    std::vector<DecodedByte> decoded;
+    if (rules.tone) {
+      DecodedByte d;
+      d.half_count = hb.size();
+      decoded.push_back(d);
+    } else {
+      decoded = decode_half_bits(hb, fmt_);
+    }
+    for (const DecodedByte& d : decoded) {
+      FrameResult fr;
+      const size_t h0 = d.first_half, h1 = d.first_half + d.half_count - 1;
+      fr.first_pulse = hb_pulse[h0];
+      fr.last_pulse = hb_pulse[h1];
+      fr.start = r.pulses[fr.first_pulse].a + hb_off[h0] * rules.pulse_time;
+      fr.error_bit = d.error_bit;
+      const int idx = static_cast<int>(r.frames.size());
+      for (size_t h = h0; h <= h1; ++h) {
+        PulseMetrics& p = r.pulses[hb_pulse[h]];
+        const std::string role = rules.tone ? "" : half_bit_role(h - h0, fmt_);
+        if (p.frame != idx) {
+          p.frame = idx;
+          p.role = role;
+        } else if (!role.empty() && role != p.role) {
+          p.role += "/" + role;
+        }
+      }
+      const PulseMetrics* trunc = nullptr;
+      const PulseMetrics* timing = nullptr;
+      const PulseMetrics* weak = nullptr;
+      for (size_t p = fr.first_pulse; p <= fr.last_pulse; ++p) {
+        const PulseMetrics& pm = r.pulses[p];
+        if (pm.truncated && !trunc) trunc = &pm;
+        if (pm.timing_fail && !timing) timing = &pm;
+        if (pm.weak_fail && !weak) weak = &pm;
+      }
+      auto first_fail = [](const PulseMetrics& pm, const char* a, const char* b) {
+        for (const std::string& f : pm.fails)
+          if (f.rfind(a, 0) == 0 || (b && f.rfind(b, 0) == 0)) return f;
+        return pm.fails.empty() ? std::string() : pm.fails.front();
+      };
+      if (trunc) {
+        fr.fault = "truncated";
+        fr.detail = "the record cuts " + place(*trunc);
+      } else if (timing) {
+        fr.fault = "timing";
+        fr.detail = place(*timing) + ": " + first_fail(*timing, "width", "edge");
+      } else if (!d.fault.empty()) {
+        fr.fault = d.fault;
+        fr.detail = d.detail;
+      } else if (weak) {
+        fr.fault = "weak bit";
+        fr.detail = place(*weak) + ": " + first_fail(*weak, "vstart", "vend");
+      }
+      if (fr.fault.empty() && d.byte) {
+        fr.byte = d.byte;
+        r.bytes.push_back(*d.byte);
+      }
+      r.frames.push_back(std::move(fr));
+    }
+  }
+
+  if (opt.expect) {
+    r.expect = opt.expect;
+    const auto& e = *opt.expect;
+    for (size_t i = 0; i < std::max(e.size(), r.bytes.size()); ++i) {
+      if (i >= e.size() || i >= r.bytes.size()) {
+        r.expect_match = false;
+        r.expect_detail = fmt::format("expected {} bytes, decoded {}", e.size(), r.bytes.size());
+        break;
+      }
+      if (e[i] != r.bytes[i]) {
+        r.expect_match = false;
+        r.expect_detail = fmt::format("byte {}: expected {}, decoded {}", i, byte_hex(e[i]),
+                                      byte_hex(r.bytes[i]));
+        break;
+      }
+    }
+  }
+
+  r.worst = worst_margins(r.pulses);
+
+  // Item 11: the verdict.
+  if (r.pulses.empty())
+    r.reasons.push_back(fmt::format("no pulses: nothing stays past +/-{:g} V for {:g} ns",
+                                    rules.vth, ns(rules.min_pulse)));
+  if (size_t nf = r.failing())
+    r.reasons.push_back(fmt::format("{} of {} pulses fail", nf, r.pulses.size()));
+  for (size_t i = 0; i < r.frames.size(); ++i)
+    if (r.frames[i].fails())
+      r.reasons.push_back(fmt::format("frame {} at {:.4f} us does not decode: {} ({})", i,
+                                      r.frames[i].start * 1e6, r.frames[i].fault,
+                                      r.frames[i].detail));
+  if (!r.expect_match)
+    r.reasons.push_back("decoded bytes differ from the expected: " + r.expect_detail);
+  r.pass = r.reasons.empty();
+  return r;
+}
+
+StatusOr<CheckResult> check_waveform(const Waveform& w, const Rules& rules, const CheckOptions& opt,
+                                     size_t column) {
+  if (column >= w.columns.size())
+    return Status::Error(fmt::format("the waveform has no column {}", column));
+  return check_samples(w.time, w.columns[column], rules, opt);
+}
+
+json to_json(const CheckResult& r) {
+  json j;
+  j["verdict"] = r.pass ? "pass" : "fail";
+  j["reasons"] = r.reasons;
+  j["rules"] = r.rules;
+  j["rules_source"] = r.rules_source;
+  j["samples"] = r.samples;
+  j["t_begin_s"] = r.t_begin;
+  j["t_end_s"] = r.t_end;
+
+  json worst = json::object();
+  for (const WorstMargin& w : r.worst) {
+    const bool tm = is_time_metric(w.metric);
+    const double k = tm ? 1e9 : 1.0;
+    worst[w.metric] = {{"value", w.j.value * k},
+                       {"limit", w.j.limit * k},
+                       {"margin", w.j.margin * k},
+                       {"unit", tm ? "ns" : "V"},
+                       {"pulse", w.pulse},
+                       {"time_s", w.time},
+                       {"frame", w.frame >= 0 ? json(w.frame) : json(nullptr)},
+                       {"bit", w.role.empty() ? json(nullptr) : json(w.role)}};
+  }
+  size_t frames_failing = 0;
+  for (const FrameResult& f : r.frames) frames_failing += f.fails() ? 1 : 0;
+  j["summary"] = {{"pulses", r.pulses.size()},
+                  {"failing", r.failing()},
+                  {"frames", r.frames.size()},
+                  {"frames_failing", frames_failing},
+                  {"ringing", r.ringing.size()},
+                  {"idle_undershoots", r.idle.size()},
+                  {"vstart_min", opt_num(r.vstart_min())},
+                  {"vend_min", opt_num(r.vend_min())},
+                  {"width_min_ns", opt_num(r.width_min(), 1e9)},
+                  {"width_max_ns", opt_num(r.width_max(), 1e9)},
+                  {"edge_max_ns", opt_num(r.edge_max(), 1e9)},
+                  {"worst", worst}};
+
+  json pulses = json::array();
+  for (const PulseMetrics& p : r.pulses) {
+    json cls = p.truncated ? json(nullptr) : (p.idle ? json("idle") : json(p.k));
+    json dips = json::array();
+    for (const Dip& d : p.dips)
+      dips.push_back(
+          {{"start_s", d.start}, {"length_ns", ns(d.end - d.start)}, {"lowest", d.lowest}});
+    pulses.push_back({{"index", p.index},
+                      {"sign", p.sign},
+                      {"start_s", p.a},
+                      {"end_s", p.b},
+                      {"width_ns", num(ns(p.width.value))},
+                      {"class", cls},
+                      {"edge_ns", num(ns(p.edge.value))},
+                      {"vstart", num(p.vstart.value)},
+                      {"vend", num(p.vend.value)},
+                      {"droop", num(p.droop.value)},
+                      {"dips", dips},
+                      {"frame", p.frame >= 0 ? json(p.frame) : json(nullptr)},
+                      {"bit", p.role.empty() ? json(nullptr) : json(p.role)},
+                      {"fails", p.fails},
+                      {"warnings", p.warnings}});
+  }
+  j["pulses"] = std::move(pulses);
+
+  json ringing = json::array();
+  for (const Ringing& g : r.ringing)
+    ringing.push_back({{"start_s", g.start},
+                       {"end_s", g.end},
+                       {"duration_ns", ns(g.end - g.start)},
+                       {"sign", g.sign},
+                       {"peak", g.peak},
+                       {"peak_s", g.peak_t}});
+  j["ringing"] = std::move(ringing);
+  json idle = json::array();
+  for (const IdleUndershoot& u : r.idle)
+    idle.push_back({{"start_s", u.start},
+                    {"end_s", u.end},
+                    {"sign", u.sign},
+                    {"peak", u.peak},
+                    {"peak_s", u.peak_t},
+                    {"after_pulse", u.after_pulse}});
+  j["idle"] = std::move(idle);
+
+  json frames = json::array();
+  for (const FrameResult& f : r.frames)
+    frames.push_back({{"start_s", f.start},
+                      {"byte", f.byte ? json(byte_hex(*f.byte)) : json(nullptr)},
+                      {"fault", f.fault.empty() ? json(nullptr) : json(f.fault)},
+                      {"detail", f.detail.empty() ? json(nullptr) : json(f.detail)},
+                      {"error_bit", f.error_bit},
+                      {"first_pulse", f.first_pulse},
+                      {"last_pulse", f.last_pulse}});
+  json decoded = {
+      {"bytes", to_hex(r.bytes)},
+      {"format",
+       {{"sof", r.frame_format.sof},
+        {"sof_value", r.frame_format.sof_value},
+        {"bit_order", r.frame_format.bit_order == BitOrder::kLsbFirst ? "lsb" : "msb"}}},
+      {"frames", std::move(frames)}};
+  if (r.tone) decoded["format"] = nullptr;
+  if (r.expect) {
+    decoded["expect"] = to_hex(*r.expect);
+    decoded["match"] = r.expect_match;
+    decoded["mismatch"] = r.expect_detail.empty() ? json(nullptr) : json(r.expect_detail);
+  }
+  j["decoded"] = std::move(decoded);
+  return j;
+}
+
+std::string summary_text(const CheckResult& r, const std::string& source) {
+  std::string out;
+  const size_t nf = r.failing();
+  size_t frames_failing = 0;
+  for (const FrameResult& f : r.frames) frames_failing += f.fails() ? 1 : 0;
+  out += fmt::format("{}{} (rules {})\n", source.empty() ? "" : source + ": ",
+                     r.pass ? "PASS" : "FAIL", r.rules);
+  for (const std::string& why : r.reasons) out += "  " + why + "\n";
+  if (!r.worst.empty()) {
+    out += "worst margin per metric:\n";
+    for (const WorstMargin& w : r.worst) {
+      const PulseMetrics& p = r.pulses[w.pulse];
+      if (is_time_metric(w.metric))
+        out += fmt::format("  {:<7}{:>+9.1f} ns  {:7.1f} ns vs {:5.0f} ns  {}\n", w.metric,
+                           ns(w.j.margin), ns(w.j.value), ns(w.j.limit), place(p));
+      else
+        out += fmt::format("  {:<7}{:>+9.1f} mV  {:7.3f} V  vs {:5.2f} V   {}\n", w.metric,
+                           w.j.margin * 1e3, w.j.value, w.j.limit, place(p));
+    }
+  }
+  out += fmt::format(
+      "counts: {} pulses ({} failing), {} ringing, {} idle undershoots, {} {} "
+      "({} failing)\n",
+      r.pulses.size(), nf, r.ringing.size(), r.idle.size(), r.frames.size(),
+      r.tone ? "runs" : "frames", frames_failing);
+  if (!r.tone) {
+    out += "decoded: " + (r.bytes.empty() ? std::string("(none)") : to_hex(r.bytes));
+    if (r.expect)
+      out += r.expect_match ? "  (as expected)"
+                            : "  (expected " + to_hex(*r.expect) + ": " + r.expect_detail + ")";
+    out += "\n";
+  }
+  const size_t kMax = 20;
+  std::vector<std::string> fails, warns;
+  for (const PulseMetrics& p : r.pulses) {
+    for (const std::string& f : p.fails) fails.push_back(place(p) + ": " + f);
+    for (const std::string& w : p.warnings) warns.push_back(place(p) + ": " + w);
+  }
+  for (size_t i = 0; i < r.frames.size(); ++i)
+    if (!r.frames[i].fault.empty())
+      (r.frames[i].fails() ? fails : warns)
+          .push_back(fmt::format("frame {} at {:.4f} us: {}: {}", i, r.frames[i].start * 1e6,
+                                 r.frames[i].fault, r.frames[i].detail));
+  for (const Ringing& g : r.ringing)
+    warns.push_back(
+        fmt::format("ringing: {} excursion of {:.1f} ns at {:.4f} us, peak {:.3f} V "
+                    "(not a pulse)",
+                    sign_str(g.sign), ns(g.end - g.start), g.start * 1e6, g.peak));
+  for (const IdleUndershoot& u : r.idle)
+    warns.push_back(fmt::format("idle undershoot: {} to {:.3f} V at {:.4f} us after pulse {}",
+                                sign_str(u.sign), u.sign * u.peak, u.peak_t * 1e6, u.after_pulse));
+  auto list = [&](const char* title, const std::vector<std::string>& items) {
+    if (items.empty()) return;
+    out += fmt::format("{} ({}):\n", title, items.size());
+    for (size_t i = 0; i < std::min(items.size(), kMax); ++i) out += "  " + items[i] + "\n";
+    if (items.size() > kMax) out += fmt::format("  ... and {} more\n", items.size() - kMax);
+  };
+  list("failures", fails);
+  list("warnings", warns);
+  return out;
+}
+
+Status write_pulses_csv(const CheckResult& r, const std::string& path) {
+  const std::string tmp = path + ".tmp";
+  std::FILE* f = std::fopen(tmp.c_str(), "w");
+  if (!f) return Status::Error(path + ": error: cannot write the file");
+  auto cell = [](double x, double scale = 1) {
+    return std::isnan(x) ? std::string() : fmt::format("{:.9g}", x * scale);
+  };
+  auto quoted = [](const std::vector<std::string>& items) {
+    std::string s;
+    for (const std::string& i : items) s += (s.empty() ? "" : " | ") + i;
+    std::string q = "\"";
+    for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return q + "\"";
+  };
+  std::fputs(
+      "index,sign,start_s,end_s,width_ns,class,edge_ns,vstart,vend,droop,frame,bit,fails,"
+      "warnings\n",
+      f);
+  for (const PulseMetrics& p : r.pulses) {
+    const std::string cls = p.truncated ? "" : (p.idle ? "idle" : std::to_string(p.k));
+    const std::string line = fmt::format(
+        "{},{},{:.12g},{:.12g},{},{},{},{},{},{},{},{},{},{}\n", p.index, p.sign, p.a, p.b,
+        cell(p.width.value, 1e9), cls, cell(p.edge.value, 1e9), cell(p.vstart.value),
+        cell(p.vend.value), cell(p.droop.value), p.frame >= 0 ? std::to_string(p.frame) : "",
+        p.role, quoted(p.fails), quoted(p.warnings));
+    std::fputs(line.c_str(), f);
+  }
+  bool ok = std::fflush(f) == 0;
+  ok = std::fclose(f) == 0 && ok;
+  std::error_code ec;
+  if (!ok) {
+    std::filesystem::remove(tmp, ec);
+    return Status::Error(path + ": error: write failed");
+  }
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    return Status::Error(path + ": error: cannot rename the temp file: " + ec.message());
+  }
+  return Status::Ok();
+}
+
+}  // namespace isolink::eye

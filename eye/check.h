@@ -1,0 +1,93 @@
+// The eye checker: a waveform and a rule set in, a verdict with margins, decoded bytes, JSON and a
+// text summary out. Every checker path (isolink check, isolink run, sweeps) goes through here.
+//
+// Usage:
+//   StatusOr<Rules> rules = load_rules("bq7961x");
+//   StatusOr<Waveform> w = read_differential_csv("wave.csv");
+//   CheckOptions opt;  opt.expect = *parse_hex_bytes("80 00 02 15 0B CB 49");
+//   StatusOr<CheckResult> r = check_waveform(*w, *rules, opt);
+//   std::puts(summary_text(*r).c_str());        // for people
+//   std::string j = to_json(*r).dump(2);        // machine readable (names are stable)
+//   Status s = write_pulses_csv(*r, "pulses.csv");
+//   return r->pass ? 0 : 1;
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json_fwd.hpp>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "eye/decode.h"
+#include "eye/metrics.h"
+#include "eye/pulses.h"
+#include "eye/rules.h"
+#include "solver/status.h"
+#include "solver/waveform.h"
+
+namespace isolink::eye {
+
+// Overrides of the rule set's decoding options, and the bytes expected.
+struct CheckOptions {
+  std::optional<bool> sof;                     // SOF bit present
+  std::optional<int> sof_value;                // its value
+  std::optional<BitOrder> bit_order;           // LSB / MSB first
+  std::optional<std::vector<uint8_t>> expect;  // compare the decoded bytes with these
+};
+
+// One decoded byte (a frame), or a run of pulses that did not decode.
+struct FrameResult {
+  double start = 0;        // its preamble's start (s)
+  size_t first_pulse = 0;  // pulses first_pulse..last_pulse
+  size_t last_pulse = 0;
+  std::optional<uint8_t> byte;  // null when it did not decode (or for tone rules)
+  bool error_bit = false;       // the byte-error bit was set
+  std::string fault;            // "" or "sync", "timing", "weak bit", "length", "truncated"
+  std::string detail;           // the fault in words
+  bool fails() const { return !fault.empty() && fault != "truncated"; }
+};
+
+struct CheckResult {
+  std::string rules;                           // rule set name
+  std::string rules_source;                    // where it came from
+  bool tone = false;                           // tone rules: nothing is decoded
+  FrameFormat frame_format;                    // decoding options in effect
+  bool pass = false;                           // the verdict
+  std::vector<std::string> reasons;            // why it fails, one line each (empty on pass)
+  size_t samples = 0;                          // samples in the waveform
+  double t_begin = 0, t_end = 0;               // its time span (s)
+  std::vector<PulseMetrics> pulses;            // in time order
+  std::vector<Ringing> ringing;                // warnings
+  std::vector<IdleUndershoot> idle;            // warnings
+  std::vector<FrameResult> frames;             // decoded bytes / runs, in time order
+  std::vector<uint8_t> bytes;                  // all decoded bytes in order
+  std::optional<std::vector<uint8_t>> expect;  // the bytes expected, when given
+  bool expect_match = true;                    // decoded bytes == expected (true when none given)
+  std::string expect_detail;                   // first difference, in words
+  std::vector<WorstMargin> worst;              // per metric, the smallest margin
+
+  size_t failing() const;                    // pulses that fail
+  std::optional<double> vstart_min() const;  // over all measured pulses (V)
+  std::optional<double> vend_min() const;    // over all measured pulses (V)
+  std::optional<double> width_min() const;   // over pulses ending in an opposite edge (s)
+  std::optional<double> width_max() const;   // same (s)
+  std::optional<double> edge_max() const;    // over all edges (s)
+};
+
+// Checks time/value samples (t strictly increasing) against rules.
+StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const double> v,
+                                    const Rules& rules, const CheckOptions& opt = {});
+// Checks column `column` of w.
+StatusOr<CheckResult> check_waveform(const Waveform& w, const Rules& rules,
+                                     const CheckOptions& opt = {}, size_t column = 0);
+
+// The JSON object, keys in a fixed order (verdict, reasons, rules, ..., summary, pulses, ringing,
+// idle, decoded).
+nlohmann::ordered_json to_json(const CheckResult& r);
+// A few lines for people: verdict, worst margin per metric with place, counts, failures.
+std::string summary_text(const CheckResult& r, const std::string& source = "");
+// The per-pulse table as CSV, written to a temp file then renamed.
+Status write_pulses_csv(const CheckResult& r, const std::string& path);
+
+}  // namespace isolink::eye

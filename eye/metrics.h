@@ -1,0 +1,90 @@
+// Eye metrics per pulse (design.md "Eye metrics" items 5-11): width and class, edge time,
+// VSTART / VEND / droop judged by the amplitude rule, idle undershoot, margins.
+//
+// Usage:
+//   Segmentation seg = segment(t, v, segment_params(rules));
+//   std::vector<PulseMetrics> pm = measure_pulses(t, v, seg, rules);
+//   std::vector<IdleUndershoot> idle = find_idle_undershoots(t, v, seg, rules);
+//   std::vector<WorstMargin> worst = worst_margins(pm);   // one per metric, smallest margin
+// Margins are distances to the limit, positive = inside; NaN where a metric does not apply.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "eye/pulses.h"
+#include "eye/rules.h"
+
+namespace isolink::eye {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// One judged quantity.
+struct Judged {
+  double value = kNaN;   // the measurement (s or V)
+  double limit = kNaN;   // the limit it was judged against (the nearer one for a window)
+  double margin = kNaN;  // distance to the limit, positive = inside
+  bool measured() const { return !std::isnan(value); }
+  bool judged() const { return !std::isnan(margin); }
+};
+
+struct PulseMetrics {
+  size_t index = 0;          // position in time order
+  int sign = 0;              // +1 / -1
+  double a = 0, b = 0;       // start and end crossings (s)
+  bool idle = false;         // no transition after it: runs into idle (width = b - a, not judged)
+  bool truncated = false;    // cut by the record: nothing judged
+  int k = 0;                 // class round(width / T)
+  int half_bits = 0;         // half bits it carries for decoding (>= 1)
+  Judged width;              // thigh / tlow (s)
+  Judged edge;               // trise / tfall into this pulse (s); not measured for a frame's first
+  Judged vstart;             // max of s*v over [a, (a+b)/2] (V)
+  Judged vend;               // s*v at b - vend_offset (V)
+  Judged droop;              // vstart - vend (V); over droop_max is a warning
+  std::vector<Dip> dips;     // each one fails the pulse
+  bool timing_fail = false;  // width / class / edge outside the rules
+  bool weak_fail = false;    // dip, VSTART or VEND outside the rules
+  std::vector<std::string> fails;     // "metric: what" per broken rule
+  std::vector<std::string> warnings;  // "metric: what" per warning
+  int frame = -1;                     // decoded frame (byte) it belongs to, -1 = none
+  std::string role;                   // its place in the frame ("preamble", "bit 3", ...)
+
+  bool failing() const { return !fails.empty(); }
+};
+
+// After a frame's last pulse (sign s) returned, s*v above idle.level within tblank.
+struct IdleUndershoot {
+  size_t after_pulse = 0;     // the frame's last pulse
+  int sign = 0;               // = that pulse's sign
+  double start = 0, end = 0;  // crossings of the level (s)
+  double peak = 0;            // max of s*v (V)
+  double peak_t = 0;
+};
+
+// The smallest margin of one metric over all pulses, and where.
+struct WorstMargin {
+  std::string metric;  // "vstart", "vend", "width", "edge", "droop"
+  Judged j;            // value, limit, margin
+  size_t pulse = 0;    // pulse index
+  double time = 0;     // pulse start a (s)
+  int frame = -1;      // decoded frame index, -1 = none
+  std::string role;    // place in the frame
+};
+
+SegmentParams segment_params(const Rules& r);
+// Items 5-9 for every pulse of seg.
+std::vector<PulseMetrics> measure_pulses(std::span<const double> t, std::span<const double> v,
+                                         const Segmentation& seg, const Rules& r);
+// Item 10, after every frame.
+std::vector<IdleUndershoot> find_idle_undershoots(std::span<const double> t,
+                                                  std::span<const double> v,
+                                                  const Segmentation& seg, const Rules& r);
+// Item 11: per metric (vstart, vend, width, edge, droop) the judged pulse with the smallest margin;
+// metrics nothing was judged on are left out.
+std::vector<WorstMargin> worst_margins(const std::vector<PulseMetrics>& pulses);
+
+}  // namespace isolink::eye

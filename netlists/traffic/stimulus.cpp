@@ -1,0 +1,209 @@
+#include "netlists/traffic/stimulus.h"
+
+#include <fmt/format.h>
+
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "netlists/traffic/command.h"
+#include "netlists/traffic/patterns.h"
+
+namespace isolink::traffic {
+namespace {
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  for (char& ch : out) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  return out;
+}
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
+  return s;
+}
+
+std::vector<std::string_view> split_ws(std::string_view text) {
+  std::vector<std::string_view> out;
+  size_t i = 0;
+  while (i < text.size()) {
+    while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+    size_t j = i;
+    while (j < text.size() && !std::isspace(static_cast<unsigned char>(text[j]))) ++j;
+    if (j > i) out.push_back(text.substr(i, j - i));
+    i = j;
+  }
+  return out;
+}
+
+StatusOr<long> parse_count(std::string_view what, std::string_view value, long lo, long hi) {
+  std::string v(value);
+  char* end = nullptr;
+  const long n = v.empty() ? 0 : std::strtol(v.c_str(), &end, 10);
+  if (v.empty() || end != v.c_str() + v.size()) {
+    return Status::Error(fmt::format("{}={} is not a whole number", what, value));
+  }
+  if (n < lo || n > hi) {
+    return Status::Error(
+        fmt::format("{}={} is out of range: it must be {}-{}", what, value, lo, hi));
+  }
+  return n;
+}
+
+Status add_tone_item(DriveBuilder& b, std::string_view name,
+                     const std::vector<std::string_view>& fields, const StimulusOptions& opt) {
+  StatusOr<Tone> tone = parse_tone(name);
+  if (!tone) return tone.status();
+  ToneOptions to = opt.tone;
+  for (std::string_view f : fields) {
+    const size_t eq = f.find('=');
+    const std::string key = lower(f.substr(0, eq));
+    const std::string_view value = eq == std::string_view::npos ? "" : f.substr(eq + 1);
+    if (eq != std::string_view::npos && key == "couplets") {
+      StatusOr<long> n = parse_count("couplets", value, 1, 100000);
+      if (!n) return n.status();
+      to.couplets = static_cast<int>(*n);
+    } else if (eq != std::string_view::npos && key == "pulse") {
+      StatusOr<double> t = parse_time(value);
+      if (!t) return t.status().with_context("pulse");
+      to.pulse = *t;
+    } else {
+      return Status::Error(
+          fmt::format("tone: unknown field '{}' (expected couplets=N, pulse=T)", f));
+    }
+  }
+  return b.add_tone(*tone, to);
+}
+
+}  // namespace
+
+StatusOr<double> parse_time(std::string_view text) {
+  const std::string s = lower(trim(text));
+  if (s.empty()) return Status::Error("empty time: expected e.g. 250n or 1us");
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  if (end == s.c_str()) {
+    return Status::Error(fmt::format("'{}' is not a time: expected e.g. 250n, 1us, 2.5e-7", text));
+  }
+  std::string suffix(end);
+  int exp10 = 0;
+  if (suffix.rfind("meg", 0) == 0) {
+    exp10 = 6;
+    suffix.erase(0, 3);
+  } else if (!suffix.empty() && suffix != "s") {
+    switch (suffix[0]) {
+      case 'f':
+        exp10 = -15;
+        break;
+      case 'p':
+        exp10 = -12;
+        break;
+      case 'n':
+        exp10 = -9;
+        break;
+      case 'u':
+        exp10 = -6;
+        break;
+      case 'm':
+        exp10 = -3;
+        break;
+      case 'k':
+        exp10 = 3;
+        break;
+      case 'g':
+        exp10 = 9;
+        break;
+      default:
+        return Status::Error(fmt::format(
+            "'{}' has an unknown unit suffix '{}': use f p n u m k meg g", text, suffix));
+    }
+    suffix.erase(0, 1);
+  }
+  if (!suffix.empty() && suffix != "s") {
+    return Status::Error(fmt::format("'{}' has trailing text after the number", text));
+  }
+  // Re-read mantissa and unit as one decimal ("3.8e-6") so the result is the double nearest the
+  // written value (3.8 * 1e-6 is one ulp off).
+  const std::string mantissa = s.substr(0, static_cast<size_t>(end - s.c_str()));
+  double out = v;
+  if (exp10 != 0 && mantissa.find('e') == std::string::npos) {
+    out = std::strtod(fmt::format("{}e{}", mantissa, exp10).c_str(), nullptr);
+  } else if (exp10 != 0) {
+    out = v * std::pow(10.0, exp10);
+  }
+  if (!std::isfinite(out)) return Status::Error(fmt::format("'{}' is not a finite time", text));
+  return out;
+}
+
+Status add_item(DriveBuilder& b, std::string_view item, const StimulusOptions& opt) {
+  const std::vector<std::string_view> tok = split_ws(item);
+  if (tok.empty()) return Status::Ok();
+  const std::string kw = lower(tok[0]);
+  const std::vector<std::string_view> rest(tok.begin() + 1, tok.end());
+  if (kw == "idle") {
+    if (rest.size() != 1) return Status::Error("idle: expected one time, e.g. 'idle 20us'");
+    StatusOr<double> t = parse_time(rest[0]);
+    if (!t) return t.status().with_context("idle");
+    return b.add_idle(*t);
+  }
+  if (kw == "tone") {
+    if (rest.empty()) return Status::Error("tone: expected a tone name, e.g. 'tone wake'");
+    return add_tone_item(b, rest[0], {rest.begin() + 1, rest.end()}, opt);
+  }
+  if (parse_tone(kw).ok()) return add_tone_item(b, kw, rest, opt);
+  if (kw == "pattern") {
+    if (rest.empty()) return Status::Error("pattern: expected a name, e.g. 'pattern prbs7'");
+    StatusOr<Pattern> p = parse_pattern(rest[0]);
+    if (!p) return p.status();
+    size_t n = default_pattern_bytes(*p);
+    for (size_t i = 1; i < rest.size(); ++i) {
+      const std::string_view f = rest[i];
+      const size_t eq = f.find('=');
+      if (eq == std::string_view::npos || lower(f.substr(0, eq)) != "bytes") {
+        return Status::Error(fmt::format("pattern: unknown field '{}' (expected bytes=N)", f));
+      }
+      StatusOr<long> v = parse_count("bytes", f.substr(eq + 1), 1, 1000000);
+      if (!v) return v.status().with_context("pattern");
+      n = static_cast<size_t>(*v);
+    }
+    return b.add_frame(pattern_bytes(*p, n), std::string(pattern_name(*p)));
+  }
+  StatusOr<std::vector<uint8_t>> bytes = command_bytes(item);
+  if (!bytes) {
+    if (bytes.status().message().rfind("unknown command", 0) == 0) {
+      return Status::Error(
+          fmt::format("unknown item '{}': expected a command (single-read ... raw), a tone (wake, "
+                      "sleep-to-active, shutdown, heartbeat, fault), 'pattern NAME' or 'idle T'",
+                      tok[0]));
+    }
+    return bytes.status();
+  }
+  return b.add_frame(*bytes, std::string(trim(item)));
+}
+
+StatusOr<Drive> build_drive(std::string_view script, const StimulusOptions& opt) {
+  DriveBuilder b(opt.encoding, opt.timing);
+  size_t index = 0;
+  size_t pos = 0;
+  while (pos <= script.size()) {
+    size_t next = script.find_first_of(";\n", pos);
+    if (next == std::string_view::npos) next = script.size();
+    std::string_view item = script.substr(pos, next - pos);
+    const size_t hash = item.find('#');
+    if (hash != std::string_view::npos) item = item.substr(0, hash);
+    item = trim(item);
+    if (!item.empty()) {
+      ++index;
+      Status s = add_item(b, item, opt);
+      if (!s.ok()) return s.with_context(fmt::format("item {} ({})", index, item));
+    }
+    pos = next + 1;
+  }
+  if (index == 0) return Status::Error("stimulus is empty: no command, tone or pattern given");
+  return b.finish();
+}
+
+}  // namespace isolink::traffic

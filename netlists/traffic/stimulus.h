@@ -1,0 +1,39 @@
+// Stimulus scripts: a list of commands, tones, patterns and idle times -> one Drive.
+//
+// Usage:
+//   StimulusOptions opt;                       // encoding, timing, tone defaults
+//   StatusOr<Drive> d = build_drive("wake; stack-write reg=0x0100 data=02B778BC;"
+//                                   " pattern prbs7 bytes=32; idle 20u; tone fault couplets=4",
+//                                   opt);
+//   if (!d) return d.status();                 // "item 3 (pattern prbs7 bytes=0): ..."
+// Items are separated by ';' or newlines; empty items and '#' comments are skipped:
+//   <command text>                     see command.h (single-read ..., raw ...)
+//   tone NAME [couplets=N] [pulse=T]   or just NAME (wake, sleep-to-active, shutdown, ...)
+//   pattern NAME [bytes=N]             see patterns.h (prbs7, prbs15, all256, alt, ...)
+//   idle T                             extra idle before the next item
+// Times take SPICE suffixes with an optional trailing "s": 250n, 250ns, 1u, 1us, 2.5e-7, 20us.
+#pragma once
+
+#include <string_view>
+
+#include "netlists/traffic/drive.h"
+#include "netlists/traffic/encoding.h"
+#include "netlists/traffic/tones.h"
+#include "solver/status.h"
+
+namespace isolink::traffic {
+
+struct StimulusOptions {
+  EncodingOptions encoding;  // byte frame format
+  Timing timing;             // lead, gaps, tail
+  ToneOptions tone;          // default couplets and pulse width for tones
+};
+
+// Seconds from "250n", "250ns", "1u", "1us", "10ms", "1meg"... (SPICE suffixes, case-insensitive).
+StatusOr<double> parse_time(std::string_view text);
+// Adds one script item to b (a command, tone, pattern or idle).
+Status add_item(DriveBuilder& b, std::string_view item, const StimulusOptions& opt);
+// Builds the drive of a whole script; errors name the item number and its text.
+StatusOr<Drive> build_drive(std::string_view script, const StimulusOptions& opt = {});
+
+}  // namespace isolink::traffic

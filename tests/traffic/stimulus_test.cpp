@@ -1,0 +1,93 @@
+#include "netlists/traffic/stimulus.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+namespace isolink::traffic {
+namespace {
+
+TEST(ParseTime, SpiceSuffixes) {
+  struct Case {
+    const char* text;
+    double seconds;
+  };
+  const Case cases[] = {{"250n", 250e-9},   {"250ns", 250e-9}, {"1u", 1e-6},     {"1us", 1e-6},
+                        {"2.5e-7", 2.5e-7}, {"10ms", 10e-3},   {"3.8U", 3.8e-6}, {"1s", 1.0},
+                        {"5p", 5e-12},      {"0", 0.0}};
+  for (const Case& c : cases) {
+    StatusOr<double> t = parse_time(c.text);
+    ASSERT_TRUE(t.ok()) << c.text << ": " << t.status().message();
+    EXPECT_NEAR(*t, c.seconds, c.seconds * 1e-12) << c.text;
+  }
+  // Exactly the literal, not one ulp off (250 * 1e-9 != 250e-9 in doubles).
+  EXPECT_EQ(*parse_time("250n"), 250e-9);
+  EXPECT_EQ(*parse_time("3.8u"), 3.8e-6);
+  EXPECT_FALSE(parse_time("").ok());
+  EXPECT_FALSE(parse_time("fast").ok());
+  EXPECT_NE(parse_time("10x").status().message().find("unknown unit suffix 'x'"),
+            std::string::npos);
+  EXPECT_NE(parse_time("10nsec").status().message().find("trailing text"), std::string::npos);
+}
+
+TEST(Stimulus, ScriptBuildsItemsInOrder) {
+  StatusOr<Drive> d = build_drive(
+      "wake couplets=2; stack-read reg=0x0215 n=12 # comment\n"
+      "pattern alt bytes=2; idle 20u; tone fault couplets=1 pulse=2u");
+  ASSERT_TRUE(d.ok()) << d.status().message();
+  ASSERT_EQ(d->frames.size(), 4u);
+  EXPECT_EQ(d->frames[0].kind, FrameKind::kTone);
+  EXPECT_EQ(d->frames[0].couplets, 2);
+  EXPECT_NEAR(d->frames[0].start, 1e-6, 1e-15);  // lead
+  EXPECT_NEAR(d->frames[0].end, 5e-6, 1e-15);    // 2 couplets x 2 x 1 us
+  EXPECT_EQ(d->frames[1].label, "stack-read reg=0x0215 n=12");
+  EXPECT_EQ(d->frames[1].bytes, (std::vector<uint8_t>{0xA0, 0x02, 0x15, 0x0B, 0xCC, 0xB3}));
+  EXPECT_NEAR(d->frames[1].start, 17e-6, 1e-15);  // + 12 us frame gap
+  EXPECT_EQ(d->frames[2].label, "alt");
+  EXPECT_EQ(d->frames[2].bytes, (std::vector<uint8_t>{0x55, 0xAA}));
+  EXPECT_EQ(d->frames[3].kind, FrameKind::kTone);
+  EXPECT_EQ(d->frames[3].tone, Tone::kFault);
+  // idle 20u adds to the 12 us frame gap.
+  EXPECT_NEAR(d->frames[3].start - d->frames[2].end, 32e-6, 1e-12);
+  EXPECT_NEAR(d->frames[3].end - d->frames[3].start, 4e-6, 1e-12);  // 1 couplet of 2 us pulses
+  EXPECT_NEAR(d->duration(), d->frames[3].end + 5e-6, 1e-12);       // tail
+}
+
+TEST(Stimulus, OptionsReachTheEncoder) {
+  StimulusOptions opt;
+  opt.encoding.half_bit = 500e-9;
+  opt.encoding.sof = false;
+  opt.timing.lead = 0;
+  opt.timing.tail = 0;
+  StatusOr<Drive> d = build_drive("raw 00 nocrc", opt);
+  ASSERT_TRUE(d.ok()) << d.status().message();
+  EXPECT_NEAR(d->duration(), 24 * 500e-9, 1e-15);  // 12 bit times without SOF
+  EXPECT_EQ(d->segments.size(), 24u);              // no SOF: no double pulse in 0x00
+}
+
+TEST(Stimulus, ErrorsNameTheItem) {
+  StatusOr<Drive> d = build_drive("wake; stack-read reg=0x0215 n=200");
+  ASSERT_FALSE(d.ok());
+  const std::string& m = d.status().message();
+  EXPECT_NE(m.find("item 2 (stack-read reg=0x0215 n=200)"), std::string::npos) << m;
+  EXPECT_NE(m.find("n=200 is out of range"), std::string::npos) << m;
+
+  d = build_drive("jump");
+  ASSERT_FALSE(d.ok());
+  EXPECT_NE(d.status().message().find("unknown item 'jump'"), std::string::npos);
+  d = build_drive("pattern prbs7 bytes=0");
+  ASSERT_FALSE(d.ok());
+  EXPECT_NE(d.status().message().find("bytes=0 is out of range"), std::string::npos);
+  d = build_drive("tone wake couplets=0");
+  ASSERT_FALSE(d.ok());
+  EXPECT_NE(d.status().message().find("couplets=0 is out of range"), std::string::npos);
+  d = build_drive("idle");
+  ASSERT_FALSE(d.ok());
+  d = build_drive(" ; # only a comment");
+  ASSERT_FALSE(d.ok());
+  EXPECT_NE(d.status().message().find("stimulus is empty"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace isolink::traffic
