@@ -63,6 +63,9 @@ std::vector<uint8_t> encode_command(const Command& c);
 // parse_command + encode_command.
 StatusOr<std::vector<uint8_t>> command_bytes(std::string_view text);
 
+// The whitespace-separated words of text (views into it).
+std::vector<std::string_view> split_ws(std::string_view text);
+
 // "B3 01 00 02" (upper-case, single spaces).
 std::string hex_bytes(const std::vector<uint8_t>& bytes);
 // Parses hex digits (optional 0x prefix) into bytes; field names the value in errors.
