@@ -1,0 +1,47 @@
+// AC small-signal analysis: the phasor response of a linear circuit to one source driven with a
+// unit amplitude, every other source set to zero (V sources short, I sources open).
+//
+//   Circuit c;  ...add cards...;  c.finalize();
+//   StatusOr<AcAnalysis> ac = AcAnalysis::create(c);              // pattern and LU analysis once
+//   StatusOr<AcSolution> x = ac->solve("vin", 1e6);               // 1 V (or 1 A) at 1 MHz
+//   std::complex<double> v = x->voltage(probe);                   // a Probe from parse_probe
+// Solves (G + j 2 pi f C) x = b with Eigen's sparse LU; the G and C stamps are the ones the
+// transient engine uses, floating nodes tied as there. Used for impedances, attenuation and
+// filter responses (cable and part-library checks), not for time-domain results.
+#pragma once
+
+#include <complex>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "solver/circuit.h"
+#include "solver/probe.h"
+#include "solver/status.h"
+
+namespace isolink {
+
+struct AcSolution {
+  double frequency = 0;                     // Hz
+  std::vector<std::complex<double>> x;      // per unknown; x[0] is ground (0)
+  std::complex<double> voltage(const Probe& p) const { return x[p.a] - x[p.b]; }
+};
+
+class AcAnalysis {
+ public:
+  // The circuit must be finalized and outlive the analysis.
+  static StatusOr<AcAnalysis> create(const Circuit& circuit);
+  AcAnalysis(AcAnalysis&&) noexcept;
+  AcAnalysis& operator=(AcAnalysis&&) noexcept;
+  ~AcAnalysis();
+
+  // Drives the named V or I source (lower case) with amplitude 1 at frequency f (Hz, >= 0).
+  StatusOr<AcSolution> solve(const std::string& source, double frequency);
+
+ private:
+  AcAnalysis();
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace isolink
