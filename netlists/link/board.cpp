@@ -4,19 +4,13 @@
 
 #include <fmt/format.h>
 
+#include "netlists/link/cards.h"
+
 namespace isolink::link {
 
 namespace {
-Card make_card(char letter, const std::string& name, std::vector<std::string> nodes, double v) {
-  Card c;
-  c.letter = letter;
-  c.name = name;
-  c.nodes = std::move(nodes);
-  c.node_locs.resize(c.nodes.size());
-  CardArg a;
-  a.number = v;
-  c.args.push_back(a);
-  return c;
+Card value_card(char letter, const std::string& name, std::vector<std::string> nodes, double v) {
+  return make_card(letter, name, std::move(nodes), {number_arg(v)});
 }
 }  // namespace
 
@@ -40,25 +34,22 @@ StatusOr<BoardNetwork> board_preset(const std::string& device) {
   return Status::Error("unknown device '" + device + "' (known: bq7961x, bq79600, bq79606a)");
 }
 
-Status add_board_network(Circuit& circuit, const std::string& prefix, const std::string& pin_p,
+Status add_board_network(std::vector<Card>& cards, const std::string& prefix, const std::string& pin_p,
                          const std::string& pin_n, const std::string& line_p,
                          const std::string& line_n, const BoardNetwork& b) {
   if (Status s = b.validate(); !s.ok()) return s;
-  std::vector<Card> cards;
   for (auto [side, pin, line] : {std::tuple{"p", pin_p, line_p}, std::tuple{"n", pin_n, line_n}}) {
     std::string from = pin;
     if (b.r_pin > 0) {
       const std::string esd = prefix + "_esd" + side;
-      cards.push_back(make_card('r', "r" + prefix + "pin" + side, {pin, esd}, b.r_pin));
+      cards.push_back(value_card('r', "r" + prefix + "pin" + side, {pin, esd}, b.r_pin));
       from = esd;
     }
-    cards.push_back(make_card('r', "r" + prefix + "ser" + side, {from, line}, b.r_line));
+    cards.push_back(value_card('r', "r" + prefix + "ser" + side, {from, line}, b.r_line));
     if (b.bypass_c > 0)
-      cards.push_back(make_card('c', "c" + prefix + "byp" + side, {line, "0"}, b.bypass_c));
+      cards.push_back(value_card('c', "c" + prefix + "byp" + side, {line, "0"}, b.bypass_c));
   }
-  cards.push_back(make_card('r', "r" + prefix + "term", {line_p, line_n}, b.termination));
-  for (const Card& c : cards)
-    if (Status s = circuit.add(c); !s.ok()) return s;
+  cards.push_back(value_card('r', "r" + prefix + "term", {line_p, line_n}, b.termination));
   return Status::Ok();
 }
 

@@ -2,7 +2,7 @@
 // from domain.md section 4.
 //
 //   StatusOr<BoardNetwork> b = board_preset("bq7961x");
-//   add_board_network(circuit, "rxb", "rxp", "rxn", "rxlp", "rxln", *b);
+//   add_board_network(cards, "rxb", "rxp", "rxn", "rxlp", "rxln", *b);
 // Topology per line: pin -- r_pin -- esd node -- r_line -- line node, bypass_c from the line
 // node to ground; termination across the two line nodes. r_pin = 0 means no ESD split (one
 // series resistor r_line).
@@ -15,7 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "solver/circuit.h"
+#include "solver/card.h"
+#include "solver/status.h"
 
 namespace isolink::link {
 
@@ -32,7 +33,7 @@ struct BoardNetwork {
 StatusOr<BoardNetwork> board_preset(const std::string& device);
 std::vector<std::string> board_preset_names();
 
-Status add_board_network(Circuit& circuit, const std::string& prefix, const std::string& pin_p,
+Status add_board_network(std::vector<Card>& cards, const std::string& prefix, const std::string& pin_p,
                          const std::string& pin_n, const std::string& line_p,
                          const std::string& line_n, const BoardNetwork& board);
 

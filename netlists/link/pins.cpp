@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include "netlists/link/cards.h"
+
 namespace isolink::link {
 
 namespace {
@@ -12,22 +14,6 @@ Status positive(const char* model, const char* field, double v) {
   return Status::Error(fmt::format("{}.{} = {:g}: must be positive", model, field, v));
 }
 
-Card make_card(char letter, const std::string& name, std::vector<std::string> nodes,
-               std::vector<CardArg> args) {
-  Card c;
-  c.letter = letter;
-  c.name = name;
-  c.nodes = std::move(nodes);
-  c.node_locs.resize(c.nodes.size());
-  c.args = std::move(args);
-  return c;
-}
-
-CardArg number(double v) {
-  CardArg a;
-  a.number = v;
-  return a;
-}
 }  // namespace
 
 Status TxDriverModel::validate() const {
@@ -41,7 +27,7 @@ Status RxLoadModel::validate() const {
   return positive("rx_load", "c_in", c_in);
 }
 
-Status add_tx_driver(Circuit& circuit, const std::string& prefix, const std::string& p,
+Status add_tx_driver(std::vector<Card>& cards, const std::string& prefix, const std::string& p,
                      const std::string& n, const traffic::Drive& drive, const TxDriverModel& model) {
   if (Status s = model.validate(); !s.ok()) return s;
   for (int sign : {+1, -1}) {
@@ -53,29 +39,25 @@ Status add_tx_driver(Circuit& circuit, const std::string& prefix, const std::str
     StatusOr<std::vector<double>> points = traffic::line_pwl(drive, sign, model.edge, model.vdd);
     if (!points) return points.status().with_context("tx driver");
     pwl.call = std::move(*points);
-    if (Status s = circuit.add(make_card('v', "v" + prefix + side, {internal, "0"}, {pwl})); !s.ok())
-      return s;
-    if (Status s = circuit.add(make_card('r', "r" + prefix + side, {internal, sign > 0 ? p : n},
-                                         {number(model.r_out)}));
-        !s.ok())
-      return s;
+    cards.push_back(make_card('v', "v" + prefix + side, {internal, "0"}, {pwl}));
+    cards.push_back(make_card('r', "r" + prefix + side, {internal, sign > 0 ? p : n},
+                              {number_arg(model.r_out)}));
   }
   return Status::Ok();
 }
 
-Status add_rx_load(Circuit& circuit, const std::string& prefix, const std::string& p,
+Status add_rx_load(std::vector<Card>& cards, const std::string& prefix, const std::string& p,
                    const std::string& n, const RxLoadModel& model) {
   if (Status s = model.validate(); !s.ok()) return s;
   const std::string bias = prefix + "_bias";
-  std::vector<Card> cards{
-      make_card('v', "v" + prefix + "bias", {bias, "0"}, {number(model.bias)}),
-      make_card('r', "r" + prefix + "inp", {p, bias}, {number(model.r_in)}),
-      make_card('r', "r" + prefix + "inn", {n, bias}, {number(model.r_in)}),
-      make_card('c', "c" + prefix + "inp", {p, "0"}, {number(model.c_in)}),
-      make_card('c', "c" + prefix + "inn", {n, "0"}, {number(model.c_in)}),
-  };
-  for (const Card& c : cards)
-    if (Status s = circuit.add(c); !s.ok()) return s;
+  for (Card& c : std::vector<Card>{
+      make_card('v', "v" + prefix + "bias", {bias, "0"}, {number_arg(model.bias)}),
+      make_card('r', "r" + prefix + "inp", {p, bias}, {number_arg(model.r_in)}),
+      make_card('r', "r" + prefix + "inn", {n, bias}, {number_arg(model.r_in)}),
+      make_card('c', "c" + prefix + "inp", {p, "0"}, {number_arg(model.c_in)}),
+      make_card('c', "c" + prefix + "inn", {n, "0"}, {number_arg(model.c_in)}),
+       })
+    cards.push_back(std::move(c));
   return Status::Ok();
 }
 

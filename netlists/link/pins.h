@@ -1,10 +1,10 @@
-// Pin models of the daisy-chain devices: the TX driver and the RX load, added to a Circuit as
-// ordinary elements built in code (no netlist text on the way).
+// Pin models of the daisy-chain devices: the TX driver and the RX load, appended as ordinary
+// element Cards built in code (netlists/link/cards.h).
 //
 //   traffic::Drive drive = builder.finish();
-//   Circuit c;
-//   add_tx_driver(c, "tx", "txp", "txn", drive, TxDriverModel{});   // VTX.P/N + output resistors
-//   add_rx_load(c, "rx", "rxp", "rxn", RxLoadModel{});              // R to bias, C to ground
+//   std::vector<Card> cards;
+//   add_tx_driver(cards, "tx", "txp", "txn", drive, TxDriverModel{});  // VTX.P/N + output Rs
+//   add_rx_load(cards, "rx", "rxp", "rxn", RxLoadModel{});             // R to bias, C to ground
 // The probed differential voltage is v(rxp,rxn): at the pins.
 //
 // Defaults (our assumptions where the data sheets are silent; netlists/link/README.md):
@@ -17,7 +17,10 @@
 #include <string>
 
 #include "netlists/traffic/drive.h"
-#include "solver/circuit.h"
+#include <vector>
+
+#include "solver/card.h"
+#include "solver/status.h"
 
 namespace isolink::link {
 
@@ -39,11 +42,11 @@ struct RxLoadModel {
 
 // Adds sources "v<prefix>p"/"v<prefix>n" (PWL from the drive's segments, corners as
 // breakpoints) behind resistors "r<prefix>p"/"r<prefix>n" to the pins p and n.
-Status add_tx_driver(Circuit& circuit, const std::string& prefix, const std::string& p,
+Status add_tx_driver(std::vector<Card>& cards, const std::string& prefix, const std::string& p,
                      const std::string& n, const traffic::Drive& drive, const TxDriverModel& model);
 
 // Adds the receiver input network at pins p and n (bias source "v<prefix>bias").
-Status add_rx_load(Circuit& circuit, const std::string& prefix, const std::string& p,
+Status add_rx_load(std::vector<Card>& cards, const std::string& prefix, const std::string& p,
                    const std::string& n, const RxLoadModel& model);
 
 }  // namespace isolink::link

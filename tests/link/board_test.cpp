@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "netlists/link/cards.h"
 #include "solver/transient.h"
 
 namespace isolink::link {
@@ -24,16 +25,10 @@ TEST(Board, PresetsFollowTheApplicationNotes) {
 
 TEST(Board, DcThroughTheNetworkIsTheSeriesDivider) {
   // 1 V across the pins of a bq79606a network: the line nodes see the termination's share.
+  std::vector<Card> cards{make_card('v', "v1", {"pp", "pn"}, {number_arg(1.0)})};
+  ASSERT_TRUE(add_board_network(cards, "b", "pp", "pn", "lp", "ln", *board_preset("bq79606a")).ok());
   Circuit c;
-  Card v;
-  v.letter = 'v';
-  v.name = "v1";
-  v.nodes = {"pp", "pn"};
-  v.node_locs.resize(2);
-  v.args.resize(1);
-  v.args[0].number = 1.0;
-  ASSERT_TRUE(c.add(v).ok());
-  ASSERT_TRUE(add_board_network(c, "b", "pp", "pn", "lp", "ln", *board_preset("bq79606a")).ok());
+  ASSERT_TRUE(add_cards(c, cards).ok());
   ASSERT_TRUE(c.finalize().ok());
   auto x = dc_operating_point(c);
   ASSERT_TRUE(x.ok()) << x.status().message();

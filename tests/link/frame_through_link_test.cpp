@@ -3,6 +3,7 @@
 
 #include "eye/check.h"
 #include "netlists/link/board.h"
+#include "netlists/link/cards.h"
 #include "netlists/link/pins.h"
 #include "netlists/traffic/command.h"
 #include "solver/transient.h"
@@ -18,11 +19,13 @@ TEST(FrameThroughLink, StackWriteDecodesToTheSameBytes) {
   const traffic::Drive drive = builder.finish();
 
   // BQ79600 pins and board -> direct short connection -> BQ7961x board and pins.
+  std::vector<Card> cards;
+  ASSERT_TRUE(add_tx_driver(cards, "tx", "txp", "txn", drive, TxDriverModel{}).ok());
+  ASSERT_TRUE(add_board_network(cards, "txb", "txp", "txn", "lp", "ln", *board_preset("bq79600")).ok());
+  ASSERT_TRUE(add_board_network(cards, "rxb", "rxp", "rxn", "lp", "ln", *board_preset("bq7961x")).ok());
+  ASSERT_TRUE(add_rx_load(cards, "rx", "rxp", "rxn", RxLoadModel{}).ok());
   Circuit c;
-  ASSERT_TRUE(add_tx_driver(c, "tx", "txp", "txn", drive, TxDriverModel{}).ok());
-  ASSERT_TRUE(add_board_network(c, "txb", "txp", "txn", "lp", "ln", *board_preset("bq79600")).ok());
-  ASSERT_TRUE(add_board_network(c, "rxb", "rxp", "rxn", "lp", "ln", *board_preset("bq7961x")).ok());
-  ASSERT_TRUE(add_rx_load(c, "rx", "rxp", "rxn", RxLoadModel{}).ok());
+  ASSERT_TRUE(add_cards(c, cards).ok());
   ASSERT_TRUE(c.finalize().ok());
   auto probe = parse_probe(c, "v(rxp,rxn)");
   ASSERT_TRUE(probe.ok());

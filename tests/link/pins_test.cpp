@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "netlists/link/cards.h"
 #include "solver/transient.h"
 
 namespace isolink::link {
@@ -14,23 +15,18 @@ traffic::Drive couplet_drive() {  // idle 1 us, + 250 ns, - 250 ns, idle 1 us
 }
 
 TEST(Pins, TooLongAnEdgeIsAnError) {
-  Circuit c;
-  Status s = add_tx_driver(c, "tx", "p", "n", couplet_drive(), TxDriverModel{.edge = 300e-9});
+  std::vector<Card> cards;
+  Status s = add_tx_driver(cards, "tx", "p", "n", couplet_drive(), TxDriverModel{.edge = 300e-9});
   EXPECT_NE(s.message().find("edge time 3e-07 s is too long"), std::string::npos) << s.message();
 }
 
 TEST(Pins, DriverIntoTerminatedReceiverGivesTheResistiveDivider) {
+  std::vector<Card> cards;
+  ASSERT_TRUE(add_tx_driver(cards, "tx", "p", "n", couplet_drive(), TxDriverModel{}).ok());
+  ASSERT_TRUE(add_rx_load(cards, "rx", "p", "n", RxLoadModel{}).ok());
+  cards.push_back(make_card('r', "rterm", {"p", "n"}, {number_arg(1e3)}));
   Circuit c;
-  ASSERT_TRUE(add_tx_driver(c, "tx", "p", "n", couplet_drive(), TxDriverModel{}).ok());
-  ASSERT_TRUE(add_rx_load(c, "rx", "p", "n", RxLoadModel{}).ok());
-  Card term;
-  term.letter = 'r';
-  term.name = "rterm";
-  term.nodes = {"p", "n"};
-  term.node_locs.resize(2);
-  term.args.resize(1);
-  term.args[0].number = 1e3;
-  ASSERT_TRUE(c.add(term).ok());
+  ASSERT_TRUE(add_cards(c, cards).ok());
   ASSERT_TRUE(c.finalize().ok());
   auto probe = parse_probe(c, "v(p,n)");
   ASSERT_TRUE(probe.ok());
