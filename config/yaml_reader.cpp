@@ -1,0 +1,289 @@
+#include "config/yaml_reader.h"
+
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+namespace isolink::config {
+
+namespace {
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+// Unit symbols accepted after the number (lower case), the first is the canonical one.
+std::vector<std::string> unit_words(Unit unit) {
+  switch (unit) {
+    case Unit::kOhm: return {"ohm", "ohms", "r"};
+    case Unit::kFarad: return {"f"};
+    case Unit::kHenry: return {"h"};
+    case Unit::kSecond: return {"s"};
+    case Unit::kVolt: return {"v"};
+    case Unit::kAmpere: return {"a"};
+    case Unit::kHertz: return {"hz"};
+    case Unit::kMetre: return {"m"};
+    case Unit::kCelsius: return {"c", "degc"};
+    case Unit::kSiemens: return {"s"};
+    case Unit::kNone: return {};
+  }
+  return {};
+}
+
+std::string rule_text(Rule rule) {
+  switch (rule) {
+    case Rule::kPositive: return "must be > 0";
+    case Rule::kNonNegative: return "must be >= 0";
+    case Rule::kAny: return "";
+  }
+  return "";
+}
+
+bool obeys(Rule rule, double v) {
+  if (rule == Rule::kPositive) return v > 0;
+  if (rule == Rule::kNonNegative) return v >= 0;
+  return true;
+}
+
+}  // namespace
+
+const char* unit_symbol(Unit unit) {
+  switch (unit) {
+    case Unit::kOhm: return "ohm";
+    case Unit::kFarad: return "F";
+    case Unit::kHenry: return "H";
+    case Unit::kSecond: return "s";
+    case Unit::kVolt: return "V";
+    case Unit::kAmpere: return "A";
+    case Unit::kHertz: return "Hz";
+    case Unit::kMetre: return "m";
+    case Unit::kCelsius: return "degC";
+    case Unit::kSiemens: return "S";
+    case Unit::kNone: return "";
+  }
+  return "";
+}
+
+bool parse_quantity(std::string_view text, Unit unit, double* out) {
+  std::string s = lower(text);
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.pop_back();
+  size_t start = 0;
+  while (start < s.size() && std::isspace(static_cast<unsigned char>(s[start]))) ++start;
+  s.erase(0, start);
+  if (s.empty()) return false;
+  double v = 0;
+  const char* b = s.data();
+  const char* e = s.data() + s.size();
+  auto [ptr, ec] = std::from_chars(b, e, v);
+  if (ec != std::errc() || !std::isfinite(v)) return false;
+  std::string rest(ptr, e);
+  while (!rest.empty() && rest[0] == ' ') rest.erase(0, 1);
+  const std::vector<std::string> words = unit_words(unit);
+  auto is_unit = [&](const std::string& r) {
+    if (r.empty()) return true;
+    for (const std::string& w : words)
+      if (r == w) return true;
+    return false;
+  };
+  if (unit == Unit::kMetre || unit == Unit::kCelsius || unit == Unit::kNone) {
+    // No scale suffixes: "12m" is 12 metres, not 12 milli.
+    if (!is_unit(rest)) return false;
+    *out = v;
+    return true;
+  }
+  double scale = 1.0;
+  static const std::pair<const char*, double> kSuffixes[] = {
+      {"meg", 1e6}, {"mil", 25.4e-6}, {"f", 1e-15}, {"p", 1e-12}, {"n", 1e-9}, {"u", 1e-6},
+      {"m", 1e-3},  {"k", 1e3},       {"g", 1e9},   {"t", 1e12}};
+  if (!is_unit(rest)) {
+    bool found = false;
+    for (const auto& [sfx, mult] : kSuffixes) {
+      const std::string_view sv(sfx);
+      if (rest.compare(0, sv.size(), sv) == 0 && is_unit(rest.substr(sv.size()))) {
+        scale = mult;
+        found = true;
+        break;
+      }
+    }
+    if (!found) return false;
+  }
+  *out = v * scale;
+  return std::isfinite(*out);
+}
+
+std::string node_kind(const YAML::Node& node) {
+  if (!node.IsDefined() || node.IsNull()) return "nothing";
+  if (node.IsMap()) return "map";
+  if (node.IsSequence()) return "list";
+  return "value";
+}
+
+std::string node_text(const YAML::Node& node) {
+  if (node.IsDefined() && node.IsScalar()) return node.Scalar();
+  return "<" + node_kind(node) + ">";
+}
+
+StatusOr<YamlDoc> YamlDoc::load_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status::Error(fmt::format("{}: error: cannot open the file", path));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return from_text(ss.str(), path);
+}
+
+StatusOr<YamlDoc> YamlDoc::from_text(const std::string& text, const std::string& name) {
+  YamlDoc doc;
+  doc.file_ = SourceFile::FromText(name, text);
+  try {
+    doc.root_ = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    SourceLoc loc{doc.file_, e.mark.line + 1, e.mark.column + 1};
+    if (e.mark.line < 0) loc.line = 0;
+    return error_at(loc, "YAML syntax: " + e.msg);
+  }
+  return doc;
+}
+
+SourceLoc YamlDoc::loc(const YAML::Node& node) const {
+  SourceLoc l{file_, 0, 0};
+  if (node.IsDefined()) {
+    const YAML::Mark m = node.Mark();
+    if (m.line >= 0 && !m.is_null()) l.line = m.line + 1, l.col = m.column + 1;
+  }
+  return l;
+}
+
+Status YamlDoc::error(const YAML::Node& node, const std::string& message) const {
+  return error_at(loc(node), message);
+}
+
+Status read_map(const YamlDoc& doc, const YAML::Node& node, const std::string& path,
+                const std::vector<Field>& fields) {
+  if (!node.IsDefined() || node.IsNull()) return Status::Ok();
+  const std::string where = path.empty() ? "the top level" : "'" + path + "'";
+  if (!node.IsMap())
+    return doc.error(node, fmt::format("{} must be a map of keys, found a {}", where,
+                                       node_kind(node)));
+  for (auto it = node.begin(); it != node.end(); ++it) {
+    const std::string key = it->first.Scalar();
+    const std::string full = path.empty() ? key : path + "." + key;
+    const Field* f = nullptr;
+    for (const Field& x : fields)
+      if (x.key == key) f = &x;
+    if (f == nullptr) {
+      std::string known;
+      for (const Field& x : fields) known += (known.empty() ? "" : ", ") + x.key;
+      return doc.error(it->first, fmt::format("unknown key '{}' in {} (known keys: {})", full,
+                                              where, known));
+    }
+    if (Status s = f->read(it->second, full); !s.ok()) return s;
+  }
+  return Status::Ok();
+}
+
+FieldReader read_quantity(const YamlDoc& doc, Unit unit, Rule rule, double* out) {
+  return [&doc, unit, rule, out](const YAML::Node& n, const std::string& key) -> Status {
+    double v = 0;
+    const char* sym = unit_symbol(unit);
+    if (!n.IsScalar() || !parse_quantity(n.Scalar(), unit, &v)) {
+      std::string expect = unit == Unit::kMetre || unit == Unit::kCelsius || unit == Unit::kNone
+                               ? fmt::format("a number{}{}", *sym ? " in " : "", sym)
+                               : fmt::format("a value in {} (SPICE suffixes allowed, e.g. 2.2n "
+                                             "or 2.2n{})",
+                                             sym, sym);
+      return doc.error(n, fmt::format("key '{}': expected {}, found '{}'", key, expect,
+                                      node_text(n)));
+    }
+    if (!obeys(rule, v))
+      return doc.error(n, fmt::format("key '{}' = {}: {}", key, n.Scalar(), rule_text(rule)));
+    *out = v;
+    return Status::Ok();
+  };
+}
+
+FieldReader read_quantity(const YamlDoc& doc, Unit unit, Rule rule, std::optional<double>* out) {
+  return [&doc, unit, rule, out](const YAML::Node& n, const std::string& key) -> Status {
+    double v = 0;
+    if (Status s = read_quantity(doc, unit, rule, &v)(n, key); !s.ok()) return s;
+    *out = v;
+    return Status::Ok();
+  };
+}
+
+FieldReader read_text(const YamlDoc& doc, std::string* out) {
+  return [&doc, out](const YAML::Node& n, const std::string& key) -> Status {
+    if (!n.IsScalar())
+      return doc.error(n, fmt::format("key '{}': expected text, found a {}", key, node_kind(n)));
+    *out = n.Scalar();
+    return Status::Ok();
+  };
+}
+
+FieldReader read_choice(const YamlDoc& doc, std::vector<std::string> options, std::string* out) {
+  return [&doc, options, out](const YAML::Node& n, const std::string& key) -> Status {
+    std::string names;
+    for (const std::string& o : options) {
+      if (n.IsScalar() && lower(n.Scalar()) == o) {
+        *out = o;
+        return Status::Ok();
+      }
+      names += (names.empty() ? "" : " | ") + o;
+    }
+    return doc.error(n, fmt::format("key '{}': expected {}, found '{}'", key, names,
+                                    node_text(n)));
+  };
+}
+
+FieldReader read_bool(const YamlDoc& doc, bool* out) {
+  return [&doc, out](const YAML::Node& n, const std::string& key) -> Status {
+    bool b = false;
+    if (!n.IsScalar() || !YAML::convert<bool>::decode(n, b))
+      return doc.error(n, fmt::format("key '{}': expected true or false, found '{}'", key,
+                                      node_text(n)));
+    *out = b;
+    return Status::Ok();
+  };
+}
+
+FieldReader read_int(const YamlDoc& doc, int lo, int hi, int* out) {
+  return [&doc, lo, hi, out](const YAML::Node& n, const std::string& key) -> Status {
+    const std::string s = n.IsScalar() ? n.Scalar() : "";
+    int v = 0;
+    auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (s.empty() || ec != std::errc() || ptr != s.data() + s.size())
+      return doc.error(n, fmt::format("key '{}': expected a whole number, found '{}'", key,
+                                      node_text(n)));
+    if (v < lo || v > hi)
+      return doc.error(n, fmt::format("key '{}' = {}: must be in {}..{}", key, v, lo, hi));
+    *out = v;
+    return Status::Ok();
+  };
+}
+
+FieldReader read_text_list(const YamlDoc& doc, std::vector<std::string>* out) {
+  return [&doc, out](const YAML::Node& n, const std::string& key) -> Status {
+    out->clear();
+    if (n.IsScalar()) {
+      out->push_back(n.Scalar());
+      return Status::Ok();
+    }
+    if (!n.IsSequence())
+      return doc.error(n, fmt::format("key '{}': expected a list of text, found a {}", key,
+                                      node_kind(n)));
+    for (size_t i = 0; i < n.size(); ++i) {
+      if (!n[i].IsScalar())
+        return doc.error(n[i], fmt::format("key '{}[{}]': expected text, found a {}", key, i,
+                                           node_kind(n[i])));
+      out->push_back(n[i].Scalar());
+    }
+    return Status::Ok();
+  };
+}
+
+}  // namespace isolink::config

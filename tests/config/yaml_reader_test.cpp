@@ -1,0 +1,87 @@
+#include "config/yaml_reader.h"
+
+#include <gtest/gtest.h>
+
+namespace isolink::config {
+namespace {
+
+TEST(ParseQuantity, SuffixesAndUnits) {
+  double v = 0;
+  EXPECT_TRUE(parse_quantity("2.2n", Unit::kFarad, &v));
+  EXPECT_DOUBLE_EQ(v, 2.2e-9);
+  EXPECT_TRUE(parse_quantity("2.2nF", Unit::kFarad, &v));
+  EXPECT_DOUBLE_EQ(v, 2.2e-9);
+  EXPECT_TRUE(parse_quantity("49 ohm", Unit::kOhm, &v));
+  EXPECT_DOUBLE_EQ(v, 49);
+  EXPECT_TRUE(parse_quantity("10meg", Unit::kHertz, &v));
+  EXPECT_DOUBLE_EQ(v, 10e6);
+  EXPECT_TRUE(parse_quantity("1.5kohm", Unit::kOhm, &v));
+  EXPECT_DOUBLE_EQ(v, 1500);
+  EXPECT_TRUE(parse_quantity("150uH", Unit::kHenry, &v));
+  EXPECT_DOUBLE_EQ(v, 150e-6);
+  // Wrong unit, junk, and lengths without scale suffixes.
+  EXPECT_FALSE(parse_quantity("2.2nH", Unit::kFarad, &v));
+  EXPECT_FALSE(parse_quantity("abc", Unit::kOhm, &v));
+  EXPECT_FALSE(parse_quantity("", Unit::kOhm, &v));
+  EXPECT_TRUE(parse_quantity("12m", Unit::kMetre, &v));
+  EXPECT_DOUBLE_EQ(v, 12);  // metres, never milli
+  EXPECT_TRUE(parse_quantity("12 m", Unit::kMetre, &v));
+  EXPECT_DOUBLE_EQ(v, 12);
+  EXPECT_FALSE(parse_quantity("1.5k", Unit::kMetre, &v));
+  EXPECT_FALSE(parse_quantity("12ft", Unit::kMetre, &v));
+}
+
+TEST(ReadMap, UnknownKeyNamesFileLineColumnAndKnownKeys) {
+  auto doc = YamlDoc::from_text("cable:\n  length: 3\n  lenght: 4\n", "spec.yaml");
+  ASSERT_TRUE(doc.ok());
+  double length = 0;
+  Status s = read_map(*doc, doc->root()["cable"], "cable",
+                      {{"length", read_quantity(*doc, Unit::kMetre, Rule::kPositive, &length)}});
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("spec.yaml:3:3: error: unknown key 'cable.lenght'"),
+            std::string::npos)
+      << s.message();
+  EXPECT_NE(s.message().find("known keys: length"), std::string::npos);
+  EXPECT_NE(s.message().find("   lenght: 4\n   ^"), std::string::npos) << s.message();
+}
+
+TEST(ReadMap, ValuesRulesAndChoices) {
+  auto doc = YamlDoc::from_text("a: -1\nb: pvcx\nc: 2.2nH\nd: [x, y]\ne: 31\n", "t.yaml");
+  ASSERT_TRUE(doc.ok());
+  double a = 0, c = 0;
+  std::string b;
+  std::vector<std::string> d;
+  int e = 0;
+  auto one = [&](const char* key, FieldReader r) {
+    return r(doc->root()[key], key);
+  };
+  Status sa = one("a", read_quantity(*doc, Unit::kMetre, Rule::kPositive, &a));
+  EXPECT_NE(sa.message().find("t.yaml:1:4: error: key 'a' = -1: must be > 0"), std::string::npos)
+      << sa.message();
+  Status sb = one("b", read_choice(*doc, {"pp", "pvc"}, &b));
+  EXPECT_NE(sb.message().find("key 'b': expected pp | pvc, found 'pvcx'"), std::string::npos);
+  Status sc = one("c", read_quantity(*doc, Unit::kFarad, Rule::kPositive, &c));
+  EXPECT_NE(sc.message().find("key 'c': expected a value in F"), std::string::npos)
+      << sc.message();
+  EXPECT_TRUE(one("d", read_text_list(*doc, &d)).ok());
+  EXPECT_EQ(d, (std::vector<std::string>{"x", "y"}));
+  Status se = one("e", read_int(*doc, 18, 30, &e));
+  EXPECT_NE(se.message().find("key 'e' = 31: must be in 18..30"), std::string::npos);
+}
+
+TEST(YamlDoc, SyntaxErrorHasItsPosition) {
+  auto doc = YamlDoc::from_text("a: [1, 2\nb: 3\n", "bad.yaml");
+  ASSERT_FALSE(doc.ok());
+  EXPECT_NE(doc.status().message().find("bad.yaml:"), std::string::npos);
+  EXPECT_NE(doc.status().message().find("YAML syntax"), std::string::npos);
+}
+
+TEST(YamlDoc, MissingFileIsAnError) {
+  auto doc = YamlDoc::load_file("/nonexistent/spec.yaml");
+  ASSERT_FALSE(doc.ok());
+  EXPECT_NE(doc.status().message().find("/nonexistent/spec.yaml: error: cannot open"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace isolink::config
