@@ -9,10 +9,13 @@ int main(int argc, char** argv) {
   CLI::App app{"isolink: signal integrity of BMS daisy-chain links (BQ7961x, BQ79600, BQ79606A)"};
   app.require_subcommand(1);
   int exit_code = 0;
+  isolink::cli::add_run_command(app, &exit_code);
   isolink::cli::add_sim_command(app, &exit_code);
   isolink::cli::add_check_command(app, &exit_code);
   isolink::cli::add_frame_command(app, &exit_code);
   isolink::cli::add_elements_command(app, &exit_code);
+  isolink::cli::add_parts_command(app, &exit_code);
+  isolink::cli::add_export_command(app, &exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,51 @@
+// One link spec, simulated and scored in each of its directions: the work of `isolink run` and
+// of every sweep point.
+//
+//   StatusOr<PartLibrary> parts = PartLibrary::load(part_dirs);
+//   StatusOr<LinkRun> run = run_link(spec, *parts, {});
+//   for (const DirectionRun& d : run->directions) ... d.data_check->pass, d.sim.wave ...
+//   return run->pass ? 0 : 1;
+// Each direction is its own transient (the link is half-duplex). Data frames are scored with the
+// receiving device's rule set and tones with the tone rules, each over its own time windows.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cli/simulate.h"
+#include "eye/check.h"
+#include "eye/rules.h"
+#include "netlists/link/expand.h"
+#include "netlists/link/link_spec.h"
+#include "netlists/link/parts.h"
+
+namespace isolink::cli {
+
+struct DirectionRun {
+  link::ExpandedLink link;
+  SimulationResult sim;                     // columns: v(rxp,rxn), v(rxp), v(rxn), v(txp,txn)
+  eye::Rules rules;                         // the receiver's data rules
+  std::optional<eye::CheckResult> data;     // the data frames' check (when any were sent)
+  std::optional<eye::CheckResult> tones;    // the tones' check (when any were sent)
+  bool pass = false;
+};
+
+struct LinkRun {
+  std::vector<DirectionRun> directions;
+  bool pass = false;                        // every direction passes
+  double seconds = 0;                       // wall time, all directions
+};
+
+struct RunOptions {
+  link::ExpandOptions expand;
+  std::optional<double> reltol;             // overrides the spec's sim.reltol
+};
+
+// The probes recorded per direction, in column order.
+const std::vector<std::string>& run_probes();
+
+StatusOr<LinkRun> run_link(const link::LinkSpec& spec, const link::PartLibrary& parts,
+                           const RunOptions& opt = {});
+
+}  // namespace isolink::cli

@@ -1,0 +1,34 @@
+// The text parts of the `isolink run` bundle: report.json, report.md, wave.csv. The images come
+// from reports/ (eye_png.h, wave_png.h). Every file is written to a temporary name and renamed.
+//
+//   nlohmann::ordered_json j = run_report_json(spec, run);
+//   std::string md = run_report_markdown(spec, run, {"eye.png", "wave.png"});
+//   Waveform w = run_waveforms(run);          // every direction's probes on one time axis
+//   Status s = write_file_atomic(dir + "/report.md", md);
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "cli/link_run.h"
+#include "netlists/link/link_spec.h"
+#include "solver/waveform.h"
+
+namespace isolink::cli {
+
+// The spec with every default filled in (what was simulated).
+nlohmann::ordered_json link_spec_json(const link::LinkSpec& spec);
+// verdict, spec, per direction: rules, verdict, check JSON (eye/check.h), tones, solver stats.
+nlohmann::ordered_json run_report_json(const link::LinkSpec& spec, const LinkRun& run);
+// A reviewer's page: verdict, worst margins per direction, BOM, cable, run time, the images.
+std::string run_report_markdown(const link::LinkSpec& spec, const LinkRun& run,
+                                const std::vector<std::string>& images);
+// The probes of every direction, resampled onto one uniform axis, columns "down v(rxp,rxn)", ...
+Waveform run_waveforms(const LinkRun& run, double dt);
+// Writes text to path through path + ".tmp" and a rename.
+Status write_file_atomic(const std::string& path, const std::string& text);
+// "pass" / "FAIL" lines for the terminal: one per direction, with the worst margins.
+std::string run_summary_text(const link::LinkSpec& spec, const LinkRun& run);
+
+}  // namespace isolink::cli

@@ -1,0 +1,184 @@
+#include "netlists/link/expand.h"
+
+#include <fmt/format.h>
+
+#include "netlists/link/board.h"
+#include "netlists/link/cable.h"
+#include "netlists/link/cards.h"
+
+namespace isolink::link {
+
+namespace {
+
+// The error of a spec value, at the place it was written.
+Status at(const SourceLoc& loc, const std::string& message) {
+  return loc.valid() ? error_at(loc, message) : Status::Error(message);
+}
+
+StatusOr<BoardNetwork> board_for(const EndSpec& end) {
+  StatusOr<BoardNetwork> b = board_preset(end.device);
+  if (!b) return b.status();
+  const std::string& type = end.isolation.type;
+  // BQ79606A: 10 kohm with cap and cap + choke, 1 kohm with a transformer (domain.md 4.4).
+  if (end.device == "bq79606a" && type.rfind("transformer", 0) == 0) b->termination = 1e3;
+  if (end.series_r) b->r_line = *end.series_r;
+  if (end.bypass_c) b->bypass_c = *end.bypass_c;
+  if (end.termination) b->termination = *end.termination;
+  return b;
+}
+
+StatusOr<TransformerModel> transformer_for(const EndSpec& end, const PartLibrary& parts,
+                                           const std::string& where) {
+  const IsolationSpec& iso = end.isolation;
+  std::string number = iso.part;
+  if (number.empty()) number = end.device == "bq79606a" ? "CDEP99-102" : "HMU1228NL";
+  const Part* part = parts.find(number);
+  if (part == nullptr)
+    return at(iso.loc, fmt::format("{}.isolation.part: unknown part '{}' (see `isolink parts`)",
+                                   where, number));
+  if (part->kind != PartKind::Transformer)
+    return at(iso.loc, fmt::format("{}.isolation.part: '{}' is not a transformer", where, number));
+  TransformerModel m = part->transformer;
+  if (iso.inductance) m.inductance = *iso.inductance;
+  if (iso.leakage) m.leakage = *iso.leakage;
+  if (iso.dcr) m.dcr = *iso.dcr;
+  if (iso.winding_c) m.winding_c = *iso.winding_c;
+  if (iso.centre_tap_c) m.centre_tap_c = *iso.centre_tap_c;
+  if (Status s = m.validate(); !s.ok())
+    return at(iso.loc, fmt::format("{}.isolation: {}", where, s.message()));
+  return m;
+}
+
+StatusOr<ChokeModel> choke_for(const IsolationSpec& iso, const std::string& number,
+                               const PartLibrary& parts, const std::string& where) {
+  const Part* part = parts.find(number);
+  if (part == nullptr)
+    return at(iso.loc, fmt::format("{}.isolation.chokes: unknown part '{}' (see `isolink parts`)",
+                                   where, number));
+  if (part->kind != PartKind::Choke)
+    return at(iso.loc,
+              fmt::format("{}.isolation.chokes: '{}' is not a common-mode choke", where, number));
+  return part->choke;
+}
+
+// One end's board and isolation between its device pins (pin_p/pin_n) and its cable connector
+// nodes; returns the connector node names.
+StatusOr<std::pair<std::string, std::string>> add_end(std::vector<Card>& cards,
+                                                      const EndSpec& end, const std::string& side,
+                                                      const std::string& where,
+                                                      const PartLibrary& parts) {
+  StatusOr<BoardNetwork> board = board_for(end);
+  if (!board) return at(end.loc, fmt::format("{}: {}", where, board.status().message()));
+  const std::string pin_p = side + "p", pin_n = side + "n";
+  std::string p = side + "_lp", n = side + "_ln";
+  if (Status s = add_board_network(cards, side + "b", pin_p, pin_n, p, n, *board); !s.ok())
+    return at(end.loc, fmt::format("{}: {}", where, s.message()));
+  const IsolationSpec& iso = end.isolation;
+  const std::string& type = iso.type;
+  int stage = 0;
+  auto next = [&](const std::string& tag) {
+    ++stage;
+    return std::pair{fmt::format("{}_{}{}p", side, tag, stage),
+                     fmt::format("{}_{}{}n", side, tag, stage)};
+  };
+  if (type == "cap" || type == "capchoke") {
+    auto [a, b] = next("c");
+    cards.push_back(make_card('c', "c" + side + "isop", {p, a}, {number_arg(iso.cap)}));
+    cards.push_back(make_card('c', "c" + side + "ison", {n, b}, {number_arg(iso.cap)}));
+    p = a, n = b;
+  }
+  if (type == "transformer" || type == "transformer_choke") {
+    StatusOr<TransformerModel> m = transformer_for(end, parts, where);
+    if (!m) return m.status();
+    auto [a, b] = next("t");
+    if (Status s = add_transformer(cards, "t" + side, p, n, a, b, *m); !s.ok())
+      return at(iso.loc, fmt::format("{}.isolation: {}", where, s.message()));
+    p = a, n = b;
+  }
+  if (type == "capchoke" || type == "transformer_choke") {
+    std::vector<std::string> chokes = iso.chokes;
+    if (chokes.empty()) chokes = {"ACT45B-510-2P-TL003"};
+    for (size_t i = 0; i < chokes.size(); ++i) {
+      StatusOr<ChokeModel> m = choke_for(iso, chokes[i], parts, where);
+      if (!m) return m.status();
+      auto [a, b] = next("k");
+      if (Status s = add_choke(cards, fmt::format("l{}{}", side, i + 1), p, n, a, b, *m); !s.ok())
+        return at(iso.loc, fmt::format("{}.isolation: {}", where, s.message()));
+      p = a, n = b;
+    }
+  }
+  // CBYPASS2: 100 pF per line on the cable side of a transformer (TI's transformer figure).
+  double cable_side_c = iso.cable_side_c;
+  if (cable_side_c < 0) cable_side_c = type.rfind("transformer", 0) == 0 ? 100e-12 : 0.0;
+  if (cable_side_c > 0) {
+    cards.push_back(make_card('c', "c" + side + "cabp", {p, "0"}, {number_arg(cable_side_c)}));
+    cards.push_back(make_card('c', "c" + side + "cabn", {n, "0"}, {number_arg(cable_side_c)}));
+  }
+  if (iso.esd > 0) {
+    // The ESD part sits at the board's ESD node when it has one (BQ79606A), else at the connector.
+    const bool esd_node = board->r_pin > 0;
+    const std::string ep = esd_node ? side + "b_esdp" : p, en = esd_node ? side + "b_esdn" : n;
+    cards.push_back(make_card('c', "c" + side + "esdp", {ep, "0"}, {number_arg(iso.esd)}));
+    cards.push_back(make_card('c', "c" + side + "esdn", {en, "0"}, {number_arg(iso.esd)}));
+  }
+  return std::pair{p, n};
+}
+
+NetlistOption option(const std::string& key, double v) {
+  return NetlistOption{key, number_arg(v), {}};
+}
+
+}  // namespace
+
+StatusOr<ExpandedLink> expand_link(const LinkSpec& spec, const PartLibrary& parts, Direction d,
+                                   const ExpandOptions& opt) {
+  ExpandedLink out;
+  out.direction = d;
+  const bool down = d == Direction::kDown;
+  const EndSpec& from = down ? spec.tx : spec.rx;
+  const EndSpec& to = down ? spec.rx : spec.tx;
+  const std::string from_key = down ? "tx" : "rx", to_key = down ? "rx" : "tx";
+  out.transmitter = from.device;
+  out.receiver = to.device;
+  out.rules = device_rules(to.device);
+  out.description = fmt::format("{}: {} -> {}", direction_name(d), from.device, to.device);
+
+  StatusOr<traffic::Drive> drive = traffic::build_drive(spec.stimulus.to_script(), opt.stimulus);
+  if (!drive) return at(spec.stimulus.loc, "stimulus: " + drive.status().message());
+  out.drive = std::move(*drive);
+  for (const traffic::DriveFrame& f : out.drive.frames)
+    out.expected.insert(out.expected.end(), f.bytes.begin(), f.bytes.end());
+
+  std::vector<Card>& cards = out.netlist.cards;
+  if (Status s = add_tx_driver(cards, "tx", "txp", "txn", out.drive, opt.driver); !s.ok())
+    return s.with_context("tx driver");
+  auto a = add_end(cards, from, "tx", from_key, parts);
+  if (!a) return a.status();
+  auto b = add_end(cards, to, "rx", to_key, parts);
+  if (!b) return b.status();
+  if (Status s = add_cable(cards, "cab", a->first, a->second, b->first, b->second, spec.cable,
+                           opt.driver.edge);
+      !s.ok())
+    return at(spec.cable_loc, "cable: " + s.message());
+  StatusOr<CableModel> cm = cable_model(spec.cable);
+  if (cm) out.cable_segments = cable_segments(spec.cable, *cm, opt.driver.edge);
+  if (Status s = add_rx_load(cards, "rx", "rxp", "rxn", opt.load); !s.ok())
+    return s.with_context("rx load");
+
+  out.netlist.title = fmt::format("isolink link spec '{}', {}", spec.name, out.description);
+  TranSpec tran;
+  tran.tstep = spec.sim.tstep;
+  tran.tstop = out.drive.duration();
+  if (spec.sim.tmax) tran.tmax = *spec.sim.tmax;
+  out.netlist.tran = tran;
+  if (spec.sim.method == "gear") {
+    CardArg w;
+    w.kind = CardArg::Kind::Word;
+    w.word = "gear";
+    out.netlist.options.push_back(NetlistOption{"method", w, {}});
+  }
+  if (spec.sim.reltol) out.netlist.options.push_back(option("reltol", *spec.sim.reltol));
+  return out;
+}
+
+}  // namespace isolink::link

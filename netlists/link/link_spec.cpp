@@ -1,0 +1,205 @@
+#include "netlists/link/link_spec.h"
+
+#include <fmt/format.h>
+
+namespace isolink::link {
+
+using config::Field;
+using config::read_bool;
+using config::read_choice;
+using config::read_int;
+using config::read_map;
+using config::read_quantity;
+using config::read_text;
+using config::read_text_list;
+using config::Rule;
+using config::Unit;
+using config::YamlDoc;
+
+const char* direction_name(Direction d) { return d == Direction::kDown ? "down" : "up"; }
+
+std::vector<std::string> device_names() { return {"bq79600", "bq7961x", "bq79606a"}; }
+
+std::string device_rules(const std::string& device) {
+  return device == "bq79600" ? "bq79600" : "bq7961x";
+}
+
+std::string StimulusSpec::to_script() const {
+  std::string s;
+  auto add = [&s](const std::string& item) { s += (s.empty() ? "" : "; ") + item; };
+  for (const std::string& t : tones) add("tone " + t);
+  for (const std::string& f : frames) add(f);
+  for (const std::string& p : patterns) add("pattern " + p);
+  if (!script.empty()) add(script);
+  return s;
+}
+
+namespace {
+
+Status read_isolation(const YamlDoc& doc, const YAML::Node& node, const std::string& path,
+                      IsolationSpec* iso) {
+  iso->loc = doc.loc(node);
+  std::string chokes_key;
+  Status s = read_map(
+      doc, node, path,
+      {
+          {"type", read_choice(doc, {"none", "cap", "capchoke", "transformer", "transformer_choke"},
+                               &iso->type)},
+          {"cap", read_quantity(doc, Unit::kFarad, Rule::kPositive, &iso->cap)},
+          {"chokes", read_text_list(doc, &iso->chokes)},
+          {"part", read_text(doc, &iso->part)},
+          {"inductance", read_quantity(doc, Unit::kHenry, Rule::kPositive, &iso->inductance)},
+          {"leakage", read_quantity(doc, Unit::kHenry, Rule::kNonNegative, &iso->leakage)},
+          {"dcr", read_quantity(doc, Unit::kOhm, Rule::kNonNegative, &iso->dcr)},
+          {"winding_c", read_quantity(doc, Unit::kFarad, Rule::kNonNegative, &iso->winding_c)},
+          {"centre_tap_c",
+           read_quantity(doc, Unit::kFarad, Rule::kNonNegative, &iso->centre_tap_c)},
+          {"cable_side_c",
+           read_quantity(doc, Unit::kFarad, Rule::kNonNegative, &iso->cable_side_c)},
+          {"esd", read_quantity(doc, Unit::kFarad, Rule::kNonNegative, &iso->esd)},
+      });
+  if (!s.ok()) return s;
+  if (iso->chokes.size() > 2 && node["chokes"])
+    return doc.error(node["chokes"], fmt::format("key '{}.chokes': one or two chokes, found {}",
+                                                 path, iso->chokes.size()));
+  const bool has_chokes = iso->type == "capchoke" || iso->type == "transformer_choke";
+  if (!has_chokes && node.IsMap() && node["chokes"])
+    return doc.error(node["chokes"],
+                     fmt::format("key '{}.chokes': type {} has no chokes (use capchoke or "
+                                 "transformer_choke)",
+                                 path, iso->type));
+  const bool has_xfmr = iso->type == "transformer" || iso->type == "transformer_choke";
+  if (!has_xfmr && node.IsMap())
+    for (const char* k : {"part", "inductance", "leakage", "dcr", "winding_c", "centre_tap_c"})
+      if (node[k])
+        return doc.error(node[k], fmt::format("key '{}.{}': only for a transformer (type is {})",
+                                              path, k, iso->type));
+  return Status::Ok();
+}
+
+Status read_end(const YamlDoc& doc, const YAML::Node& node, const std::string& path,
+                EndSpec* end) {
+  end->loc = doc.loc(node);
+  std::vector<std::string> devices = device_names();
+  return read_map(
+      doc, node, path,
+      {
+          {"device", read_choice(doc, devices, &end->device)},
+          {"series_r", read_quantity(doc, Unit::kOhm, Rule::kPositive, &end->series_r)},
+          {"bypass_c", read_quantity(doc, Unit::kFarad, Rule::kNonNegative, &end->bypass_c)},
+          {"termination", read_quantity(doc, Unit::kOhm, Rule::kPositive, &end->termination)},
+          {"isolation",
+           [&](const YAML::Node& n, const std::string& p) {
+             return read_isolation(doc, n, p, &end->isolation);
+           }},
+      });
+}
+
+Status read_cable(const YamlDoc& doc, const YAML::Node& node, CableSpec* cable) {
+  std::optional<double> r, l, c, g;
+  Status s = read_map(
+      doc, node, "cable",
+      {
+          {"length", read_quantity(doc, Unit::kMetre, Rule::kPositive, &cable->length)},
+          {"material", read_choice(doc, {"pp", "pvc"}, &cable->material)},
+          {"gauge", read_int(doc, 18, 30, &cable->gauge)},
+          {"temperature", read_quantity(doc, Unit::kCelsius, Rule::kAny, &cable->temperature)},
+          {"r", read_quantity(doc, Unit::kOhm, Rule::kNonNegative, &cable->r)},
+          {"l", read_quantity(doc, Unit::kHenry, Rule::kPositive, &cable->l)},
+          {"c", read_quantity(doc, Unit::kFarad, Rule::kPositive, &cable->c)},
+          {"g", read_quantity(doc, Unit::kSiemens, Rule::kNonNegative, &cable->g)},
+          {"segments", read_int(doc, 1, 1000, &cable->segments)},
+          {"skin_effect", read_bool(doc, &cable->skin_effect)},
+          {"dielectric_loss", read_bool(doc, &cable->dielectric_loss)},
+      });
+  if (!s.ok()) return s;
+  if (cable->temperature < -55 || cable->temperature > 150)
+    return doc.error(node["temperature"],
+                     fmt::format("key 'cable.temperature' = {:g}: must be in -55..150 degC",
+                                 cable->temperature));
+  if (Status v = cable->validate(); !v.ok()) return doc.error(node, v.message());
+  return Status::Ok();
+}
+
+Status read_stimulus(const YamlDoc& doc, const YAML::Node& node, StimulusSpec* st) {
+  st->loc = doc.loc(node);
+  std::string direction = "both";
+  Status s = read_map(doc, node, "stimulus",
+                      {
+                          {"frames", read_text_list(doc, &st->frames)},
+                          {"tones", read_text_list(doc, &st->tones)},
+                          {"patterns", read_text_list(doc, &st->patterns)},
+                          {"script", read_text(doc, &st->script)},
+                          {"direction", read_choice(doc, {"down", "up", "both"}, &direction)},
+                      });
+  if (!s.ok()) return s;
+  if (direction == "down") st->directions = {Direction::kDown};
+  if (direction == "up") st->directions = {Direction::kUp};
+  return Status::Ok();
+}
+
+}  // namespace
+
+StatusOr<LinkSpec> read_link_spec(const YamlDoc& doc) {
+  LinkSpec spec;
+  spec.source = doc.path();
+  spec.tx.device = "bq79600";
+  spec.stimulus.frames = {"stack-write reg=0x0100 data=02B778BC"};
+  const YAML::Node& root = doc.root();
+  if (!root.IsMap())
+    return doc.error(root, "a link spec is a YAML map with keys name, tx, rx, cable, stimulus");
+  bool stimulus_given = false;
+  Status s = read_map(
+      doc, root, "",
+      {
+          {"name", read_text(doc, &spec.name)},
+          {"tx", [&](const YAML::Node& n, const std::string& p) {
+             return read_end(doc, n, p, &spec.tx);
+           }},
+          {"rx", [&](const YAML::Node& n, const std::string& p) {
+             return read_end(doc, n, p, &spec.rx);
+           }},
+          {"cable", [&](const YAML::Node& n, const std::string&) {
+             spec.cable_loc = doc.loc(n);
+             return read_cable(doc, n, &spec.cable);
+           }},
+          {"stimulus", [&](const YAML::Node& n, const std::string&) {
+             stimulus_given = true;
+             spec.stimulus.frames.clear();
+             return read_stimulus(doc, n, &spec.stimulus);
+           }},
+          {"sim", [&](const YAML::Node& n, const std::string& p) {
+             return read_map(
+                 doc, n, p,
+                 {
+                     {"tstep", read_quantity(doc, Unit::kSecond, Rule::kPositive, &spec.sim.tstep)},
+                     {"tmax", read_quantity(doc, Unit::kSecond, Rule::kPositive, &spec.sim.tmax)},
+                     {"method", read_choice(doc, {"trap", "gear"}, &spec.sim.method)},
+                     {"reltol", read_quantity(doc, Unit::kNone, Rule::kPositive, &spec.sim.reltol)},
+                 });
+           }},
+      });
+  if (!s.ok()) return s;
+  if (spec.name.empty() || spec.name.find_first_of("/\\") != std::string::npos)
+    return doc.error(root["name"], fmt::format("key 'name' = '{}': must be a non-empty name "
+                                               "without '/' (it names the report folder)",
+                                               spec.name));
+  if (stimulus_given && spec.stimulus.to_script().empty())
+    return doc.error(root["stimulus"],
+                     "key 'stimulus': give at least one of frames, tones, patterns or script");
+  return spec;
+}
+
+StatusOr<LinkSpec> read_link_spec_file(const std::string& path) {
+  StatusOr<YamlDoc> doc = YamlDoc::load_file(path);
+  if (!doc) return doc.status();
+  return read_link_spec(*doc);
+}
+
+StatusOr<LinkSpec> read_link_spec_text(const std::string& text, const std::string& name) {
+  StatusOr<YamlDoc> doc = YamlDoc::from_text(text, name);
+  if (!doc) return doc.status();
+  return read_link_spec(*doc);
+}
+
+}  // namespace isolink::link
