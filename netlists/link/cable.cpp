@@ -22,6 +22,7 @@ constexpr double kAlphaCu = 0.00393;        // 1/K, copper resistance temperatur
 constexpr double kFillDiff = 0.70;          // differential fill factor: er_eff = 1 + q (er - 1)
 constexpr int kSkinSections = 7;            // R || L sections per conductor
 constexpr int kDielectricBranches = 7;      // series R-C branches across the pair
+constexpr int kMaxLossStride = 4;          // segments per loss section, at most
 constexpr double kNeighbourCoupling = 0.1;  // kappa between adjacent segments' inductors
 
 // Insulation wall (mm) for even gauges 18..30, interpolated for odd ones (assumed, typical
@@ -416,6 +417,11 @@ StatusOr<CableModel> cable_model(const CableSpec& spec) {
   return m;
 }
 
+int loss_stride(int segments) { return std::clamp(segments / 8, 1, kMaxLossStride); }
+int loss_stride(const CableSpec& spec, int segments) {
+  return spec.loss_stride > 0 ? spec.loss_stride : loss_stride(segments);
+}
+
 int cable_segments(const CableSpec& spec, const CableModel& m, double edge_time) {
   if (spec.segments > 0) return spec.segments;
   if (!(edge_time > 0)) return 200;
@@ -449,13 +455,36 @@ Status add_cable(std::vector<Card>& cards, const std::string& prefix, const std:
   const double l_seg = m.l_self * dz / (1 + 2 * kappa);
   auto l_of = [&](int i) { return (i == 1 || i == n) ? l_seg * (1 + kappa) : l_seg; };
 
+  // Loss sections: the skin ladders and the dielectric branches are small corrections to each
+  // segment's R, L and C, so they are lumped every `stride` segments (their values scaled by the
+  // length they stand for) instead of in every segment: most of a segment's unknowns are in its
+  // ladders, and the wave's timing needs the fine LC segments, not fine loss sections.
+  const int stride = loss_stride(spec, n);
+  // Segment i (1..n) carries the skin ladder of segments i - stride + 1 .. i (and the last one
+  // the rest).
+  auto series_loss_length = [&](int i) -> double {
+    if (i == n) return dz * (n - (n - 1) / stride * stride);
+    return i % stride == 0 ? dz * stride : 0.0;
+  };
+  // Node j (0..n) carries the dielectric branches of the shunt length around it: nodes are
+  // grouped in runs of `stride` from node 0; the run's middle node carries the run's length.
+  auto shunt_loss_length = [&](int j) -> double {
+    auto len_of = [&](int k) { return (k == 0 || k == n) ? dz / 2 : dz; };
+    const int first = j / stride * stride;
+    const int last = std::min(n, first + stride - 1);
+    if (j != (first + last) / 2) return 0.0;
+    double total = 0;
+    for (int k = first; k <= last; ++k) total += len_of(k);
+    return total;
+  };
+
   // Series branches of segment i (1..n), per conductor: R_dc, L_ext (coupled), skin sections.
   for (int i = 1; i <= n; ++i) {
     for (char side : {'p', 'n'}) {
       std::string from = node(side, i - 1);
       int k = 0;
       auto next = [&]() { return fmt::format("{}_{}{}_{}", prefix, side, i, k++); };
-      const bool last_is_l = m.skin.empty();
+      const bool last_is_l = m.skin.empty() || series_loss_length(i) == 0;
       if (m.r_dc > 0) {
         std::string to = next();
         cards.push_back(
@@ -465,12 +494,13 @@ Status add_cable(std::vector<Card>& cards, const std::string& prefix, const std:
       std::string to = last_is_l ? node(side, i) : next();
       cards.push_back(card('l', fmt::format("l{}_{}{}", prefix, side, i), {from, to}, l_of(i)));
       from = to;
-      for (size_t s = 0; s < m.skin.size(); ++s) {
+      const double skin_len = series_loss_length(i);
+      for (size_t s = 0; s < m.skin.size() && skin_len > 0; ++s) {
         to = s + 1 == m.skin.size() ? node(side, i) : next();
         cards.push_back(card('r', fmt::format("r{}_{}{}_s{}", prefix, side, i, s), {from, to},
-                             m.skin[s].r * dz));
+                             m.skin[s].r * skin_len));
         cards.push_back(card('l', fmt::format("l{}_{}{}_s{}", prefix, side, i, s), {from, to},
-                             m.skin[s].l * dz));
+                             m.skin[s].l * skin_len));
         from = to;
       }
     }
@@ -494,8 +524,9 @@ Status add_cable(std::vector<Card>& cards, const std::string& prefix, const std:
     const std::string p = node('p', j), q = node('n', j);
     cards.push_back(card('c', fmt::format("c{}_pn{}", prefix, j), {p, q},
                          (m.c_inf * c_diff - m.c_g / 2) * len));
-    for (size_t b = 0; b < m.dielectric.size(); ++b) {
-      const double cb = m.dielectric[b].c * c_diff * len;
+    const double loss_len = shunt_loss_length(j);
+    for (size_t b = 0; b < m.dielectric.size() && loss_len > 0; ++b) {
+      const double cb = m.dielectric[b].c * c_diff * loss_len;
       const std::string mid = fmt::format("{}_pn{}_d{}", prefix, j, b);
       cards.push_back(
           card('r', fmt::format("r{}_pn{}_d{}", prefix, j, b), {p, mid}, m.dielectric[b].tau / cb));

@@ -51,7 +51,8 @@ struct CableSpec {
   //   g: differential conductance (S/m) at 1 MHz: sets the effective loss tangent
   //      g / (2 pi 1 MHz c); G then grows with frequency (constant loss tangent). 0 = no loss.
   std::optional<double> r, l, c, g;
-  int segments = 0;             // 0: chosen from the edge time (cable_segments); else 1..1000
+  int segments = 0;             // 0: chosen from the edge time (cable_segments)
+  int loss_stride = 0;          // segments per loss section; 0: automatic (loss_stride()); else 1..1000
   bool skin_effect = true;      // false: DC resistance only, no internal inductance
   bool dielectric_loss = true;  // false: loss-free dielectric, capacitances constant
 
@@ -156,6 +157,10 @@ StatusOr<CableModel> cable_model(const CableSpec& spec);
 // (length / velocity / n) is at most edge_time / 10, within [2, 200] (200 for an edge_time that
 // is not > 0).
 int cable_segments(const CableSpec& spec, const CableModel& m, double edge_time);
+// Segments per loss section: the skin ladders and dielectric branches are lumped every this many
+// segments (segments / 8, within [1, 4]), scaled by the length they stand for.
+int loss_stride(int segments);
+int loss_stride(const CableSpec& spec, int segments);  // spec.loss_stride when > 0
 
 // Appends the cable's element cards between the ends (a_p, a_n) and (b_p, b_n); node "0" is the
 // reference (chassis). Element names are the element letter, then prefix, then "_..." (SPICE

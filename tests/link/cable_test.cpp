@@ -347,10 +347,11 @@ TEST(Cable, LosslessLimitDelayAndImpedance) {
 // 50 %) with 10 ns edges (10-90 %), 49 ohm in each line, 100 ohm load. The edges are smooth
 // (erf-shaped, as a driver's are; sampled every 0.25 ns): ideal linear ramps have corners whose
 // spectrum reaches past any lumped ladder's cutoff (README "Cable", segment count).
-StatusOr<Waveform> received_pulse(int segments, int* used) {
+StatusOr<Waveform> received_pulse(int segments, int* used, int loss_stride = 0) {
   CableSpec spec;
   spec.length = 10;
   spec.segments = segments;
+  spec.loss_stride = loss_stride;
   const double edge = 10e-9, t0 = 15e-9, width = 250e-9, dt = 0.25e-9;
   std::vector<Card> cards;
   if (Status s = add_cable(cards, "cab", "ap", "an", "bp", "bn", spec, edge); !s.ok()) return s;
@@ -398,6 +399,40 @@ TEST(Cable, DoublingTheSegmentsMovesTheWaveformLessThan5mV) {
   EXPECT_EQ(n2, 2 * n);
   EXPECT_GT(peak, 2.3);  // 5 V * 100 / (98 + 100), less a little cable loss
   EXPECT_LT(worst, 5e-3);
+}
+
+TEST(Cable, LumpingTheLossEveryFewSegmentsMovesTheWaveformLessThan2mV) {
+  // The skin and dielectric ladders in every segment against lumped every loss_stride(46) = 4.
+  int n = 0, n1 = 0;
+  auto lumped = received_pulse(0, &n);
+  ASSERT_TRUE(lumped.ok()) << lumped.status().message();
+  auto every = received_pulse(0, &n1, 1);
+  ASSERT_TRUE(every.ok()) << every.status().message();
+  EXPECT_EQ(loss_stride(n), 4);
+  double worst = 0;
+  for (size_t i = 0; i < every->samples(); ++i)
+    worst = std::max(worst, std::abs(every->columns[0][i] - lumped->value_at(0, every->time[i])));
+  std::printf("10 m PP, loss in every segment vs every 4th: max difference %.2f mV\n", 1e3 * worst);
+  EXPECT_LT(worst, 2e-3);
+}
+
+TEST(Cable, LossSectionsAddUpToTheWholeLength) {
+  // However the skin ladders are lumped, their elements stand for the whole length: the first
+  // section's resistors of both conductors add up to 2 r_0 length.
+  for (int stride : {1, 3, 4}) {
+    CableSpec spec;
+    spec.length = 7;
+    spec.segments = 10;
+    spec.loss_stride = stride;
+    std::vector<Card> cards;
+    ASSERT_TRUE(add_cable(cards, "cab", "ap", "an", "bp", "bn", spec).ok());
+    double skin_r = 0;
+    for (const Card& c : cards)
+      if (c.letter == 'r' && c.name.find("_s0") != std::string::npos) skin_r += c.args[0].number;
+    auto m = cable_model(spec);
+    ASSERT_TRUE(m.ok());
+    EXPECT_NEAR(skin_r, 2 * m->skin[0].r * spec.length, 1e-9 * skin_r) << stride;
+  }
 }
 
 TEST(Cable, CardsAreNamedAfterThePrefix) {
