@@ -72,8 +72,9 @@ StatusOr<LinkRun> run_link(const link::LinkSpec& spec, const link::PartLibrary& 
     if (!tone_windows.empty()) {
       StatusOr<eye::Rules> tone_rules = eye::load_rules("tone");
       if (!tone_rules) return tone_rules.status();
+      dr.tone_rules = *tone_rules;
       filter(dr.sim.wave, tone_windows, true, t, v);
-      StatusOr<eye::CheckResult> r = eye::check_samples(t, v, *tone_rules, {});
+      StatusOr<eye::CheckResult> r = eye::check_samples(t, v, dr.tone_rules, {});
       if (!r) return r.status().with_context(dr.link.description + ", tone check");
       dr.tones = std::move(*r);
       dr.pass = dr.pass && dr.tones->pass;

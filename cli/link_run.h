@@ -26,6 +26,7 @@ struct DirectionRun {
   link::ExpandedLink link;
   SimulationResult sim;                     // columns: v(rxp,rxn), v(rxp), v(rxn), v(txp,txn)
   eye::Rules rules;                         // the receiver's data rules
+  eye::Rules tone_rules;                    // the tone rules (when tones were sent)
   std::optional<eye::CheckResult> data;     // the data frames' check (when any were sent)
   std::optional<eye::CheckResult> tones;    // the tones' check (when any were sent)
   bool pass = false;

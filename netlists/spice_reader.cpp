@@ -18,6 +18,17 @@
 namespace isolink {
 namespace {
 
+// ngspice's flattened names: "r.x1.r3" is element "x1.r3" of kind r (as spice_writer writes
+// hierarchical names, and as K cards name such inductors: "l.x1.l3").
+std::string unflatten(const std::string& name) {
+  if (name.size() > 2 && name[1] == '.') {
+    const std::string rest = name.substr(2);
+    const std::size_t dot = rest.rfind('.');
+    if (dot != std::string::npos && dot + 1 < rest.size() && rest[dot + 1] == name[0]) return rest;
+  }
+  return name;
+}
+
 namespace fs = std::filesystem;
 using spice::LogicalLine;
 using spice::lower;
@@ -408,13 +419,7 @@ class Reader {
       return error_at(line.at(0), "unknown element letter '" + std::string(1, letter) + "' in '" +
                                       local + "' (known: " + known + "x)");
     }
-    // ngspice's flattened names: "r.x1.r3" is element "x1.r3" of kind r.
-    if (local.size() > 2 && local[1] == '.') {
-      const std::string rest = local.substr(2);
-      const std::size_t dot = rest.rfind('.');
-      if (dot != std::string::npos && dot + 1 < rest.size() && rest[dot + 1] == letter)
-        local = rest;
-    }
+    local = unflatten(local);
     Card card;
     card.letter = letter;
     card.name = ctx.prefix + local;
@@ -440,7 +445,7 @@ class Reader {
                                                " '" + local + "' needs " +
                                                std::to_string(kind->ref_count) +
                                                " (usage: " + kind->usage + ")");
-      card.refs.push_back(ctx.prefix + lower(line.toks[i].text));
+      card.refs.push_back(ctx.prefix + unflatten(lower(line.toks[i].text)));
       card.ref_locs.push_back(line.at(i));
     }
     while (i < n && !line.assignment(i)) {

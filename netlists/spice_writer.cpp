@@ -44,7 +44,9 @@ std::string write_spice(const Netlist& n) {
   for (const Card& c : n.cards) {
     out += element_name(c);
     for (const auto& node : c.nodes) out.append(" ").append(node);
-    for (const auto& ref : c.refs) out.append(" ").append(ref);
+    // K names inductors: a hierarchical one by its flattened name too ("x1.l3" -> "l.x1.l3").
+    for (const auto& ref : c.refs)
+      out.append(" ").append(ref.find('.') == std::string::npos ? ref : "l." + ref);
     for (const auto& a : c.args) {
       out += ' ';
       write_arg(out, a);

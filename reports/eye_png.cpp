@@ -96,8 +96,12 @@ void draw_notes(Canvas& c, const EyePanelLayout& L, const EyePanel& p, const eye
   const double step = 23;
   const double x = n.x0 + 14;
   double y = n.y0 + 12;
+  const int max_w = n.width() - 24;
   auto line = [&](const std::string& s, Color col, FontFace f = FontFace::kMono) {
-    c.text(x, y, s, fs, col, f, HAlign::kLeft, VAlign::kTop);
+    std::string shown = s;  // cut to the box
+    while (shown.size() > 4 && c.measure(shown, fs, f).width > max_w)
+      shown = shown.substr(0, shown.size() - 4) + "...";
+    c.text(x, y, shown, fs, col, f, HAlign::kLeft, VAlign::kTop);
     y += step;
   };
   line("Worst margins", kInk, FontFace::kBold);
@@ -114,7 +118,7 @@ void draw_notes(Canvas& c, const EyePanelLayout& L, const EyePanel& p, const eye
       line(fmt::format("{:<7}{:>10} {:>9} {:>11}", metric_name(w.metric), t.value, t.limit,
                        t.margin),
            w.j.margin < 0 ? bad : kInk);
-      line("  " + where_text(w) + (warning && w.j.margin < 0 ? " (warning)" : ""),
+      line((warning && w.j.margin < 0 ? "  warning: " : "  ") + where_text(w),
            w.j.margin < 0 ? bad : kMuted, FontFace::kSans);
     }
   if (!any) line("no pulse was judged", kMuted, FontFace::kSans);
@@ -137,7 +141,8 @@ void draw_notes(Canvas& c, const EyePanelLayout& L, const EyePanel& p, const eye
   const UnitScale tu = si_scale(T, "s");
   line(fmt::format("folds {}: every T = {:g} {} from each", h.windows(), T * tu.factor, tu.unit),
        kInk, FontFace::kSans);
-  line(fmt::format("  frame's preamble +{:g} V crossing", rules.vth), kInk, FontFace::kSans);
+  line(fmt::format("  {} +{:g} V crossing", r.tone ? "run's first" : "frame's preamble", rules.vth),
+       kInk, FontFace::kSans);
   line(fmt::format("resolution {:.3g} ns/px x {:.3g} mV/px", L.grid.dt_per_px() * 1e9,
                    L.grid.dv_per_px() * 1e3),
        kInk, FontFace::kSans);
@@ -275,9 +280,9 @@ void draw_panel(Canvas& c, const EyePanelLayout& L, const EyePanel& p) {
                kInk, HAlign::kCenter, VAlign::kCenter);
 
   const std::string x_title =
-      fmt::format("time after fold origin (every T = {:g} {} from the preamble's +{:g} V crossing)",
+      fmt::format("time after fold origin (every T = {:g} {} from the {} +{:g} V crossing)",
                   rules.pulse_time * si_scale(rules.pulse_time, "s").factor,
-                  si_scale(rules.pulse_time, "s").unit, vth);
+                  si_scale(rules.pulse_time, "s").unit, r.tone ? "run's first" : "preamble's", vth);
   draw_axes(c, a, xt, yt, x_title, "differential voltage v(P) - v(N)", style::kLabelSize);
   draw_colorbar(c, L.colorbar, map, scale, "hits per pixel (log scale)", style::kLabelSize);
   draw_notes(c, L, p, h);

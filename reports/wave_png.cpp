@@ -259,7 +259,7 @@ void draw_panel(Canvas& c, const WavePanelLayout& L, const WavePanel& p) {
   std::vector<double> cm(p.p.size());
   for (size_t i = 0; i < cm.size(); ++i) cm[i] = 0.5 * (p.p[i] + p.n[i]);
   const AxisTicks bt = make_ticks(b.x, tu, 10);
-  const AxisTicks byt = make_ticks(b.y, UnitScale{1, "V"}, 5);
+  const AxisTicks byt = make_ticks(b.y, UnitScale{1, "V"}, 6);
   draw_grid(c, b, bt, byt, kGrid);
   c.series(b, p.time, p.p, LineStyle{.color = kSeriesP, .width = 2});
   c.series(b, p.time, p.n, LineStyle{.color = kSeriesN, .width = 2});
@@ -304,11 +304,7 @@ WaveLayout wave_layout(const std::vector<WavePanel>& panels, const WaveReportInf
           }
       if (!(hi >= lo)) lo = hi = 0;
       const double pad = std::max(0.08 * (hi - lo), 0.25);
-      lo -= pad;
-      hi += pad;
-      const double step = nice_step(hi - lo, 5);
-      P.pins = PlotArea::make({x0, py + 640, x1, py + 840}, t0, t1, std::floor(lo / step) * step,
-                              std::ceil(hi / step) * step);
+      P.pins = PlotArea::make({x0, py + 640, x1, py + 840}, t0, t1, lo - pad, hi + pad);
     }
     L.panels.push_back(P);
   }

@@ -1,6 +1,7 @@
 // reports_preview [DIR]: renders eye.png / wave.png for synthetic links so people can judge the
 // layout: a passing two-direction link (pass_eye.png, pass_wave.png), a failing one with a 150 ns
-// pulse and a weak frame (fail_eye.png, fail_wave.png), and a single direction (one_eye.png).
+// pulse (fail_eye.png, fail_wave.png), a single direction (one_eye.png) and a wake tone burst
+// judged with the tone rules (tone_eye.png).
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -86,5 +87,22 @@ int main(int argc, char** argv) {
                dir + "/fail_wave.png");
   rc |=
       report(render_eye_png({eye_panel(down, a)}, ei, dir + "/one_eye.png"), dir + "/one_eye.png");
+  // A wake tone burst: 1 us pulses, judged with the tone rules.
+  synth::Pwl pwl;
+  synth::Train tone;
+  tone.T = 1e-6;
+  for (int k = 0; k < 16; ++k)
+    tone.pulses.push_back({.sign = k % 2 ? -1 : +1, .vstart = 2.4, .vend = 2.0});
+  synth::append_train(pwl, tone);
+  const Waveform tw = synth::sample(pwl, 1e-9, tone.end() + 5e-6);
+  const eye::Rules tr = fixtures::rules("tone");
+  const eye::CheckResult tc = *eye::check_samples(tw.time, tw.columns[0], tr);
+  rc |= report(render_eye_png({{.direction = "up: wake tone",
+                                .time = tw.time,
+                                .diff = tw.columns[0],
+                                .rules = &tr,
+                                .result = &tc}},
+                              ei, dir + "/tone_eye.png"),
+               dir + "/tone_eye.png");
   return rc;
 }
