@@ -1,5 +1,6 @@
 // isolink run: a link spec simulated with its traffic, each receiver scored, and the report
 // bundle (eye.png, wave.png, report.json, report.md, wave.csv) written to a folder.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -62,8 +63,13 @@ int run_run(const RunArgs& a) {
   if (Status s = write_file_atomic(dir + "/report.md", run_report_markdown(*spec, *run, images));
       !s.ok())
     return fail(s);
+  std::vector<std::string> warned;  // both directions share most warnings: print each once
   for (const DirectionRun& d : run->directions)
-    for (const std::string& w : d.sim.warnings) std::fprintf(stderr, "%s\n", w.c_str());
+    for (const std::string& w : d.sim.warnings)
+      if (std::find(warned.begin(), warned.end(), w) == warned.end()) {
+        warned.push_back(w);
+        std::fprintf(stderr, "%s\n", w.c_str());
+      }
   if (!a.quiet) {
     std::fputs(run_summary_text(*spec, *run).c_str(), stdout);
     std::printf("report: %s/report.md\n", dir.c_str());

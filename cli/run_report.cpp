@@ -7,6 +7,9 @@
 
 #include <fmt/format.h>
 
+#include "netlists/link/cable.h"
+#include "netlists/link/cards.h"
+
 namespace isolink::cli {
 
 namespace {
@@ -39,36 +42,6 @@ ordered_json end_json(const link::EndSpec& e) {
                       {"isolation", iso}};
 }
 
-std::string si(double v, const char* unit) {
-  if (v == 0) return fmt::format("0 {}", unit);
-  static const std::pair<double, const char*> kScales[] = {
-      {1e9, "G"}, {1e6, "M"}, {1e3, "k"}, {1, ""}, {1e-3, "m"}, {1e-6, "u"}, {1e-9, "n"},
-      {1e-12, "p"}, {1e-15, "f"}};
-  for (const auto& [s, p] : kScales)
-    if (std::fabs(v) >= s * 0.9999) return fmt::format("{:.4g} {}{}", v / s, p, unit);
-  return fmt::format("{:.3g} {}", v, unit);
-}
-
-std::string isolation_text(const link::EndSpec& e) {
-  const link::IsolationSpec& i = e.isolation;
-  std::string s;
-  if (i.type == "none") s = "none (direct)";
-  if (i.type == "cap" || i.type == "capchoke") s = si(i.cap, "F") + " per line";
-  if (i.type.rfind("transformer", 0) == 0) {
-    s = "transformer " + (i.part.empty() ? std::string("(device default)") : i.part);
-    if (i.inductance) s += ", OCL " + si(*i.inductance, "H");
-  }
-  if (i.type == "capchoke" || i.type == "transformer_choke") {
-    s += " + choke";
-    if (i.chokes.size() > 1) s += "s";
-    s += " ";
-    std::string list;
-    for (const std::string& c : i.chokes) list += (list.empty() ? "" : " + ") + c;
-    s += list.empty() ? "(default)" : list;
-  }
-  if (i.esd > 0) s += ", ESD " + si(i.esd, "F");
-  return s;
-}
 
 std::string margin_cell(const eye::CheckResult& r, const char* metric, const char* unit,
                         double scale) {
@@ -162,15 +135,10 @@ std::string run_report_markdown(const link::LinkSpec& spec, const LinkRun& run,
     md += "\n";
   }
   for (const std::string& img : images) md += fmt::format("![{}]({})\n\n", img, img);
-  md += "## Bill of materials\n\n| end | device | series R | bypass C | termination | isolation "
-        "|\n|---|---|---|---|---|---|\n";
-  for (const auto& [label, e] : {std::pair{"tx", &spec.tx}, std::pair{"rx", &spec.rx}}) {
-    auto opt = [](const std::optional<double>& v, const char* unit) {
-      return v ? si(*v, unit) : std::string("preset");
-    };
-    md += fmt::format("| {} | {} | {} | {} | {} | {} |\n", label, e->device,
-                      opt(e->series_r, "ohm"), opt(e->bypass_c, "F"),
-                      opt(e->termination, "ohm"), isolation_text(*e));
+  md += "## Bill of materials (as simulated)\n\n";
+  if (!run.directions.empty()) {
+    const link::ExpandedLink& x = run.directions.front().link;
+    md += "- tx end: " + x.tx_bom + "\n- rx end: " + x.rx_bom + "\n";
   }
   md += fmt::format("\n## Cable\n\n{} m of {} AWG {} twisted pair at {} degC", spec.cable.length,
                     spec.cable.gauge, spec.cable.material == "pp" ? "PP" : "PVC",
@@ -178,7 +146,15 @@ std::string run_report_markdown(const link::LinkSpec& spec, const LinkRun& run,
   if (spec.cable.r || spec.cable.l || spec.cable.c || spec.cable.g)
     md += " (explicit per-metre values override the preset)";
   if (!run.directions.empty())
-    md += fmt::format(", {} sections.\n", run.directions.front().link.cable_segments);
+    md += fmt::format(", {} sections", run.directions.front().link.cable_segments);
+  if (StatusOr<link::CableModel> cm = link::cable_model(spec.cable); cm.ok()) {
+    const double a10 = std::real(cm->gamma_diff(10e6)) * spec.cable.length * 8.685889638;
+    md += fmt::format(": differential impedance {:.0f} ohm, velocity {:.2f} c, delay {:.1f} ns, "
+                      "loss {:.2f} dB at 10 MHz",
+                      cm->z_diff(), cm->velocity() / 299792458.0,
+                      spec.cable.length / cm->velocity() * 1e9, a10);
+  }
+  md += ".\n";
   md += "\n## Traffic\n\n";
   md += fmt::format("`{}`\n\n", spec.stimulus.to_script());
   md += "## Solver\n\n| direction | unknowns | steps | rejected | factorizations | time |\n"
@@ -239,12 +215,13 @@ std::string run_summary_text(const link::LinkSpec& spec, const LinkRun& run) {
                      d.pass ? "pass" : "FAIL");
     for (const eye::CheckResult* r : {d.data ? &*d.data : nullptr, d.tones ? &*d.tones : nullptr}) {
       if (r == nullptr) continue;
-      for (const eye::WorstMargin& w : r->worst)
-        s += fmt::format("    worst {:<6} {:>9.4g} (limit {:.4g}, margin {:+.4g}) at {:.3f} us\n",
-                         w.metric, w.j.value * (w.metric == "width" || w.metric == "edge" ? 1e9 : 1),
-                         w.j.limit * (w.metric == "width" || w.metric == "edge" ? 1e9 : 1),
-                         w.j.margin * (w.metric == "width" || w.metric == "edge" ? 1e9 : 1),
-                         w.time * 1e6);
+      for (const eye::WorstMargin& w : r->worst) {
+        const bool ns = w.metric == "width" || w.metric == "edge";
+        const double k = ns ? 1e9 : 1;
+        s += fmt::format("    worst {:<6} {:>8.4g} {:<2} (limit {:.4g}, margin {:+.4g}{}) at {:.3f} us\n",
+                         w.metric, w.j.value * k, ns ? "ns" : "V", w.j.limit * k, w.j.margin * k,
+                         w.metric == "droop" ? ", a warning" : "", w.time * 1e6);
+      }
       for (size_t i = 0; i < r->reasons.size() && i < 5; ++i) s += "    " + r->reasons[i] + "\n";
     }
   }

@@ -1,5 +1,7 @@
 #include "netlists/link/cards.h"
 
+#include <cmath>
+
 #include <fmt/format.h>
 
 namespace isolink::link {
@@ -21,6 +23,16 @@ CardArg number_arg(double v) {
   CardArg a;
   a.number = v;
   return a;
+}
+
+std::string format_si(double v, const char* unit) {
+  if (v == 0) return fmt::format("0 {}", unit);
+  static const std::pair<double, const char*> kScales[] = {
+      {1e9, "G"},  {1e6, "M"},  {1e3, "k"},   {1, ""},
+      {1e-3, "m"}, {1e-6, "u"}, {1e-9, "n"}, {1e-12, "p"}, {1e-15, "f"}};
+  for (const auto& [s, p] : kScales)
+    if (std::fabs(v) >= s * 0.9999) return fmt::format("{:.4g} {}{}", v / s, p, unit);
+  return fmt::format("{:.3g} {}", v, unit);
 }
 
 Status add_cards(Circuit& circuit, const std::vector<Card>& cards) {

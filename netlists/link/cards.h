@@ -19,6 +19,8 @@ Card make_card(char letter, std::string name, std::vector<std::string> nodes,
                std::vector<CardArg> args, std::vector<std::string> refs = {});
 // A positional number argument.
 CardArg number_arg(double v);
+// "2.2 nF", "49 ohm", "260 uH": 4 significant digits with an SI prefix, for reports.
+std::string format_si(double v, const char* unit);
 // Adds every card to the circuit; the first failure names the card.
 Status add_cards(Circuit& circuit, const std::vector<Card>& cards);
 

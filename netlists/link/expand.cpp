@@ -66,7 +66,8 @@ StatusOr<ChokeModel> choke_for(const IsolationSpec& iso, const std::string& numb
 StatusOr<std::pair<std::string, std::string>> add_end(std::vector<Card>& cards,
                                                       const EndSpec& end, const std::string& side,
                                                       const std::string& where,
-                                                      const PartLibrary& parts) {
+                                                      const PartLibrary& parts,
+                                                      std::string* bom) {
   StatusOr<BoardNetwork> board = board_for(end);
   if (!board) return at(end.loc, fmt::format("{}: {}", where, board.status().message()));
   const std::string pin_p = side + "p", pin_n = side + "n";
@@ -75,13 +76,19 @@ StatusOr<std::pair<std::string, std::string>> add_end(std::vector<Card>& cards,
     return at(end.loc, fmt::format("{}: {}", where, s.message()));
   const IsolationSpec& iso = end.isolation;
   const std::string& type = iso.type;
+  *bom = fmt::format("{}: {} per line{}, {} bypass, {} termination", end.device,
+                     format_si(board->r_line, "ohm"),
+                     board->r_pin > 0 ? " + " + format_si(board->r_pin, "ohm") + " at the pin" : "",
+                     format_si(board->bypass_c, "F"), format_si(board->termination, "ohm"));
   int stage = 0;
   auto next = [&](const std::string& tag) {
     ++stage;
     return std::pair{fmt::format("{}_{}{}p", side, tag, stage),
                      fmt::format("{}_{}{}n", side, tag, stage)};
   };
+  if (type == "none") *bom += "; no isolation";
   if (type == "cap" || type == "capchoke") {
+    *bom += "; " + format_si(iso.cap, "F") + " isolation cap per line";
     auto [a, b] = next("c");
     cards.push_back(make_card('c', "c" + side + "isop", {p, a}, {number_arg(iso.cap)}));
     cards.push_back(make_card('c', "c" + side + "ison", {n, b}, {number_arg(iso.cap)}));
@@ -90,6 +97,12 @@ StatusOr<std::pair<std::string, std::string>> add_end(std::vector<Card>& cards,
   if (type == "transformer" || type == "transformer_choke") {
     StatusOr<TransformerModel> m = transformer_for(end, parts, where);
     if (!m) return m.status();
+    *bom += fmt::format("; transformer {} (OCL {}, leakage {}, DCR {}{})",
+                        iso.part.empty() ? "(device default part)" : iso.part,
+                        format_si(m->inductance, "H"), format_si(m->leakage, "H"),
+                        format_si(m->dcr, "ohm"),
+                        m->centre_tap_c > 0 ? ", centre tap " + format_si(m->centre_tap_c, "F")
+                                            : "");
     auto [a, b] = next("t");
     if (Status s = add_transformer(cards, "t" + side, p, n, a, b, *m); !s.ok())
       return at(iso.loc, fmt::format("{}.isolation: {}", where, s.message()));
@@ -101,6 +114,8 @@ StatusOr<std::pair<std::string, std::string>> add_end(std::vector<Card>& cards,
     for (size_t i = 0; i < chokes.size(); ++i) {
       StatusOr<ChokeModel> m = choke_for(iso, chokes[i], parts, where);
       if (!m) return m.status();
+      *bom += fmt::format("; choke {} ({} per winding, k {:.4f})", chokes[i],
+                          format_si(m->inductance, "H"), m->k);
       auto [a, b] = next("k");
       if (Status s = add_choke(cards, fmt::format("l{}{}", side, i + 1), p, n, a, b, *m); !s.ok())
         return at(iso.loc, fmt::format("{}.isolation: {}", where, s.message()));
@@ -111,12 +126,14 @@ StatusOr<std::pair<std::string, std::string>> add_end(std::vector<Card>& cards,
   double cable_side_c = iso.cable_side_c;
   if (cable_side_c < 0) cable_side_c = type.rfind("transformer", 0) == 0 ? 100e-12 : 0.0;
   if (cable_side_c > 0) {
+    *bom += "; " + format_si(cable_side_c, "F") + " per line on the cable side";
     cards.push_back(make_card('c', "c" + side + "cabp", {p, "0"}, {number_arg(cable_side_c)}));
     cards.push_back(make_card('c', "c" + side + "cabn", {n, "0"}, {number_arg(cable_side_c)}));
   }
   if (iso.esd > 0) {
     // The ESD part sits at the board's ESD node when it has one (BQ79606A), else at the connector.
     const bool esd_node = board->r_pin > 0;
+    *bom += "; ESD " + format_si(iso.esd, "F") + " per line";
     const std::string ep = esd_node ? side + "b_esdp" : p, en = esd_node ? side + "b_esdn" : n;
     cards.push_back(make_card('c', "c" + side + "esdp", {ep, "0"}, {number_arg(iso.esd)}));
     cards.push_back(make_card('c', "c" + side + "esdn", {en, "0"}, {number_arg(iso.esd)}));
@@ -152,9 +169,9 @@ StatusOr<ExpandedLink> expand_link(const LinkSpec& spec, const PartLibrary& part
   std::vector<Card>& cards = out.netlist.cards;
   if (Status s = add_tx_driver(cards, "tx", "txp", "txn", out.drive, opt.driver); !s.ok())
     return s.with_context("tx driver");
-  auto a = add_end(cards, from, "tx", from_key, parts);
+  auto a = add_end(cards, from, "tx", from_key, parts, down ? &out.tx_bom : &out.rx_bom);
   if (!a) return a.status();
-  auto b = add_end(cards, to, "rx", to_key, parts);
+  auto b = add_end(cards, to, "rx", to_key, parts, down ? &out.rx_bom : &out.tx_bom);
   if (!b) return b.status();
   if (Status s = add_cable(cards, "cab", a->first, a->second, b->first, b->second, spec.cable,
                            opt.driver.edge);

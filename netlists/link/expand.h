@@ -40,6 +40,7 @@ struct ExpandedLink {
   traffic::Drive drive;                 // what the transmitter sends
   std::vector<uint8_t> expected;        // data bytes sent, in order
   int cable_segments = 0;               // sections the cable was split into
+  std::string tx_bom, rx_bom;           // each spec end's parts as built, in words
 };
 
 StatusOr<ExpandedLink> expand_link(const LinkSpec& spec, const PartLibrary& parts, Direction d,
