@@ -6,10 +6,25 @@
 //   klu.solve(x);                                // in place, x has pattern.size() entries
 // The key identifies a matrix (the engines use alpha, the coefficient of C): when a step size
 // comes back, its factorization is reused instead of refactored.
+//
+// A transient step is one solve, so the solve is what counts, and for circuit matrices its time
+// is set less by the number of entries than by the longest chain of dependent updates (each
+// unknown waits for the ones it depends on). Two orderings are tried on the first matrix:
+//   - KLU's default: BTF blocks, AMD inside them (least fill; on a cable ladder every unknown
+//     then waits for the previous one: a chain of ~390 rows over L and U for 204 unknowns);
+//   - METIS nested dissection (through CHOLMOD) of A + A', no BTF (a little more fill, a chain
+//     of ~46 on the same ladder: the CPU overlaps independent rows).
+// The first matrix should look like the later ones (the engines factor the DC matrix, whose
+// pivots differ, with a separate Ordering::Amd solver). The one with the lower modelled solve cost
+// (off-diagonal entries + kChainWeight x chain length of L and U) is kept for the whole run. KLU
+// factors (partial pivoting, row scaling); each factorization is then copied out (klu_extract) into
+// row-oriented arrays: row permutation with the scaling folded in, strictly lower L, strictly upper
+// U pre-divided by its diagonal, the off-diagonal BTF blocks, and the column permutation. solve()
+// runs on those: no division and no per-column unpacking.
 #pragma once
 
-#include <list>
 #include <memory>
+#include <string>
 
 #include "solver/mna.h"
 #include "solver/status.h"
@@ -19,13 +34,19 @@ namespace isolink {
 class KluSolver {
  public:
   static constexpr size_t kCacheSize = 24;
+  // Cost of one link of the dependency chain, in off-diagonal entries (latency of a load, a
+  // multiply and a subtract against the throughput of independent ones; measured on x86-64).
+  static constexpr double kChainWeight = 5.0;
+
+  enum class Ordering { Auto, Amd, NestedDissection };
 
   KluSolver();
   ~KluSolver();
   KluSolver(const KluSolver&) = delete;
   KluSolver& operator=(const KluSolver&) = delete;
 
-  Status analyze(const MnaPattern& pattern);
+  // Auto picks on the first factorization (see above); the others force one (tests, benches).
+  Status analyze(const MnaPattern& pattern, Ordering ordering = Ordering::Auto);
   // Makes the factorization stored under key current; false when none is cached.
   bool select(double key);
   // Factors values (over the pattern) and stores it under key. On a singular matrix the error
@@ -37,6 +58,16 @@ class KluSolver {
 
   int factorizations() const { return factorizations_; }  // numeric factorizations done
   int reuses() const { return reuses_; }                  // times select() found one cached
+
+  // About the current factorization, for benches and tests.
+  struct Info {
+    std::string ordering;  // "amd" or "nested dissection"
+    long lu_nonzeros = 0;  // entries of L and U, diagonals included (as KLU counts them)
+    long offdiagonal = 0;  // entries the solve multiplies (L, U and F off their diagonals)
+    int chain = 0;         // longest chain of dependent rows, L and U together
+    int blocks = 0;        // BTF blocks
+  };
+  Info info() const;
 
  private:
   struct Impl;

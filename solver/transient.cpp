@@ -66,6 +66,13 @@ struct System {
   std::vector<double> g, c;  // value arrays (+ trash)
   KluSolver klu;
   int n = 0;                 // unknowns without ground
+  // The elements with an excitation (sources): the only ones stamp_rhs is called on.
+  std::vector<const Element*> sources;
+  // C without its zero entries, by rows, for C * v on every step: row r (unknown r + 1) has
+  // entries c_start[r] .. c_start[r + 1], columns as unknowns (1..n).
+  std::vector<int> c_start, c_col;
+  std::vector<double> c_val;
+  std::vector<double> a;     // G + alpha C, factorization input
 
   Status build(const Circuit& circuit) {
     n = circuit.unknown_count();
@@ -78,41 +85,75 @@ struct System {
     c.assign(pattern.value_count(), 0.0);
     for (auto& e : elements) e->stamp(g.data(), c.data());
     for (int node : circuit.floating_nodes()) g[pattern.slot(node, node)] += Circuit::kFloatingTie;
+    for (const auto& e : elements)
+      if (e->has_excitation()) sources.push_back(e.get());
+    const auto& cp = pattern.col_start();
+    const auto& ri = pattern.row_index();
+    c_start.assign(n + 1, 0);
+    for (int col = 0; col < n; ++col)
+      for (int k = cp[col]; k < cp[col + 1]; ++k)
+        if (c[k] != 0.0) ++c_start[ri[k] + 1];
+    for (int r = 0; r < n; ++r) c_start[r + 1] += c_start[r];
+    c_col.assign(c_start[n], 0);
+    c_val.assign(c_start[n], 0.0);
+    std::vector<int> next(c_start.begin(), c_start.end() - 1);
+    for (int col = 0; col < n; ++col)
+      for (int k = cp[col]; k < cp[col + 1]; ++k)
+        if (c[k] != 0.0) c_col[next[ri[k]]] = col + 1, c_val[next[ri[k]]++] = c[k];
+    a.resize(pattern.nonzeros());
     return klu.analyze(pattern);
   }
 
-  // y += C * v over unknowns 1..n (index 0 ignored).
-  void add_c_times(const std::vector<double>& v, double scale, std::vector<double>& y) const {
-    const auto& cp = pattern.col_start();
-    const auto& ri = pattern.row_index();
-    for (int col = 0; col < n; ++col) {
-      const double vc = v[col + 1] * scale;
-      if (vc == 0.0) continue;
-      for (int k = cp[col]; k < cp[col + 1]; ++k) y[ri[k] + 1] += c[k] * vc;
+  // y -= C * v over unknowns 1..n (index 0 ignored).
+  void sub_c_times(const double* __restrict v, double* __restrict y) const {
+    const int* __restrict cs = c_start.data();
+    const int* __restrict cc = c_col.data();
+    const double* __restrict cv = c_val.data();
+    for (int r = 0; r < n; ++r) {
+      double s = 0.0;
+      for (int k = cs[r]; k < cs[r + 1]; ++k) s += cv[k] * v[cc[k]];
+      y[r + 1] -= s;
     }
   }
 
-  void rhs(const Circuit& circuit, double t, std::vector<double>& b) const {
+  // b = excitation at time t (index 0 = ground, zero).
+  void rhs(double t, std::vector<double>& b) const {
     std::fill(b.begin(), b.end(), 0.0);
-    for (const auto& e : circuit.elements()) e->stamp_rhs(t, b.data());
+    for (const Element* e : sources) e->stamp_rhs(t, b.data());
     b[0] = 0.0;
   }
 
   Status select_or_factor(const Circuit& circuit, double alpha) {
     if (klu.select(alpha)) return Status::Ok();
-    std::vector<double> a(pattern.nonzeros());
     for (int k = 0; k < pattern.nonzeros(); ++k) a[k] = g[k] + alpha * c[k];
-    Status s = klu.factor(alpha, a.data());
-    if (!s.ok() && klu.singular_column() >= 0)
-      return Status::Error(fmt::format("singular matrix: {} is not determined by the circuit",
-                                       circuit.unknown_name(klu.singular_column() + 1)));
-    return s;
+    return name_singular(circuit, klu, klu.factor(alpha, a.data()));
   }
 
   // Solves in place: b holds the right-hand side (index 0 ignored), then x.
   Status solve(std::vector<double>& b) {
     Status s = klu.solve(b.data() + 1);
     b[0] = 0.0;
+    return s;
+  }
+
+  // The DC operating point into x (n + 1 entries). It has its own factorization with KLU's
+  // default ordering: at DC the inductor branches have no diagonal and KLU pivots away from a
+  // fill-reducing order, so this matrix says nothing about which ordering suits the transient
+  // matrices; the transient KluSolver decides on its first (transient) factorization instead.
+  Status dc(const Circuit& circuit, std::vector<double>& x) const {
+    KluSolver dc_klu;
+    if (Status s = dc_klu.analyze(pattern, KluSolver::Ordering::Amd); !s.ok()) return s;
+    if (Status s = name_singular(circuit, dc_klu, dc_klu.factor(0.0, g.data())); !s.ok()) return s;
+    rhs(0.0, x);
+    Status s = dc_klu.solve(x.data() + 1);
+    x[0] = 0.0;
+    return s;
+  }
+
+  static Status name_singular(const Circuit& circuit, const KluSolver& k, Status s) {
+    if (!s.ok() && k.singular_column() >= 0)
+      return Status::Error(fmt::format("singular matrix: {} is not determined by the circuit",
+                                       circuit.unknown_name(k.singular_column() + 1)));
     return s;
   }
 };
@@ -147,10 +188,8 @@ struct History {
 StatusOr<std::vector<double>> dc_operating_point(const Circuit& circuit) {
   System sys;
   if (Status s = sys.build(circuit); !s.ok()) return s;
-  if (Status s = sys.select_or_factor(circuit, 0.0); !s.ok()) return s.with_context("DC operating point");
   std::vector<double> x(sys.n + 1);
-  sys.rhs(circuit, 0.0, x);
-  if (Status s = sys.solve(x); !s.ok()) return s.with_context("DC operating point");
+  if (Status s = sys.dc(circuit, x); !s.ok()) return s.with_context("DC operating point");
   return x;
 }
 
@@ -180,12 +219,11 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
   stats.breakpoints = static_cast<int>(bps.size());
 
   // Initial state.
-  std::vector<double> x(n + 1, 0.0), xdot(n + 1, 0.0), b(n + 1), rhs(n + 1), xnew(n + 1);
+  std::vector<double> x(n + 1, 0.0), xdot(n + 1, 0.0), hist_part(n + 1, 0.0), xnew(n + 1);
   if (!opt.uic) {
-    if (Status s = sys.select_or_factor(circuit, 0.0); !s.ok()) return s.with_context("DC operating point");
-    sys.rhs(circuit, 0.0, x);
-    if (Status s = sys.solve(x); !s.ok()) return s.with_context("DC operating point");
+    if (Status s = sys.dc(circuit, x); !s.ok()) return s.with_context("DC operating point");
     ++stats.solves;
+    ++stats.factorizations;
   }
 
   Waveform w;
@@ -197,18 +235,29 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
   };
   record(0.0, x);
 
-  // Which unknowns the error control watches, and their absolute tolerances.
-  std::vector<int> watched;
-  std::vector<double> abs_tol;
+  // Which unknowns the error control watches, and their tolerances (trtol folded in).
   // As SPICE does, only states count: nodes with capacitance (C diagonal) and inductor currents;
   // a node without capacitance is algebraic and follows the states.
-  std::vector<bool> has_c(n + 1, false);
-  for (int u = 1; u <= n; ++u) has_c[u] = sys.c[sys.pattern.slot(u, u)] != 0.0;
+  std::vector<int> watched;
+  std::vector<double> abs_tol;
   for (int u = 1; u <= n; ++u) {
-    if ((circuit.unknown_is_node(u) && has_c[u]) || circuit.unknown_is_state(u)) {
+    const bool has_c = sys.c[sys.pattern.slot(u, u)] != 0.0;
+    if ((circuit.unknown_is_node(u) && has_c) || circuit.unknown_is_state(u)) {
       watched.push_back(u);
-      abs_tol.push_back(circuit.unknown_is_node(u) ? opt.vntol : opt.abstol);
+      abs_tol.push_back(opt.trtol * (circuit.unknown_is_node(u) ? opt.vntol : opt.abstol));
     }
+  }
+  const double rel_tol = opt.trtol * opt.reltol;
+  // The relative part scales with the largest |x| the unknown has had so far (its own, since
+  // t = 0), not with its value now: an oscillating current passes through zero twice a period,
+  // and a tolerance relative to its value there would hold the step down for nothing (that made
+  // the cable's ringing currents set most steps of the 15 m example).
+  // inv_tol = 1 / tolerance, recomputed only when a peak grows (rarely, once the signals have
+  // had their first full swing), so the error loop has no division.
+  std::vector<double> peak(watched.size(), 0.0), inv_tol(watched.size(), 0.0);
+  for (size_t k = 0; k < watched.size(); ++k) {
+    peak[k] = std::fabs(x[watched[k]]);
+    inv_tol[k] = 1.0 / (rel_tol * peak[k] + abs_tol[k]);
   }
 
   // History since the last breakpoint: up to 3 points, oldest first (fixed storage).
@@ -245,50 +294,48 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
     // Integration formula: x1' = a0 x1 + hist; system (G + a0 C) x1 = b1 - C hist.
     const bool euler = after_bp || hist.count < 2;
     const bool gear = !euler && opt.method == IntegrationMethod::Gear2;
+    const double inv_step = 1.0 / step;
     double a0;
-    std::fill(rhs.begin(), rhs.end(), 0.0);  // rhs <- hist (the x1-independent part of x1')
     if (euler) {
-      a0 = 1.0 / step;
-      for (int u = 1; u <= n; ++u) rhs[u] = -x[u] / step;
+      a0 = inv_step;
+      for (int u = 1; u <= n; ++u) hist_part[u] = -x[u] * inv_step;
     } else if (gear) {
       const double h0 = t - hist.t(hist.count - 2);
       const double rho = step / h0;
       a0 = (1 + 2 * rho) / (step * (1 + rho));
-      const double a1 = -(1 + rho) / step, a2 = rho * rho / (step * (1 + rho));
+      const double a1 = -(1 + rho) * inv_step, a2 = rho * rho / (step * (1 + rho));
       const auto& xm1 = hist.x(hist.count - 2);
-      for (int u = 1; u <= n; ++u) rhs[u] = a1 * x[u] + a2 * xm1[u];
+      for (int u = 1; u <= n; ++u) hist_part[u] = a1 * x[u] + a2 * xm1[u];
     } else {
-      a0 = 2.0 / step;
-      for (int u = 1; u <= n; ++u) rhs[u] = -2.0 * x[u] / step - xdot[u];
+      a0 = 2.0 * inv_step;
+      for (int u = 1; u <= n; ++u) hist_part[u] = -a0 * x[u] - xdot[u];
     }
-    sys.rhs(circuit, t + step, b);
-    sys.add_c_times(rhs, -1.0, b);
+    sys.rhs(t + step, xnew);
+    sys.sub_c_times(hist_part.data(), xnew.data());
     if (Status s = sys.select_or_factor(circuit, a0); !s.ok())
       return s.with_context(fmt::format("transient at t={:g} s", t + step));
-    xnew = b;
     if (Status s = sys.solve(xnew); !s.ok()) return s.with_context(fmt::format("t={:g} s", t + step));
     ++stats.solves;
 
-    // Truncation error from the third divided difference over the last four points.
+    // Truncation error h^3 * coef * x''' with x''' = 6 x the third divided difference over the
+    // last four points, written as weights on the three successive differences (no division in
+    // the loop), against trtol * (reltol * peak |x| + abstol) with the peak up to the last
+    // accepted point; ratio = the worst error / tolerance.
     double ratio = 0.0;
     if (hist.count == 3) {
       const double t1 = t + step, t0 = hist.t(2), tm1 = hist.t(1), tm2 = hist.t(0);
       const auto &x0 = hist.x(2), &xm1 = hist.x(1), &xm2 = hist.x(0);
       const double coef = gear ? (2.0 / 9.0) * 6.0 : (1.0 / 12.0) * 6.0;
-      const double h3 = step * step * step * coef;
+      const double ia = 1.0 / (t1 - t0), ib = 1.0 / (t0 - tm1), ic = 1.0 / (tm1 - tm2);
+      const double ie = 1.0 / (t1 - tm1), iff = 1.0 / (t0 - tm2), ig = 1.0 / (t1 - tm2);
+      const double h3 = step * step * step * coef * ig;
+      const double w1 = h3 * ie * ia, w2 = -h3 * ib * (ie + iff), w3 = h3 * iff * ic;
       for (size_t k = 0; k < watched.size(); ++k) {
         const int u = watched[k];
-        const double d10 = (xnew[u] - x0[u]) / (t1 - t0);
-        const double d0m = (x0[u] - xm1[u]) / (t0 - tm1);
-        const double dm2 = (xm1[u] - xm2[u]) / (tm1 - tm2);
-        const double dd2a = (d10 - d0m) / (t1 - tm1);
-        const double dd2b = (d0m - dm2) / (t0 - tm2);
-        const double dd3 = (dd2a - dd2b) / (t1 - tm2);
-        const double err = h3 * std::fabs(dd3);
-        const double tol =
-            opt.trtol * (opt.reltol * std::max(std::fabs(xnew[u]), std::fabs(x0[u])) + abs_tol[k]);
-        if (err / tol > ratio) {
-          ratio = err / tol;
+        const double r = inv_tol[k] * std::fabs(w1 * (xnew[u] - x0[u]) + w2 * (x0[u] - xm1[u]) +
+                                                w3 * (xm1[u] - xm2[u]));
+        if (r > ratio) {
+          ratio = r;
           worst_unknown = u;
         }
       }
@@ -308,11 +355,15 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
 
     // Accept.
     ++stats.accepted;
-    for (int u = 1; u <= n; ++u) xdot[u] = a0 * xnew[u] + rhs[u];
+    for (int u = 1; u <= n; ++u) xdot[u] = a0 * xnew[u] + hist_part[u];
     t = lands ? bp : t + step;
     std::swap(x, xnew);
     hist.push(t, x);
     record(t, x);
+    for (size_t k = 0; k < watched.size(); ++k) {
+      const double a = std::fabs(x[watched[k]]);
+      if (a > peak[k]) peak[k] = a, inv_tol[k] = 1.0 / (rel_tol * a + abs_tol[k]);
+    }
 
     const double grow = ratio > 0 ? std::min(2.0, 0.9 * std::cbrt(1.0 / ratio)) : 2.0;
     if (!lands) last_regular_h = step;
@@ -326,7 +377,7 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
     }
   }
 
-  stats.factorizations = sys.klu.factorizations();
+  stats.factorizations += sys.klu.factorizations();
   stats.reuses = sys.klu.reuses();
   if (stats_out) *stats_out = stats;
   return w;

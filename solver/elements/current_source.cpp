@@ -18,6 +18,7 @@ class CurrentSource final : public Element {
   CurrentSource(const Card& card, SourceFunction f) : Element(card.name, card.loc), f_(std::move(f)) {}
   void declare(MnaPattern&) override {}
   void stamp(double*, double*) const override {}
+  bool has_excitation() const override { return true; }
   void stamp_rhs(double t, double* b) const override {
     const double i = f_.value(t);
     b[nodes_[0]] -= i, b[nodes_[1]] += i;

@@ -57,6 +57,8 @@ class Element {
   virtual void stamp(double* g, double* c) const = 0;
   // Excitation at time t into b (b[0] is the ground trash entry).
   virtual void stamp_rhs(double t, double* b) const {}
+  // True when stamp_rhs adds anything (sources): the engines call stamp_rhs on these only.
+  virtual bool has_excitation() const { return false; }
   // Resolves time defaults that depend on the analysis (ngspice: PULSE TR defaults to TSTEP).
   virtual void bind_time(double tstep, double tstop) {}
   // Times in (0, tstop] where the excitation has a corner.

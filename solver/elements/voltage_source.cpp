@@ -25,6 +25,7 @@ class VoltageSource final : public Element {
   void stamp(double* g, double*) const override {
     g[a_br_] += 1, g[b_br_] -= 1, g[br_a_] += 1, g[br_b_] -= 1;
   }
+  bool has_excitation() const override { return true; }
   void stamp_rhs(double t, double* b) const override { b[branches_[0]] += f_.value(t); }
   void bind_time(double tstep, double tstop) override { f_.bind_time(tstep, tstop); }
   void breakpoints(double tstop, std::vector<double>& out) const override {
