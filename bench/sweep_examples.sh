@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# isolink sweep on the example sweep files, one after another:
+#   bash bench/sweep_examples.sh [ISOLINK_BINARY] [JOBS] [SWEEP...]
+# (defaults: build/cli/isolink, JOBS = all cores, every netlists/examples/sweep_*.yaml). For each:
+# points, pass / fail / error, wall time of the whole sweep (simulation, results.csv, summary.json,
+# PNGs) and points per minute; the summed run time of the points over the wall time shows how well
+# the cores were used. Set MPI_NP=N to run under `mpirun -np N` on this machine instead
+# (ISOLINK_MPI builds; rank 0 only hands out points, so N = cores + 1).
+# Prints a Markdown table (for bench/README.md); the outputs stay in $OUT (default a temp folder).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+ISOLINK=${1:-build/cli/isolink}
+JOBS=${2:-0}
+shift $(($# < 2 ? $# : 2))
+if (($# > 0)); then sweeps=("$@"); else sweeps=(netlists/examples/sweep_*.yaml); fi
+OUT=${OUT:-$(mktemp -d)}
+jobs_arg=()
+[ "$JOBS" != 0 ] && jobs_arg=(-j "$JOBS")
+launch=()
+if [ -n "${MPI_NP:-}" ]; then
+  launch=(mpirun --allow-run-as-root --oversubscribe -np "$MPI_NP")
+  export OMPI_MCA_btl_vader_single_copy_mechanism=none OMPI_MCA_plm=${OMPI_MCA_plm:-isolated}
+fi
+
+echo "| sweep | points | pass / fail / error | wall s | points/min | point s (mean) | cores busy |"
+echo "|---|---|---|---|---|---|---|"
+for f in "${sweeps[@]}"; do
+  name=$(basename "$f" .yaml)
+  dir="$OUT/$name"
+  rm -rf "$dir"
+  s=$(date +%s%N)
+  "${launch[@]}" "$ISOLINK" sweep "$f" -o "$dir" -q "${jobs_arg[@]}" >/dev/null 2>&1 || true
+  e=$(date +%s%N)
+  awk -F, -v name="$name" -v ns=$((e - s)) '
+    NR == 1 { for (i = 1; i <= NF; i++) { if ($i == "verdict") v = i; if ($i == "seconds") t = i }; next }
+    { n++; c[$v]++; sum += $t }
+    END {
+      wall = ns / 1e9
+      printf "| %s | %d | %d / %d / %d | %.1f | %.1f | %.2f | %.2f |\n", name, n, c["pass"],
+             c["fail"], c["error"], wall, n / wall * 60, sum / n, sum / wall
+    }' "$dir/results.csv"
+done
+echo
+echo "outputs: $OUT"

@@ -1,0 +1,722 @@
+#include "cli/sweep_run.h"
+
+#include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "cli/run_report.h"
+#include "reports/sweep_plots.h"
+
+namespace isolink::cli::sweep {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// The columns after the point's own: verdict .. error.
+const std::vector<std::string> kResultColumns = {
+    "verdict",         "worst_metric",  "worst_margin_rel",
+    "margin_vstart_V", "margin_vend_V", "margin_width_ns",
+    "margin_edge_ns",  "decoded_ok",    "fail_reason",
+    "seconds",         "error"};
+// Scale of each kMetrics margin in the CSV (V, V, ns, ns).
+constexpr std::array<double, 4> kCsvScale = {1.0, 1.0, 1e9, 1e9};
+
+double now_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"') out += '"';
+    out += (c == '\n' || c == '\r') ? ' ' : c;
+  }
+  return out + "\"";
+}
+
+std::string num(double v) {
+  return std::isnan(v) ? "" : fmt::format("{:.6g}", v);
+}
+
+bool parse_double(const std::string& s, double* out) {
+  if (s.empty()) {
+    *out = kNaN;
+    return true;
+  }
+  char* end = nullptr;
+  *out = std::strtod(s.c_str(), &end);
+  return end != s.c_str() && *end == '\0';
+}
+
+std::string first_line(const std::string& s) {
+  return s.substr(0, s.find('\n'));
+}
+
+}  // namespace
+
+std::string duration_text(double s) {
+  if (!(s >= 0) || !std::isfinite(s)) return "?";
+  if (s < 60) return fmt::format("{:.1f} s", s);
+  const long t = std::lround(s);
+  if (t < 3600) return fmt::format("{} min {:02} s", t / 60, t % 60);
+  return fmt::format("{} h {:02} min", t / 3600, (t % 3600) / 60);
+}
+
+std::vector<std::string> split_csv_line(std::string_view line) {
+  std::vector<std::string> out;
+  std::string cur;
+  bool quoted = false, was_quoted = false;
+  for (size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c == '"') {
+        if (i + 1 < line.size() && line[i + 1] == '"') {
+          cur += '"';
+          ++i;
+        } else {
+          quoted = false;
+        }
+      } else {
+        cur += c;
+      }
+    } else if (c == '"' && cur.empty() && !was_quoted) {
+      quoted = was_quoted = true;
+    } else if (c == ',') {
+      out.push_back(cur);
+      cur.clear();
+      was_quoted = false;
+    } else if (c != '\r' && c != '\n') {
+      cur += c;
+    }
+  }
+  out.push_back(cur);
+  return out;
+}
+
+std::vector<std::string> results_header(const SweepSpec& s) {
+  std::vector<std::string> h{"point"};
+  for (const std::string& c : s.point_columns()) h.push_back(c);
+  h.insert(h.end(), kResultColumns.begin(), kResultColumns.end());
+  return h;
+}
+
+std::string results_row(const PointResult& r) {
+  std::string line = fmt::format("{}", r.index);
+  auto add = [&line](const std::string& f) { line += "," + csv_field(f); };
+  for (const std::string& c : r.cells) add(c);
+  add(r.verdict);
+  add(r.worst_metric);
+  add(num(r.worst_rel));
+  for (size_t m = 0; m < kMetrics.size(); ++m) add(num(r.margin[m] * kCsvScale[m]));
+  add(r.decoded_ok ? (*r.decoded_ok ? "true" : "false") : "");
+  add(r.reason);
+  add(fmt::format("{:.2f}", r.seconds));
+  add(r.error);
+  return line + "\n";
+}
+
+StatusOr<PointResult> parse_results_row(std::string_view line, size_t ncells, size_t ncolumns) {
+  const std::vector<std::string> f = split_csv_line(line);
+  if (f.size() != ncolumns)
+    return Status::Error(fmt::format("{} fields, expected {}", f.size(), ncolumns));
+  PointResult r;
+  char* end = nullptr;
+  const unsigned long long idx = std::strtoull(f[0].c_str(), &end, 10);
+  if (f[0].empty() || *end != '\0') return Status::Error("point is not a number: '" + f[0] + "'");
+  r.index = static_cast<size_t>(idx);
+  size_t k = 1;
+  for (size_t i = 0; i < ncells; ++i) r.cells.push_back(f[k++]);
+  r.verdict = f[k++];
+  if (r.verdict != "pass" && r.verdict != "fail" && r.verdict != "error")
+    return Status::Error("verdict is not pass, fail or error: '" + r.verdict + "'");
+  r.worst_metric = f[k++];
+  if (!parse_double(f[k++], &r.worst_rel)) return Status::Error("bad worst_margin_rel");
+  for (size_t m = 0; m < kMetrics.size(); ++m) {
+    double v = 0;
+    if (!parse_double(f[k++], &v)) return Status::Error("bad margin");
+    r.margin[m] = v / kCsvScale[m];
+  }
+  const std::string& d = f[k++];
+  if (d == "true") r.decoded_ok = true;
+  if (d == "false") r.decoded_ok = false;
+  r.reason = f[k++];
+  if (!parse_double(f[k++], &r.seconds)) return Status::Error("bad seconds");
+  if (std::isnan(r.seconds)) r.seconds = 0;
+  r.error = f[k++];
+  return r;
+}
+
+PointResult round_trip(const PointResult& r, size_t ncells, size_t ncolumns) {
+  std::string row = results_row(r);
+  row.pop_back();
+  StatusOr<PointResult> p = parse_results_row(row, ncells, ncolumns);
+  return p ? *p : r;
+}
+
+PointResult score_run(const LinkRun& run) {
+  PointResult r;
+  r.verdict = run.pass ? "pass" : "fail";
+  r.seconds = run.seconds;
+  std::array<std::optional<eye::Judged>, 4> worst;
+  bool any_data = false, decoded = true;
+  std::vector<std::string> reasons;
+  auto reason = [&reasons](const std::string& why) {
+    if (std::find(reasons.begin(), reasons.end(), why) == reasons.end()) reasons.push_back(why);
+  };
+  for (const DirectionRun& d : run.directions) {
+    for (const std::optional<eye::CheckResult>* c : {&d.data, &d.tones}) {
+      if (!c->has_value()) continue;
+      const eye::CheckResult& cr = **c;
+      if (!cr.pass) {
+        if (cr.pulses.empty()) reason("no signal");
+        for (const eye::PulseMetrics& p : cr.pulses)
+          for (const std::string& f : p.fails) reason(f.substr(0, f.find(':')));
+        for (const eye::FrameResult& f : cr.frames)
+          if (f.fails()) reason("decode: " + f.fault);
+        if (!cr.expect_match) reason("bytes differ");
+      }
+      for (const eye::WorstMargin& w : (*c)->worst) {
+        if (!w.j.judged()) continue;
+        for (size_t m = 0; m < kMetrics.size(); ++m)
+          if (w.metric == kMetrics[m] && (!worst[m] || w.j.margin < worst[m]->margin))
+            worst[m] = w.j;
+      }
+    }
+    if (d.data) {
+      any_data = true;
+      bool frames_ok = !d.data->frames.empty() && d.data->expect_match;
+      for (const eye::FrameResult& f : d.data->frames) frames_ok = frames_ok && !f.fails();
+      decoded = decoded && frames_ok;
+    }
+  }
+  if (any_data) r.decoded_ok = decoded;
+  for (const std::string& why : reasons) r.reason += (r.reason.empty() ? "" : "; ") + why;
+  for (size_t m = 0; m < kMetrics.size(); ++m) {
+    if (!worst[m]) continue;
+    r.margin[m] = worst[m]->margin;
+    const double lim = std::abs(worst[m]->limit);
+    const double rel = lim > 0 ? worst[m]->margin / lim : kNaN;
+    if (!std::isnan(rel) && (std::isnan(r.worst_rel) || rel < r.worst_rel)) {
+      r.worst_rel = rel;
+      r.worst_metric = kMetrics[m];
+    }
+  }
+  if (r.worst_metric.empty()) {
+    r.worst_metric = "none";
+    if (!run.pass) r.worst_rel = -1.0;
+  }
+  return r;
+}
+
+PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t index,
+                      const PointOptions& opt) {
+  const double t0 = now_seconds();
+  PointResult r;
+  r.index = index;
+  auto fail = [&](const std::string& message) {
+    r.verdict = "error";
+    r.worst_metric.clear();
+    r.worst_rel = kNaN;
+    r.margin.fill(kNaN);
+    r.decoded_ok.reset();
+    r.reason.clear();
+    r.error = first_line(message);
+    r.seconds = now_seconds() - t0;
+    return r;
+  };
+  try {
+    PointOutcome po = make_point(s, index);
+    r.cells = po.point.cells;
+    if (!po.status.ok()) return fail(po.status.message());
+    StatusOr<LinkRun> run = run_link(po.point.spec, parts, opt.run);
+    if (!run) return fail(run.status().message());
+    std::vector<std::string> cells = std::move(r.cells);
+    r = score_run(*run);
+    r.index = index;
+    r.cells = std::move(cells);
+    if (!opt.waves_dir.empty()) {
+      const Waveform w = run_waveforms(*run, po.point.spec.sim.tstep);
+      const std::string path = fmt::format("{}/point_{:05}.csv", opt.waves_dir, index);
+      if (Status st = write_waveform_csv(w, path); !st.ok()) return fail(st.message());
+    }
+  } catch (const std::exception& e) {
+    return fail(std::string("internal error: ") + e.what());
+  }
+  r.seconds = now_seconds() - t0;
+  return r;
+}
+
+// --- results.csv -----------------------------------------------------------------------------
+
+StatusOr<std::unique_ptr<ResultLog>> ResultLog::open(const SweepSpec& s, const SweepOptions& opt) {
+  std::unique_ptr<ResultLog> log(new ResultLog());
+  log->spec_ = &s;
+  log->quiet_ = opt.quiet;
+  log->tty_ = isatty(STDERR_FILENO) != 0;
+  log->total_ = s.size();
+  log->have_.assign(log->total_, false);
+  log->ncells_ = s.point_columns().size();
+  const std::vector<std::string> header = results_header(s);
+  log->ncolumns_ = header.size();
+  log->path_ = opt.out_dir + "/results.csv";
+  std::string header_line;
+  for (const std::string& h : header)
+    header_line += (header_line.empty() ? "" : ",") + csv_field(h);
+  header_line += "\n";
+
+  std::string keep = header_line;
+  if (opt.resume) {
+    std::ifstream in(log->path_, std::ios::binary);
+    if (in) {
+      std::stringstream ss;
+      ss << in.rdbuf();
+      const std::string text = ss.str();
+      size_t pos = 0, line_no = 0;
+      while (pos < text.size()) {
+        const size_t nl = text.find('\n', pos);
+        if (nl == std::string::npos) break;  // a row cut short by a crash: run that point again
+        const std::string line = text.substr(pos, nl - pos);
+        pos = nl + 1;
+        ++line_no;
+        if (line_no == 1) {
+          if (line + "\n" != header_line && line + "\r\n" != header_line)
+            return Status::Error(fmt::format(
+                "{}:1: error: --resume: the columns differ from this sweep's ({}); was it written "
+                "by another sweep file?",
+                log->path_, header_line.substr(0, header_line.size() - 1)));
+          continue;
+        }
+        if (line.empty()) continue;
+        StatusOr<PointResult> r = parse_results_row(line, log->ncells_, log->ncolumns_);
+        if (!r)
+          return Status::Error(fmt::format("{}:{}: error: --resume: cannot read the row: {}",
+                                           log->path_, line_no, r.status().message()));
+        if (r->index >= log->total_ || log->have_[r->index]) continue;
+        // The row must describe the same point (the sweep file may have been edited since).
+        const std::vector<std::string> cells = make_point(s, r->index).point.cells;
+        if (cells != r->cells) {
+          std::string want, have;
+          for (const std::string& c : cells) want += (want.empty() ? "" : ",") + c;
+          for (const std::string& c : r->cells) have += (have.empty() ? "" : ",") + c;
+          return Status::Error(fmt::format(
+              "{}:{}: error: --resume: point {} is {} in this sweep but {} in the file; was the "
+              "sweep file changed? (start again without --resume)",
+              log->path_, line_no, r->index, want, have));
+        }
+        log->have_[r->index] = true;
+        log->results_.push_back(*r);
+        keep += line + "\n";
+        if (r->verdict == "pass") ++log->pass_;
+        if (r->verdict == "fail") ++log->fail_;
+        if (r->verdict == "error") ++log->error_;
+      }
+    }
+  }
+  log->skipped_ = log->results_.size();
+  log->todo_count_ = log->total_ - log->skipped_;
+  // The kept rows (or just the header) through a temporary file, then appended to.
+  if (Status st = write_file_atomic(log->path_, keep); !st.ok()) return st;
+  log->file_ = std::fopen(log->path_.c_str(), "ab");
+  if (!log->file_)
+    return Status::Error(fmt::format("{}: error: cannot open for appending", log->path_));
+  log->start_ = now_seconds();
+  return log;
+}
+
+ResultLog::~ResultLog() {
+  if (file_) std::fclose(file_);
+}
+
+std::vector<size_t> ResultLog::todo() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  std::vector<size_t> t;
+  for (size_t i = 0; i < total_; ++i)
+    if (!have_[i]) t.push_back(i);
+  return t;
+}
+
+void ResultLog::add(const PointResult& in) {
+  PointResult padded = in;
+  padded.cells.resize(ncells_);  // a point that failed before its cells were known
+  const PointResult r = round_trip(padded, ncells_, ncolumns_);
+  const std::string row = results_row(r);
+  std::lock_guard<std::mutex> lock(mu_);
+  if (r.index >= total_ || have_[r.index]) return;
+  have_[r.index] = true;
+  std::fputs(row.c_str(), file_);
+  std::fflush(file_);
+  results_.push_back(r);
+  ++done_now_;
+  if (r.verdict == "pass") ++pass_;
+  if (r.verdict == "fail") ++fail_;
+  if (r.verdict == "error") ++error_;
+  progress(r);
+}
+
+void ResultLog::progress(const PointResult& r) {
+  if (quiet_) return;
+  if (r.verdict == "error") {
+    if (tty_) std::fputs("\r\033[K", stderr);
+    std::fprintf(stderr, "sweep: point %zu: error: %s\n", r.index, r.error.c_str());
+  }
+  const double t = now_seconds();
+  const bool last = done_now_ == todo_count_;
+  if (!last && last_print_ >= 0 && t - last_print_ < (tty_ ? 0.5 : 5.0)) return;
+  last_print_ = t;
+  const double elapsed = t - start_;
+  const double rate = elapsed > 0 ? done_now_ / elapsed * 60.0 : 0.0;
+  const double left = done_now_ > 0 ? elapsed / done_now_ * (todo_count_ - done_now_) : kNaN;
+  const std::string line = fmt::format(
+      "sweep: {}/{} points ({} pass, {} fail, {} error), {:.1f} points/min, {}",
+      skipped_ + done_now_, total_, pass_, fail_, error_, rate,
+      last ? "done in " + duration_text(elapsed) : "about " + duration_text(left) + " left");
+  if (tty_)
+    std::fprintf(stderr, "\r\033[K%s%s", line.c_str(), last ? "\n" : "");
+  else
+    std::fprintf(stderr, "%s\n", line.c_str());
+  std::fflush(stderr);
+}
+
+std::vector<PointResult> ResultLog::results() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  std::vector<PointResult> out = results_;
+  std::sort(out.begin(), out.end(),
+            [](const PointResult& a, const PointResult& b) { return a.index < b.index; });
+  return out;
+}
+
+// --- summary.json and plots --------------------------------------------------------------------
+
+namespace {
+
+using nlohmann::ordered_json;
+
+ordered_json num_json(double v) {
+  return std::isnan(v) ? ordered_json(nullptr) : ordered_json(v);
+}
+
+// A grid point's verdict and margin over its Monte Carlo samples (pass only when all pass).
+struct GridCell {
+  bool any = false;
+  std::string verdict;  // pass | fail | error
+  double margin = kNaN;
+};
+
+std::vector<GridCell> grid_cells(const SweepSpec& s, const std::vector<PointResult>& results) {
+  std::vector<GridCell> cells(s.grid_size());
+  for (const PointResult& r : results) {
+    GridCell& c = cells[r.index / s.samples()];
+    if (!c.any) {
+      c.any = true;
+      c.verdict = r.verdict;
+    } else if (r.verdict == "error" || (r.verdict == "fail" && c.verdict == "pass")) {
+      c.verdict = r.verdict;
+    }
+    if (!std::isnan(r.worst_rel) && (std::isnan(c.margin) || r.worst_rel < c.margin))
+      c.margin = r.worst_rel;
+  }
+  return cells;
+}
+
+// The axes with more than one value (a key given one value is a fixed override).
+std::vector<size_t> varying_axes(const SweepSpec& s) {
+  std::vector<size_t> v;
+  for (size_t k = 0; k < s.axes.size(); ++k)
+    if (s.axes[k].values.size() > 1) v.push_back(k);
+  return v;
+}
+
+// Row-major grid index of a value index per axis.
+size_t grid_index(const SweepSpec& s, const std::vector<size_t>& idx) {
+  size_t g = 0;
+  for (size_t k = 0; k < s.axes.size(); ++k) g = g * s.axes[k].values.size() + idx[k];
+  return g;
+}
+
+ordered_json boundary_json(const SweepSpec& s, const std::vector<PointResult>& results) {
+  const std::vector<size_t> vary = varying_axes(s);
+  if (vary.empty() || s.mode == Mode::kZip) return nullptr;
+  const size_t ax = vary[0];
+  const Axis& x = s.axes[ax];
+  const std::vector<GridCell> cells = grid_cells(s, results);
+  // The first varying key's value order: ascending for numbers, as listed otherwise.
+  std::vector<size_t> order(x.values.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  bool numeric = true;
+  for (const AxisValue& v : x.values) numeric = numeric && v.number.has_value();
+  if (numeric)
+    std::stable_sort(order.begin(), order.end(),
+                     [&](size_t a, size_t b) { return *x.values[a].number < *x.values[b].number; });
+  // One line per combination of the other varying keys.
+  size_t others = 1;
+  for (size_t k = 1; k < vary.size(); ++k) others *= s.axes[vary[k]].values.size();
+  ordered_json along = ordered_json::array();
+  for (size_t o = 0; o < others; ++o) {
+    std::vector<size_t> idx(s.axes.size(), 0);
+    ordered_json at = ordered_json::object();
+    for (size_t k = vary.size(), rest = o; k-- > 1;) {
+      const Axis& a = s.axes[vary[k]];
+      idx[vary[k]] = rest % a.values.size();
+      rest /= a.values.size();
+    }
+    for (size_t k = 1; k < vary.size(); ++k)
+      at[s.axes[vary[k]].key] = s.axes[vary[k]].values[idx[vary[k]]].label;
+    auto grid_of = [&](size_t i) {
+      idx[ax] = i;
+      return grid_index(s, idx);
+    };
+    ordered_json transitions = ordered_json::array();
+    ordered_json pass_values = ordered_json::array();
+    const GridCell* prev = nullptr;
+    size_t prev_i = 0;
+    for (size_t i : order) {
+      const GridCell& c = cells[grid_of(i)];
+      if (!c.any) continue;
+      if (c.verdict == "pass") pass_values.push_back(x.values[i].label);
+      if (prev && prev->verdict != c.verdict) {
+        ordered_json t{{"from", x.values[prev_i].label},
+                       {"from_verdict", prev->verdict},
+                       {"to", x.values[i].label},
+                       {"to_verdict", c.verdict}};
+        double crossing = kNaN;
+        if (numeric && !std::isnan(prev->margin) && !std::isnan(c.margin) &&
+            (prev->margin >= 0) != (c.margin >= 0)) {
+          double x0 = *x.values[prev_i].number, x1 = *x.values[i].number;
+          const double f = prev->margin / (prev->margin - c.margin);
+          if (x.log && x0 > 0 && x1 > 0)
+            crossing = std::exp(std::log(x0) + f * (std::log(x1) - std::log(x0)));
+          else
+            crossing = x0 + f * (x1 - x0);
+        }
+        // 4 significant digits: an interpolation between two points is no more exact than that.
+        t["margin_crossing"] =
+            num_json(std::isnan(crossing) ? kNaN : std::stod(fmt::format("{:.4g}", crossing)));
+        transitions.push_back(t);
+      }
+      prev = &c;
+      prev_i = i;
+    }
+    ordered_json line{{"at", at}};
+    line["pass"] = pass_values;
+    line["transitions"] = transitions;
+    along.push_back(line);
+  }
+  return ordered_json{{"axis", x.key}, {"along", along}};
+}
+
+reports::SweepPlotData plot_data(const SweepSpec& s, const std::vector<PointResult>& results) {
+  reports::SweepPlotData d;
+  d.title = s.name;
+  d.source = s.path;
+  d.samples = s.mc.samples;
+  // Only the keys that vary are axes; the fixed ones are named in the charts' note.
+  std::vector<size_t> vary = varying_axes(s);
+  for (const Axis& a : s.axes)
+    if (a.values.size() == 1)
+      d.note += (d.note.empty() ? "fixed: " : ", ") + a.key + " = " + a.values[0].label;
+  // zip: the keys move together, so the first one is the x axis and the others ride along.
+  if (s.mode == Mode::kZip && vary.size() > 1) {
+    std::string with;
+    for (size_t k = 1; k < vary.size(); ++k)
+      with += (with.empty() ? "" : ", ") + s.axes[vary[k]].key;
+    d.note += (d.note.empty() ? "" : "; ") + ("zip: " + with + " with " + s.axes[vary[0]].key);
+    vary.resize(1);
+  }
+  for (size_t k : vary) {
+    const Axis& a = s.axes[k];
+    reports::SweepPlotAxis pa;
+    pa.name = a.key;
+    pa.unit = a.unit == config::Unit::kNone ? "" : config::unit_symbol(a.unit);
+    pa.log = a.log;
+    bool numeric = !a.variants;
+    for (const AxisValue& v : a.values) {
+      pa.labels.push_back(v.label);
+      numeric = numeric && v.number.has_value();
+    }
+    if (numeric)
+      for (const AxisValue& v : a.values) pa.values.push_back(*v.number);
+    // Wide positive ranges read better on a log axis.
+    if (numeric && !pa.values.empty()) {
+      const auto [lo, hi] = std::minmax_element(pa.values.begin(), pa.values.end());
+      if (*lo > 0 && *hi / *lo >= 20) pa.log = true;
+    }
+    d.axes.push_back(std::move(pa));
+  }
+  for (const PointResult& r : results) {
+    reports::SweepPlotPoint p;
+    const std::vector<size_t> idx = s.grid_indices(r.index / s.samples());
+    for (size_t k : vary) p.axis.push_back(idx[k]);
+    p.margin = r.worst_rel;
+    p.verdict = r.verdict;
+    p.reason = r.reason;
+    d.points.push_back(std::move(p));
+  }
+  return d;
+}
+
+}  // namespace
+
+nlohmann::ordered_json summary_json(const SweepSpec& s, const std::vector<PointResult>& results) {
+  ordered_json j;
+  j["sweep"] = s.path;
+  j["name"] = s.name;
+  j["base"] = s.base_inline ? ordered_json("(inline)") : ordered_json(s.base_path);
+  j["mode"] = s.mode == Mode::kZip ? "zip" : "grid";
+  ordered_json axes = ordered_json::array();
+  for (const Axis& a : s.axes) {
+    ordered_json values = ordered_json::array();
+    for (const AxisValue& v : a.values) values.push_back(v.label);
+    axes.push_back({{"key", a.key}, {"values", values}});
+  }
+  j["axes"] = axes;
+  if (s.mc.samples > 0) {
+    ordered_json tol = ordered_json::array();
+    for (const Tolerance& t : s.mc.tolerances) tol.push_back(t.key);
+    j["monte_carlo"] = {{"samples", s.mc.samples}, {"seed", s.mc.seed}, {"tolerances", tol}};
+  } else {
+    j["monte_carlo"] = nullptr;
+  }
+  size_t pass = 0, fail = 0, error = 0;
+  const PointResult* worst = nullptr;
+  std::map<std::string, size_t> worst_metrics;
+  for (const PointResult& r : results) {
+    pass += r.verdict == "pass";
+    fail += r.verdict == "fail";
+    error += r.verdict == "error";
+    if (r.verdict != "error") ++worst_metrics[r.worst_metric];
+    if (!std::isnan(r.worst_rel) && (!worst || r.worst_rel < worst->worst_rel)) worst = &r;
+  }
+  const size_t done = pass + fail + error;
+  j["points"] = s.size();
+  j["done"] = done;
+  j["pass"] = pass;
+  j["fail"] = fail;
+  j["error"] = error;
+  // Errors count as not passing: a point that cannot be simulated is not a pass.
+  j["pass_yield"] = done ? ordered_json(static_cast<double>(pass) / done) : ordered_json(nullptr);
+  j["worst_metric_counts"] = worst_metrics;
+  if (worst) {
+    ordered_json w{{"point", worst->index}};
+    const std::vector<std::string> cols = s.point_columns();
+    for (size_t i = 0; i < cols.size() && i < worst->cells.size(); ++i)
+      w[cols[i]] = worst->cells[i];
+    w["verdict"] = worst->verdict;
+    w["worst_metric"] = worst->worst_metric;
+    w["worst_margin_rel"] = worst->worst_rel;
+    j["worst"] = w;
+  } else {
+    j["worst"] = nullptr;
+  }
+  if (s.mc.samples > 0 && !s.axes.empty()) {
+    // Yield per grid point.
+    std::vector<size_t> gp(s.grid_size(), 0), gn(s.grid_size(), 0);
+    for (const PointResult& r : results) {
+      const size_t g = r.index / s.samples();
+      ++gn[g];
+      gp[g] += r.verdict == "pass";
+    }
+    ordered_json by = ordered_json::array();
+    for (size_t g = 0; g < s.grid_size(); ++g) {
+      ordered_json e;
+      const std::vector<size_t> idx = s.grid_indices(g);
+      for (size_t k = 0; k < s.axes.size(); ++k) e[s.axes[k].key] = s.axes[k].values[idx[k]].label;
+      e["done"] = gn[g];
+      e["pass_yield"] =
+          gn[g] ? ordered_json(static_cast<double>(gp[g]) / gn[g]) : ordered_json(nullptr);
+      by.push_back(e);
+    }
+    j["yield_by_grid_point"] = by;
+  }
+  j["boundary"] = boundary_json(s, results);
+  return j;
+}
+
+Status finish_sweep(const SweepSpec& s, const std::vector<PointResult>& results,
+                    const SweepOptions& opt, SweepOutcome* out) {
+  out->points = s.size();
+  out->pass = out->fail = out->error = 0;
+  for (const PointResult& r : results) {
+    out->pass += r.verdict == "pass";
+    out->fail += r.verdict == "fail";
+    out->error += r.verdict == "error";
+  }
+  ordered_json j = summary_json(s, results);
+  if (Status st = write_file_atomic(opt.out_dir + "/summary.json", j.dump(2) + "\n"); !st.ok())
+    return st;
+  out->files.push_back("results.csv");
+  out->files.push_back("summary.json");
+  if (!opt.plots) return Status::Ok();
+  const reports::SweepPlotData d = plot_data(s, results);
+  if (!d.axes.empty()) {
+    if (Status st = reports::render_margin_png(d, opt.out_dir + "/sweep_margin.png"); !st.ok())
+      return st;
+    out->files.push_back("sweep_margin.png");
+  }
+  if (d.axes.size() >= 2 && s.mode == Mode::kGrid) {
+    if (Status st = reports::render_heatmap_png(d, opt.out_dir + "/sweep_heatmap.png"); !st.ok())
+      return st;
+    out->files.push_back("sweep_heatmap.png");
+  }
+  if (s.mc.samples > 0) {
+    if (Status st = reports::render_mc_histogram_png(d, opt.out_dir + "/mc_histogram.png");
+        !st.ok())
+      return st;
+    out->files.push_back("mc_histogram.png");
+  }
+  return Status::Ok();
+}
+
+StatusOr<SweepOutcome> run_sweep(const SweepSpec& s, const link::PartLibrary& parts,
+                                 const SweepOptions& opt_in) {
+  const double t0 = now_seconds();
+  SweepOptions opt = opt_in;
+  std::error_code ec;
+  std::filesystem::create_directories(opt.out_dir, ec);
+  if (ec)
+    return Status::Error(
+        fmt::format("{}: error: cannot create the folder: {}", opt.out_dir, ec.message()));
+  if (opt.keep_waves) {
+    opt.point.waves_dir = opt.out_dir + "/waves";
+    std::filesystem::create_directories(opt.point.waves_dir, ec);
+    if (ec)
+      return Status::Error(fmt::format("{}: error: cannot create the folder: {}",
+                                       opt.point.waves_dir, ec.message()));
+  }
+  StatusOr<std::unique_ptr<ResultLog>> log = ResultLog::open(s, opt);
+  if (!log) return log.status();
+  ResultLog& L = **log;
+  const std::vector<size_t> todo = L.todo();
+  const int threads = opt.jobs > 0 ? opt.jobs : tbb::this_task_arena::max_concurrency();
+  tbb::task_arena arena(threads);
+  arena.execute([&] {
+    // One task per point (grain 1): points take seconds, so scheduling costs nothing, and a
+    // thread only ever holds the point it is running.
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, todo.size(), 1),
+        [&](const tbb::blocked_range<size_t>& range) {
+          for (size_t i = range.begin(); i != range.end(); ++i)
+            L.add(run_point(s, parts, todo[i], opt.point));
+        },
+        tbb::simple_partitioner());
+  });
+  SweepOutcome out;
+  out.skipped = L.skipped();
+  if (Status st = finish_sweep(s, L.results(), opt, &out); !st.ok()) return st;
+  out.seconds = now_seconds() - t0;
+  return out;
+}
+
+}  // namespace isolink::cli::sweep

@@ -1,0 +1,152 @@
+// Running a sweep: each point through run_link (cli/link_run.h), scored to one row of
+// results.csv; the points in parallel on all cores (oneTBB) or across MPI ranks (sweep_mpi.h);
+// then summary.json and the plots (reports/sweep_plots.h).
+//
+//   StatusOr<SweepSpec> s = read_sweep_file(path);
+//   StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
+//   SweepOptions opt{.out_dir = "out", .jobs = 0};
+//   StatusOr<SweepOutcome> r = run_sweep(*s, *parts, opt);   // r->fail + r->error == 0: all pass
+//
+// results.csv: one row per point, appended (and flushed) as points finish, so rows are in
+// completion order; `point` is the point's index (sort by it). Columns:
+//   point, <one per swept key, named by its dotted path>, [sample, mc.<key>...], verdict
+//   (pass | fail | error), worst_metric, worst_margin_rel, margin_vstart_V, margin_vend_V,
+//   margin_width_ns, margin_edge_ns, decoded_ok, fail_reason, seconds, error
+// Margins are each metric's worst (smallest) margin over the directions and over the data and
+// tone checks, in the metric's unit: distance to the limit, positive = inside (eye/metrics.h).
+// worst_margin_rel is the smallest of margin / |limit| over the four metrics (the fraction by which
+// the value could move before reaching its limit) and worst_metric names it; on a failing point on
+// which no pulse was judged at all (nothing crossed the threshold) it is -1 and worst_metric is
+// "none". fail_reason lists what failed, in short: the metrics of failing pulses (dip, width, edge,
+// vstart, vend), "decode: <fault>" for frames that do not decode, "bytes differ", "no signal" (no
+// pulse at all); a point can fail with every margin positive (a dip, a frame that does not decode).
+// A point whose spec is invalid or whose simulation fails has verdict "error", the message's
+// first line in `error` (CSV-quoted) and empty margins; the sweep goes on. Numbers are written with
+// 6 significant digits and every total (summary.json, plots) is computed from the rows as written,
+// so a resumed or MPI run gives the same files as one threaded run.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cli/link_run.h"
+#include "cli/sweep_spec.h"
+#include "netlists/link/parts.h"
+#include "solver/status.h"
+
+namespace isolink::cli::sweep {
+
+inline constexpr std::array<const char*, 4> kMetrics = {"vstart", "vend", "width", "edge"};
+
+struct PointResult {
+  size_t index = 0;
+  std::vector<std::string> cells;  // SweepSpec::point_columns()
+  std::string verdict;             // pass | fail | error
+  std::string worst_metric;        // one of kMetrics, "none", or "" (error)
+  double worst_rel = std::numeric_limits<double>::quiet_NaN();
+  // Per kMetrics entry, the worst margin in SI units (V, V, s, s); NaN when not judged.
+  std::array<double, 4> margin = {
+      std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
+      std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+  std::optional<bool> decoded_ok;  // every data frame decoded to the bytes sent; none: no data
+  std::string reason;              // fail_reason: why a failing point fails ("dip; decode: sync")
+  double seconds = 0;              // wall time of the point
+  std::string error;
+};
+
+// The results.csv header for a sweep.
+std::vector<std::string> results_header(const SweepSpec& s);
+// One CSV line (with '\n').
+std::string results_row(const PointResult& r);
+// Parses a line written by results_row under header (ncells = point_columns().size()).
+StatusOr<PointResult> parse_results_row(std::string_view line, size_t ncells, size_t ncolumns);
+// The result as the CSV stores it (numbers rounded to what is written).
+PointResult round_trip(const PointResult& r, size_t ncells, size_t ncolumns);
+// Splits one CSV line (RFC 4180 quoting, no newlines inside fields).
+std::vector<std::string> split_csv_line(std::string_view line);
+
+// Scores a finished run: verdict, margins, decoded_ok.
+PointResult score_run(const LinkRun& run);
+
+struct PointOptions {
+  RunOptions run;
+  std::string waves_dir;  // non-empty: write each point's waveforms there (--keep-waves)
+};
+// Makes, runs and scores point `index`; never fails (errors become verdict "error").
+PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t index,
+                      const PointOptions& opt);
+
+struct SweepOptions {
+  std::string out_dir;      // results.csv, summary.json, PNGs (created)
+  int jobs = 0;             // threads (0: all cores)
+  bool resume = false;      // skip points already in results.csv
+  bool keep_waves = false;  // out_dir/waves/point_NNNNN.csv per point
+  bool plots = true;
+  bool quiet = false;  // no progress
+  PointOptions point;  // waves_dir is filled in from keep_waves
+};
+
+struct SweepOutcome {
+  size_t points = 0, pass = 0, fail = 0, error = 0;
+  size_t skipped = 0;              // already in results.csv (--resume)
+  double seconds = 0;              // wall time of this run
+  std::vector<std::string> files;  // written, relative to out_dir
+};
+
+// results.csv while a sweep runs: the rows kept from an earlier run (--resume), then each new
+// row appended and flushed under a lock; progress on stderr.
+class ResultLog {
+ public:
+  static StatusOr<std::unique_ptr<ResultLog>> open(const SweepSpec& s, const SweepOptions& opt);
+  ~ResultLog();
+  ResultLog(const ResultLog&) = delete;
+  ResultLog& operator=(const ResultLog&) = delete;
+
+  // Point indices still to run, ascending.
+  std::vector<size_t> todo() const;
+  size_t skipped() const { return skipped_; }
+  // Records a result (thread-safe): appends its row, prints progress.
+  void add(const PointResult& r);
+  // Every result so far, by point index.
+  std::vector<PointResult> results() const;
+  const std::string& path() const { return path_; }
+
+ private:
+  ResultLog() = default;
+  void progress(const PointResult& r);
+  const SweepSpec* spec_ = nullptr;
+  std::string path_;
+  std::FILE* file_ = nullptr;
+  size_t ncells_ = 0, ncolumns_ = 0, total_ = 0, skipped_ = 0, done_now_ = 0, todo_count_ = 0;
+  size_t pass_ = 0, fail_ = 0, error_ = 0;
+  bool quiet_ = false, tty_ = false;
+  double start_ = 0, last_print_ = -1;
+  std::vector<PointResult> results_;
+  std::vector<bool> have_;
+  mutable std::mutex mu_;
+};
+
+// summary.json: counts, pass yield, the worst point, the pass/fail boundary along the first axis.
+nlohmann::ordered_json summary_json(const SweepSpec& s, const std::vector<PointResult>& results);
+// summary.json and the plots from the results (sorted by point); the files written are added to
+// out->files.
+Status finish_sweep(const SweepSpec& s, const std::vector<PointResult>& results,
+                    const SweepOptions& opt, SweepOutcome* out);
+
+// The whole sweep on this machine's cores.
+StatusOr<SweepOutcome> run_sweep(const SweepSpec& s, const link::PartLibrary& parts,
+                                 const SweepOptions& opt);
+
+// "12.3 s", "4 min 05 s", "1 h 02 min" for progress lines.
+std::string duration_text(double seconds);
+
+}  // namespace isolink::cli::sweep

@@ -1,0 +1,262 @@
+// results.csv rows, scoring a run, summary.json and the resume log, without simulating.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "cli/sweep_run.h"
+#include "cli/sweep_spec.h"
+
+namespace isolink::cli::sweep {
+namespace {
+
+const std::string kSweep = R"(base:
+  tx: {device: bq7961x, isolation: {type: cap, cap: 2.2n}}
+  rx: {device: bq7961x, isolation: {type: cap, cap: 2.2n}}
+  cable: {length: 1}
+sweep:
+  cable.length: [1, 2, 5, 10]
+  rx.isolation.cap: [1n, 4.7n]
+)";
+
+SweepSpec spec() {
+  StatusOr<SweepSpec> s = read_sweep_text(kSweep, "sweep.yaml");
+  if (!s) ADD_FAILURE() << s.status().message();
+  return s ? *s : SweepSpec{};
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::string temp_dir(const std::string& name) {
+  const std::string d = ::testing::TempDir() + "isolink_sweep_results_" + name;
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+PointResult result(size_t index, const SweepSpec& s, const std::string& verdict, double rel) {
+  PointResult r;
+  r.index = index;
+  r.cells = make_point(s, index).point.cells;
+  r.verdict = verdict;
+  r.worst_metric = verdict == "error" ? "" : "vstart";
+  r.worst_rel = verdict == "error" ? NAN : rel;
+  if (verdict != "error") r.margin = {rel * 1.6, 0.5, 20e-9, 30e-9};
+  if (verdict != "error") r.decoded_ok = verdict == "pass";
+  r.seconds = 1.25;
+  if (verdict == "error") r.error = "link.yaml:3:5: error: unknown part 'X, \"Y\"'";
+  return r;
+}
+
+TEST(SweepResults, HeaderAndRowRoundTrip) {
+  const SweepSpec s = spec();
+  const std::vector<std::string> h = results_header(s);
+  EXPECT_EQ(h, (std::vector<std::string>{"point", "cable.length", "rx.isolation.cap", "verdict",
+                                         "worst_metric", "worst_margin_rel", "margin_vstart_V",
+                                         "margin_vend_V", "margin_width_ns", "margin_edge_ns",
+                                         "decoded_ok", "fail_reason", "seconds", "error"}));
+  PointResult r = result(3, s, "fail", -0.0123456789);
+  r.reason = "vstart; decode: weak bit";
+  const std::string row = results_row(r);
+  EXPECT_EQ(row,
+            "3,2,4.7e-09,fail,vstart,-0.0123457,-0.0197531,0.5,20,30,false,vstart; decode: "
+            "weak bit,1.25,\n");
+  StatusOr<PointResult> back = parse_results_row(row.substr(0, row.size() - 1), 2, h.size());
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ(back->index, 3u);
+  EXPECT_EQ(back->cells, (std::vector<std::string>{"2", "4.7e-09"}));
+  EXPECT_EQ(back->verdict, "fail");
+  EXPECT_DOUBLE_EQ(back->worst_rel, -0.0123457);
+  EXPECT_DOUBLE_EQ(back->margin[2], 20e-9);
+  EXPECT_EQ(back->decoded_ok, std::optional<bool>(false));
+  EXPECT_EQ(back->reason, "vstart; decode: weak bit");
+  EXPECT_EQ(results_row(*back), row);  // a fixed point
+  // An error row: CSV-quoted message, empty margins.
+  const PointResult e = result(5, s, "error", 0);
+  const std::string erow = results_row(e);
+  EXPECT_EQ(erow,
+            "5,5,4.7e-09,error,,,,,,,,,1.25,\"link.yaml:3:5: error: unknown part 'X, "
+            "\"\"Y\"\"'\"\n");
+  StatusOr<PointResult> eback = parse_results_row(erow.substr(0, erow.size() - 1), 2, h.size());
+  ASSERT_TRUE(eback.ok()) << eback.status().message();
+  EXPECT_EQ(eback->error, e.error);
+  EXPECT_TRUE(std::isnan(eback->worst_rel));
+  EXPECT_FALSE(eback->decoded_ok.has_value());
+  // Malformed rows.
+  EXPECT_FALSE(parse_results_row("3,2,4.7e-09,fail", 2, h.size()).ok());
+  EXPECT_FALSE(parse_results_row("x,2,4.7e-09,fail,,,,,,,,,1,", 2, h.size()).ok());
+  EXPECT_FALSE(parse_results_row("3,2,4.7e-09,maybe,,,,,,,,,1,", 2, h.size()).ok());
+  EXPECT_EQ(split_csv_line("a,\"b,c\",,\"d\"\"e\""),
+            (std::vector<std::string>{"a", "b,c", "", "d\"e"}));
+}
+
+eye::WorstMargin wm(const std::string& metric, double value, double limit, double margin) {
+  eye::WorstMargin w;
+  w.metric = metric;
+  w.j.value = value;
+  w.j.limit = limit;
+  w.j.margin = margin;
+  return w;
+}
+
+TEST(SweepResults, ScoreTakesTheWorstOverDirectionsAndChecks) {
+  LinkRun run;
+  run.pass = false;
+  DirectionRun down, up;
+  eye::CheckResult a;
+  a.pass = true;
+  a.worst = {wm("vstart", 2.0, 1.6, 0.4), wm("vend", 1.5, 1.2, 0.3),
+             wm("width", 270e-9, 280e-9, 10e-9), wm("droop", 0.5, 1.0, 0.5)};
+  a.frames.resize(1);
+  a.pulses.resize(1);
+  down.data = a;
+  eye::CheckResult b = a;
+  b.pass = false;
+  b.worst = {wm("vstart", 1.7, 1.6, 0.1), wm("edge", 50e-9, 60e-9, 10e-9)};
+  b.pulses[0].fails = {"dip: 3.0 ns below 1.20 V"};
+  b.frames[0].fault = "weak bit";
+  up.data = b;
+  eye::CheckResult t;
+  t.tone = true;
+  t.pass = true;
+  t.worst = {wm("width", 1.05e-6, 1.08e-6, 30e-9)};
+  up.tones = t;
+  run.directions = {down, up};
+  const PointResult r = score_run(run);
+  EXPECT_EQ(r.verdict, "fail");
+  EXPECT_DOUBLE_EQ(r.margin[0], 0.1);    // vstart: up
+  EXPECT_DOUBLE_EQ(r.margin[1], 0.3);    // vend: down
+  EXPECT_DOUBLE_EQ(r.margin[2], 10e-9);  // width: data, not the tone's 30 ns
+  EXPECT_DOUBLE_EQ(r.margin[3], 10e-9);  // edge
+  // Relative: vstart 0.1/1.6 = 0.0625, vend 0.25, width 10/280 = 0.0357, edge 10/60.
+  EXPECT_EQ(r.worst_metric, "width");
+  EXPECT_DOUBLE_EQ(r.worst_rel, 10e-9 / 280e-9);
+  EXPECT_EQ(r.decoded_ok, std::optional<bool>(false));
+  EXPECT_EQ(r.reason, "dip; decode: weak bit");
+  // Nothing judged on a failing run: -1, "none".
+  LinkRun dead;
+  DirectionRun d;
+  eye::CheckResult empty;
+  empty.pass = false;
+  d.data = empty;
+  dead.directions = {d};
+  const PointResult z = score_run(dead);
+  EXPECT_EQ(z.worst_metric, "none");
+  EXPECT_DOUBLE_EQ(z.worst_rel, -1.0);
+  EXPECT_EQ(z.reason, "no signal");
+  EXPECT_EQ(z.decoded_ok, std::optional<bool>(false));
+}
+
+TEST(SweepResults, SummaryCountsYieldAndBoundary) {
+  const SweepSpec s = spec();
+  // cap 1n passes up to 5 m (margin 0.1 at 5, -0.1 at 10: crossing 7.5 m); 4.7n up to 2 m.
+  const double m1[4] = {0.3, 0.2, 0.1, -0.1}, m2[4] = {0.2, 0.05, -0.05, -0.2};
+  std::vector<PointResult> rs;
+  for (size_t i = 0; i < 4; ++i) {
+    rs.push_back(result(2 * i, s, m1[i] >= 0 ? "pass" : "fail", m1[i]));
+    if (i != 3) rs.push_back(result(2 * i + 1, s, m2[i] >= 0 ? "pass" : "fail", m2[i]));
+  }
+  rs.push_back(result(7, s, "error", 0));
+  const nlohmann::ordered_json j = summary_json(s, rs);
+  EXPECT_EQ(j["points"], 8);
+  EXPECT_EQ(j["done"], 8);
+  EXPECT_EQ(j["pass"], 5);
+  EXPECT_EQ(j["fail"], 2);
+  EXPECT_EQ(j["error"], 1);
+  EXPECT_DOUBLE_EQ(j["pass_yield"].get<double>(), 5.0 / 8.0);
+  EXPECT_EQ(j["worst"]["point"], 6);
+  EXPECT_EQ(j["worst"]["cable.length"], "10");
+  EXPECT_DOUBLE_EQ(j["worst"]["worst_margin_rel"].get<double>(), -0.1);
+  const auto& along = j["boundary"]["along"];
+  EXPECT_EQ(j["boundary"]["axis"], "cable.length");
+  ASSERT_EQ(along.size(), 2u);
+  EXPECT_EQ(along[0]["at"]["rx.isolation.cap"], "1e-09");
+  EXPECT_EQ(along[0]["pass"], nlohmann::ordered_json({"1", "2", "5"}));
+  ASSERT_EQ(along[0]["transitions"].size(), 1u);
+  EXPECT_EQ(along[0]["transitions"][0]["from"], "5");
+  EXPECT_EQ(along[0]["transitions"][0]["to"], "10");
+  EXPECT_DOUBLE_EQ(along[0]["transitions"][0]["margin_crossing"].get<double>(), 7.5);
+  // 4.7n: pass at 1, 2; fail at 5 (crossing 2 + 3 * 0.05 / 0.1 = 3.5); error at 10.
+  ASSERT_EQ(along[1]["transitions"].size(), 2u);
+  EXPECT_DOUBLE_EQ(along[1]["transitions"][0]["margin_crossing"].get<double>(), 3.5);
+  EXPECT_EQ(along[1]["transitions"][1]["to_verdict"], "error");
+  EXPECT_TRUE(along[1]["transitions"][1]["margin_crossing"].is_null());
+}
+
+TEST(SweepResults, ResumeKeepsGoodRowsAndDropsACutRow) {
+  const SweepSpec s = spec();
+  const std::string dir = temp_dir("resume");
+  std::string header;
+  for (const std::string& h : results_header(s)) header += (header.empty() ? "" : ",") + h;
+  const std::string row2 = results_row(result(2, s, "pass", 0.2));
+  const std::string row6 = results_row(result(6, s, "fail", -0.1));
+  {
+    std::ofstream out(dir + "/results.csv");
+    out << header << "\n" << row2 << row6 << "4,5,1e-09,pa";  // the last row was cut short
+  }
+  SweepOptions opt;
+  opt.out_dir = dir;
+  opt.resume = true;
+  opt.quiet = true;
+  {
+    StatusOr<std::unique_ptr<ResultLog>> log = ResultLog::open(s, opt);
+    ASSERT_TRUE(log.ok()) << log.status().message();
+    EXPECT_EQ((*log)->skipped(), 2u);
+    EXPECT_EQ((*log)->todo(), (std::vector<size_t>{0, 1, 3, 4, 5, 7}));
+    EXPECT_EQ(slurp(dir + "/results.csv"), header + "\n" + row2 + row6);
+    (*log)->add(result(4, s, "pass", 0.05));
+    (*log)->add(result(4, s, "pass", 0.05));  // a second time: ignored
+    EXPECT_EQ((*log)->results().size(), 3u);
+    EXPECT_EQ((*log)->results()[1].index, 4u);  // by index
+  }
+  EXPECT_EQ(slurp(dir + "/results.csv"),
+            header + "\n" + row2 + row6 + results_row(result(4, s, "pass", 0.05)));
+  // A row whose values are not this sweep's point is refused.
+  {
+    std::ofstream out(dir + "/results.csv");
+    out << header << "\n"
+        << "2,7,1e-09,pass,vstart,0.2,0.32,0.5,20,30,true,,1.25,\n";
+  }
+  StatusOr<std::unique_ptr<ResultLog>> changed = ResultLog::open(s, opt);
+  ASSERT_FALSE(changed.ok());
+  EXPECT_NE(changed.status().message().find(
+                "results.csv:2: error: --resume: point 2 is 2,1e-09 in this sweep but 7,1e-09 in "
+                "the file"),
+            std::string::npos)
+      << changed.status().message();
+  // Without --resume the file starts again.
+  opt.resume = false;
+  {
+    StatusOr<std::unique_ptr<ResultLog>> log = ResultLog::open(s, opt);
+    ASSERT_TRUE(log.ok());
+    EXPECT_EQ((*log)->todo().size(), 8u);
+  }
+  EXPECT_EQ(slurp(dir + "/results.csv"), header + "\n");
+  // Another sweep's file is refused.
+  {
+    std::ofstream out(dir + "/results.csv");
+    out << "point,cable.length,verdict\n0,1,pass\n";
+  }
+  opt.resume = true;
+  StatusOr<std::unique_ptr<ResultLog>> bad = ResultLog::open(s, opt);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("results.csv:1: error: --resume: the columns differ"),
+            std::string::npos)
+      << bad.status().message();
+}
+
+TEST(SweepResults, DurationText) {
+  EXPECT_EQ(duration_text(12.34), "12.3 s");
+  EXPECT_EQ(duration_text(245), "4 min 05 s");
+  EXPECT_EQ(duration_text(3720), "1 h 02 min");
+}
+
+}  // namespace
+}  // namespace isolink::cli::sweep

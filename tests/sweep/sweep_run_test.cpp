@@ -1,0 +1,258 @@
+// Small real sweeps through the isolink binary (short links, one frame, one direction): rows and
+// columns of results.csv, verdicts equal to `isolink run` on the same spec, a point that cannot
+// run, --resume, Monte Carlo, and the MPI run with 2 ranks against the threaded one. Every test
+// here simulates: the names carry "Sim" (ctest label sweep-sim).
+#include "cli/sweep_run.h"
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace isolink::cli::sweep {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kBinary = ISOLINK_BINARY;
+const std::string kMpiexec = ISOLINK_MPIEXEC;
+
+std::string fmt_length(double l) {
+  std::ostringstream o;
+  o << l;
+  return o.str();
+}
+
+// A capacitor link with one short frame, down only.
+std::string cap_link(double length) {
+  return "name: t\n"
+         "tx: {device: bq7961x, isolation: {type: cap, cap: 2.2n}}\n"
+         "rx: {device: bq7961x, isolation: {type: cap, cap: 2.2n}}\n"
+         "cable: {length: " +
+         fmt_length(length) +
+         ", material: pp}\n"
+         "stimulus: {frames: [\"single-read dev=1 reg=0x0215 n=1\"], direction: down}\n";
+}
+
+std::string temp_dir(const std::string& name) {
+  const std::string d = ::testing::TempDir() + "isolink_sweep_run_" + name;
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+void write(const std::string& path, const std::string& text) {
+  std::ofstream(path) << text;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Runs a shell command; its exit status.
+int run(const std::string& cmd) {
+  const int st = std::system(cmd.c_str());
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+struct Csv {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;  // sorted by point
+  size_t col(const std::string& name) const {
+    const auto it = std::find(header.begin(), header.end(), name);
+    EXPECT_NE(it, header.end()) << name;
+    return static_cast<size_t>(it - header.begin());
+  }
+};
+
+Csv read_csv(const std::string& path) {
+  Csv c;
+  std::ifstream in(path);
+  std::string line;
+  if (std::getline(in, line)) c.header = split_csv_line(line);
+  while (std::getline(in, line))
+    if (!line.empty()) c.rows.push_back(split_csv_line(line));
+  std::sort(c.rows.begin(), c.rows.end(),
+            [](const auto& a, const auto& b) { return std::stoul(a[0]) < std::stoul(b[0]); });
+  return c;
+}
+
+TEST(SweepSim, ResultsMatchIsolinkRunPointByPoint) {
+  const std::string dir = temp_dir("match");
+  write(dir + "/link.yaml", cap_link(1));
+  write(dir + "/sweep.yaml", "base: link.yaml\nsweep:\n  cable.length: [0.5, 1, 2]\n");
+  const int rc = run(kBinary + " sweep " + dir + "/sweep.yaml -o " + dir + "/out -j 2 -q");
+  const Csv csv = read_csv(dir + "/out/results.csv");
+  EXPECT_EQ(csv.header, (std::vector<std::string>{
+                            "point", "cable.length", "verdict", "worst_metric", "worst_margin_rel",
+                            "margin_vstart_V", "margin_vend_V", "margin_width_ns", "margin_edge_ns",
+                            "decoded_ok", "fail_reason", "seconds", "error"}));
+  ASSERT_EQ(csv.rows.size(), 3u);
+  const std::vector<std::string> lengths = {"0.5", "1", "2"};
+  bool all_pass = true;
+  for (size_t i = 0; i < 3; ++i) {
+    const std::vector<std::string>& r = csv.rows[i];
+    ASSERT_EQ(r.size(), csv.header.size());
+    EXPECT_EQ(r[0], std::to_string(i));
+    EXPECT_EQ(r[1], lengths[i]);
+    EXPECT_EQ(r[csv.col("error")], "");
+    // The same spec through `isolink run`.
+    const std::string spec = dir + "/point" + std::to_string(i) + ".yaml";
+    write(spec, cap_link(std::stod(lengths[i])));
+    const std::string rdir = dir + "/run" + std::to_string(i);
+    const int rrc = run(kBinary + " run " + spec + " -o " + rdir + " --no-images -q");
+    ASSERT_TRUE(rrc == 0 || rrc == 1) << rrc;
+    EXPECT_EQ(r[csv.col("verdict")], rrc == 0 ? "pass" : "fail") << "point " << i;
+    all_pass = all_pass && rrc == 0;
+    const nlohmann::json rep = nlohmann::json::parse(slurp(rdir + "/report.json"));
+    const nlohmann::json& worst = rep["directions"][0]["check"]["summary"]["worst"];
+    EXPECT_NEAR(std::stod(r[csv.col("margin_vstart_V")]), worst["vstart"]["margin"].get<double>(),
+                1e-5)
+        << "point " << i;
+    EXPECT_NEAR(std::stod(r[csv.col("margin_width_ns")]), worst["width"]["margin"].get<double>(),
+                1e-4)
+        << "point " << i;
+    EXPECT_EQ(r[csv.col("decoded_ok")],
+              rep["directions"][0]["check"]["verdict"] == "pass" ? "true" : "false");
+  }
+  EXPECT_EQ(rc, all_pass ? 0 : 1);
+  const nlohmann::json sum = nlohmann::json::parse(slurp(dir + "/out/summary.json"));
+  EXPECT_EQ(sum["points"], 3);
+  EXPECT_EQ(sum["done"], 3);
+  EXPECT_EQ(sum["pass"].get<int>() + sum["fail"].get<int>(), 3);
+  EXPECT_TRUE(fs::exists(dir + "/out/sweep_margin.png"));
+  EXPECT_FALSE(fs::exists(dir + "/out/sweep_heatmap.png"));  // one axis
+}
+
+TEST(SweepSim, AFailingPointIsRecordedAndTheSweepGoesOn) {
+  const std::string dir = temp_dir("error");
+  write(dir + "/sweep.yaml", R"(base:
+  name: xfmr
+  tx: {device: bq7961x, isolation: {type: transformer, part: HMU1228NL}}
+  rx: {device: bq7961x, isolation: {type: transformer, part: HMU1228NL}}
+  cable: {length: 1}
+  stimulus: {frames: ["single-read dev=1 reg=0x0215 n=1"], direction: down}
+sweep:
+  ends.isolation.part: [NOPE-123, HMU1228NL]
+)");
+  const int rc =
+      run(kBinary + " sweep " + dir + "/sweep.yaml -o " + dir + "/out -q 2> " + dir + "/err");
+  EXPECT_EQ(rc, 1);  // done, but a point could not run
+  const Csv csv = read_csv(dir + "/out/results.csv");
+  ASSERT_EQ(csv.rows.size(), 2u);
+  EXPECT_EQ(csv.rows[0][1], "NOPE-123");
+  EXPECT_EQ(csv.rows[0][csv.col("verdict")], "error");
+  EXPECT_NE(csv.rows[0][csv.col("error")].find("NOPE-123"), std::string::npos)
+      << csv.rows[0][csv.col("error")];
+  EXPECT_EQ(csv.rows[0][csv.col("margin_vstart_V")], "");
+  EXPECT_TRUE(csv.rows[1][csv.col("verdict")] == "pass" ||
+              csv.rows[1][csv.col("verdict")] == "fail");
+  EXPECT_EQ(csv.rows[1][csv.col("error")], "");
+  EXPECT_NE(csv.rows[1][csv.col("margin_vstart_V")], "");
+  const nlohmann::json sum = nlohmann::json::parse(slurp(dir + "/out/summary.json"));
+  EXPECT_EQ(sum["error"], 1);
+  EXPECT_EQ(sum["done"], 2);
+}
+
+TEST(SweepSim, ResumeSkipsThePointsAlreadyDone) {
+  const std::string dir = temp_dir("resume");
+  write(dir + "/link.yaml", cap_link(1));
+  write(dir + "/sweep.yaml", "base: link.yaml\nsweep:\n  cable.length: [1, 2]\n");
+  fs::create_directories(dir + "/out");
+  // Point 0 "done" by an earlier run (made-up numbers: a re-run would replace them).
+  const std::string header =
+      "point,cable.length,verdict,worst_metric,worst_margin_rel,margin_vstart_V,margin_vend_V,"
+      "margin_width_ns,margin_edge_ns,decoded_ok,fail_reason,seconds,error\n";
+  const std::string done = "0,1,pass,vstart,0.5,0.8,0.6,30,40,true,,99.00,\n";
+  write(dir + "/out/results.csv", header + done);
+  const int rc = run(kBinary + " sweep " + dir + "/sweep.yaml -o " + dir +
+                     "/out --resume --keep-waves > " + dir + "/stdout 2> " + dir + "/stderr");
+  EXPECT_TRUE(rc == 0 || rc == 1) << rc;
+  const std::string text = slurp(dir + "/out/results.csv");
+  EXPECT_EQ(text.substr(0, header.size() + done.size()), header + done);
+  const Csv csv = read_csv(dir + "/out/results.csv");
+  ASSERT_EQ(csv.rows.size(), 2u);
+  EXPECT_EQ(csv.rows[1][1], "2");
+  EXPECT_NE(csv.rows[1][csv.col("seconds")], "99.00");
+  EXPECT_NE(slurp(dir + "/stdout").find("2 points: "), std::string::npos) << slurp(dir + "/stdout");
+  EXPECT_NE(slurp(dir + "/stdout").find("(1 from the earlier run)"), std::string::npos);
+  EXPECT_NE(slurp(dir + "/stderr").find("sweep: 2/2 points"), std::string::npos)
+      << slurp(dir + "/stderr");
+  // --keep-waves: the point that ran has its waveforms.
+  EXPECT_FALSE(fs::exists(dir + "/out/waves/point_00000.csv"));
+  ASSERT_TRUE(fs::exists(dir + "/out/waves/point_00001.csv"));
+  EXPECT_EQ(slurp(dir + "/out/waves/point_00001.csv").substr(0, 24), "time,down v(rxp,rxn),dow");
+}
+
+TEST(SweepSim, MonteCarloWritesTheHistogramAndYield) {
+  const std::string dir = temp_dir("mc");
+  write(dir + "/link.yaml", cap_link(1));
+  write(dir + "/sweep.yaml", R"(base: link.yaml
+monte_carlo:
+  samples: 3
+  seed: 5
+  tolerances: {tx.isolation.cap: 10%, cable.temperature: {normal: [25, 20]}}
+)");
+  const int rc = run(kBinary + " sweep " + dir + "/sweep.yaml -o " + dir + "/out -q");
+  EXPECT_TRUE(rc == 0 || rc == 1) << rc;
+  const Csv csv = read_csv(dir + "/out/results.csv");
+  EXPECT_EQ(csv.header[1], "sample");
+  EXPECT_EQ(csv.header[2], "mc.tx.isolation.cap");
+  ASSERT_EQ(csv.rows.size(), 3u);
+  for (const auto& r : csv.rows) {
+    const double c = std::stod(r[2]);
+    EXPECT_GE(c, 2.2e-9 * 0.9);
+    EXPECT_LE(c, 2.2e-9 * 1.1);
+  }
+  const nlohmann::json sum = nlohmann::json::parse(slurp(dir + "/out/summary.json"));
+  EXPECT_EQ(sum["monte_carlo"]["samples"], 3);
+  EXPECT_DOUBLE_EQ(sum["pass_yield"].get<double>(), sum["pass"].get<double>() / 3.0);
+  EXPECT_TRUE(fs::exists(dir + "/out/mc_histogram.png"));
+  EXPECT_FALSE(fs::exists(dir + "/out/sweep_margin.png"));  // no axis
+}
+
+TEST(SweepSim, MpiTwoRanksGiveTheThreadedResults) {
+  if (kMpiexec.empty()) GTEST_SKIP() << "built without MPI (ISOLINK_MPI=OFF)";
+  const std::string dir = temp_dir("mpi");
+  write(dir + "/link.yaml", cap_link(1));
+  write(dir + "/sweep.yaml",
+        "base: link.yaml\nsweep:\n  cable.length: [0.5, 1]\n  rx.isolation.cap: [1n, 4.7n]\n");
+  const int rc_threads = run(kBinary + " sweep " + dir + "/sweep.yaml -o " + dir + "/threads -q");
+  // As root (CI) OpenMPI wants --allow-run-as-root; --oversubscribe for machines with 1 core; no
+  // single-copy (CMA) transport inside containers; plm isolated: start the ranks on this machine
+  // without looking for ssh (Debian's openmpi-bin only recommends openssh-client).
+  const std::string env =
+      "OMPI_MCA_btl_vader_single_copy_mechanism=none OMPI_MCA_rmaps_base_oversubscribe=1 "
+      "OMPI_MCA_plm=isolated OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 ";
+  const int rc_mpi =
+      run(env + kMpiexec + " --allow-run-as-root --oversubscribe -np 2 " + kBinary + " sweep " +
+          dir + "/sweep.yaml -o " + dir + "/mpi -q > " + dir + "/mpi.log 2>&1");
+  EXPECT_EQ(rc_mpi, rc_threads) << slurp(dir + "/mpi.log");
+  Csv a = read_csv(dir + "/threads/results.csv"), b = read_csv(dir + "/mpi/results.csv");
+  ASSERT_EQ(a.header, b.header);
+  ASSERT_EQ(a.rows.size(), 4u);
+  ASSERT_EQ(b.rows.size(), 4u) << slurp(dir + "/mpi.log");
+  const size_t sec = a.col("seconds");
+  for (size_t i = 0; i < 4; ++i) {
+    a.rows[i].erase(a.rows[i].begin() + static_cast<long>(sec));
+    b.rows[i].erase(b.rows[i].begin() + static_cast<long>(sec));
+    EXPECT_EQ(a.rows[i], b.rows[i]) << "point " << i;
+  }
+  EXPECT_EQ(slurp(dir + "/threads/summary.json"), slurp(dir + "/mpi/summary.json"));
+  EXPECT_TRUE(fs::exists(dir + "/mpi/sweep_heatmap.png"));
+  EXPECT_TRUE(fs::exists(dir + "/mpi/sweep_margin.png"));
+}
+
+}  // namespace
+}  // namespace isolink::cli::sweep
