@@ -47,6 +47,9 @@ struct Example {
   const char* down, *up;     // per-direction verdicts
 };
 
+// The test names already say which example: print only the file in ctest's listing.
+void PrintTo(const Example& e, std::ostream* os) { *os << e.file; }
+
 class RunExamples : public ::testing::TestWithParam<Example> {};
 
 TEST_P(RunExamples, BundleAndVerdict) {
