@@ -10,12 +10,14 @@
 #include <vector>
 
 #include "cli/commands.h"
+#include "netlists/link/cards.h"
 #include "netlists/link/parts.h"
 
 namespace isolink::cli {
 namespace {
 
 using link::Figure;
+using link::format_si;
 using link::Part;
 using link::PartKind;
 
@@ -24,18 +26,6 @@ struct PartsArgs {
   std::string part;
   bool json = false;
 };
-
-// 51e-6 -> "51 uH", 2800 -> "2.8 kohm".
-std::string si(double v, const char* unit) {
-  static const std::pair<double, const char*> kPrefixes[] = {
-      {1e9, "G"},  {1e6, "M"},  {1e3, "k"},   {1, ""},     {1e-3, "m"},
-      {1e-6, "u"}, {1e-9, "n"}, {1e-12, "p"}, {1e-15, "f"}};
-  if (v == 0 || !std::isfinite(v)) return fmt::format("{:g} {}", v, unit);
-  for (const auto& [scale, prefix] : kPrefixes)
-    if (std::fabs(v) >= scale * 0.9999995)
-      return fmt::format("{:.4g} {}{}", v / scale, prefix, unit);
-  return fmt::format("{:g} {}", v, unit);
-}
 
 const char* unit_of(const std::string& key) {
   if (key == "inductance" || key == "leakage") return "H";
@@ -48,9 +38,10 @@ const char* unit_of(const std::string& key) {
 
 std::string range_text(const Figure& f) {
   if (f.tolerance) return fmt::format("+/-{:g} %", *f.tolerance * 100);
-  if (f.min && f.max) return si(*f.min, unit_of(f.key)) + " .. " + si(*f.max, unit_of(f.key));
-  if (f.min) return "min " + si(*f.min, unit_of(f.key));
-  if (f.max) return "max " + si(*f.max, unit_of(f.key));
+  if (f.min && f.max)
+    return format_si(*f.min, unit_of(f.key)) + " .. " + format_si(*f.max, unit_of(f.key));
+  if (f.min) return "min " + format_si(*f.min, unit_of(f.key));
+  if (f.max) return "max " + format_si(*f.max, unit_of(f.key));
   return "";
 }
 
@@ -58,17 +49,17 @@ std::string range_text(const Figure& f) {
 std::string values_text(const Part& p) {
   switch (p.kind) {
     case PartKind::Choke:
-      return fmt::format("{}, k {:.5f}", si(p.choke.inductance, "H"), p.choke.k);
+      return fmt::format("{}, k {:.5f}", format_si(p.choke.inductance, "H"), p.choke.k);
     case PartKind::Transformer: {
-      std::string s = "OCL " + si(p.transformer.inductance, "H");
+      std::string s = "OCL " + format_si(p.transformer.inductance, "H");
       if (const Figure* f = p.figure("inductance"); f && f->min && f->max)
-        s += " (" + si(*f->min, "H") + " .. " + si(*f->max, "H") + ")";
-      s += ", Lleak " + si(p.transformer.leakage, "H");
-      if (p.transformer.centre_tap_c > 0) s += ", CT " + si(p.transformer.centre_tap_c, "F");
+        s += " (" + format_si(*f->min, "H") + " .. " + format_si(*f->max, "H") + ")";
+      s += ", Lleak " + format_si(p.transformer.leakage, "H");
+      if (p.transformer.centre_tap_c > 0) s += ", CT " + format_si(p.transformer.centre_tap_c, "F");
       return s;
     }
     case PartKind::Capacitor: {
-      std::string s = si(p.capacitor.capacitance, "F");
+      std::string s = format_si(p.capacitor.capacitance, "F");
       if (p.capacitor.tolerance > 0) s += fmt::format(" +/-{:g} %", p.capacitor.tolerance * 100);
       if (!p.dielectric.empty()) s += " " + p.dielectric;
       return s;
@@ -79,9 +70,9 @@ std::string values_text(const Part& p) {
 
 std::string rating_text(const Part& p) {
   std::vector<std::string> r;
-  if (p.rated_current) r.push_back(si(*p.rated_current, "A"));
-  if (p.rated_voltage) r.push_back(si(*p.rated_voltage, "V"));
-  if (p.isolation_voltage) r.push_back(si(*p.isolation_voltage, "V") + " isolation");
+  if (p.rated_current) r.push_back(format_si(*p.rated_current, "A"));
+  if (p.rated_voltage) r.push_back(format_si(*p.rated_voltage, "V"));
+  if (p.isolation_voltage) r.push_back(format_si(*p.isolation_voltage, "V") + " isolation");
   std::string s;
   for (const std::string& x : r) s += (s.empty() ? "" : ", ") + x;
   return s.empty() ? "-" : s;
@@ -89,7 +80,7 @@ std::string rating_text(const Part& p) {
 
 std::string zcm_text(const Part& p) {
   if (!p.cm_impedance) return "-";
-  return si(*p.cm_impedance, "ohm") + " @ " + si(p.cm_frequency.value_or(0), "Hz");
+  return format_si(*p.cm_impedance, "ohm") + " @ " + format_si(p.cm_frequency.value_or(0), "Hz");
 }
 
 nlohmann::json to_json(const Part& p) {
@@ -171,8 +162,8 @@ void print_part(const Part& p) {
   if (!p.datasheet.empty()) std::printf("  from: %s\n", p.datasheet.c_str());
   if (!p.overrides.empty()) std::printf("  overrides the part at %s\n", p.overrides.c_str());
   for (const Figure& f : p.figures) {
-    std::string v = si(f.value, unit_of(f.key));
-    if (f.frequency) v += " @ " + si(*f.frequency, "Hz");
+    std::string v = format_si(f.value, unit_of(f.key));
+    if (f.frequency) v += " @ " + format_si(*f.frequency, "Hz");
     if (!f.measured.empty()) v += " (" + f.measured + ")";
     const std::string range = range_text(f);
     if (!range.empty()) v += " [" + range + "]";
@@ -184,19 +175,22 @@ void print_part(const Part& p) {
       std::printf(
           "  model: L %s per winding, k %.6f (CM %s, DM %s per line), DCR %s, "
           "Cw %s, Rloss %s\n",
-          si(p.choke.inductance, "H").c_str(), p.choke.k,
-          si(p.choke.inductance * (1 + p.choke.k), "H").c_str(),
-          si(p.choke.inductance * (1 - p.choke.k), "H").c_str(), si(p.choke.dcr, "ohm").c_str(),
-          si(p.choke.winding_c, "F").c_str(), si(p.choke.loss_r, "ohm").c_str());
+          format_si(p.choke.inductance, "H").c_str(), p.choke.k,
+          format_si(p.choke.inductance * (1 + p.choke.k), "H").c_str(),
+          format_si(p.choke.inductance * (1 - p.choke.k), "H").c_str(),
+          format_si(p.choke.dcr, "ohm").c_str(), format_si(p.choke.winding_c, "F").c_str(),
+          format_si(p.choke.loss_r, "ohm").c_str());
       break;
     case PartKind::Transformer:
       std::printf(
           "  model: OCL %s, k %.6f (leakage %s, other winding shorted), DCR %s per "
           "winding, inter-winding C %s, centre tap %s\n",
-          si(p.transformer.inductance, "H").c_str(), p.transformer.k(),
-          si(p.transformer.leakage, "H").c_str(), si(p.transformer.dcr, "ohm").c_str(),
-          si(p.transformer.winding_c, "F").c_str(),
-          p.transformer.centre_tap_c > 0 ? si(p.transformer.centre_tap_c, "F").c_str() : "none");
+          format_si(p.transformer.inductance, "H").c_str(), p.transformer.k(),
+          format_si(p.transformer.leakage, "H").c_str(),
+          format_si(p.transformer.dcr, "ohm").c_str(),
+          format_si(p.transformer.winding_c, "F").c_str(),
+          p.transformer.centre_tap_c > 0 ? format_si(p.transformer.centre_tap_c, "F").c_str()
+                                         : "none");
       break;
     case PartKind::Capacitor:
       break;

@@ -432,13 +432,14 @@ int cable_segments(const CableSpec& spec, const CableModel& m, double edge_time)
 
 Status add_cable(std::vector<Card>& cards, const std::string& prefix, const std::string& a_p,
                  const std::string& a_n, const std::string& b_p, const std::string& b_n,
-                 const CableSpec& spec, double edge_time) {
+                 const CableSpec& spec, double edge_time, int* segments) {
   if (!(edge_time > 0) || !std::isfinite(edge_time))
     return Status::Error(fmt::format("cable {}: edge time {:g} s must be > 0", prefix, edge_time));
   StatusOr<CableModel> model = cable_model(spec);
   if (!model) return model.status();
   const CableModel& m = *model;
   const int n = cable_segments(spec, m, edge_time);
+  if (segments != nullptr) *segments = n;
   const double dz = m.length / n;
 
   auto node = [&](char side, int j) -> std::string {

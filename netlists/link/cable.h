@@ -165,9 +165,10 @@ int loss_stride(const CableSpec& spec, int segments);  // spec.loss_stride when 
 // Appends the cable's element cards between the ends (a_p, a_n) and (b_p, b_n); node "0" is the
 // reference (chassis). Element names are the element letter, then prefix, then "_..." (SPICE
 // style, as the pin models: "lcab_p3", "kcab_3", "ccab_pn0"); internal nodes are
-// "<prefix>_...". edge_time (s, > 0) sets the segment count when spec.segments is 0.
+// "<prefix>_...". edge_time (s, > 0) sets the segment count when spec.segments is 0; the count
+// used goes to *segments when given.
 Status add_cable(std::vector<Card>& cards, const std::string& prefix, const std::string& a_p,
                  const std::string& a_n, const std::string& b_p, const std::string& b_n,
-                 const CableSpec& spec, double edge_time = 10e-9);
+                 const CableSpec& spec, double edge_time = 10e-9, int* segments = nullptr);
 
 }  // namespace isolink::link

@@ -1,8 +1,8 @@
 #include "netlists/link/cards.h"
 
-#include <cmath>
-
 #include <fmt/format.h>
+
+#include <cmath>
 
 namespace isolink::link {
 
@@ -26,18 +26,20 @@ CardArg number_arg(double v) {
 }
 
 std::string format_si(double v, const char* unit) {
-  if (v == 0) return fmt::format("0 {}", unit);
-  static const std::pair<double, const char*> kScales[] = {
-      {1e9, "G"},  {1e6, "M"},  {1e3, "k"},   {1, ""},
-      {1e-3, "m"}, {1e-6, "u"}, {1e-9, "n"}, {1e-12, "p"}, {1e-15, "f"}};
-  for (const auto& [s, p] : kScales)
-    if (std::fabs(v) >= s * 0.9999) return fmt::format("{:.4g} {}{}", v / s, p, unit);
-  return fmt::format("{:.3g} {}", v, unit);
+  static const std::pair<double, const char*> kPrefixes[] = {
+      {1e9, "G"},  {1e6, "M"},  {1e3, "k"},   {1, ""},     {1e-3, "m"},
+      {1e-6, "u"}, {1e-9, "n"}, {1e-12, "p"}, {1e-15, "f"}};
+  if (v == 0 || !std::isfinite(v)) return fmt::format("{:g} {}", v, unit);
+  for (const auto& [scale, prefix] : kPrefixes)
+    if (std::fabs(v) >= scale * 0.9999995)
+      return fmt::format("{:.4g} {}{}", v / scale, prefix, unit);
+  return fmt::format("{:g} {}", v, unit);
 }
 
 Status add_cards(Circuit& circuit, const std::vector<Card>& cards) {
   for (const Card& c : cards)
-    if (Status s = circuit.add(c); !s.ok()) return s.with_context(fmt::format("element {}", c.name));
+    if (Status s = circuit.add(c); !s.ok())
+      return s.with_context(fmt::format("element {}", c.name));
   return Status::Ok();
 }
 

@@ -63,11 +63,10 @@ StatusOr<ChokeModel> choke_for(const IsolationSpec& iso, const std::string& numb
 
 // One end's board and isolation between its device pins (pin_p/pin_n) and its cable connector
 // nodes; returns the connector node names.
-StatusOr<std::pair<std::string, std::string>> add_end(std::vector<Card>& cards,
-                                                      const EndSpec& end, const std::string& side,
+StatusOr<std::pair<std::string, std::string>> add_end(std::vector<Card>& cards, const EndSpec& end,
+                                                      const std::string& side,
                                                       const std::string& where,
-                                                      const PartLibrary& parts,
-                                                      std::string* bom) {
+                                                      const PartLibrary& parts, std::string* bom) {
   StatusOr<BoardNetwork> board = board_for(end);
   if (!board) return at(end.loc, fmt::format("{}: {}", where, board.status().message()));
   const std::string pin_p = side + "p", pin_n = side + "n";
@@ -97,12 +96,11 @@ StatusOr<std::pair<std::string, std::string>> add_end(std::vector<Card>& cards,
   if (type == "transformer" || type == "transformer_choke") {
     StatusOr<TransformerModel> m = transformer_for(end, parts, where);
     if (!m) return m.status();
-    *bom += fmt::format("; transformer {} (OCL {}, leakage {}, DCR {}{})",
-                        iso.part.empty() ? "(device default part)" : iso.part,
-                        format_si(m->inductance, "H"), format_si(m->leakage, "H"),
-                        format_si(m->dcr, "ohm"),
-                        m->centre_tap_c > 0 ? ", centre tap " + format_si(m->centre_tap_c, "F")
-                                            : "");
+    *bom += fmt::format(
+        "; transformer {} (OCL {}, leakage {}, DCR {}{})",
+        iso.part.empty() ? "(device default part)" : iso.part, format_si(m->inductance, "H"),
+        format_si(m->leakage, "H"), format_si(m->dcr, "ohm"),
+        m->centre_tap_c > 0 ? ", centre tap " + format_si(m->centre_tap_c, "F") : "");
     auto [a, b] = next("t");
     if (Status s = add_transformer(cards, "t" + side, p, n, a, b, *m); !s.ok())
       return at(iso.loc, fmt::format("{}.isolation: {}", where, s.message()));
@@ -174,11 +172,9 @@ StatusOr<ExpandedLink> expand_link(const LinkSpec& spec, const PartLibrary& part
   auto b = add_end(cards, to, "rx", to_key, parts, down ? &out.rx_bom : &out.tx_bom);
   if (!b) return b.status();
   if (Status s = add_cable(cards, "cab", a->first, a->second, b->first, b->second, spec.cable,
-                           opt.driver.edge);
+                           opt.driver.edge, &out.cable_segments);
       !s.ok())
     return at(spec.cable_loc, "cable: " + s.message());
-  StatusOr<CableModel> cm = cable_model(spec.cable);
-  if (cm) out.cable_segments = cable_segments(spec.cable, *cm, opt.driver.edge);
   if (Status s = add_rx_load(cards, "rx", "rxp", "rxn", opt.load); !s.ok())
     return s.with_context("rx load");
 

@@ -128,17 +128,6 @@ std::string join(const std::vector<std::string>& v) {
   return out;
 }
 
-std::string si(double v, const char* unit) {
-  static const std::pair<double, const char*> kPrefixes[] = {
-      {1e9, "G"},  {1e6, "M"},  {1e3, "k"},   {1, ""},     {1e-3, "m"},
-      {1e-6, "u"}, {1e-9, "n"}, {1e-12, "p"}, {1e-15, "f"}};
-  if (v == 0 || !std::isfinite(v)) return fmt::format("{:g} {}", v, unit);
-  for (const auto& [scale, prefix] : kPrefixes)
-    if (std::fabs(v) >= scale * 0.9999995)
-      return fmt::format("{:.4g} {}{}", v / scale, prefix, unit);
-  return fmt::format("{:g} {}", v, unit);
-}
-
 // Reads part files key by key into Parts.
 class PartReader {
  public:
@@ -437,14 +426,14 @@ class PartReader {
         return error_at(lk.loc, fmt::format("key 'leakage' = {}: must be below the inductance "
                                             "{} (measured with the other winding shorted it is "
                                             "L (1 - k^2))",
-                                            si(lk.value, "H"), si(l.value, "H")));
+                                            format_si(lk.value, "H"), format_si(l.value, "H")));
       k = std::sqrt(1 - lk.value / l.value);
     } else {
       if (!(lk.value < 2 * l.value))
         return error_at(lk.loc, fmt::format("key 'leakage' = {}: must be below twice the "
                                             "inductance {} (measured differentially it is "
                                             "2 L (1 - k))",
-                                            si(lk.value, "H"), si(l.value, "H")));
+                                            format_si(lk.value, "H"), format_si(l.value, "H")));
       k = 1 - lk.value / (2 * l.value);
     }
     const double dcr = get("dcr")->value, cw = get("winding_c")->value;
@@ -480,7 +469,7 @@ class PartReader {
         loss.source = fmt::format(
             "fitted: parallel loss per winding that makes |Zcm| at {} = "
             "{} (cm_impedance) with the winding_c above",
-            si(*z->frequency, "Hz"), si(z->value, "ohm"));
+            format_si(*z->frequency, "Hz"), format_si(z->value, "ohm"));
     }
     m.loss_r = loss.value;
     if (Status s = m.validate(); !s.ok()) return error_at(part.loc, s.message());
@@ -500,13 +489,13 @@ class PartReader {
       return Status::Error(fmt::format(
           "cannot fit: without loss |Zcm| at {} is only {}, below the {} to fit (the winding "
           "capacitance puts the self-resonance too far away: change winding_c)",
-          si(f, "Hz"), si(1 / std::abs(y0), "ohm"), si(z, "ohm")));
+          format_si(f, "Hz"), format_si(1 / std::abs(y0), "ohm"), format_si(z, "ohm")));
     const double g = std::sqrt(need) - y0.real();
     if (!(g > 0))
       return Status::Error(
           fmt::format("cannot fit: the DCR alone already brings |Zcm| at {} "
                       "below {}",
-                      si(f, "Hz"), si(z, "ohm")));
+                      format_si(f, "Hz"), format_si(z, "ohm")));
     return 2 / g;
   }
 
