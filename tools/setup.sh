@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 PACKAGES=(
   build-essential cmake ccache pkg-config
   libeigen3-dev libsuitesparse-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libfmt-dev
-  libopenimageio-dev libtbb-dev fonts-dejavu-core
+  libopenimageio-dev openimageio-tools libtbb-dev fonts-dejavu-core
   openmpi-bin libopenmpi-dev
   libgtest-dev libgmock-dev libbenchmark-dev ngspice
 )
