@@ -9,6 +9,8 @@
 //   TX driver -> txp/txn -> board (series R, bypass C, termination) -> tx_lp/tx_ln
 //   -> isolation (cap | cap + chokes | transformer | transformer + chokes) -> tx_cp/tx_cn
 //   -> cable -> rx_cp/rx_cn -> isolation -> rx_lp/rx_ln -> board -> rxp/rxn -> RX load.
+// X caps (x_cap) across and Y caps (y_cap, to the chassis "0") sit at each end's connector
+// (the cable side of its isolation).
 // Node names follow the role in this direction: txp/txn always drive, rxp/rxn always receive.
 #pragma once
 
@@ -26,21 +28,27 @@
 namespace isolink::link {
 
 struct ExpandOptions {
-  TxDriverModel driver;                 // the transmitting pins
-  RxLoadModel load;                     // the receiving pins
-  traffic::StimulusOptions stimulus;    // encoding and timing of the traffic
+  TxDriverModel driver;               // the transmitting pins
+  RxLoadModel load;                   // the receiving pins
+  traffic::StimulusOptions stimulus;  // encoding and timing of the traffic
+  // Ground nodes of the transmitting and the receiving board. "0" (the default) is the chassis:
+  // both boards' grounds joined to it, as `isolink run` simulates. Other names keep the boards
+  // apart (isolink noise): everything the board references goes to its ground node, which
+  // reaches the chassis through the end's chassis_c; the cable's capacitance to the chassis and
+  // the Y caps stay on "0".
+  std::string tx_ground = "0", rx_ground = "0";
 };
 
 struct ExpandedLink {
   Direction direction = Direction::kDown;
-  std::string transmitter, receiver;    // device names
-  std::string rules;                    // rule set the receiver is scored with
-  std::string description;              // "down: bq79600 -> bq7961x"
-  Netlist netlist;                      // cards, .tran, options
-  traffic::Drive drive;                 // what the transmitter sends
-  std::vector<uint8_t> expected;        // data bytes sent, in order
-  int cable_segments = 0;               // sections the cable was split into
-  std::string tx_bom, rx_bom;           // each spec end's parts as built, in words
+  std::string transmitter, receiver;  // device names
+  std::string rules;                  // rule set the receiver is scored with
+  std::string description;            // "down: bq79600 -> bq7961x"
+  Netlist netlist;                    // cards, .tran, options
+  traffic::Drive drive;               // what the transmitter sends
+  std::vector<uint8_t> expected;      // data bytes sent, in order
+  int cable_segments = 0;             // sections the cable was split into
+  std::string tx_bom, rx_bom;         // each spec end's parts as built, in words
 };
 
 StatusOr<ExpandedLink> expand_link(const LinkSpec& spec, const PartLibrary& parts, Direction d,
