@@ -33,13 +33,14 @@
 #include <string>
 #include <vector>
 
+#include "analysis/link_run.h"
+#include "base/status.h"
+#include "base/waveform.h"
 #include "eye/check.h"
 #include "eye/rules.h"
 #include "netlists/link/expand.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
-#include "solver/status.h"
-#include "solver/waveform.h"
 
 namespace isolink::analysis {
 
@@ -181,6 +182,14 @@ std::string noise_spice(const NoiseCircuit& c, const link::NoiseSpec& n);
 StatusOr<NoiseResult> analyze_noise(const link::LinkSpec& spec, const link::PartLibrary& parts,
                                     std::span<const NoiseDirectionInput> inputs,
                                     const NoiseOptions& opt = {});
+
+// The link simulated and scored per direction (run_link), then analyze_noise on it: the work of
+// `isolink noise`.
+struct NoiseRun {
+  LinkRun run;
+  NoiseResult noise;
+};
+StatusOr<NoiseRun> run_noise(const link::LinkSpec& spec, const link::PartLibrary& parts);
 
 // The shape of `isolink noise --json` (issue 16) with more fields.
 nlohmann::ordered_json noise_json(const NoiseResult& r);

@@ -8,13 +8,13 @@
 #include <vector>
 
 #include "analysis/noise.h"
+#include "base/atomic_file.h"
 #include "cli/commands.h"
-#include "cli/link_run.h"
-#include "cli/run_report.h"
 #include "netlists/link/cards.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
 #include "reports/noise_png.h"
+#include "reports/run_report.h"
 
 namespace isolink::cli {
 namespace {
@@ -46,16 +46,10 @@ int run_noise(const NoiseArgs& a) {
       return fail(s);
   }
   // The link's own waveform per direction sets how much noise the receiver can take.
-  StatusOr<LinkRun> run = run_link(*spec, *parts);
-  if (!run) return fail(run.status().with_context(a.spec));
-  std::vector<analysis::NoiseDirectionInput> inputs;
-  for (const DirectionRun& d : run->directions) {
-    const bool data = d.data.has_value();
-    inputs.push_back({d.link.direction, data ? &*d.data : &*d.tones,
-                      data ? &d.rules : &d.tone_rules, &d.sim.wave, d.link.expected});
-  }
-  StatusOr<analysis::NoiseResult> noise = analysis::analyze_noise(*spec, *parts, inputs);
-  if (!noise) return fail(noise.status().with_context(a.spec));
+  StatusOr<analysis::NoiseRun> nr = analysis::run_noise(*spec, *parts);
+  if (!nr) return fail(nr.status().with_context(a.spec));
+  const analysis::LinkRun* run = &nr->run;
+  const analysis::NoiseResult* noise = &nr->noise;
 
   const std::string dir = a.out_dir.empty() ? "reports/out/" + spec->name : a.out_dir;
   std::error_code ec;
@@ -69,10 +63,11 @@ int run_noise(const NoiseArgs& a) {
       return fail(s);
     images.push_back("noise.png");
   }
-  nlohmann::ordered_json j = run_report_json(*spec, *run);
+  nlohmann::ordered_json j = reports::run_report_json(*spec, *run);
   j["noise"] = analysis::noise_json(*noise);
   if (Status s = write_file_atomic(dir + "/report.json", j.dump(2) + "\n"); !s.ok()) return fail(s);
-  std::string md = run_report_markdown(*spec, *run, {}) + "\n" + analysis::noise_markdown(*noise);
+  std::string md =
+      reports::run_report_markdown(*spec, *run, {}) + "\n" + analysis::noise_markdown(*noise);
   for (const std::string& i : images) md += fmt::format("![{}]({})\n", i, i);
   if (Status s = write_file_atomic(dir + "/report.md", md); !s.ok()) return fail(s);
 

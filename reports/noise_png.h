@@ -9,7 +9,7 @@
 #include <string>
 
 #include "analysis/noise.h"
-#include "solver/status.h"
+#include "base/status.h"
 
 namespace isolink::reports {
 

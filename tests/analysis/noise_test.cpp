@@ -12,7 +12,6 @@
 #include <fstream>
 #include <numbers>
 
-#include "cli/link_run.h"
 #include "eye/rules.h"
 #include "netlists/link/cards.h"
 #include "ngspice_runner.h"
@@ -222,12 +221,9 @@ TEST(NoiseBudget, FollowsTheReceiverRules) {
 }
 
 StatusOr<NoiseResult> analyze(const link::LinkSpec& spec) {
-  StatusOr<cli::LinkRun> run = cli::run_link(spec, parts());
-  if (!run) return run.status();
-  std::vector<NoiseDirectionInput> in;
-  for (const cli::DirectionRun& d : run->directions)
-    in.push_back({d.link.direction, &*d.data, &d.rules, &d.sim.wave, d.link.expected});
-  return analyze_noise(spec, parts(), in);
+  StatusOr<NoiseRun> r = run_noise(spec, parts());
+  if (!r) return r.status();
+  return r->noise;
 }
 
 // TI's BCI setup (domain.md 6: ISO 11452-4, 1.7 m, 1 Mbps): the three isolation types with TI's
