@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "base/csv.h"
 #include "cli/commands.h"
 #include "cli/sweep_run.h"
 #include "cli/sweep_spec.h"
@@ -39,16 +40,17 @@ int fail(const Status& s) {
 }
 
 int list_points(const sweep::SweepSpec& s) {
-  std::string header = "point";
-  for (const std::string& c : s.point_columns()) header += "," + c;
-  std::printf("%s,spec\n", header.c_str());
+  std::vector<std::string> header{"point"};
+  for (const std::string& c : s.point_columns()) header.push_back(c);
+  header.push_back("spec");
+  std::fputs(csv_row(header).c_str(), stdout);
   for (size_t i = 0; i < s.size(); ++i) {
     const sweep::PointOutcome p = sweep::make_point(s, i);
-    std::string line = fmt::format("{}", i);
-    for (const std::string& c : p.point.cells) line += "," + c;
-    std::string st = p.status.ok() ? "ok" : p.status.message();
-    st = st.substr(0, st.find('\n'));
-    std::printf("%s,%s\n", line.c_str(), st.c_str());
+    std::vector<std::string> row{fmt::format("{}", i)};
+    for (const std::string& c : p.point.cells) row.push_back(c);
+    const std::string st = p.status.ok() ? "ok" : p.status.message();
+    row.push_back(st.substr(0, st.find('\n')));
+    std::fputs(csv_row(row).c_str(), stdout);
   }
   return 0;
 }

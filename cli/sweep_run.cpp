@@ -16,6 +16,7 @@
 #include <map>
 #include <sstream>
 
+#include "base/csv.h"
 #include "cli/run_report.h"
 #include "reports/sweep_plots.h"
 
@@ -37,14 +38,12 @@ double now_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"') out += '"';
-    out += (c == '\n' || c == '\r') ? ' ' : c;
-  }
-  return out + "\"";
+// One line per CSV record (results.csv is read back line by line on --resume).
+std::string cell(const std::string& s) {
+  std::string flat = s;
+  for (char& c : flat)
+    if (c == '\n' || c == '\r') c = ' ';
+  return csv_field(flat);
 }
 
 std::string num(double v) {
@@ -75,37 +74,6 @@ std::string duration_text(double s) {
   return fmt::format("{} h {:02} min", t / 3600, (t % 3600) / 60);
 }
 
-std::vector<std::string> split_csv_line(std::string_view line) {
-  std::vector<std::string> out;
-  std::string cur;
-  bool quoted = false, was_quoted = false;
-  for (size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted) {
-      if (c == '"') {
-        if (i + 1 < line.size() && line[i + 1] == '"') {
-          cur += '"';
-          ++i;
-        } else {
-          quoted = false;
-        }
-      } else {
-        cur += c;
-      }
-    } else if (c == '"' && cur.empty() && !was_quoted) {
-      quoted = was_quoted = true;
-    } else if (c == ',') {
-      out.push_back(cur);
-      cur.clear();
-      was_quoted = false;
-    } else if (c != '\r' && c != '\n') {
-      cur += c;
-    }
-  }
-  out.push_back(cur);
-  return out;
-}
-
 std::vector<std::string> results_header(const SweepSpec& s) {
   std::vector<std::string> h{"point"};
   for (const std::string& c : s.point_columns()) h.push_back(c);
@@ -115,7 +83,7 @@ std::vector<std::string> results_header(const SweepSpec& s) {
 
 std::string results_row(const PointResult& r) {
   std::string line = fmt::format("{}", r.index);
-  auto add = [&line](const std::string& f) { line += "," + csv_field(f); };
+  auto add = [&line](const std::string& f) { line += "," + cell(f); };
   for (const std::string& c : r.cells) add(c);
   add(r.verdict);
   add(r.worst_metric);
@@ -273,8 +241,7 @@ StatusOr<std::unique_ptr<ResultLog>> ResultLog::open(const SweepSpec& s, const S
   log->ncolumns_ = header.size();
   log->path_ = opt.out_dir + "/results.csv";
   std::string header_line;
-  for (const std::string& h : header)
-    header_line += (header_line.empty() ? "" : ",") + csv_field(h);
+  for (const std::string& h : header) header_line += (header_line.empty() ? "" : ",") + cell(h);
   header_line += "\n";
 
   std::string keep = header_line;

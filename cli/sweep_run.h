@@ -38,6 +38,7 @@
 #include <string_view>
 #include <vector>
 
+#include "base/csv.h"
 #include "cli/link_run.h"
 #include "cli/sweep_spec.h"
 #include "netlists/link/parts.h"
@@ -71,8 +72,8 @@ std::string results_row(const PointResult& r);
 StatusOr<PointResult> parse_results_row(std::string_view line, size_t ncells, size_t ncolumns);
 // The result as the CSV stores it (numbers rounded to what is written).
 PointResult round_trip(const PointResult& r, size_t ncells, size_t ncolumns);
-// Splits one CSV line (RFC 4180 quoting, no newlines inside fields).
-std::vector<std::string> split_csv_line(std::string_view line);
+// One CSV line back into its fields (base/csv.h; results.csv has no newlines inside fields).
+using isolink::split_csv_line;
 
 // Scores a finished run: verdict, margins, decoded_ok.
 PointResult score_run(const LinkRun& run);

@@ -89,8 +89,8 @@ TEST_P(RunExamples, BundleAndVerdict) {
   std::string header;
   std::getline(csv, header);
   EXPECT_EQ(header,
-            "time,down v(rxp,rxn),down v(rxp),down v(rxn),down v(txp,txn),up v(rxp,rxn),up v(rxp),"
-            "up v(rxn),up v(txp,txn)");
+            "time,\"down v(rxp,rxn)\",down v(rxp),down v(rxn),\"down v(txp,txn)\","
+            "\"up v(rxp,rxn)\",up v(rxp),up v(rxn),\"up v(txp,txn)\"");
 }
 
 INSTANTIATE_TEST_SUITE_P(
