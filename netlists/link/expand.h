@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,21 +27,24 @@
 namespace isolink::link {
 
 struct ExpandOptions {
-  TxDriverModel driver;                 // the transmitting pins
-  RxLoadModel load;                     // the receiving pins
-  traffic::StimulusOptions stimulus;    // encoding and timing of the traffic
+  TxDriverModel driver;               // the transmitting pins
+  RxLoadModel load;                   // the receiving pins
+  traffic::StimulusOptions stimulus;  // encoding and timing of the traffic
+  // Drives the link with this instead of the spec's stimulus (analyses that make their own
+  // traffic, e.g. one edge for the worst-case search); .tran then ends with it.
+  std::optional<traffic::Drive> drive;
 };
 
 struct ExpandedLink {
   Direction direction = Direction::kDown;
-  std::string transmitter, receiver;    // device names
-  std::string rules;                    // rule set the receiver is scored with
-  std::string description;              // "down: bq79600 -> bq7961x"
-  Netlist netlist;                      // cards, .tran, options
-  traffic::Drive drive;                 // what the transmitter sends
-  std::vector<uint8_t> expected;        // data bytes sent, in order
-  int cable_segments = 0;               // sections the cable was split into
-  std::string tx_bom, rx_bom;           // each spec end's parts as built, in words
+  std::string transmitter, receiver;  // device names
+  std::string rules;                  // rule set the receiver is scored with
+  std::string description;            // "down: bq79600 -> bq7961x"
+  Netlist netlist;                    // cards, .tran, options
+  traffic::Drive drive;               // what the transmitter sends
+  std::vector<uint8_t> expected;      // data bytes sent, in order
+  int cable_segments = 0;             // sections the cable was split into
+  std::string tx_bom, rx_bom;         // each spec end's parts as built, in words
 };
 
 StatusOr<ExpandedLink> expand_link(const LinkSpec& spec, const PartLibrary& parts, Direction d,
