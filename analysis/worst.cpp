@@ -268,7 +268,8 @@ Status WorstOptions::validate() const {
                                                      {"tail_tol", tail_tol},
                                                      {"reltol", reltol},
                                                      {"settle_tol", settle_tol},
-                                                     {"max_span", max_span}};
+                                                     {"max_span", max_span},
+                                                     {"max_memory", max_memory}};
   for (const auto& [name, v] : positive)
     if (!(v > 0) || !std::isfinite(v))
       return Status::Error(
@@ -342,17 +343,23 @@ StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::Par
           w->value_at(0, lead + static_cast<double>(i - out.pre) * opt.dt) - out.v_idle;
     out.span = span;
     out.settle = 0;
-    for (long i = n - n / 10; i < n; ++i)
+    out.drift = 0;
+    const long half = to_samples(opt.expand.stimulus.encoding.half_bit, opt.dt);
+    for (long i = n - n / 10; i < n; ++i) {
       out.settle = std::max(out.settle, std::abs(out.e[static_cast<size_t>(i)] - out.e.back()));
+      out.drift = std::max(out.drift, std::abs(out.e[static_cast<size_t>(i)] -
+                                               out.e[static_cast<size_t>(i - half)]));
+    }
     for (double x : out.e)
       if (!std::isfinite(x))
         return Status::Error(link->description + ": the edge response is not finite");
-    if (out.settle <= opt.settle_tol) break;
+    if (out.drift <= opt.settle_tol) break;
     if (span * 2 > opt.max_span)
       return Status::Error(fmt::format(
-          "{}: the edge response has not settled {:g} us after the edge (still moving by {:.2f} "
-          "mV, more than {:.2f} mV): the link's memory is too long for the worst-case search",
-          link->description, span * 1e6, out.settle * 1e3, opt.settle_tol * 1e3));
+          "{}: the edge response has not settled {:g} us after the edge (a half bit's response is "
+          "still {:.1f} uV, more than {:.1f} uV): the link's memory is too long for the "
+          "worst-case search",
+          link->description, span * 1e6, out.drift * 1e6, opt.settle_tol * 1e6));
   }
   out.engine = fmt::format("transient, reltol {:g}, tmax = the {:g} ns grid it is sampled on",
                            opt.reltol, opt.dt * 1e9);
@@ -423,7 +430,9 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
   // Memory and bounds (method items 2 and 3).
   const std::vector<double> env = pulse_envelope(e, half);
   long memory = 0;
-  while (memory < static_cast<long>(env.size()) && bound_from(env, memory, half) > opt.tail_tol)
+  const long max_memory = to_samples(opt.max_memory, dt);
+  while (memory < static_cast<long>(env.size()) && memory < max_memory &&
+         bound_from(env, memory, half) > opt.tail_tol)
     memory += half;
   dw.memory = static_cast<double>(memory) * dt;
   dw.gap_min = opt.gap_min;
@@ -728,11 +737,10 @@ nlohmann::ordered_json worst_json(const WorstResult& r) {
     dj["scored"] = d.scored;
     dj["ranked"] = d.ranked;
     dj["seconds"] = d.seconds;
-    dj["edge_response"] = {{"engine", d.edge.engine},
-                           {"span_us", d.edge.span * 1e6},
-                           {"settle_mV", d.edge.settle * 1e3},
-                           {"v_idle", d.edge.v_idle},
-                           {"seconds", d.edge.seconds}};
+    dj["edge_response"] = {
+        {"engine", d.edge.engine},          {"span_us", d.edge.span * 1e6},
+        {"settle_mV", d.edge.settle * 1e3}, {"half_bit_residue_uV", d.edge.drift * 1e6},
+        {"v_idle", d.edge.v_idle},          {"seconds", d.edge.seconds}};
     ordered_json w = ordered_json::object();
     for (const WorstMetric& m : d.metrics) {
       ordered_json mj;

@@ -16,7 +16,10 @@
 //    0 -> +1 level change (edge_response; today from a tight transient run until it settles).
 // 2. Memory: p(t) = E(t) - E(t - T) is one half bit's response. Half bits older than tau move v
 //    by at most B(tau) = sum_k max |p| over [tau + kT, tau + (k + 1) T) (|level| <= 1, at most one
-//    half bit per T). The memory M is the smallest tau with B(tau) <= tail_tol.
+//    half bit per T). The memory M is the smallest tau with B(tau) <= tail_tol (at most
+//    max_memory; B(M) is reported either way). The edge response is run until a half bit's
+//    response E(t) - E(t - T) stays below settle_tol over the last 10 % of the run; past the run E
+//    is taken as constant (a slow residual drift cancels in DC-balanced frames to first order).
 // 3. Traffic inside the memory of one byte frame (the "target": any byte, error bit 0 or 1, 512
 //    patterns) is the previous byte frame (512 patterns or none) at a gap g >= gap_min (3.8 us,
 //    the shortest the devices produce) on a gap_step grid up to M; anything older is at least
@@ -54,6 +57,7 @@ struct EdgeResponse {
   double v_idle = 0;      // v(rxp,rxn) with the line idle (V)
   double span = 0;        // simulated time after the corner (s)
   double settle = 0;      // max |e - e.back()| over the last 10 % of the span (V)
+  double drift = 0;       // max |E(t) - E(t - T)| over the last 10 %: a half bit's residue (V)
   std::string engine;     // what produced it ("transient reltol 1e-06")
   double seconds = 0;     // wall time
   // e at n samples after the corner: 0 before the record, e.back() after it.
@@ -66,16 +70,17 @@ struct EdgeResponse {
 };
 
 struct WorstOptions {
-  double dt = 1e-9;            // synthesis grid (s); edges and gaps fall on it
-  double gap_min = 3.8e-6;     // shortest idle between byte frames (traffic::Timing byte_gap)
-  double gap_step = 50e-9;     // gap grid of the previous byte (s)
-  double tail_tol = 0.5e-3;    // V: the memory ends where the tail bound falls below this
-  double reltol = 1e-6;        // transient tolerance of the edge response
-  double settle_tol = 0.2e-3;  // V: the edge response counts as settled
-  double max_span = 400e-6;    // s: longest edge-response run before giving up
-  int max_candidates = 24;     // target patterns carried into the history search per metric
-  int verify = 6;              // best-ranked histories scored exactly per candidate and metric
-  bool exhaustive = false;     // score every target x history combination (brute force)
+  double dt = 1e-9;           // synthesis grid (s); edges and gaps fall on it
+  double gap_min = 3.8e-6;    // shortest idle between byte frames (traffic::Timing byte_gap)
+  double gap_step = 50e-9;    // gap grid of the previous byte (s)
+  double tail_tol = 0.5e-3;   // V: the memory ends where the tail bound falls below this
+  double reltol = 1e-6;       // transient tolerance of the edge response
+  double settle_tol = 20e-6;  // V: settled when a half bit's response stays below this
+  double max_memory = 20e-6;  // s: longest memory searched; B there is reported as the bound
+  double max_span = 400e-6;   // s: longest edge-response run before giving up
+  int max_candidates = 24;    // target patterns carried into the history search per metric
+  int verify = 6;             // best-ranked histories scored exactly per candidate and metric
+  bool exhaustive = false;    // score every target x history combination (brute force)
   // Restrict the patterns searched (tests; empty = all 512). A pattern is byte | error_bit << 8.
   std::vector<int> targets;
   std::vector<int> previous;

@@ -97,7 +97,7 @@ Keys keys_of_traffic(const Traffic& t, double from, double to) {
 
 TEST(WorstCase, EdgeResponseSettlesAndSuperposesLikeTheTransient) {
   const Fixture& f = fixture();
-  EXPECT_LE(f.edge.settle, f.opt.settle_tol);
+  EXPECT_LE(f.edge.drift, f.opt.settle_tol);
   EXPECT_NEAR(f.edge.v_idle, 0.0, 1e-6);  // symmetric pins at idle
   // A stack-write (9 byte frames) with uneven gaps, synthesized and simulated.
   const std::vector<uint8_t> bytes =
