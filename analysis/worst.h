@@ -39,13 +39,13 @@
 #include <string>
 #include <vector>
 
+#include "base/status.h"
+#include "base/waveform.h"
 #include "eye/check.h"
 #include "eye/rules.h"
 #include "netlists/link/expand.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
-#include "solver/status.h"
-#include "solver/waveform.h"
 
 namespace isolink::analysis {
 

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "analysis/worst.h"
+#include "base/atomic_file.h"
 #include "cli/commands.h"
-#include "cli/run_report.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
 #include "reports/worst_png.h"

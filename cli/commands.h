@@ -18,6 +18,5 @@ void add_sweep_command(CLI::App& app, int* exit_code);
 void add_worst_command(CLI::App& app, int* exit_code);
 
 // The element table of the README (`isolink elements --markdown`).
-std::string element_reference_markdown();
 
 }  // namespace isolink::cli

@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "analysis/worst.h"
+#include "base/status.h"
 #include "netlists/traffic/encoding.h"
-#include "solver/status.h"
 
 namespace isolink::reports {
 

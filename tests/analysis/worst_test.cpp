@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "cli/link_run.h"
+#include "analysis/link_run.h"
 #include "eye/check.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/traffic/command.h"
@@ -113,7 +113,7 @@ TEST(WorstCase, EdgeResponseSettlesAndSuperposesLikeTheTransient) {
   }
   spec.stimulus.gaps = t.gaps;
   spec.sim.reltol = 1e-6;
-  StatusOr<cli::LinkRun> run = cli::run_link(spec, f.parts);
+  StatusOr<LinkRun> run = run_link(spec, f.parts);
   ASSERT_TRUE(run.ok()) << run.status().message();
   const Waveform& sim = run->directions[0].sim.wave;
   const Waveform syn = synthesize(f.edge, t, f.opt.expand.stimulus.encoding, 0, sim.time.back());
@@ -259,7 +259,7 @@ TEST(WorstCase, ReproduceBlocksShowTheWorstValueInTheTransient) {
     link::LinkSpec spec = f.spec;
     spec.stimulus = reproduce_spec(m, link::Direction::kDown);
     spec.sim.reltol = 1e-5;
-    StatusOr<cli::LinkRun> run = cli::run_link(spec, f.parts);
+    StatusOr<LinkRun> run = run_link(spec, f.parts);
     ASSERT_TRUE(run.ok()) << run.status().message();
     ASSERT_TRUE(run->directions[0].data.has_value());
     const Keys k = keys_of(*run->directions[0].data, f.rules);
