@@ -1,20 +1,23 @@
 // isolink run: a link spec simulated with its traffic, each receiver scored, and the report
 // bundle (eye.png, wave.png, report.json, report.md, wave.csv) written to a folder.
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
-#include <fmt/format.h>
-
-#include "cli/commands.h"
-#include "base/atomic_file.h"
 #include "analysis/link_run.h"
-#include "reports/run_images.h"
-#include "reports/run_report.h"
+#include "analysis/worst.h"
+#include "base/atomic_file.h"
+#include "cli/commands.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
+#include "reports/run_images.h"
+#include "reports/run_report.h"
+#include "reports/worst_png.h"
 
 namespace isolink::cli {
 using namespace isolink::analysis;  // run_link, LinkRun, run_waveforms
@@ -27,6 +30,7 @@ struct RunArgs {
   std::vector<std::string> part_dirs;
   std::string direction;
   bool no_images = false;
+  bool no_worst = false;
   bool quiet = false;
 };
 
@@ -47,25 +51,41 @@ int run_run(const RunArgs& a) {
 
   StatusOr<LinkRun> run = run_link(*spec, *parts);
   if (!run) return fail(run.status().with_context(a.spec));
+  // The worst case over all legal traffic, beside the spec's traffic (its own verdict).
+  std::optional<analysis::WorstResult> worst;
+  if (!a.no_worst) {
+    StatusOr<analysis::WorstResult> w = analysis::worst_case(*spec, *parts);
+    if (!w) return fail(w.status().with_context(a.spec + ", worst case"));
+    worst = std::move(*w);
+  }
 
   const std::string dir = a.out_dir.empty() ? "reports/out/" + spec->name : a.out_dir;
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
-  if (ec) return fail(Status::Error(fmt::format("{}: error: cannot create the folder: {}", dir,
-                                                ec.message())));
+  if (ec)
+    return fail(
+        Status::Error(fmt::format("{}: error: cannot create the folder: {}", dir, ec.message())));
   std::vector<std::string> images;
   if (!a.no_images) {
     if (Status s = render_run_images(*spec, *run, dir, &images); !s.ok()) return fail(s);
   }
   const Waveform wave = run_waveforms(*run, spec->sim.tstep);
   if (Status s = write_waveform_csv(wave, dir + "/wave.csv"); !s.ok()) return fail(s);
-  if (Status s = write_file_atomic(dir + "/report.json", run_report_json(*spec, *run).dump(2) +
-                                                             "\n");
-      !s.ok())
+  nlohmann::ordered_json json = run_report_json(*spec, *run);
+  std::string md = run_report_markdown(*spec, *run, images);
+  if (worst) {
+    json["worst_case"] = analysis::worst_json(*worst);
+    md += "\n## Worst case over all traffic\n\n" + analysis::worst_markdown(*worst);
+    if (!a.no_images) {
+      std::vector<std::string> files;
+      if (Status s = reports::render_worst_pngs(*worst, spec->name, {}, dir, &files); !s.ok())
+        return fail(s);
+      for (const std::string& f : files) md += fmt::format("![{}]({})\n\n", f, f);
+    }
+  }
+  if (Status s = write_file_atomic(dir + "/report.json", json.dump(2) + "\n"); !s.ok())
     return fail(s);
-  if (Status s = write_file_atomic(dir + "/report.md", run_report_markdown(*spec, *run, images));
-      !s.ok())
-    return fail(s);
+  if (Status s = write_file_atomic(dir + "/report.md", md); !s.ok()) return fail(s);
   std::vector<std::string> warned;  // both directions share most warnings: print each once
   for (const DirectionRun& d : run->directions)
     for (const std::string& w : d.sim.warnings)
@@ -75,6 +95,7 @@ int run_run(const RunArgs& a) {
       }
   if (!a.quiet) {
     std::fputs(run_summary_text(*spec, *run).c_str(), stdout);
+    if (worst) std::fputs(analysis::worst_summary_text(*worst).c_str(), stdout);
     std::printf("report: %s/report.md\n", dir.c_str());
   }
   return run->pass ? 0 : 1;
@@ -85,8 +106,9 @@ int run_run(const RunArgs& a) {
 void add_run_command(CLI::App& app, int* exit_code) {
   auto args = std::make_shared<RunArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "run", "Simulate a link spec with its traffic, score each receiver and write the report "
-             "(eye.png, wave.png, report.json, report.md, wave.csv)");
+      "run",
+      "Simulate a link spec with its traffic, score each receiver and write the report "
+      "(eye.png, wave.png, report.json, report.md, wave.csv)");
   cmd->add_option("spec", args->spec, "Link spec (YAML), e.g. netlists/examples/xfmr_12m.yaml")
       ->required();
   cmd->add_option("-o,--output", args->out_dir, "Report folder (default reports/out/<name>)");
@@ -94,6 +116,8 @@ void add_run_command(CLI::App& app, int* exit_code) {
   cmd->add_option("--direction", args->direction, "Override the spec: down | up | both")
       ->check(CLI::IsMember({"down", "up", "both"}));
   cmd->add_flag("--no-images", args->no_images, "Skip eye.png and wave.png");
+  cmd->add_flag("--no-worst", args->no_worst,
+                "Skip the worst case over all traffic (its report section and verdict)");
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing but errors");
   cmd->callback([args, exit_code] { *exit_code = run_run(*args); });
 }

@@ -15,6 +15,7 @@ void add_parts_command(CLI::App& app, int* exit_code);
 void add_run_command(CLI::App& app, int* exit_code);
 void add_export_command(CLI::App& app, int* exit_code);
 void add_sweep_command(CLI::App& app, int* exit_code);
+void add_worst_command(CLI::App& app, int* exit_code);
 
 // The element table of the README (`isolink elements --markdown`).
 

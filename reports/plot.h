@@ -61,6 +61,7 @@ inline constexpr Color kLevel = rgb(0x333333);      // VSTART levels (dashed)
 inline constexpr Color kSeriesP = rgb(0x1F77B4);    // P line
 inline constexpr Color kSeriesN = rgb(0xFF7F0E);    // N line
 inline constexpr Color kSeriesCm = rgb(0x2CA02C);   // common mode
+inline constexpr Color kMark = rgb(0xF28E00);       // a marked pulse (the worst case's)
 
 enum class FontFace { kSans, kBold, kMono };
 enum class HAlign { kLeft, kCenter, kRight };

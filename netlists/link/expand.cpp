@@ -165,9 +165,13 @@ StatusOr<ExpandedLink> expand_link(const LinkSpec& spec, const PartLibrary& part
   out.rules = device_rules(to.device);
   out.description = fmt::format("{}: {} -> {}", direction_name(d), from.device, to.device);
 
-  StatusOr<traffic::Drive> drive = traffic::build_drive(spec.stimulus.to_script(), opt.stimulus);
-  if (!drive) return at(spec.stimulus.loc, "stimulus: " + drive.status().message());
-  out.drive = std::move(*drive);
+  if (opt.drive) {
+    out.drive = *opt.drive;
+  } else {
+    StatusOr<traffic::Drive> drive = traffic::build_drive(spec.stimulus.to_script(), opt.stimulus);
+    if (!drive) return at(spec.stimulus.loc, "stimulus: " + drive.status().message());
+    out.drive = std::move(*drive);
+  }
   for (const traffic::DriveFrame& f : out.drive.frames)
     out.expected.insert(out.expected.end(), f.bytes.begin(), f.bytes.end());
 

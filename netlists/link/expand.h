@@ -14,6 +14,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,9 @@ struct ExpandOptions {
   TxDriverModel driver;               // the transmitting pins
   RxLoadModel load;                   // the receiving pins
   traffic::StimulusOptions stimulus;  // encoding and timing of the traffic
+  // Drives the link with this instead of the spec's stimulus (analyses that make their own
+  // traffic, e.g. one edge for the worst-case search); .tran then ends with it.
+  std::optional<traffic::Drive> drive;
 };
 
 struct ExpandedLink {

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include "netlists/traffic/stimulus.h"
+
 namespace isolink::link {
 
 using config::Field;
@@ -16,9 +18,13 @@ using config::Rule;
 using config::Unit;
 using config::YamlDoc;
 
-const char* direction_name(Direction d) { return d == Direction::kDown ? "down" : "up"; }
+const char* direction_name(Direction d) {
+  return d == Direction::kDown ? "down" : "up";
+}
 
-std::vector<std::string> device_names() { return {"bq79600", "bq7961x", "bq79606a"}; }
+std::vector<std::string> device_names() {
+  return {"bq79600", "bq7961x", "bq79606a"};
+}
 
 std::string device_rules(const std::string& device) {
   return device == "bq79600" ? "bq79600" : "bq7961x";
@@ -28,7 +34,10 @@ std::string StimulusSpec::to_script() const {
   std::string s;
   auto add = [&s](const std::string& item) { s += (s.empty() ? "" : "; ") + item; };
   for (const std::string& t : tones) add("tone " + t);
-  for (const std::string& f : frames) add(f);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    if (i < gaps.size()) add(fmt::format("gap {:.12g}", gaps[i]));
+    add(frames[i]);
+  }
   for (const std::string& p : patterns) add("pattern " + p);
   if (!script.empty()) add(script);
   return s;
@@ -77,8 +86,7 @@ Status read_isolation(const YamlDoc& doc, const YAML::Node& node, const std::str
   return Status::Ok();
 }
 
-Status read_end(const YamlDoc& doc, const YAML::Node& node, const std::string& path,
-                EndSpec* end) {
+Status read_end(const YamlDoc& doc, const YAML::Node& node, const std::string& path, EndSpec* end) {
   end->loc = doc.loc(node);
   std::vector<std::string> devices = device_names();
   return read_map(
@@ -124,15 +132,31 @@ Status read_cable(const YamlDoc& doc, const YAML::Node& node, CableSpec* cable) 
 Status read_stimulus(const YamlDoc& doc, const YAML::Node& node, StimulusSpec* st) {
   st->loc = doc.loc(node);
   std::string direction = "both";
+  std::vector<std::string> gaps;
   Status s = read_map(doc, node, "stimulus",
                       {
                           {"frames", read_text_list(doc, &st->frames)},
+                          {"gaps", read_text_list(doc, &gaps)},
                           {"tones", read_text_list(doc, &st->tones)},
                           {"patterns", read_text_list(doc, &st->patterns)},
                           {"script", read_text(doc, &st->script)},
                           {"direction", read_choice(doc, {"down", "up", "both"}, &direction)},
                       });
   if (!s.ok()) return s;
+  if (!gaps.empty()) {
+    const YAML::Node& at = node["gaps"];
+    if (gaps.size() != st->frames.size())
+      return doc.error(at, fmt::format("key 'stimulus.gaps': {} gaps for {} frames: give one gap "
+                                       "(the idle before it) per frame",
+                                       gaps.size(), st->frames.size()));
+    for (const std::string& g : gaps) {
+      StatusOr<double> t = traffic::parse_time(g);
+      if (!t || !(*t >= 0))
+        return doc.error(at, fmt::format("key 'stimulus.gaps': '{}' {}", g,
+                                         t ? "must be a time >= 0" : t.status().message()));
+      st->gaps.push_back(*t);
+    }
+  }
   if (direction == "down") st->directions = {Direction::kDown};
   if (direction == "up") st->directions = {Direction::kUp};
   return Status::Ok();
@@ -153,22 +177,23 @@ StatusOr<LinkSpec> read_link_spec(const YamlDoc& doc) {
       doc, root, "",
       {
           {"name", read_text(doc, &spec.name)},
-          {"tx", [&](const YAML::Node& n, const std::string& p) {
-             return read_end(doc, n, p, &spec.tx);
-           }},
-          {"rx", [&](const YAML::Node& n, const std::string& p) {
-             return read_end(doc, n, p, &spec.rx);
-           }},
-          {"cable", [&](const YAML::Node& n, const std::string&) {
+          {"tx", [&](const YAML::Node& n,
+                     const std::string& p) { return read_end(doc, n, p, &spec.tx); }},
+          {"rx", [&](const YAML::Node& n,
+                     const std::string& p) { return read_end(doc, n, p, &spec.rx); }},
+          {"cable",
+           [&](const YAML::Node& n, const std::string&) {
              spec.cable_loc = doc.loc(n);
              return read_cable(doc, n, &spec.cable);
            }},
-          {"stimulus", [&](const YAML::Node& n, const std::string&) {
+          {"stimulus",
+           [&](const YAML::Node& n, const std::string&) {
              stimulus_given = true;
              spec.stimulus.frames.clear();
              return read_stimulus(doc, n, &spec.stimulus);
            }},
-          {"sim", [&](const YAML::Node& n, const std::string& p) {
+          {"sim",
+           [&](const YAML::Node& n, const std::string& p) {
              return read_map(
                  doc, n, p,
                  {

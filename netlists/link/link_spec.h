@@ -8,7 +8,8 @@
 //   name, tx / rx: {device, series_r, bypass_c, termination, isolation: {type, cap, chokes,
 //   part, inductance, leakage, dcr, winding_c, centre_tap_c, cable_side_c, esd}},
 //   cable: {length, material, gauge, temperature, r, l, c, g, segments},
-//   stimulus: {frames, tones, patterns, script, direction}, sim: {tstep, tmax, method, reltol}.
+//   stimulus: {frames, gaps, tones, patterns, script, direction}, sim: {tstep, tmax, method,
+//   reltol}.
 // `tx` is the end that transmits in the down direction (the host / bridge side); `rx` the end
 // that receives it. With direction up (or both) the rx end transmits back to the tx end.
 #pragma once
@@ -40,10 +41,10 @@ struct IsolationSpec {
 };
 
 struct EndSpec {
-  std::string device = "bq7961x";      // bq79600 | bq7961x | bq79606a
-  std::optional<double> series_r;      // ohm per line (board preset's when absent)
-  std::optional<double> bypass_c;      // F per line
-  std::optional<double> termination;   // ohm, differential
+  std::string device = "bq7961x";     // bq79600 | bq7961x | bq79606a
+  std::optional<double> series_r;     // ohm per line (board preset's when absent)
+  std::optional<double> bypass_c;     // F per line
+  std::optional<double> termination;  // ohm, differential
   IsolationSpec isolation;
   SourceLoc loc;
 };
@@ -56,6 +57,7 @@ struct StimulusSpec {
   std::vector<std::string> tones;     // tone items ("wake", "fault couplets=4")
   std::vector<std::string> patterns;  // pattern items ("prbs7 bytes=32")
   std::string script;                 // a stimulus script (traffic/stimulus.h), after the above
+  std::vector<double> gaps;           // s, the idle before each frame (empty: lead / frame gap)
   std::vector<Direction> directions{Direction::kDown, Direction::kUp};
   SourceLoc loc;
   // The stimulus script of all items: tones, then frames, then patterns, then script.
@@ -63,15 +65,15 @@ struct StimulusSpec {
 };
 
 struct SimSpec {
-  double tstep = 1e-9;                // s, output resolution
-  std::optional<double> tmax;         // s, largest internal step
-  std::string method = "trap";        // trap | gear
+  double tstep = 1e-9;          // s, output resolution
+  std::optional<double> tmax;   // s, largest internal step
+  std::string method = "trap";  // trap | gear
   std::optional<double> reltol;
 };
 
 struct LinkSpec {
   std::string name = "link";
-  std::string source;                 // the file it was read from
+  std::string source;  // the file it was read from
   EndSpec tx, rx;
   CableSpec cable;
   SourceLoc cable_loc;

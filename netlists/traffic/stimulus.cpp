@@ -136,6 +136,12 @@ Status add_item(DriveBuilder& b, std::string_view item, const StimulusOptions& o
     if (!t) return t.status().with_context("idle");
     return b.add_idle(*t);
   }
+  if (kw == "gap") {
+    if (rest.size() != 1) return Status::Error("gap: expected one time, e.g. 'gap 3.8us'");
+    StatusOr<double> t = parse_time(rest[0]);
+    if (!t) return t.status().with_context("gap");
+    return b.set_gap(*t);
+  }
   if (kw == "tone") {
     if (rest.empty()) return Status::Error("tone: expected a tone name, e.g. 'tone wake'");
     return add_tone_item(b, rest[0], {rest.begin() + 1, rest.end()}, opt);
@@ -158,17 +164,31 @@ Status add_item(DriveBuilder& b, std::string_view item, const StimulusOptions& o
     }
     return b.add_frame(pattern_bytes(*p, n), std::string(pattern_name(*p)));
   }
-  StatusOr<std::vector<uint8_t>> bytes = command_bytes(item);
+  // `raw ... err`: the bytes go out with the byte-error bit set (as a resent byte).
+  int error_bit = -1;
+  std::string command(item);
+  if (kw == "raw") {
+    command.clear();
+    for (std::string_view w : tok) {
+      if (lower(w) == "err") {
+        error_bit = 1;
+      } else {
+        command += (command.empty() ? "" : " ") + std::string(w);
+      }
+    }
+  }
+  StatusOr<std::vector<uint8_t>> bytes = command_bytes(command);
   if (!bytes) {
     if (bytes.status().message().rfind("unknown command", 0) == 0) {
       return Status::Error(
           fmt::format("unknown item '{}': expected a command (single-read ... raw), a tone (wake, "
-                      "sleep-to-active, shutdown, heartbeat, fault), 'pattern NAME' or 'idle T'",
+                      "sleep-to-active, shutdown, heartbeat, fault), 'pattern NAME', 'idle T' or "
+                      "'gap T'",
                       tok[0]));
     }
     return bytes.status();
   }
-  return b.add_frame(*bytes, std::string(trim(item)));
+  return b.add_frame(*bytes, std::string(trim(item)), error_bit);
 }
 
 StatusOr<Drive> build_drive(std::string_view script, const StimulusOptions& opt) {

@@ -89,5 +89,26 @@ TEST(Stimulus, ErrorsNameTheItem) {
   EXPECT_NE(d.status().message().find("stimulus is empty"), std::string::npos);
 }
 
+TEST(Stimulus, GapSetsTheIdleBeforeTheNextItemExactly) {
+  // gap replaces the 1 us lead and the 12 us frame gap; idle still adds to it.
+  StatusOr<Drive> d = build_drive(
+      "gap 2u; raw 5A nocrc; gap 3.85u; raw 35 nocrc err; "
+      "idle 1u; gap 4u; raw 00 nocrc");
+  ASSERT_TRUE(d.ok()) << d.status().message();
+  ASSERT_EQ(d->frames.size(), 3u);
+  const double frame = 6.5e-6;
+  EXPECT_NEAR(d->frames[0].start, 2e-6, 1e-15);
+  EXPECT_NEAR(d->frames[1].start, 2e-6 + frame + 3.85e-6, 1e-15);
+  EXPECT_NEAR(d->frames[2].start, d->frames[1].end + 5e-6, 1e-15);
+  // err: the second byte carries the error bit: its last bit is (+, -), so the half bit before
+  // the postamble is -, touching it (one 500 ns negative pulse at the end).
+  EXPECT_EQ(d->level_at(d->frames[1].end - 0.6e-6), +1);
+  EXPECT_EQ(d->level_at(d->frames[1].end - 0.4e-6), -1);
+  EXPECT_EQ(d->level_at(d->frames[0].end - 0.4e-6), +1);  // 0x5A with error bit 0: (-, +)
+  EXPECT_FALSE(build_drive("gap -1u; raw 00 nocrc").ok());
+  EXPECT_NE(build_drive("gap; raw 00").status().message().find("gap: expected one time"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace isolink::traffic
