@@ -1,12 +1,12 @@
 // isolink run: a link spec simulated with its traffic, each receiver scored, and the report
 // bundle (eye.png, wave.png, report.json, report.md, wave.csv) written to a folder.
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
-
-#include <fmt/format.h>
 
 #include "cli/commands.h"
 #include "cli/link_run.h"
@@ -23,6 +23,7 @@ struct RunArgs {
   std::string out_dir;
   std::vector<std::string> part_dirs;
   std::string direction;
+  std::string engine = "auto";
   bool no_images = false;
   bool quiet = false;
 };
@@ -42,22 +43,25 @@ int run_run(const RunArgs& a) {
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load(a.part_dirs);
   if (!parts) return fail(parts.status());
 
-  StatusOr<LinkRun> run = run_link(*spec, *parts);
+  RunOptions ro;
+  ro.engine = *parse_engine(a.engine);  // CLI11 checked the choice
+  StatusOr<LinkRun> run = run_link(*spec, *parts, ro);
   if (!run) return fail(run.status().with_context(a.spec));
 
   const std::string dir = a.out_dir.empty() ? "reports/out/" + spec->name : a.out_dir;
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
-  if (ec) return fail(Status::Error(fmt::format("{}: error: cannot create the folder: {}", dir,
-                                                ec.message())));
+  if (ec)
+    return fail(
+        Status::Error(fmt::format("{}: error: cannot create the folder: {}", dir, ec.message())));
   std::vector<std::string> images;
   if (!a.no_images) {
     if (Status s = render_run_images(*spec, *run, dir, &images); !s.ok()) return fail(s);
   }
   const Waveform wave = run_waveforms(*run, spec->sim.tstep);
   if (Status s = write_waveform_csv(wave, dir + "/wave.csv"); !s.ok()) return fail(s);
-  if (Status s = write_file_atomic(dir + "/report.json", run_report_json(*spec, *run).dump(2) +
-                                                             "\n");
+  if (Status s =
+          write_file_atomic(dir + "/report.json", run_report_json(*spec, *run).dump(2) + "\n");
       !s.ok())
     return fail(s);
   if (Status s = write_file_atomic(dir + "/report.md", run_report_markdown(*spec, *run, images));
@@ -82,14 +86,18 @@ int run_run(const RunArgs& a) {
 void add_run_command(CLI::App& app, int* exit_code) {
   auto args = std::make_shared<RunArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "run", "Simulate a link spec with its traffic, score each receiver and write the report "
-             "(eye.png, wave.png, report.json, report.md, wave.csv)");
+      "run",
+      "Simulate a link spec with its traffic, score each receiver and write the report "
+      "(eye.png, wave.png, report.json, report.md, wave.csv)");
   cmd->add_option("spec", args->spec, "Link spec (YAML), e.g. netlists/examples/xfmr_12m.yaml")
       ->required();
   cmd->add_option("-o,--output", args->out_dir, "Report folder (default reports/out/<name>)");
   cmd->add_option("--parts", args->part_dirs, "Extra part-library folder (repeatable)");
   cmd->add_option("--direction", args->direction, "Override the spec: down | up | both")
       ->check(CLI::IsMember({"down", "up", "both"}));
+  cmd->add_option("--engine", args->engine,
+                  "auto (LTI, the default: every link is linear), lti, transient (the cross-check)")
+      ->check(CLI::IsMember({"auto", "lti", "transient"}));
   cmd->add_flag("--no-images", args->no_images, "Skip eye.png and wave.png");
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing but errors");
   cmd->callback([args, exit_code] { *exit_code = run_run(*args); });
