@@ -152,7 +152,10 @@ StatusOr<LtiResponses> LtiResponses::compute(const Circuit& circuit,
   hist.push(0.0, x);
   double tau = 0.0, h = ladder(h0);
   int worst_unknown = 0;
-  size_t next_check = 16;  // settle checks at geometrically spaced march points
+  // Largest |chord slope| of each probe's response so far: no settling before it has arrived.
+  std::vector<std::vector<double>> probe_peak(nk, std::vector<double>(np, 0.0));
+  size_t next_check = 16;  // settle checks at geometrically spaced march points and times
+  double next_check_tau = 0.0;
 
   while (tau < horizon * (1 - 1e-12)) {
     if (r.stats_.steps + r.stats_.rejected >= opt.max_steps)
@@ -219,31 +222,42 @@ StatusOr<LtiResponses> LtiResponses::compute(const Circuit& circuit,
     r.tau_.push_back(tau);
     for (size_t k = 0; k < nk; ++k)
       for (size_t p = 0; p < np; ++p) {
-        r.r_[k][p].push_back(probes[p].value(x[k].data()));
-        r.s_[k][p].push_back(probes[p].value(xdot[k].data()));
+        auto &R = r.r_[k][p], &S = r.s_[k][p];
+        R.push_back(probes[p].value(x[k].data()));
+        S.push_back(probes[p].value(xdot[k].data()));
+        const double chord = (R.back() - R[R.size() - 2]) / step;
+        probe_peak[k][p] = std::max(probe_peak[k][p], std::fabs(chord));
       }
     // Error per unit time scales as h^2: grow by sqrt, at most 2x.
     const double grow = ratio > 0 ? std::min(2.0, 0.9 * std::sqrt(1.0 / ratio)) : 2.0;
     h = ladder(std::max(step * std::max(grow, 0.5), hmin));
 
-    // Settling (see lti.h), checked at march points 16, 16 * 1.1, ...
+    // Settling (see lti.h), checked whenever the step count or the time has grown by 10 %.
     const size_t i = r.tau_.size() - 1;
-    if (i >= next_check) {
+    if (i >= next_check || (i >= 16 && tau >= next_check_tau)) {
       next_check = static_cast<size_t>(static_cast<double>(i) * 1.1) + 1;
+      next_check_tau = tau * 1.1;
       bool settled = true;
       const size_t from = static_cast<size_t>(
           std::lower_bound(r.tau_.begin(), r.tau_.end(), 0.5 * tau) - r.tau_.begin());
+      // On chord slopes (R_j - R_j-1) / h_j, the mean of S over each step: the trapezoidal rule's
+      // derivative S carries a +-delta alternation that never damps, its chords do not.
+      auto chord = [&](const std::vector<double>& R, size_t j) {
+        return (R[j] - R[j - 1]) / (r.tau_[j] - r.tau_[j - 1]);
+      };
       for (size_t k = 0; k < nk && settled; ++k)
         for (size_t p = 0; p < np && settled; ++p) {
-          const auto& s = r.s_[k][p];
-          const double slope = (s[i] - s[i - 1]) / (r.tau_[i] - r.tau_[i - 1]);
-          if (std::fabs(slope) * (horizon - tau) > opt.settle_tol ||
-              std::fabs(s[i] - r.gain_[k][p]) > opt.settle_tol) {
+          const auto& R = r.r_[k][p];
+          const double last = chord(R, i);
+          const double slope = (last - chord(R, i - 1)) / (0.5 * (r.tau_[i] - r.tau_[i - 2]));
+          if (probe_peak[k][p] < 100 * opt.settle_tol ||
+              std::fabs(slope) * (horizon - tau) > opt.settle_tol ||
+              std::fabs(last - r.gain_[k][p]) > opt.settle_tol) {
             settled = false;
             break;
           }
-          for (size_t j = from; j < i; ++j)
-            if (std::fabs(s[j] - s[i]) > opt.settle_tol) {
+          for (size_t j = std::max<size_t>(from, 1); j < i; ++j)
+            if (std::fabs(chord(R, j) - last) > opt.settle_tol) {
               settled = false;
               break;
             }
@@ -255,6 +269,33 @@ StatusOr<LtiResponses> LtiResponses::compute(const Circuit& circuit,
     }
   }
   r.stats_.settled_at = tau;
+  // S at the march points from R alone: the slope at tau_i of the parabola through the points
+  // i-1, i, i+1 (second order on any spacing; one-sided at the ends). Not the trapezoidal
+  // derivative xdot: its error from the first (Euler) step alternates in sign and never damps,
+  // and the Hermite interpolant would carry it into the output.
+  const size_t m = r.tau_.size();
+  for (size_t k = 0; k < nk; ++k)
+    for (size_t p = 0; p < np; ++p) {
+      const auto& R = r.r_[k][p];
+      auto& S = r.s_[k][p];
+      auto chord = [&](size_t j) { return (R[j] - R[j - 1]) / (r.tau_[j] - r.tau_[j - 1]); };
+      for (size_t i = 1; i + 1 < m; ++i) {
+        const double hp = r.tau_[i] - r.tau_[i - 1], hn = r.tau_[i + 1] - r.tau_[i];
+        S[i] = (hn * chord(i) + hp * chord(i + 1)) / (hp + hn);
+      }
+      if (m >= 3) {
+        const double h1 = r.tau_[1], h2 = r.tau_[2] - r.tau_[1];
+        S[0] = chord(1) - h1 * (chord(2) - chord(1)) / (h1 + h2);
+        const double hl = r.tau_[m - 1] - r.tau_[m - 2], hq = r.tau_[m - 2] - r.tau_[m - 3];
+        S[m - 1] = chord(m - 1) + hl * (chord(m - 1) - chord(m - 2)) / (hl + hq);
+      }
+    }
+  // Beyond the march R continues with the last chord slope (see the settle check).
+  const size_t e = r.tau_.size() - 1;
+  r.end_slope_.assign(nk, std::vector<double>(np, 0.0));
+  for (size_t k = 0; k < nk; ++k)
+    for (size_t p = 0; p < np; ++p)
+      r.end_slope_[k][p] = (r.r_[k][p][e] - r.r_[k][p][e - 1]) / (r.tau_[e] - r.tau_[e - 1]);
   r.stats_.factorizations += sys.klu.factorizations();
   return r;
 }
@@ -283,7 +324,7 @@ double LtiResponses::hermite(size_t k, size_t p, size_t i, double tau) const {
 double LtiResponses::ramp_response(size_t k, size_t p, double tau) const {
   if (tau <= 0) return 0.0;
   const double end = tau_.back();
-  if (tau >= end) return r_[k][p].back() + s_[k][p].back() * (tau - end);
+  if (tau >= end) return r_[k][p].back() + end_slope_[k][p] * (tau - end);
   size_t i = std::upper_bound(tau_.begin(), tau_.end(), tau) - tau_.begin() - 1;
   return hermite(k, p, i, tau);
 }
@@ -291,7 +332,7 @@ double LtiResponses::ramp_response(size_t k, size_t p, double tau) const {
 double LtiResponses::step_response(size_t k, size_t p, double tau) const {
   if (tau <= 0) return 0.0;
   const double end = tau_.back();
-  if (tau >= end) return s_[k][p].back();
+  if (tau >= end) return end_slope_[k][p];
   size_t i = std::upper_bound(tau_.begin(), tau_.end(), tau) - tau_.begin() - 1;
   // Derivative of the Hermite interpolant.
   const double h = tau_[i + 1] - tau_[i];
@@ -345,7 +386,7 @@ void LtiResponses::superpose(const std::vector<SourceInput>& inputs, double t0, 
       }
       if (i < count)
         for (size_t p = 0; p < np; ++p) {
-          const double rend = r_[k][p][last], send = s_[k][p][last];
+          const double rend = r_[k][p][last], send = end_slope_[k][p];
           // slope * (rend + send * (t - ramp.t - end)), t = t0 + i dt
           da[p][i] += ramp.slope * (rend - send * (ramp.t + end - t0));
           db[p][i] += ramp.slope * send;
@@ -399,7 +440,7 @@ Waveform LtiResponses::waveform(const std::vector<SourceInput>& inputs, const Gr
       for (size_t p = 0; p < np; ++p) {
         if (!grid.grid_probes.empty() && (p >= grid.grid_probes.size() || !grid.grid_probes[p]))
           continue;
-        const double scale = is_current_[p] ? 1e3 : 1.0;
+        const double scale = is_current_[p] ? 1e3 : 1.0;  // 1 mV -> 1 uA
         for (long i = 0; i + 1 < count; ++i)
           worst =
               std::max(worst, scale * std::fabs(mids[p][i] - 0.5 * (rows[p][i] + rows[p][i + 1])));

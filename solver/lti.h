@@ -30,10 +30,13 @@
 // third divided difference of the last four points, as the transient engine does.
 //
 // Settling. The march runs to `horizon` (the longest lag a caller will ask for; run with the
-// simulated span), or stops early once the response has settled: over the trailing half of the
-// march [tau/2, tau] every probe's step response stays within settle_tol of its value at tau,
+// simulated span), or stops early once the response has settled: every probe's step response
+// has arrived (|S| has exceeded 100 settle_tol: a cable delays it; a probe that no source
+// reaches keeps the march going to the horizon), over the trailing half of the march
+// [tau/2, tau] it stays within settle_tol of its value at tau,
 // |S'(tau)| * (horizon - tau) <= settle_tol, and S(tau) is within settle_tol of the DC gain from a
-// DC solve. Beyond the end, R is extended as a straight line R(T) + S(T) (t - T). Circuits with
+// DC solve (S taken as chord slopes of R: the trapezoidal derivative alternates by a small +-delta
+// that never damps). Beyond the end, R is extended as a straight line with its last chord slope. Circuits with
 // nodes tied to ground through 1e-12 S (between isolation caps) settle to DC only over hours, so
 // for them the march simply runs to the horizon with large steps on the slow tail.
 #pragma once
@@ -51,8 +54,8 @@ namespace isolink {
 
 struct LtiOptions {
   double horizon = 0.0;        // s, longest lag needed (> 0); the simulated span
-  double step_reltol = 1e-6;   // truncation error per unit time, relative to peak |S|
-  double step_abstol = 1e-8;   // same, absolute (V/V for nodes, A/V for branch currents)
+  double step_reltol = 1e-5;   // truncation error per unit time, relative to peak |S|
+  double step_abstol = 1e-7;   // same, absolute (V/V for nodes, A/V for branch currents)
   double settle_tol = 1e-6;    // V/V (A/V): early stop, see above
   double first_step = 0.0;     // s; 0 = min(1e-12, horizon * 1e-9)
   double max_step = 0.0;       // s; 0 = horizon / 64
@@ -156,6 +159,7 @@ class LtiResponses {
   std::vector<std::vector<double>> gain_;                // [k][p]
   std::vector<double> tau_;                              // march times, tau_[0] = 0
   std::vector<std::vector<std::vector<double>>> r_, s_;  // [k][p][i]: R and S at tau_[i]
+  std::vector<std::vector<double>> end_slope_;           // [k][p]: R's slope beyond the march
   LtiStats stats_;
 };
 
