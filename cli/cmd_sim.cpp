@@ -1,16 +1,18 @@
 // isolink sim NETLIST.cir --probe 'v(rxp,rxn)' [-o wave.csv] [--engine auto|lti|transient]: the
-// response of a SPICE netlist, by the LTI engine when the circuit allows it (see cli/simulate.h).
+// response of a SPICE netlist, by the LTI engine when the circuit allows it (see
+// analysis/simulate.h).
 #include <fmt/format.h>
 
 #include <cstdio>
 #include <iostream>
 #include <optional>
 
+#include "analysis/simulate.h"
 #include "cli/commands.h"
-#include "cli/simulate.h"
 #include "netlists/lexer.h"
 
 namespace isolink::cli {
+using namespace isolink::analysis;  // simulate_netlist
 
 namespace {
 struct SimArgs {

@@ -36,19 +36,19 @@
 // [tau/2, tau] it stays within settle_tol of its value at tau,
 // |S'(tau)| * (horizon - tau) <= settle_tol, and S(tau) is within settle_tol of the DC gain from a
 // DC solve (S taken as chord slopes of R: the trapezoidal derivative alternates by a small +-delta
-// that never damps). Beyond the end, R is extended as a straight line with its last chord slope. Circuits with
-// nodes tied to ground through 1e-12 S (between isolation caps) settle to DC only over hours, so
-// for them the march simply runs to the horizon with large steps on the slow tail.
+// that never damps). Beyond the end, R is extended as a straight line with its last chord slope.
+// Circuits with nodes tied to ground through 1e-12 S (between isolation caps) settle to DC only
+// over hours, so for them the march simply runs to the horizon with large steps on the slow tail.
 #pragma once
 
 #include <string>
 #include <vector>
 
+#include "base/status.h"
+#include "base/waveform.h"
 #include "solver/circuit.h"
 #include "solver/elements/source_function.h"
 #include "solver/probe.h"
-#include "solver/status.h"
-#include "solver/waveform.h"
 
 namespace isolink {
 

@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "cli/simulate.h"
+#include "analysis/simulate.h"
 #include "netlists/link/expand.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
@@ -28,7 +28,7 @@ struct Deviation {
 };
 Deviation compare(const Netlist& netlist, const std::string& path, double tstop) {
   const std::vector<std::string> probes = {"v(rxp,rxn)"};
-  cli::SimulationRequest req{.probes = probes};
+  analysis::SimulationRequest req{.probes = probes};
   std::string tran;
   if (tstop > 0) {
     req.tstop = tstop;
@@ -36,18 +36,18 @@ Deviation compare(const Netlist& netlist, const std::string& path, double tstop)
     std::snprintf(card, sizeof card, ".tran %.9g %.9g", netlist.tran->tstep, tstop);
     tran = card;
   }
-  req.engine = cli::Engine::Lti;
-  auto lti = cli::simulate_netlist(netlist, req);
+  req.engine = analysis::Engine::Lti;
+  auto lti = analysis::simulate_netlist(netlist, req);
   EXPECT_TRUE(lti.ok()) << lti.status().message();
-  req.engine = cli::Engine::Transient;
-  auto transient = cli::simulate_netlist(netlist, req);
+  req.engine = analysis::Engine::Transient;
+  auto transient = analysis::simulate_netlist(netlist, req);
   EXPECT_TRUE(transient.ok()) << transient.status().message();
   const std::string work = ::testing::TempDir() + "/lti_compare";
   auto ng = testing::run_ngspice(path, probes, work, testing::kNgspiceTight, tran);
   EXPECT_TRUE(ng.ok()) << ng.status().message();
   if (!lti.ok() || !transient.ok() || !ng.ok()) return {1, 1};
   EXPECT_GT(ng->samples(), 1000u);
-  EXPECT_EQ(lti->engine, cli::Engine::Lti);
+  EXPECT_EQ(lti->engine, analysis::Engine::Lti);
   EXPECT_NEAR(lti->wave.time.back(), ng->time.back(), 1e-12);
   Deviation d{testing::max_abs_difference(lti->wave, 0, *ng, 0),
               testing::max_abs_difference(transient->wave, 0, *ng, 0)};
@@ -134,13 +134,13 @@ TEST(LtiEngineChoice, AutoFallsBackOnSinAndLtiRefusesNamingTheSource) {
                          ".end\n";
   auto netlist = read_spice_file(path);
   ASSERT_TRUE(netlist.ok()) << netlist.status().message();
-  cli::SimulationRequest req{.probes = {"v(out)"}};
-  auto r = cli::simulate_netlist(*netlist, req);
+  analysis::SimulationRequest req{.probes = {"v(out)"}};
+  auto r = analysis::simulate_netlist(*netlist, req);
   ASSERT_TRUE(r.ok()) << r.status().message();
-  EXPECT_EQ(r->engine, cli::Engine::Transient);
+  EXPECT_EQ(r->engine, analysis::Engine::Transient);
   EXPECT_NE(r->engine_note.find("'vs'"), std::string::npos) << r->engine_note;
-  req.engine = cli::Engine::Lti;
-  auto forced = cli::simulate_netlist(*netlist, req);
+  req.engine = analysis::Engine::Lti;
+  auto forced = analysis::simulate_netlist(*netlist, req);
   ASSERT_FALSE(forced.ok());
   EXPECT_NE(forced.status().message().find("sin_rc.cir:2:1: error: source 'vs'"), std::string::npos)
       << forced.status().message();

@@ -10,12 +10,12 @@
 #include <string>
 #include <vector>
 
+#include "base/waveform.h"
 #include "netlists/spice_reader.h"
 #include "solver/lti.h"
 #include "solver/transient.h"
-#include "solver/waveform.h"
 
-namespace isolink::cli {
+namespace isolink::analysis {
 
 // auto: the LTI engine when the circuit allows it (check_lti: every element LTI, every source DC,
 // PULSE or PWL, no .tran uic), else the transient; lti: the LTI engine or an error naming the
@@ -51,4 +51,4 @@ struct SimulationResult {
 
 StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const SimulationRequest& req);
 
-}  // namespace isolink::cli
+}  // namespace isolink::analysis

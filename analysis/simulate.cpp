@@ -1,10 +1,10 @@
-#include "cli/simulate.h"
+#include "analysis/simulate.h"
 
 #include <chrono>
 
 #include "solver/circuit.h"
 
-namespace isolink::cli {
+namespace isolink::analysis {
 
 const char* engine_name(Engine e) {
   switch (e) {
@@ -109,4 +109,4 @@ StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const Simula
   return result;
 }
 
-}  // namespace isolink::cli
+}  // namespace isolink::analysis
