@@ -1,5 +1,7 @@
 #include "analysis/link_run.h"
 
+#include <chrono>
+
 #include <fmt/format.h>
 
 namespace isolink::analysis {

@@ -89,8 +89,8 @@ nlohmann::ordered_json run_report_json(const link::LinkSpec& spec, const LinkRun
   ordered_json dirs = ordered_json::array();
   for (const DirectionRun& d : run.directions) {
     const TransientStats& st = d.sim.stats;
-    const bool lti = d.sim.engine == Engine::Lti;
-    ordered_json solver{{"engine", engine_name(d.sim.engine)},
+    const bool lti = d.sim.engine == analysis::Engine::Lti;
+    ordered_json solver{{"engine", analysis::engine_name(d.sim.engine)},
                         {"seconds", d.sim.seconds},
                         {"nodes", d.sim.nodes},
                         {"unknowns", d.sim.unknowns},
@@ -184,7 +184,7 @@ std::string run_report_markdown(const link::LinkSpec& spec, const LinkRun& run,
       "## Solver\n\n| direction | engine | unknowns | steps | rejected | factorizations | time "
       "|\n|---|---|---|---|---|---|---|\n";
   for (const DirectionRun& d : run.directions) {
-    const bool lti = d.sim.engine == Engine::Lti;
+    const bool lti = d.sim.engine == analysis::Engine::Lti;
     md += fmt::format("| {} | {} | {} | {} | {} | {} | {:.3f} s |\n", d.link.description,
                       lti ? "LTI (edge responses)" : "transient", d.sim.unknowns,
                       lti ? d.sim.lti.steps : d.sim.stats.accepted,
@@ -192,7 +192,7 @@ std::string run_report_markdown(const link::LinkSpec& spec, const LinkRun& run,
                       lti ? d.sim.lti.factorizations : d.sim.stats.factorizations, d.sim.seconds);
   }
   for (const DirectionRun& d : run.directions)
-    if (d.sim.engine == Engine::Lti)
+    if (d.sim.engine == analysis::Engine::Lti)
       md += fmt::format(
           "\n{}: waveform by the LTI engine, superposing {} source corners on step "
           "responses marched to {:.3g} us; output every {:.3g} ns (linear "

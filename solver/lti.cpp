@@ -416,6 +416,14 @@ Waveform LtiResponses::waveform(const std::vector<SourceInput>& inputs, const Gr
       base[p] += (inputs[k].initial - sources_[k].initial) * gain_[k][p];
   }
   const double span = grid.tstop - grid.tstart;
+  // Source corners strictly inside the span: rows of their own, so that a probe on a driven node
+  // is exact between rows too (not with a given step: the caller asked for that grid).
+  std::vector<double> corners;
+  for (const SourceInput& in : inputs)
+    for (const Ramp& ramp : in.ramps)
+      if (grid.step <= 0 && ramp.t > grid.tstart && ramp.t < grid.tstop) corners.push_back(ramp.t);
+  std::sort(corners.begin(), corners.end());
+  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
   auto rows_at = [&](double t0, double dt, long count) {
     std::vector<std::vector<double>> v(np, std::vector<double>(count, 0.0));
     for (size_t p = 0; p < np; ++p) std::fill(v[p].begin(), v[p].end(), base[p]);
@@ -437,13 +445,20 @@ Waveform LtiResponses::waveform(const std::vector<SourceInput>& inputs, const Gr
     while (true) {
       auto mids = rows_at(grid.tstart + 0.5 * dt, dt, count - 1);
       double worst = 0.0;
+      // Cells holding a source corner are skipped: the corner becomes a row of its own below.
+      std::vector<char> has_corner(count, 0);
+      for (double c : corners) {
+        const long i = static_cast<long>(std::floor((c - grid.tstart) / dt));
+        if (i >= 0 && i < count) has_corner[i] = 1;
+      }
       for (size_t p = 0; p < np; ++p) {
         if (!grid.grid_probes.empty() && (p >= grid.grid_probes.size() || !grid.grid_probes[p]))
           continue;
         const double scale = is_current_[p] ? 1e3 : 1.0;  // 1 mV -> 1 uA
         for (long i = 0; i + 1 < count; ++i)
-          worst =
-              std::max(worst, scale * std::fabs(mids[p][i] - 0.5 * (rows[p][i] + rows[p][i + 1])));
+          if (!has_corner[i])
+            worst = std::max(worst,
+                             scale * std::fabs(mids[p][i] - 0.5 * (rows[p][i] + rows[p][i + 1])));
       }
       if (worst <= 0.5 * grid.interp_tol) break;
       if (2 * count - 1 > grid.max_rows) {
@@ -465,10 +480,23 @@ Waveform LtiResponses::waveform(const std::vector<SourceInput>& inputs, const Gr
     }
   }
   Waveform w;
-  w.time.resize(count);
-  for (long i = 0; i < count; ++i) w.time[i] = grid.tstart + static_cast<double>(i) * dt;
-  for (size_t p = 0; p < np; ++p) w.add_column(labels_[p], std::move(rows[p]));
-  gi.rows = count;
+  std::vector<std::vector<double>> cols(np);
+  const double tiny = dt * 1e-6;
+  size_t c = 0;
+  for (long i = 0; i < count; ++i) {
+    const double t = grid.tstart + static_cast<double>(i) * dt;
+    for (; c < corners.size() && corners[c] < t; ++c) {
+      if (corners[c] <= t - tiny && (w.time.empty() || corners[c] >= w.time.back() + tiny)) {
+        w.time.push_back(corners[c]);
+        for (size_t p = 0; p < np; ++p) cols[p].push_back(value(p, corners[c], inputs));
+      }
+    }
+    if (!w.time.empty() && t <= w.time.back()) continue;
+    w.time.push_back(t);
+    for (size_t p = 0; p < np; ++p) cols[p].push_back(rows[p][i]);
+  }
+  for (size_t p = 0; p < np; ++p) w.add_column(labels_[p], std::move(cols[p]));
+  gi.rows = static_cast<long>(w.time.size());
   gi.step = dt;
   return w;
 }

@@ -121,8 +121,10 @@ class LtiResponses {
     // The rule for step = 0: the largest step (tstop - tstart) / 2^m, m >= the one giving 20 ns or
     // less, at which every grid probe's value at each cell's midpoint is within interp_tol / 2 of
     // the linear interpolation of its ends. For a quadratic piece the midpoint is where linear
-    // interpolation errs most; for a single corner inside a cell the worst error is at most twice
-    // the midpoint's, so linear interpolation between rows stays within interp_tol.
+    // interpolation errs most; for a single kink inside a cell the worst error is at most twice
+    // the midpoint's, so linear interpolation between rows stays within interp_tol. Cells that
+    // hold a source corner are left out of the test, and every corner inside the span is a row
+    // of its own (so the grid is uniform plus the corners, and a probe on a driven node is exact).
     double interp_tol = 1e-3;       // V for voltage probes (A/1000 for currents: 1 uA)
     std::vector<bool> grid_probes;  // which probes the rule looks at (empty = all)
     long max_rows = 4'000'000;      // the rule stops refining here (a warning says so)
@@ -133,7 +135,8 @@ class LtiResponses {
     double step = 0.0;    // s, the grid's step
     std::string warning;  // set when the rule hit max_rows before meeting interp_tol
   };
-  // The probes on a uniform grid from tstart to tstop (tstop included when the step divides it).
+  // The probes on a uniform grid from tstart to tstop (tstop included when the step divides it),
+  // plus a row at every source corner when the rule chooses the step.
   // Thread-safe (const): sweeps may evaluate many inputs on one LtiResponses.
   Waveform waveform(const std::vector<SourceInput>& inputs, const GridOptions& grid,
                     GridInfo* info = nullptr) const;
