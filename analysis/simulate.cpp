@@ -6,6 +6,24 @@
 
 namespace isolink::analysis {
 
+const char* engine_name(Engine e) {
+  switch (e) {
+    case Engine::Auto:
+      return "auto";
+    case Engine::Lti:
+      return "lti";
+    case Engine::Transient:
+      return "transient";
+  }
+  return "auto";
+}
+
+StatusOr<Engine> parse_engine(const std::string& text) {
+  for (Engine e : {Engine::Auto, Engine::Lti, Engine::Transient})
+    if (text == engine_name(e)) return e;
+  return Status::Error("engine '" + text + "' is not one of auto, lti, transient");
+}
+
 StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const SimulationRequest& req) {
   SimulationResult result;
   result.warnings = netlist.warnings;
@@ -22,8 +40,8 @@ StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const Simula
     bool known = true;
     if (Status s = opt.set_option(o.key, o.value, &known); !s.ok()) return s;
     if (!known)
-      result.warnings.push_back(
-          format_diagnostic(o.loc, "warning", "option '" + o.key + "' is not used by isolink; ignored"));
+      result.warnings.push_back(format_diagnostic(
+          o.loc, "warning", "option '" + o.key + "' is not used by isolink; ignored"));
   }
   if (req.tstop) opt.tstop = *req.tstop;
   if (req.tstep) opt.tstep = *req.tstep;
@@ -47,16 +65,47 @@ StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const Simula
     if (!p) return p.status();
     probes.push_back(*p);
   }
-  if (probes.empty()) return Status::Error("no --probe given: say what to record, e.g. --probe 'v(rxp,rxn)'");
+  if (probes.empty())
+    return Status::Error("no --probe given: say what to record, e.g. --probe 'v(rxp,rxn)'");
+
+  result.nodes = circuit.node_count() - 1;
+  result.unknowns = circuit.unknown_count();
+  result.elements = static_cast<int>(circuit.elements().size());
 
   const auto start = std::chrono::steady_clock::now();
+  if (req.engine != Engine::Transient) {
+    Status lti_ok = opt.uic ? Status::Error(
+                                  ".tran uic starts from zero, not from the DC operating "
+                                  "point: the LTI engine needs the operating point")
+                            : check_lti(circuit);
+    if (!lti_ok.ok() && req.engine == Engine::Lti) return lti_ok;
+    if (lti_ok.ok()) {
+      for (const auto& e : circuit.elements()) e->bind_time(opt.tstep, opt.tstop);
+      LtiOptions lo;
+      lo.horizon = opt.tstop;
+      StatusOr<LtiResponses> responses = LtiResponses::compute(circuit, probes, lo);
+      if (!responses) return responses.status();
+      LtiResponses::GridOptions grid;
+      grid.tstart = opt.tstart;
+      grid.tstop = opt.tstop;
+      grid.step = req.grid_step;
+      grid.grid_probes = req.grid_probes;
+      result.wave = responses->waveform(responses->netlist_inputs(opt.tstop), grid, &result.grid);
+      if (!result.grid.warning.empty())
+        result.warnings.push_back("warning: " + result.grid.warning);
+      result.lti = responses->stats();
+      result.engine = Engine::Lti;
+      result.seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      return result;
+    }
+    result.engine_note = lti_ok.message();
+  }
   StatusOr<Waveform> wave = run_transient(circuit, opt, probes, &result.stats);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!wave) return wave.status();
   result.wave = std::move(*wave);
-  result.nodes = circuit.node_count() - 1;
-  result.unknowns = circuit.unknown_count();
-  result.elements = static_cast<int>(circuit.elements().size());
+  result.engine = Engine::Transient;
   return result;
 }
 

@@ -29,6 +29,7 @@ struct RunArgs {
   std::string out_dir;
   std::vector<std::string> part_dirs;
   std::string direction;
+  std::string engine = "auto";
   bool no_images = false;
   bool no_worst = false;
   bool quiet = false;
@@ -49,7 +50,9 @@ int run_run(const RunArgs& a) {
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load(a.part_dirs);
   if (!parts) return fail(parts.status());
 
-  StatusOr<LinkRun> run = run_link(*spec, *parts);
+  RunOptions ro;
+  ro.engine = *parse_engine(a.engine);  // CLI11 checked the choice
+  StatusOr<LinkRun> run = run_link(*spec, *parts, ro);
   if (!run) return fail(run.status().with_context(a.spec));
   // The worst case over all legal traffic, beside the spec's traffic (its own verdict).
   std::optional<analysis::WorstResult> worst;
@@ -115,6 +118,9 @@ void add_run_command(CLI::App& app, int* exit_code) {
   cmd->add_option("--parts", args->part_dirs, "Extra part-library folder (repeatable)");
   cmd->add_option("--direction", args->direction, "Override the spec: down | up | both")
       ->check(CLI::IsMember({"down", "up", "both"}));
+  cmd->add_option("--engine", args->engine,
+                  "auto (LTI, the default: every link is linear), lti, transient (the cross-check)")
+      ->check(CLI::IsMember({"auto", "lti", "transient"}));
   cmd->add_flag("--no-images", args->no_images, "Skip eye.png and wave.png");
   cmd->add_flag("--no-worst", args->no_worst,
                 "Skip the worst case over all traffic (its report section and verdict)");

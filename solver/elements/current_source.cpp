@@ -15,7 +15,8 @@ constexpr ParamSpec kParams[] = {
 
 class CurrentSource final : public Element {
  public:
-  CurrentSource(const Card& card, SourceFunction f) : Element(card.name, card.loc), f_(std::move(f)) {}
+  CurrentSource(const Card& card, SourceFunction f)
+      : Element(card.name, card.loc), f_(std::move(f)) {}
   void declare(MnaPattern&) override {}
   void stamp(double*, double*) const override {}
   bool has_excitation() const override { return true; }
@@ -23,6 +24,8 @@ class CurrentSource final : public Element {
     const double i = f_.value(t);
     b[nodes_[0]] -= i, b[nodes_[1]] += i;
   }
+  const SourceFunction* source_function() const override { return &f_; }
+  void stamp_unit(double* b) const override { b[nodes_[0]] -= 1.0, b[nodes_[1]] += 1.0; }
   void bind_time(double tstep, double tstop) override { f_.bind_time(tstep, tstop); }
   void breakpoints(double tstop, std::vector<double>& out) const override {
     f_.breakpoints(tstop, out);
@@ -45,9 +48,13 @@ StatusOr<std::unique_ptr<Element>> parse(const Card& card) {
 }  // namespace
 
 const ElementKind& current_source_kind() {
-  static const ElementKind kind{'i', "current source",
-                                "Iname n+ n- [DC] value | PULSE(...) | PWL(...) | SIN(...)", 2, 0,
-                                kParams, parse};
+  static const ElementKind kind{'i',
+                                "current source",
+                                "Iname n+ n- [DC] value | PULSE(...) | PWL(...) | SIN(...)",
+                                2,
+                                0,
+                                kParams,
+                                parse};
   return kind;
 }
 

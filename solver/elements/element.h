@@ -25,6 +25,7 @@ namespace isolink {
 
 class Circuit;
 class MnaPattern;
+class SourceFunction;
 
 using Slot = int;  // index into a matrix value array; MnaPattern::kTrash for ground entries
 
@@ -59,6 +60,14 @@ class Element {
   virtual void stamp_rhs(double t, double* b) const {}
   // True when stamp_rhs adds anything (sources): the engines call stamp_rhs on these only.
   virtual bool has_excitation() const { return false; }
+  // Sources: the time dependence (nullptr for elements without one) and the excitation per unit
+  // of it, so that stamp_rhs(t, b) adds source_function()->value(t) * (what stamp_unit(b) adds).
+  // The LTI engine (solver/lti.h) superposes responses to these unit excitations.
+  virtual const SourceFunction* source_function() const { return nullptr; }
+  virtual void stamp_unit(double* b) const {}
+  // False for an element whose stamps change with time or with the solution (a switch, a diode):
+  // the LTI engine refuses a circuit holding one. Every kind in the registry today is LTI.
+  virtual bool linear_time_invariant() const { return true; }
   // Resolves time defaults that depend on the analysis (ngspice: PULSE TR defaults to TSTEP).
   virtual void bind_time(double tstep, double tstop) {}
   // Times in (0, tstop] where the excitation has a corner.
@@ -81,19 +90,19 @@ class Element {
 
 // One row of an element kind's parameter table: feeds the parser, --help and the README.
 struct ParamSpec {
-  const char* name;       // lower case, as written in key=value or as the positional value
-  double default_value;   // NaN when required
-  const char* unit;       // SI unit symbol, "" when dimensionless
-  const char* doc;        // one line
+  const char* name;      // lower case, as written in key=value or as the positional value
+  double default_value;  // NaN when required
+  const char* unit;      // SI unit symbol, "" when dimensionless
+  const char* doc;       // one line
 };
 
 // One element kind: the registry in elements/registry.cpp lists them all explicitly.
 struct ElementKind {
-  char letter;                     // SPICE letter, lower case
-  const char* name;                // "resistor"
-  const char* usage;               // "Rname n+ n- value [key=value...]"
-  int node_count;                  // node tokens after the name
-  int ref_count;                   // element-name tokens after the nodes (K: 2)
+  char letter;        // SPICE letter, lower case
+  const char* name;   // "resistor"
+  const char* usage;  // "Rname n+ n- value [key=value...]"
+  int node_count;     // node tokens after the name
+  int ref_count;      // element-name tokens after the nodes (K: 2)
   std::span<const ParamSpec> params;
   StatusOr<std::unique_ptr<Element>> (*parse)(const Card& card);
 };

@@ -1,11 +1,11 @@
 #include "solver/elements/source_function.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
-
-#include <fmt/format.h>
 
 namespace isolink {
 
@@ -23,7 +23,8 @@ StatusOr<SourceFunction> SourceFunction::Parse(const Card& card) {
   for (size_t i = 0; i < args.size(); ++i) {
     const CardArg& a = args[i];
     if (a.kind == CardArg::Kind::Number) {
-      if (have_value) return error_at(a.loc, "unexpected extra value for source '" + card.name + "'");
+      if (have_value)
+        return error_at(a.loc, "unexpected extra value for source '" + card.name + "'");
       f.dc_ = a.number;
       have_value = true;
     } else if (a.kind == CardArg::Kind::Word) {
@@ -70,8 +71,8 @@ StatusOr<SourceFunction> SourceFunction::Parse(const Card& card) {
           f.pwl_v_.push_back(a.call[k + 1]);
         }
       } else {
-        return error_at(a.loc, "unknown source function '" + a.word +
-                                   "' (expected PULSE, PWL or SIN)");
+        return error_at(a.loc,
+                        "unknown source function '" + a.word + "' (expected PULSE, PWL or SIN)");
       }
       have_value = true;
     }
@@ -155,6 +156,27 @@ void SourceFunction::breakpoints(double tstop, std::vector<double>& out) const {
       return;
     }
   }
+}
+
+std::vector<Ramp> SourceFunction::ramps(double tstop) const {
+  std::vector<Ramp> out;
+  if (kind_ == Kind::Dc || !piecewise_linear() || !(tstop > 0)) return out;
+  std::vector<double> corners{0.0};
+  breakpoints(tstop, corners);
+  corners.push_back(tstop);
+  std::sort(corners.begin(), corners.end());
+  const double tiny = tstop * 1e-12;
+  std::vector<double> t;
+  for (double c : corners)
+    if (t.empty() || c - t.back() > tiny) t.push_back(c);
+  double previous = 0.0;  // slope before t[0] = 0: the function is constant before its first corner
+  for (size_t i = 0; i + 1 < t.size(); ++i) {
+    // Exact on each segment: value() is linear between consecutive corners.
+    const double slope = (value(t[i + 1]) - value(t[i])) / (t[i + 1] - t[i]);
+    if (slope != previous) out.push_back({t[i], slope - previous});
+    previous = slope;
+  }
+  return out;
 }
 
 }  // namespace isolink

@@ -12,6 +12,12 @@
 
 namespace isolink {
 
+// A change of slope: from t on, the function's slope grows by `slope` (per second).
+struct Ramp {
+  double t = 0.0;
+  double slope = 0.0;
+};
+
 class SourceFunction {
  public:
   enum class Kind { Dc, Pulse, Pwl, Sin };
@@ -24,6 +30,12 @@ class SourceFunction {
   double dc_value() const { return value(0.0); }
   void breakpoints(double tstop, std::vector<double>& out) const;
   Kind kind() const { return kind_; }
+  // DC, PULSE and PWL are piecewise linear in t; SIN is not.
+  bool piecewise_linear() const { return kind_ != Kind::Sin; }
+  // For a piecewise-linear function: its corners in [0, tstop] as ramps, in time order, so that
+  // f(t) = f(0) + sum over ramps with t_k < t of slope_k * (t - t_k) on [0, tstop]. Corners closer
+  // than 1e-12 * tstop merge (as the transient's breakpoints).
+  std::vector<Ramp> ramps(double tstop) const;
 
  private:
   Kind kind_ = Kind::Dc;
