@@ -1,13 +1,14 @@
 // isolink run: a link spec simulated with its traffic, each receiver scored, and the report
 // bundle (eye.png, wave.png, report.json, report.md, wave.csv) written to a folder.
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
 
-#include <fmt/format.h>
-
+#include "analysis/pack_spec.h"
 #include "cli/commands.h"
 #include "cli/link_run.h"
 #include "cli/run_images.h"
@@ -33,6 +34,16 @@ int fail(const Status& s) {
 }
 
 int run_run(const RunArgs& a) {
+  // A pack spec (a file with `hops:`) runs as `isolink pack`.
+  if (StatusOr<config::YamlDoc> doc = config::YamlDoc::load_file(a.spec);
+      doc && analysis::is_pack_spec(*doc)) {
+    if (!a.direction.empty())
+      return fail(
+          Status::Error(fmt::format("{}: error: --direction is for link specs; a pack "
+                                    "runs each hop in the directions it carries",
+                                    a.spec)));
+    return run_pack_command({a.spec, a.out_dir, a.part_dirs, 0, a.no_images, a.quiet});
+  }
   StatusOr<link::LinkSpec> spec = link::read_link_spec_file(a.spec);
   if (!spec) return fail(spec.status());
   if (a.direction == "down") spec->stimulus.directions = {link::Direction::kDown};
@@ -48,16 +59,17 @@ int run_run(const RunArgs& a) {
   const std::string dir = a.out_dir.empty() ? "reports/out/" + spec->name : a.out_dir;
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
-  if (ec) return fail(Status::Error(fmt::format("{}: error: cannot create the folder: {}", dir,
-                                                ec.message())));
+  if (ec)
+    return fail(
+        Status::Error(fmt::format("{}: error: cannot create the folder: {}", dir, ec.message())));
   std::vector<std::string> images;
   if (!a.no_images) {
     if (Status s = render_run_images(*spec, *run, dir, &images); !s.ok()) return fail(s);
   }
   const Waveform wave = run_waveforms(*run, spec->sim.tstep);
   if (Status s = write_waveform_csv(wave, dir + "/wave.csv"); !s.ok()) return fail(s);
-  if (Status s = write_file_atomic(dir + "/report.json", run_report_json(*spec, *run).dump(2) +
-                                                             "\n");
+  if (Status s =
+          write_file_atomic(dir + "/report.json", run_report_json(*spec, *run).dump(2) + "\n");
       !s.ok())
     return fail(s);
   if (Status s = write_file_atomic(dir + "/report.md", run_report_markdown(*spec, *run, images));
@@ -82,8 +94,9 @@ int run_run(const RunArgs& a) {
 void add_run_command(CLI::App& app, int* exit_code) {
   auto args = std::make_shared<RunArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "run", "Simulate a link spec with its traffic, score each receiver and write the report "
-             "(eye.png, wave.png, report.json, report.md, wave.csv)");
+      "run",
+      "Simulate a link spec with its traffic, score each receiver and write the report "
+      "(eye.png, wave.png, report.json, report.md, wave.csv)");
   cmd->add_option("spec", args->spec, "Link spec (YAML), e.g. netlists/examples/xfmr_12m.yaml")
       ->required();
   cmd->add_option("-o,--output", args->out_dir, "Report folder (default reports/out/<name>)");

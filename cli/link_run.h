@@ -24,23 +24,23 @@ namespace isolink::cli {
 
 struct DirectionRun {
   link::ExpandedLink link;
-  SimulationResult sim;                     // columns: v(rxp,rxn), v(rxp), v(rxn), v(txp,txn)
-  eye::Rules rules;                         // the receiver's data rules
-  eye::Rules tone_rules;                    // the tone rules (when tones were sent)
-  std::optional<eye::CheckResult> data;     // the data frames' check (when any were sent)
-  std::optional<eye::CheckResult> tones;    // the tones' check (when any were sent)
+  SimulationResult sim;                   // columns: v(rxp,rxn), v(rxp), v(rxn), v(txp,txn)
+  eye::Rules rules;                       // the receiver's data rules
+  eye::Rules tone_rules;                  // the tone rules (when tones were sent)
+  std::optional<eye::CheckResult> data;   // the data frames' check (when any were sent)
+  std::optional<eye::CheckResult> tones;  // the tones' check (when any were sent)
   bool pass = false;
 };
 
 struct LinkRun {
   std::vector<DirectionRun> directions;
-  bool pass = false;                        // every direction passes
-  double seconds = 0;                       // wall time, all directions
+  bool pass = false;   // every direction passes
+  double seconds = 0;  // wall time, all directions
 };
 
 struct RunOptions {
   link::ExpandOptions expand;
-  std::optional<double> reltol;             // overrides the spec's sim.reltol
+  std::optional<double> reltol;  // overrides the spec's sim.reltol
 };
 
 // The probes recorded per direction, in column order.
@@ -48,5 +48,8 @@ const std::vector<std::string>& run_probes();
 
 StatusOr<LinkRun> run_link(const link::LinkSpec& spec, const link::PartLibrary& parts,
                            const RunOptions& opt = {});
+// One expanded direction simulated and scored: run_link's work per direction (packs expand every
+// hop first and simulate each distinct circuit once).
+StatusOr<DirectionRun> run_direction(link::ExpandedLink link, const RunOptions& opt = {});
 
 }  // namespace isolink::cli
