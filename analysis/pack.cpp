@@ -1,7 +1,6 @@
 #include "analysis/pack.h"
 
 #include <fmt/format.h>
-#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -10,7 +9,7 @@
 #include <cmath>
 #include <map>
 
-#include "cli/sweep_run.h"
+#include "analysis/sweep_run.h"
 #include "netlists/link/cable.h"
 #include "netlists/link/expand.h"
 #include "netlists/spice_writer.h"
@@ -142,7 +141,7 @@ StatusOr<PackResult> run_pack(const PackSpec& pack, const link::PartLibrary& par
   std::vector<std::vector<link::ExpandedLink>> own(pack.hops.size());  // per hop and direction
   struct Distinct {
     link::ExpandedLink link;
-    StatusOr<cli::DirectionRun> run = Status::Error("not run");
+    StatusOr<DirectionRun> run = Status::Error("not run");
   };
   std::vector<Distinct> distinct;
   std::map<std::string, int> by_key;
@@ -168,8 +167,8 @@ StatusOr<PackResult> run_pack(const PackSpec& pack, const link::PartLibrary& par
   out.simulations = static_cast<int>(distinct.size());
 
   const DirectionRunner runner =
-      opt.runner ? opt.runner : DirectionRunner([](link::ExpandedLink x, const cli::RunOptions& o) {
-        return cli::run_direction(std::move(x), o);
+      opt.runner ? opt.runner : DirectionRunner([](link::ExpandedLink x, const RunOptions& o) {
+        return run_direction(std::move(x), o);
       });
   tbb::task_arena arena(opt.jobs > 0 ? opt.jobs : tbb::task_arena::automatic);
   arena.execute([&] {
@@ -200,11 +199,11 @@ StatusOr<PackResult> run_pack(const PackSpec& pack, const link::PartLibrary& par
         hr.same_as = out.hops[j].index;
         break;
       }
-    for (const cli::DirectionRun& d : hr.run.directions) {
-      cli::LinkRun one;
+    for (const DirectionRun& d : hr.run.directions) {
+      LinkRun one;
       one.pass = d.pass;
       one.directions.push_back(d);
-      const cli::sweep::PointResult s = cli::sweep::score_run(one);
+      const sweep::PointResult s = sweep::score_run(one);
       if (std::isnan(hr.worst_rel) || s.worst_rel < hr.worst_rel) {
         hr.worst_rel = s.worst_rel;
         hr.worst_metric = s.worst_metric;
@@ -226,7 +225,7 @@ StatusOr<PackResult> run_pack(const PackSpec& pack, const link::PartLibrary& par
       const HopResult& hr = out.hops[u.hop - 1];
       const link::Direction command = u.reversed ? link::Direction::kUp : link::Direction::kDown;
       const link::Direction reply = u.reversed ? link::Direction::kDown : link::Direction::kUp;
-      for (const cli::DirectionRun& d : hr.run.directions) {
+      for (const DirectionRun& d : hr.run.directions) {
         const bool needed =
             d.link.direction == command || (d.link.direction == reply && has_reads(h.spec));
         if (needed && !d.pass) {

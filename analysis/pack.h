@@ -3,7 +3,7 @@
 //
 //   StatusOr<PackSpec> pack = read_pack_spec_file(path);
 //   StatusOr<PackResult> r = run_pack(*pack, parts, {.jobs = 0});
-//   r->pass, r->weakest, r->hops[k].run (a cli::LinkRun per hop), r->breaks, r->timing
+//   r->pass, r->weakest, r->hops[k].run (a LinkRun per hop), r->breaks, r->timing
 //
 // Each hop is expanded in each direction it must carry; the expanded circuits are compared as
 // SPICE text (title left out) together with the receiver's rule set and the bytes expected, and
@@ -17,27 +17,27 @@
 #include <string>
 #include <vector>
 
+#include "analysis/link_run.h"
 #include "analysis/pack_spec.h"
-#include "cli/link_run.h"
+#include "base/status.h"
 #include "netlists/link/parts.h"
-#include "solver/status.h"
 
 namespace isolink::analysis {
 
 // The hook for a direction's simulation and scoring: run_direction by default; the worst case
 // over legal traffic (the LTI engine) plugs in here.
 using DirectionRunner =
-    std::function<StatusOr<cli::DirectionRun>(link::ExpandedLink, const cli::RunOptions&)>;
+    std::function<StatusOr<DirectionRun>(link::ExpandedLink, const RunOptions&)>;
 
 struct PackOptions {
   int jobs = 0;  // threads across distinct circuits (0: all cores)
-  cli::RunOptions run;
-  DirectionRunner runner;  // empty: cli::run_direction
+  RunOptions run;
+  DirectionRunner runner;  // empty: run_direction
 };
 
 struct HopResult {
-  int index = 0;     // HopSpec::index
-  cli::LinkRun run;  // the hop's directions (shared with hops of the same circuit)
+  int index = 0;  // HopSpec::index
+  LinkRun run;    // the hop's directions (shared with hops of the same circuit)
   bool pass = false;
   double worst_rel = std::numeric_limits<double>::quiet_NaN();  // smallest margin / |limit|
   std::string worst_metric;     // vstart | vend | width | edge | none

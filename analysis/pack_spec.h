@@ -31,10 +31,10 @@
 #include <string>
 #include <vector>
 
+#include "base/source_loc.h"
+#include "base/status.h"
 #include "config/yaml_reader.h"
 #include "netlists/link/link_spec.h"
-#include "solver/source_loc.h"
-#include "solver/status.h"
 
 namespace isolink::analysis {
 

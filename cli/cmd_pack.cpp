@@ -9,10 +9,10 @@
 #include <vector>
 
 #include "analysis/pack.h"
-#include "analysis/pack_report.h"
 #include "analysis/pack_spec.h"
 #include "cli/commands.h"
 #include "netlists/link/parts.h"
+#include "reports/pack_report.h"
 
 namespace isolink::cli {
 
@@ -35,18 +35,18 @@ int run_pack_command(const PackArgs& a) {
 
   const std::string dir = a.out_dir.empty() ? "reports/out/" + pack->name : a.out_dir;
   std::vector<std::string> files;
-  if (Status s = analysis::write_pack_bundle(*pack, *r, dir, a.no_images, &files); !s.ok())
+  if (Status s = reports::write_pack_bundle(*pack, *r, dir, a.no_images, &files); !s.ok())
     return fail(s);
   std::vector<std::string> warned;  // hops share most warnings: print each once
   for (const analysis::HopResult& h : r->hops)
-    for (const DirectionRun& d : h.run.directions)
+    for (const analysis::DirectionRun& d : h.run.directions)
       for (const std::string& w : d.sim.warnings)
         if (std::find(warned.begin(), warned.end(), w) == warned.end()) {
           warned.push_back(w);
           std::fprintf(stderr, "%s\n", w.c_str());
         }
   if (!a.quiet) {
-    std::fputs(analysis::pack_summary_text(*pack, *r).c_str(), stdout);
+    std::fputs(reports::pack_summary_text(*pack, *r).c_str(), stdout);
     std::printf("report: %s/report.md\n", dir.c_str());
   }
   return r->pass ? 0 : 1;

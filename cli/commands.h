@@ -31,6 +31,5 @@ struct PackArgs {
 int run_pack_command(const PackArgs& a);
 
 // The element table of the README (`isolink elements --markdown`).
-std::string element_reference_markdown();
 
 }  // namespace isolink::cli

@@ -60,8 +60,12 @@ Status draw_pack_png(const PackDiagram& d, const std::string& path) {
          HAlign::kRight, VAlign::kCenter);
   if (weakest)
     c.text(40, 95,
-           fmt::format("weakest: hop {} ({} {}), worst margin {:+.0f} %", weakest->index,
-                       length_text(weakest->length), weakest->isolation, weakest->margin * 100),
+           fmt::format("weakest: hop {} ({} {}), worst margin {}", weakest->index,
+                       length_text(weakest->length), weakest->isolation,
+                       !weakest->pass ? std::string("FAIL")
+                       : std::isfinite(weakest->margin)
+                           ? fmt::format("{:+.1f} %", weakest->margin * 100)
+                           : std::string("-")),
            20, kMuted, FontFace::kSans, HAlign::kLeft, VAlign::kCenter);
 
   // A hop's label: its number above the line, length and isolation below (beside a vertical

@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "base/status.h"
 #include "reports/plot.h"
-#include "solver/status.h"
 
 namespace isolink::reports {
 

@@ -14,8 +14,8 @@
 #include <sstream>
 #include <string>
 
-#include "analysis/pack_report.h"
-#include "cli/run_report.h"
+#include "reports/pack_report.h"
+#include "reports/run_report.h"
 
 namespace isolink::analysis {
 namespace {
@@ -214,10 +214,9 @@ TEST(PackDedupe, IdenticalCircuitsAreSimulatedOnce) {
   ASSERT_TRUE(parts.ok());
   std::atomic<int> calls{0};
   PackOptions opt;
-  opt.runner = [&calls](link::ExpandedLink x,
-                        const cli::RunOptions&) -> StatusOr<cli::DirectionRun> {
+  opt.runner = [&calls](link::ExpandedLink x, const RunOptions&) -> StatusOr<DirectionRun> {
     ++calls;
-    cli::DirectionRun d;
+    DirectionRun d;
     d.link = std::move(x);
     d.pass = true;
     return d;
@@ -272,19 +271,19 @@ TEST(PackSim, TwoHopPackEqualsTwoSingleHopRuns) {
   ASSERT_TRUE(r.ok()) << r.status().message();
   ASSERT_EQ(r->hops.size(), 2u);
   EXPECT_EQ(r->simulations, 4);
-  const nlohmann::ordered_json pj = pack_report_json(*p, *r);
+  const nlohmann::ordered_json pj = reports::pack_report_json(*p, *r);
   for (int k = 0; k < 2; ++k) {
     StatusOr<link::LinkSpec> spec = link::read_link_spec_file(dir + (k ? "/b.yaml" : "/a.yaml"));
     ASSERT_TRUE(spec.ok());
-    StatusOr<cli::LinkRun> single = cli::run_link(*spec, *parts);
+    StatusOr<LinkRun> single = run_link(*spec, *parts);
     ASSERT_TRUE(single.ok()) << single.status().message();
-    const cli::LinkRun& hop = r->hops[k].run;
+    const LinkRun& hop = r->hops[k].run;
     EXPECT_EQ(hop.pass, single->pass);
     ASSERT_EQ(hop.directions.size(), single->directions.size());
-    const nlohmann::ordered_json sj = cli::run_report_json(*spec, *single);
+    const nlohmann::ordered_json sj = reports::run_report_json(*spec, *single);
     for (size_t d = 0; d < hop.directions.size(); ++d) {
-      const cli::DirectionRun& x = hop.directions[d];
-      const cli::DirectionRun& y = single->directions[d];
+      const DirectionRun& x = hop.directions[d];
+      const DirectionRun& y = single->directions[d];
       EXPECT_EQ(x.link.direction, y.link.direction);
       EXPECT_EQ(x.sim.wave.time, y.sim.wave.time);
       EXPECT_EQ(x.sim.wave.columns[0], y.sim.wave.columns[0]);  // bit for bit

@@ -1,5 +1,5 @@
 // The text parts of the `isolink pack` bundle: report.json and report.md. The diagram (pack.png)
-// comes from reports/pack_png.h, the per-hop images from cli/run_images.h.
+// comes from pack_png.h, the per-hop images from run_images.h.
 //
 //   nlohmann::ordered_json j = pack_report_json(pack, result);
 //   std::string md = pack_report_markdown(pack, result, "pack.png", hop_dirs);
@@ -12,7 +12,16 @@
 #include "analysis/pack.h"
 #include "analysis/pack_spec.h"
 
-namespace isolink::analysis {
+namespace isolink::reports {
+
+using analysis::BreakCase;
+using analysis::BreakResult;
+using analysis::CommandTiming;
+using analysis::HopResult;
+using analysis::HopSpec;
+using analysis::PackResult;
+using analysis::PackSpec;
+using analysis::TimingSpec;
 
 // verdict, weakest_hop, hops[] {index, verdict, directions[] as in `isolink run`'s report.json},
 // ring_breaks[], timing.
@@ -32,4 +41,4 @@ std::string pack_summary_text(const PackSpec& pack, const PackResult& r);
 // "cap", "xfmr", "cap+choke" ...: an end's isolation in a few letters (tables, the diagram).
 std::string isolation_short(const link::IsolationSpec& iso);
 
-}  // namespace isolink::analysis
+}  // namespace isolink::reports

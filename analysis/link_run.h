@@ -13,14 +13,14 @@
 #include <string>
 #include <vector>
 
-#include "cli/simulate.h"
+#include "analysis/simulate.h"
 #include "eye/check.h"
 #include "eye/rules.h"
 #include "netlists/link/expand.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
 
-namespace isolink::cli {
+namespace isolink::analysis {
 
 struct DirectionRun {
   link::ExpandedLink link;
@@ -52,4 +52,7 @@ StatusOr<LinkRun> run_link(const link::LinkSpec& spec, const link::PartLibrary& 
 // hop first and simulate each distinct circuit once).
 StatusOr<DirectionRun> run_direction(link::ExpandedLink link, const RunOptions& opt = {});
 
-}  // namespace isolink::cli
+// The probes of every direction, resampled onto one uniform axis, columns "down v(rxp,rxn)", ...
+Waveform run_waveforms(const LinkRun& run, double dt);
+
+}  // namespace isolink::analysis

@@ -1,4 +1,4 @@
-#include "analysis/pack_report.h"
+#include "reports/pack_report.h"
 
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
@@ -6,12 +6,13 @@
 #include <cmath>
 #include <filesystem>
 
-#include "cli/run_images.h"
-#include "cli/run_report.h"
-#include "cli/sweep_run.h"
+#include "analysis/sweep_run.h"
+#include "base/atomic_file.h"
 #include "reports/pack_png.h"
+#include "reports/run_images.h"
+#include "reports/run_report.h"
 
-namespace isolink::analysis {
+namespace isolink::reports {
 
 namespace {
 
@@ -64,7 +65,7 @@ nlohmann::ordered_json pack_report_json(const PackSpec& pack, const PackResult& 
   for (size_t i = 0; i < r.hops.size(); ++i) {
     const HopResult& h = r.hops[i];
     const HopSpec& s = pack.hops[i];
-    const ordered_json run = cli::run_report_json(s.spec, h.run);
+    const ordered_json run = run_report_json(s.spec, h.run);
     hops.push_back(ordered_json{{"index", h.index},
                                 {"from", s.from},
                                 {"to", s.to},
@@ -156,7 +157,7 @@ std::string pack_report_markdown(const PackSpec& pack, const PackResult& r,
   for (size_t i = 0; i < r.hops.size(); ++i) {
     const HopResult& h = r.hops[i];
     const HopSpec& s = pack.hops[i];
-    const cli::sweep::PointResult p = cli::sweep::score_run(h.run);
+    const analysis::sweep::PointResult p = analysis::sweep::score_run(h.run);
     const bool weakest = h.index == r.weakest;
     const std::string b = weakest ? "**" : "";
     std::string worst =
@@ -180,7 +181,7 @@ std::string pack_report_markdown(const PackSpec& pack, const PackResult& r,
   for (size_t i = 0; i < r.hops.size(); ++i) {
     const HopResult& h = r.hops[i];
     if (h.pass || h.same_as != h.index) continue;
-    const cli::sweep::PointResult p = cli::sweep::score_run(h.run);
+    const analysis::sweep::PointResult p = analysis::sweep::score_run(h.run);
     md += fmt::format("Hop {} fails: {}.\n\n", h.index, p.reason);
   }
 
@@ -256,8 +257,8 @@ std::string pack_report_markdown(const PackSpec& pack, const PackResult& r,
   return md;
 }
 
-reports::PackDiagram pack_diagram(const PackSpec& pack, const PackResult& r) {
-  reports::PackDiagram d;
+PackDiagram pack_diagram(const PackSpec& pack, const PackResult& r) {
+  PackDiagram d;
   d.title = fmt::format("{}: {} bridge, {} x {}{}", pack.name, pack.bridge, pack.devices(),
                         pack.stack, pack.ring ? ", ring" : "");
   d.verdict = r.pass ? "PASS" : "FAIL";
@@ -266,7 +267,7 @@ reports::PackDiagram pack_diagram(const PackSpec& pack, const PackResult& r) {
   d.weakest = r.weakest;
   for (size_t i = 0; i < r.hops.size(); ++i) {
     const HopSpec& s = pack.hops[i];
-    reports::PackDiagram::Hop h;
+    PackDiagram::Hop h;
     h.index = s.index;
     h.ring_return = s.ring_return;
     h.pass = r.hops[i].pass;
@@ -303,8 +304,8 @@ Status write_pack_bundle(const PackSpec& pack, const PackResult& r, const std::s
     std::vector<std::vector<std::string>> images(r.hops.size());
     tbb::parallel_for(size_t{0}, r.hops.size(), [&](size_t i) {
       if (r.hops[i].same_as == r.hops[i].index)
-        drawn[i] = cli::render_run_images(pack.hops[i].spec, r.hops[i].run, dir + "/" + hop_dirs[i],
-                                          &images[i]);
+        drawn[i] = render_run_images(pack.hops[i].spec, r.hops[i].run, dir + "/" + hop_dirs[i],
+                                     &images[i]);
     });
     for (const Status& s : drawn)
       if (!s.ok()) return s;
@@ -326,17 +327,15 @@ Status write_pack_bundle(const PackSpec& pack, const PackResult& r, const std::s
       for (const std::string& f : images[i]) files->push_back(hop_dirs[i] + "/" + f);
     }
     diagram = "pack.png";
-    if (Status s = reports::draw_pack_png(pack_diagram(pack, r), dir + "/" + diagram); !s.ok())
-      return s;
+    if (Status s = draw_pack_png(pack_diagram(pack, r), dir + "/" + diagram); !s.ok()) return s;
     files->push_back(diagram);
   }
-  if (Status s =
-          cli::write_file_atomic(dir + "/report.json", pack_report_json(pack, r).dump(2) + "\n");
+  if (Status s = write_file_atomic(dir + "/report.json", pack_report_json(pack, r).dump(2) + "\n");
       !s.ok())
     return s;
   files->push_back("report.json");
-  if (Status s = cli::write_file_atomic(dir + "/report.md",
-                                        pack_report_markdown(pack, r, diagram, hop_dirs));
+  if (Status s =
+          write_file_atomic(dir + "/report.md", pack_report_markdown(pack, r, diagram, hop_dirs));
       !s.ok())
     return s;
   files->push_back("report.md");
@@ -350,9 +349,11 @@ std::string pack_summary_text(const PackSpec& pack, const PackResult& r) {
     if (!h.pass) s += fmt::format("  hop {}: FAIL\n", h.index);
   if (r.weakest > 0) {
     const HopResult& w = r.hops[r.weakest - 1];
-    s += fmt::format("  weakest: hop {} ({}), worst margin {:+.1f} % ({}, {})\n", w.index,
-                     hop_devices(pack, pack.hops[w.index - 1]), w.worst_rel * 100, w.worst_metric,
-                     w.worst_direction);
+    s += fmt::format(
+        "  weakest: hop {} ({}), worst margin {} ({}, {})\n", w.index,
+        hop_devices(pack, pack.hops[w.index - 1]),
+        std::isfinite(w.worst_rel) ? fmt::format("{:+.1f} %", w.worst_rel * 100) : "none judged",
+        w.worst_metric, w.worst_direction);
   }
   for (const BreakResult& b : r.breaks)
     if (!b.pass && b.c.broken > 0 && pack.ring)
@@ -364,4 +365,4 @@ std::string pack_summary_text(const PackSpec& pack, const PackResult& r) {
   return s;
 }
 
-}  // namespace isolink::analysis
+}  // namespace isolink::reports
