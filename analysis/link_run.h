@@ -50,6 +50,9 @@ const std::vector<std::string>& run_probes();
 
 StatusOr<LinkRun> run_link(const link::LinkSpec& spec, const link::PartLibrary& parts,
                            const RunOptions& opt = {});
+// One expanded direction simulated and scored: run_link's work per direction (packs expand every
+// hop first and simulate each distinct circuit once).
+StatusOr<DirectionRun> run_direction(link::ExpandedLink link, const RunOptions& opt = {});
 
 // The probes of every direction, resampled onto one uniform axis, columns "down v(rxp,rxn)", ...
 Waveform run_waveforms(const LinkRun& run, double dt);

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "analysis/pack_spec.h"
 #include "analysis/link_run.h"
 #include "analysis/worst.h"
 #include "base/atomic_file.h"
@@ -41,6 +42,16 @@ int fail(const Status& s) {
 }
 
 int run_run(const RunArgs& a) {
+  // A pack spec (a file with `hops:`) runs as `isolink pack`.
+  if (StatusOr<config::YamlDoc> doc = config::YamlDoc::load_file(a.spec);
+      doc && analysis::is_pack_spec(*doc)) {
+    if (!a.direction.empty())
+      return fail(
+          Status::Error(fmt::format("{}: error: --direction is for link specs; a pack "
+                                    "runs each hop in the directions it carries",
+                                    a.spec)));
+    return run_pack_command({a.spec, a.out_dir, a.part_dirs, 0, a.no_images, a.quiet});
+  }
   StatusOr<link::LinkSpec> spec = link::read_link_spec_file(a.spec);
   if (!spec) return fail(spec.status());
   if (a.direction == "down") spec->stimulus.directions = {link::Direction::kDown};

@@ -1,12 +1,12 @@
 #include "config/yaml_reader.h"
 
+#include <fmt/format.h>
+
 #include <cctype>
 #include <charconv>
 #include <cmath>
 #include <fstream>
 #include <sstream>
-
-#include <fmt/format.h>
 
 namespace isolink::config {
 
@@ -21,26 +21,40 @@ std::string lower(std::string_view s) {
 // Unit symbols accepted after the number (lower case), the first is the canonical one.
 std::vector<std::string> unit_words(Unit unit) {
   switch (unit) {
-    case Unit::kOhm: return {"ohm", "ohms", "r"};
-    case Unit::kFarad: return {"f"};
-    case Unit::kHenry: return {"h"};
-    case Unit::kSecond: return {"s"};
-    case Unit::kVolt: return {"v"};
-    case Unit::kAmpere: return {"a"};
-    case Unit::kHertz: return {"hz"};
-    case Unit::kMetre: return {"m"};
-    case Unit::kCelsius: return {"c", "degc"};
-    case Unit::kSiemens: return {"s"};
-    case Unit::kNone: return {};
+    case Unit::kOhm:
+      return {"ohm", "ohms", "r"};
+    case Unit::kFarad:
+      return {"f"};
+    case Unit::kHenry:
+      return {"h"};
+    case Unit::kSecond:
+      return {"s"};
+    case Unit::kVolt:
+      return {"v"};
+    case Unit::kAmpere:
+      return {"a"};
+    case Unit::kHertz:
+      return {"hz"};
+    case Unit::kMetre:
+      return {"m"};
+    case Unit::kCelsius:
+      return {"c", "degc"};
+    case Unit::kSiemens:
+      return {"s"};
+    case Unit::kNone:
+      return {};
   }
   return {};
 }
 
 std::string rule_text(Rule rule) {
   switch (rule) {
-    case Rule::kPositive: return "must be > 0";
-    case Rule::kNonNegative: return "must be >= 0";
-    case Rule::kAny: return "";
+    case Rule::kPositive:
+      return "must be > 0";
+    case Rule::kNonNegative:
+      return "must be >= 0";
+    case Rule::kAny:
+      return "";
   }
   return "";
 }
@@ -55,17 +69,28 @@ bool obeys(Rule rule, double v) {
 
 const char* unit_symbol(Unit unit) {
   switch (unit) {
-    case Unit::kOhm: return "ohm";
-    case Unit::kFarad: return "F";
-    case Unit::kHenry: return "H";
-    case Unit::kSecond: return "s";
-    case Unit::kVolt: return "V";
-    case Unit::kAmpere: return "A";
-    case Unit::kHertz: return "Hz";
-    case Unit::kMetre: return "m";
-    case Unit::kCelsius: return "degC";
-    case Unit::kSiemens: return "S";
-    case Unit::kNone: return "";
+    case Unit::kOhm:
+      return "ohm";
+    case Unit::kFarad:
+      return "F";
+    case Unit::kHenry:
+      return "H";
+    case Unit::kSecond:
+      return "s";
+    case Unit::kVolt:
+      return "V";
+    case Unit::kAmpere:
+      return "A";
+    case Unit::kHertz:
+      return "Hz";
+    case Unit::kMetre:
+      return "m";
+    case Unit::kCelsius:
+      return "degC";
+    case Unit::kSiemens:
+      return "S";
+    case Unit::kNone:
+      return "";
   }
   return "";
 }
@@ -99,8 +124,8 @@ bool parse_quantity(std::string_view text, Unit unit, double* out) {
   }
   double scale = 1.0;
   static const std::pair<const char*, double> kSuffixes[] = {
-      {"meg", 1e6}, {"mil", 25.4e-6}, {"f", 1e-15}, {"p", 1e-12}, {"n", 1e-9}, {"u", 1e-6},
-      {"m", 1e-3},  {"k", 1e3},       {"g", 1e9},   {"t", 1e12}};
+      {"meg", 1e6}, {"mil", 25.4e-6}, {"f", 1e-15}, {"p", 1e-12}, {"n", 1e-9},
+      {"u", 1e-6},  {"m", 1e-3},      {"k", 1e3},   {"g", 1e9},   {"t", 1e12}};
   if (!is_unit(rest)) {
     bool found = false;
     for (const auto& [sfx, mult] : kSuffixes) {
@@ -150,8 +175,72 @@ StatusOr<YamlDoc> YamlDoc::from_text(const std::string& text, const std::string&
   return doc;
 }
 
+namespace {
+
+// Whether node is sub or lies inside it (node identity, not equal text).
+bool inside(const YAML::Node& sub, const YAML::Node& node) {
+  if (sub.is(node)) return true;
+  if (sub.IsMap()) {
+    for (auto it = sub.begin(); it != sub.end(); ++it)
+      if (it->first.is(node) || inside(it->second, node)) return true;
+  } else if (sub.IsSequence()) {
+    for (const YAML::Node& child : sub)
+      if (inside(child, node)) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+std::shared_ptr<const SourceFile> YamlDoc::file_of(const YAML::Node& node) const {
+  // Latest first: a later merge can replace part of an earlier one.
+  for (auto it = overlays_.rbegin(); it != overlays_.rend(); ++it)
+    if (it->file != file_ && inside(it->node, node)) return it->file;
+  return file_;
+}
+
+void YamlDoc::replace(const std::string& key, const YAML::Node& value, const YamlDoc& from) {
+  root_[key] = value;
+  overlays_.push_back({value, from.file_});
+  for (const Overlay& o : from.overlays_) overlays_.push_back(o);
+}
+
+Status YamlDoc::merge(const YAML::Node& overlay, const YamlDoc& from) {
+  if (!overlay.IsDefined() || overlay.IsNull()) return Status::Ok();
+  if (!root_.IsDefined() || root_.IsNull()) root_ = YAML::Node(YAML::NodeType::Map);
+  if (!root_.IsMap()) return error(root_, "a map of keys is needed here to merge overrides into");
+  for (const Overlay& o : from.overlays_) overlays_.push_back(o);
+  return merge_map(root_, overlay, from, "");
+}
+
+Status YamlDoc::merge_map(YAML::Node target, const YAML::Node& overlay, const YamlDoc& from,
+                          const std::string& path) {
+  if (!overlay.IsMap())
+    return from.error(overlay,
+                      fmt::format("overrides{} must be a map of keys, found a {}",
+                                  path.empty() ? "" : " of '" + path + "'", node_kind(overlay)));
+  for (auto it = overlay.begin(); it != overlay.end(); ++it) {
+    if (!it->first.IsScalar()) return from.error(it->first, "a key must be a plain value");
+    const std::string key = it->first.Scalar();
+    const std::string full = path.empty() ? key : path + "." + key;
+    YAML::Node existing = target[key];
+    if (existing.IsDefined() && existing.IsMap() && it->second.IsMap()) {
+      if (Status s = merge_map(existing, it->second, from, full); !s.ok()) return s;
+      continue;
+    }
+    if (existing.IsDefined()) {
+      target[key] = it->second;
+    } else {
+      target.force_insert(it->first, it->second);  // keeps the key node: errors point at it
+      overlays_.push_back({it->first, from.file_});
+    }
+    overlays_.push_back({it->second, from.file_});
+  }
+  return Status::Ok();
+}
+
 SourceLoc YamlDoc::loc(const YAML::Node& node) const {
-  SourceLoc l{file_, 0, 0};
+  SourceLoc l{overlays_.empty() ? file_ : file_of(node), 0, 0};
   if (node.IsDefined()) {
     const YAML::Mark m = node.Mark();
     if (m.line >= 0 && !m.is_null()) l.line = m.line + 1, l.col = m.column + 1;
@@ -168,8 +257,8 @@ Status read_map(const YamlDoc& doc, const YAML::Node& node, const std::string& p
   if (!node.IsDefined() || node.IsNull()) return Status::Ok();
   const std::string where = path.empty() ? "the top level" : "'" + path + "'";
   if (!node.IsMap())
-    return doc.error(node, fmt::format("{} must be a map of keys, found a {}", where,
-                                       node_kind(node)));
+    return doc.error(node,
+                     fmt::format("{} must be a map of keys, found a {}", where, node_kind(node)));
   for (auto it = node.begin(); it != node.end(); ++it) {
     const std::string key = it->first.Scalar();
     const std::string full = path.empty() ? key : path + "." + key;
@@ -179,8 +268,8 @@ Status read_map(const YamlDoc& doc, const YAML::Node& node, const std::string& p
     if (f == nullptr) {
       std::string known;
       for (const Field& x : fields) known += (known.empty() ? "" : ", ") + x.key;
-      return doc.error(it->first, fmt::format("unknown key '{}' in {} (known keys: {})", full,
-                                              where, known));
+      return doc.error(it->first,
+                       fmt::format("unknown key '{}' in {} (known keys: {})", full, where, known));
     }
     if (Status s = f->read(it->second, full); !s.ok()) return s;
   }
@@ -194,11 +283,12 @@ FieldReader read_quantity(const YamlDoc& doc, Unit unit, Rule rule, double* out)
     if (!n.IsScalar() || !parse_quantity(n.Scalar(), unit, &v)) {
       std::string expect = unit == Unit::kMetre || unit == Unit::kCelsius || unit == Unit::kNone
                                ? fmt::format("a number{}{}", *sym ? " in " : "", sym)
-                               : fmt::format("a value in {} (SPICE suffixes allowed, e.g. 2.2n "
-                                             "or 2.2n{})",
-                                             sym, sym);
-      return doc.error(n, fmt::format("key '{}': expected {}, found '{}'", key, expect,
-                                      node_text(n)));
+                               : fmt::format(
+                                     "a value in {} (SPICE suffixes allowed, e.g. 2.2n "
+                                     "or 2.2n{})",
+                                     sym, sym);
+      return doc.error(n,
+                       fmt::format("key '{}': expected {}, found '{}'", key, expect, node_text(n)));
     }
     if (!obeys(rule, v))
       return doc.error(n, fmt::format("key '{}' = {}: {}", key, n.Scalar(), rule_text(rule)));
@@ -235,8 +325,7 @@ FieldReader read_choice(const YamlDoc& doc, std::vector<std::string> options, st
       }
       names += (names.empty() ? "" : " | ") + o;
     }
-    return doc.error(n, fmt::format("key '{}': expected {}, found '{}'", key, names,
-                                    node_text(n)));
+    return doc.error(n, fmt::format("key '{}': expected {}, found '{}'", key, names, node_text(n)));
   };
 }
 
@@ -244,8 +333,8 @@ FieldReader read_bool(const YamlDoc& doc, bool* out) {
   return [&doc, out](const YAML::Node& n, const std::string& key) -> Status {
     bool b = false;
     if (!n.IsScalar() || !YAML::convert<bool>::decode(n, b))
-      return doc.error(n, fmt::format("key '{}': expected true or false, found '{}'", key,
-                                      node_text(n)));
+      return doc.error(
+          n, fmt::format("key '{}': expected true or false, found '{}'", key, node_text(n)));
     *out = b;
     return Status::Ok();
   };
@@ -257,8 +346,8 @@ FieldReader read_int(const YamlDoc& doc, int lo, int hi, int* out) {
     int v = 0;
     auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
     if (s.empty() || ec != std::errc() || ptr != s.data() + s.size())
-      return doc.error(n, fmt::format("key '{}': expected a whole number, found '{}'", key,
-                                      node_text(n)));
+      return doc.error(
+          n, fmt::format("key '{}': expected a whole number, found '{}'", key, node_text(n)));
     if (v < lo || v > hi)
       return doc.error(n, fmt::format("key '{}' = {}: must be in {}..{}", key, v, lo, hi));
     *out = v;
@@ -274,12 +363,12 @@ FieldReader read_text_list(const YamlDoc& doc, std::vector<std::string>* out) {
       return Status::Ok();
     }
     if (!n.IsSequence())
-      return doc.error(n, fmt::format("key '{}': expected a list of text, found a {}", key,
-                                      node_kind(n)));
+      return doc.error(
+          n, fmt::format("key '{}': expected a list of text, found a {}", key, node_kind(n)));
     for (size_t i = 0; i < n.size(); ++i) {
       if (!n[i].IsScalar())
-        return doc.error(n[i], fmt::format("key '{}[{}]': expected text, found a {}", key, i,
-                                           node_kind(n[i])));
+        return doc.error(
+            n[i], fmt::format("key '{}[{}]': expected text, found a {}", key, i, node_kind(n[i])));
       out->push_back(n[i].Scalar());
     }
     return Status::Ok();
