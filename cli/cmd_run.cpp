@@ -1,13 +1,14 @@
 // isolink run: a link spec simulated with its traffic, each receiver scored, and the report
 // bundle (eye.png, wave.png, report.json, report.md, wave.csv) written to a folder.
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
 
-#include <fmt/format.h>
-
+#include "base/file_io.h"
 #include "cli/commands.h"
 #include "cli/link_run.h"
 #include "cli/run_images.h"
@@ -27,6 +28,10 @@ struct RunArgs {
   bool quiet = false;
 };
 
+// What a report folder holds: an existing folder with anything else in it is not replaced.
+const std::vector<std::string> kBundleFiles = {"eye.png", "wave.png", "report.json", "report.md",
+                                               "wave.csv"};
+
 int fail(const Status& s) {
   std::fprintf(stderr, "%s\n", s.message().c_str());
   return 2;
@@ -45,24 +50,28 @@ int run_run(const RunArgs& a) {
   StatusOr<LinkRun> run = run_link(*spec, *parts);
   if (!run) return fail(run.status().with_context(a.spec));
 
-  const std::string dir = a.out_dir.empty() ? "reports/out/" + spec->name : a.out_dir;
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) return fail(Status::Error(fmt::format("{}: error: cannot create the folder: {}", dir,
-                                                ec.message())));
+  // The spec's name becomes a folder name: made safe (no "..", separators or control bytes).
+  const std::string dir =
+      a.out_dir.empty() ? "reports/out/" + safe_path_component(spec->name) : a.out_dir;
+  // The bundle appears whole or not at all (base/file_io.h OutputBundle).
+  StatusOr<OutputBundle> bundle = OutputBundle::open(dir, kBundleFiles);
+  if (!bundle) return fail(bundle.status());
   std::vector<std::string> images;
   if (!a.no_images) {
-    if (Status s = render_run_images(*spec, *run, dir, &images); !s.ok()) return fail(s);
+    if (Status s = render_run_images(*spec, *run, bundle->staging(), &images); !s.ok())
+      return fail(s);
   }
   const Waveform wave = run_waveforms(*run, spec->sim.tstep);
-  if (Status s = write_waveform_csv(wave, dir + "/wave.csv"); !s.ok()) return fail(s);
-  if (Status s = write_file_atomic(dir + "/report.json", run_report_json(*spec, *run).dump(2) +
-                                                             "\n");
+  if (Status s = write_waveform_csv(wave, bundle->path("wave.csv")); !s.ok()) return fail(s);
+  if (Status s = write_file_atomic(bundle->path("report.json"),
+                                   run_report_json(*spec, *run).dump(2) + "\n");
       !s.ok())
     return fail(s);
-  if (Status s = write_file_atomic(dir + "/report.md", run_report_markdown(*spec, *run, images));
+  if (Status s =
+          write_file_atomic(bundle->path("report.md"), run_report_markdown(*spec, *run, images));
       !s.ok())
     return fail(s);
+  if (Status s = bundle->commit(); !s.ok()) return fail(s);
   std::vector<std::string> warned;  // both directions share most warnings: print each once
   for (const DirectionRun& d : run->directions)
     for (const std::string& w : d.sim.warnings)

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "base/file_io.h"
 #include "cli/commands.h"
 #include "cli/sweep_run.h"
 #include "cli/sweep_spec.h"
@@ -90,7 +91,7 @@ int run_sweep_command(const SweepArgs& a) {
   if (!parts) return report(parts.status());
 
   sweep::SweepOptions opt;
-  opt.out_dir = a.out_dir.empty() ? "reports/out/" + spec->name : a.out_dir;
+  opt.out_dir = a.out_dir.empty() ? "reports/out/" + safe_path_component(spec->name) : a.out_dir;
   opt.jobs = a.jobs;
   opt.resume = a.resume;
   opt.keep_waves = a.keep_waves;

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "base/file_io.h"  // write_file_atomic, for the bundle
 #include "cli/link_run.h"
 #include "netlists/link/link_spec.h"
 #include "solver/waveform.h"
@@ -26,8 +27,6 @@ std::string run_report_markdown(const link::LinkSpec& spec, const LinkRun& run,
                                 const std::vector<std::string>& images);
 // The probes of every direction, resampled onto one uniform axis, columns "down v(rxp,rxn)", ...
 Waveform run_waveforms(const LinkRun& run, double dt);
-// Writes text to path through path + ".tmp" and a rename.
-Status write_file_atomic(const std::string& path, const std::string& text);
 // "pass" / "FAIL" lines for the terminal: one per direction, with the worst margins.
 std::string run_summary_text(const link::LinkSpec& spec, const LinkRun& run);
 

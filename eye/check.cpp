@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "base/file_io.h"
+
 namespace isolink::eye {
 namespace {
 
@@ -420,9 +422,8 @@ std::string summary_text(const CheckResult& r, const std::string& source) {
 }
 
 Status write_pulses_csv(const CheckResult& r, const std::string& path) {
-  const std::string tmp = path + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "w");
-  if (!f) return Status::Error(path + ": error: cannot write the file");
+  StatusOr<OutputFile> f = OutputFile::open(path);
+  if (!f) return f.status();
   auto cell = [](double x, double scale = 1) {
     return std::isnan(x) ? std::string() : fmt::format("{:.9g}", x * scale);
   };
@@ -433,10 +434,11 @@ Status write_pulses_csv(const CheckResult& r, const std::string& path) {
     for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
     return q + "\"";
   };
-  std::fputs(
-      "index,sign,start_s,end_s,width_ns,class,edge_ns,vstart,vend,droop,frame,bit,fails,"
-      "warnings\n",
-      f);
+  if (Status s = f->write(
+          "index,sign,start_s,end_s,width_ns,class,edge_ns,vstart,vend,droop,frame,bit,fails,"
+          "warnings\n");
+      !s.ok())
+    return s;
   for (const PulseMetrics& p : r.pulses) {
     const std::string cls = p.truncated ? "" : (p.idle ? "idle" : std::to_string(p.k));
     const std::string line = fmt::format(
@@ -444,21 +446,9 @@ Status write_pulses_csv(const CheckResult& r, const std::string& path) {
         cell(p.width.value, 1e9), cls, cell(p.edge.value, 1e9), cell(p.vstart.value),
         cell(p.vend.value), cell(p.droop.value), p.frame >= 0 ? std::to_string(p.frame) : "",
         p.role, quoted(p.fails), quoted(p.warnings));
-    std::fputs(line.c_str(), f);
+    if (Status s = f->write(line); !s.ok()) return s;
   }
-  bool ok = std::fflush(f) == 0;
-  ok = std::fclose(f) == 0 && ok;
-  std::error_code ec;
-  if (!ok) {
-    std::filesystem::remove(tmp, ec);
-    return Status::Error(path + ": error: write failed");
-  }
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    return Status::Error(path + ": error: cannot rename the temp file: " + ec.message());
-  }
-  return Status::Ok();
+  return f->commit();
 }
 
 }  // namespace isolink::eye

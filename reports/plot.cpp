@@ -1,6 +1,8 @@
 #include "reports/plot.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -8,6 +10,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <system_error>
+#include <vector>
+
+#include "base/file_io.h"
 
 namespace isolink::reports {
 namespace fs = std::filesystem;
@@ -427,24 +432,23 @@ Rect Canvas::text(double x, double y, std::string_view s, int size, Color c, Fon
 }
 
 Status Canvas::write_png(const std::string& path) const {
-  const std::string tmp = path + ".tmp.png";
-  OIIO::ImageBuf out = image();
-  if (!out.write(tmp, OIIO::TypeDesc::UINT8, "png")) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    std::string err = out.geterror();
+  // OpenImageIO reports success when the disk fills up under it, so the PNG is encoded into
+  // memory and written with base/file_io.h's checked, atomic write.
+  std::vector<unsigned char> bytes;
+  OIIO::Filesystem::IOVecOutput proxy(bytes);
+  std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create("image.png", &proxy);
+  const OIIO::ImageBuf img = image();
+  OIIO::ImageSpec spec = img.spec();
+  spec.set_format(OIIO::TypeDesc::UINT8);
+  if (!out || !out->open("image.png", spec) || !img.write(out.get()) || !out->close()) {
+    std::string err = out ? out->geterror() : std::string();
+    if (err.empty()) err = img.geterror();
     if (err.empty()) err = OIIO::geterror();
-    return Status::Error(fmt::format("cannot write {}: {}", path, err));
+    return Status::Error(fmt::format("{}: error: cannot encode the PNG: {}", path, err));
   }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    std::error_code ec2;
-    fs::remove(tmp, ec2);
-    return Status::Error(
-        fmt::format("cannot write {}: rename from {}: {}", path, tmp, ec.message()));
-  }
-  return Status::Ok();
+  out.reset();
+  return write_file_atomic(
+      path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
 Rect draw_runs(Canvas& c, double x, double y, const std::vector<TextRun>& runs, int size,
