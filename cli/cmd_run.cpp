@@ -15,6 +15,7 @@
 #include "cli/run_report.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
+#include "netlists/traffic/stimulus.h"
 
 namespace isolink::cli {
 namespace {
@@ -27,6 +28,9 @@ struct RunArgs {
   bool no_images = false;
   bool quiet = false;
 };
+
+// Traffic longer than this gets a warning before the run (simulated seconds; about 250 commands).
+constexpr double kLongTrafficSeconds = 20e-3;
 
 // What a report folder holds: an existing folder with anything else in it is not replaced.
 const std::vector<std::string> kBundleFiles = {"eye.png", "wave.png", "report.json", "report.md",
@@ -47,6 +51,15 @@ int run_run(const RunArgs& a) {
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load(a.part_dirs);
   if (!parts) return fail(parts.status());
 
+  // A size check before obviously huge work (10,000 frames ran for minutes without a word).
+  if (StatusOr<traffic::Drive> d = traffic::build_drive(spec->stimulus.to_script()); d) {
+    if (d->duration() > kLongTrafficSeconds)
+      std::fprintf(stderr,
+                   "isolink run: warning: the stimulus is %.3g ms of traffic (%zu frames) per "
+                   "direction, above %.0f ms: long work (each direction is simulated in full); "
+                   "shorten it to iterate faster\n",
+                   d->duration() * 1e3, d->frames.size(), kLongTrafficSeconds * 1e3);
+  }
   StatusOr<LinkRun> run = run_link(*spec, *parts);
   if (!run) return fail(run.status().with_context(a.spec));
 
