@@ -51,6 +51,13 @@ int run_run(const RunArgs& a) {
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load(a.part_dirs);
   if (!parts) return fail(parts.status());
 
+  // The spec's name becomes a folder name: made safe (no "..", separators or control bytes).
+  const std::string dir =
+      a.out_dir.empty() ? "reports/out/" + safe_path_component(spec->name) : a.out_dir;
+  // The bundle appears whole or not at all (base/file_io.h OutputBundle); opened before the
+  // simulation so that a bad -o is reported at once.
+  StatusOr<OutputBundle> bundle = OutputBundle::open(dir, kBundleFiles);
+  if (!bundle) return fail(bundle.status());
   // A size check before obviously huge work (10,000 frames ran for minutes without a word).
   if (StatusOr<traffic::Drive> d = traffic::build_drive(spec->stimulus.to_script()); d) {
     if (d->duration() > kLongTrafficSeconds)
@@ -63,12 +70,6 @@ int run_run(const RunArgs& a) {
   StatusOr<LinkRun> run = run_link(*spec, *parts);
   if (!run) return fail(run.status().with_context(a.spec));
 
-  // The spec's name becomes a folder name: made safe (no "..", separators or control bytes).
-  const std::string dir =
-      a.out_dir.empty() ? "reports/out/" + safe_path_component(spec->name) : a.out_dir;
-  // The bundle appears whole or not at all (base/file_io.h OutputBundle).
-  StatusOr<OutputBundle> bundle = OutputBundle::open(dir, kBundleFiles);
-  if (!bundle) return fail(bundle.status());
   std::vector<std::string> images;
   if (!a.no_images) {
     if (Status s = render_run_images(*spec, *run, bundle->staging(), &images); !s.ok())
