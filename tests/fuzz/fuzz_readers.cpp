@@ -12,7 +12,7 @@
 #elif ISOLINK_FUZZ_READER == 2
 #include "netlists/link/link_spec.h"
 #elif ISOLINK_FUZZ_READER == 3
-#include "cli/sweep_spec.h"
+#include "analysis/sweep_spec.h"
 #elif ISOLINK_FUZZ_READER == 4
 #include "netlists/link/parts.h"
 #elif ISOLINK_FUZZ_READER == 5
@@ -30,7 +30,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
 #elif ISOLINK_FUZZ_READER == 2
   (void)isolink::link::read_link_spec_text(text, "fuzz.yaml");
 #elif ISOLINK_FUZZ_READER == 3
-  (void)isolink::cli::sweep::read_sweep_text(text, "fuzz.yaml");
+  (void)isolink::analysis::sweep::read_sweep_text(text, "fuzz.yaml");
 #elif ISOLINK_FUZZ_READER == 4
   (void)isolink::link::read_parts_text(text, "fuzz.yaml");
 #elif ISOLINK_FUZZ_READER == 5
