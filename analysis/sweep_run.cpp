@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -15,9 +16,11 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <system_error>
 
 #include "base/atomic_file.h"
 #include "base/csv.h"
+#include "base/file_io.h"
 
 namespace isolink::analysis::sweep {
 
@@ -320,10 +323,18 @@ void ResultLog::add(const PointResult& in) {
   const PointResult r = round_trip(padded, ncells_, ncolumns_);
   const std::string row = results_row(r);
   std::lock_guard<std::mutex> lock(mu_);
-  if (r.index >= total_ || have_[r.index]) return;
+  if (r.index >= total_ || have_[r.index] || !write_error_.ok()) return;
+  // Checked: a row the disk did not take is not counted, and the sweep stops (status()).
+  if (std::fputs(row.c_str(), file_) < 0 || std::fflush(file_) != 0) {
+    const int err = errno;
+    write_error_ = Status::Error(fmt::format(
+        "{}: error: cannot append the row of point {}: {}; {} of {} points are recorded: free "
+        "some space and run again with --resume",
+        path_, r.index, std::error_code(err, std::generic_category()).message(),
+        skipped_ + done_now_, total_));
+    return;
+  }
   have_[r.index] = true;
-  std::fputs(row.c_str(), file_);
-  std::fflush(file_);
   results_.push_back(r);
   ++done_now_;
   if (r.verdict == "pass") ++pass_;
@@ -609,10 +620,11 @@ StatusOr<SweepOutcome> run_sweep(const SweepSpec& s, const link::PartLibrary& pa
         tbb::blocked_range<size_t>(0, todo.size(), 1),
         [&](const tbb::blocked_range<size_t>& range) {
           for (size_t i = range.begin(); i != range.end(); ++i)
-            L.add(run_point(s, parts, todo[i], opt.point));
+            if (L.status().ok()) L.add(run_point(s, parts, todo[i], opt.point));
         },
         tbb::simple_partitioner());
   });
+  if (Status st = L.status(); !st.ok()) return st;
   SweepOutcome out;
   out.skipped = L.skipped();
   if (Status st = finish_sweep(s, L.results(), opt, &out); !st.ok()) return st;

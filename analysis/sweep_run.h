@@ -121,8 +121,13 @@ class ResultLog {
   // Point indices still to run, ascending.
   std::vector<size_t> todo() const;
   size_t skipped() const { return skipped_; }
-  // Records a result (thread-safe): appends its row, prints progress.
+  // Records a result (thread-safe): appends its row (checked), prints progress. After a failed
+  // write nothing more is recorded and status() says why.
   void add(const PointResult& r);
+  Status status() const {
+    std::lock_guard<std::mutex> lock(mu_);
+    return write_error_;
+  }
   // Every result so far, by point index.
   std::vector<PointResult> results() const;
   const std::string& path() const { return path_; }
@@ -139,6 +144,7 @@ class ResultLog {
   double start_ = 0, last_print_ = -1;
   std::vector<PointResult> results_;
   std::vector<bool> have_;
+  Status write_error_;
   mutable std::mutex mu_;
 };
 

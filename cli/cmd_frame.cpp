@@ -41,9 +41,15 @@ struct FrameArgs {
   std::string tail = "5u";
 };
 
+// Times are checked up front: widths and edges must be positive, idle times not negative.
 Status set_time(const std::string& flag, const std::string& text, double* out) {
   StatusOr<double> t = tr::parse_time(text);
   if (!t) return t.status().with_context(flag);
+  const bool idle =
+      flag == "--lead" || flag == "--byte-gap" || flag == "--frame-gap" || flag == "--tail";
+  if (idle ? *t < 0 : *t <= 0)
+    return Status::Error(fmt::format("{} {}: must be {} time", flag, text,
+                                     idle ? "a zero or positive" : "a positive"));
   *out = *t;
   return Status::Ok();
 }
@@ -218,7 +224,8 @@ void add_frame_command(CLI::App& app, int* exit_code) {
   cmd->add_option("--pattern", args->pattern,
                   "Send a pattern last: prbs7, prbs9, prbs15, all256, alt, zeros, ones, runs, "
                   "doubles");
-  cmd->add_option("--bytes", args->bytes, "Pattern length in bytes (default per pattern)");
+  cmd->add_option("--bytes", args->bytes, "Pattern length in bytes (default per pattern)")
+      ->check(CLI::Range(1L, 1000000L));
   auto* json = cmd->add_flag("--json", args->json, "JSON: bytes, bits, pulses (seconds), frames");
   auto* pwl = cmd->add_flag("--pwl", args->pwl, "Two ngspice PWL sources VTXP txp / VTXN txn");
   json->excludes(pwl);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "analysis/pack_spec.h"
+#include "base/file_io.h"
 #include "analysis/link_run.h"
 #include "analysis/worst.h"
 #include "base/atomic_file.h"
@@ -19,6 +20,7 @@
 #include "reports/run_images.h"
 #include "reports/run_report.h"
 #include "reports/worst_png.h"
+#include "netlists/traffic/stimulus.h"
 
 namespace isolink::cli {
 using namespace isolink::analysis;  // run_link, LinkRun, run_waveforms
@@ -35,6 +37,20 @@ struct RunArgs {
   bool no_worst = false;
   bool quiet = false;
 };
+
+// Traffic longer than this gets a warning before the run (simulated seconds; about 250 commands).
+constexpr double kLongTrafficSeconds = 20e-3;
+
+// What a report folder holds: an existing folder with anything else in it is not replaced.
+// What a report folder holds: the bundle's files and the worst-case images
+// (worst_<direction>_<metric>.png, reports/worst_png.h).
+const std::vector<std::string> kBundleFiles = [] {
+  std::vector<std::string> names = {"eye.png", "wave.png", "report.json", "report.md", "wave.csv"};
+  for (const char* d : {"down", "up"})
+    for (const char* m : {"vstart", "vend", "width_min", "width_max", "edge"})
+      names.push_back(fmt::format("worst_{}_{}.png", d, m));
+  return names;
+}();
 
 int fail(const Status& s) {
   std::fprintf(stderr, "%s\n", s.message().c_str());
@@ -61,6 +77,22 @@ int run_run(const RunArgs& a) {
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load(a.part_dirs);
   if (!parts) return fail(parts.status());
 
+  // The spec's name becomes a folder name: made safe (no "..", separators or control bytes).
+  const std::string dir =
+      a.out_dir.empty() ? "reports/out/" + safe_path_component(spec->name) : a.out_dir;
+  // The bundle appears whole or not at all (base/file_io.h OutputBundle); opened before the
+  // simulation so that a bad -o is reported at once.
+  StatusOr<OutputBundle> bundle = OutputBundle::open(dir, kBundleFiles);
+  if (!bundle) return fail(bundle.status());
+  // A size check before obviously huge work (10,000 frames ran for minutes without a word).
+  if (StatusOr<traffic::Drive> d = traffic::build_drive(spec->stimulus.to_script()); d) {
+    if (d->duration() > kLongTrafficSeconds)
+      std::fprintf(stderr,
+                   "isolink run: warning: the stimulus is %.3g ms of traffic (%zu frames) per "
+                   "direction, above %.0f ms: long work (each direction is simulated in full); "
+                   "shorten it to iterate faster\n",
+                   d->duration() * 1e3, d->frames.size(), kLongTrafficSeconds * 1e3);
+  }
   RunOptions ro;
   ro.engine = *parse_engine(a.engine);  // CLI11 checked the choice
   StatusOr<LinkRun> run = run_link(*spec, *parts, ro);
@@ -73,18 +105,13 @@ int run_run(const RunArgs& a) {
     worst = std::move(*w);
   }
 
-  const std::string dir = a.out_dir.empty() ? "reports/out/" + spec->name : a.out_dir;
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec)
-    return fail(
-        Status::Error(fmt::format("{}: error: cannot create the folder: {}", dir, ec.message())));
   std::vector<std::string> images;
   if (!a.no_images) {
-    if (Status s = render_run_images(*spec, *run, dir, &images); !s.ok()) return fail(s);
+    if (Status s = render_run_images(*spec, *run, bundle->staging(), &images); !s.ok())
+      return fail(s);
   }
   const Waveform wave = run_waveforms(*run, spec->sim.tstep);
-  if (Status s = write_waveform_csv(wave, dir + "/wave.csv"); !s.ok()) return fail(s);
+  if (Status s = write_waveform_csv(wave, bundle->path("wave.csv")); !s.ok()) return fail(s);
   nlohmann::ordered_json json = run_report_json(*spec, *run);
   std::string md = run_report_markdown(*spec, *run, images);
   if (worst) {
@@ -92,14 +119,15 @@ int run_run(const RunArgs& a) {
     md += "\n## Worst case over all traffic\n\n" + analysis::worst_markdown(*worst);
     if (!a.no_images) {
       std::vector<std::string> files;
-      if (Status s = reports::render_worst_pngs(*worst, spec->name, {}, dir, &files); !s.ok())
+      if (Status s = reports::render_worst_pngs(*worst, spec->name, {}, bundle->staging(), &files); !s.ok())
         return fail(s);
       for (const std::string& f : files) md += fmt::format("![{}]({})\n\n", f, f);
     }
   }
-  if (Status s = write_file_atomic(dir + "/report.json", json.dump(2) + "\n"); !s.ok())
+  if (Status s = write_file_atomic(bundle->path("report.json"), json.dump(2) + "\n"); !s.ok())
     return fail(s);
-  if (Status s = write_file_atomic(dir + "/report.md", md); !s.ok()) return fail(s);
+  if (Status s = write_file_atomic(bundle->path("report.md"), md); !s.ok()) return fail(s);
+  if (Status s = bundle->commit(); !s.ok()) return fail(s);
   std::vector<std::string> warned;  // both directions share most warnings: print each once
   for (const DirectionRun& d : run->directions)
     for (const std::string& w : d.sim.warnings)

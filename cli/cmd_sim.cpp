@@ -15,6 +15,9 @@ namespace isolink::cli {
 using namespace isolink::analysis;  // simulate_netlist
 
 namespace {
+// The most rows --step may ask for (about 300 MB of CSV with one probe).
+constexpr size_t kMaxResampledRows = 10'000'000;
+
 struct SimArgs {
   std::string netlist;
   std::vector<std::string> probes;
@@ -67,18 +70,24 @@ int run_sim(const SimArgs& a) {
     return 2;
   }
   for (const auto& w : r->warnings) std::cerr << w << "\n";
-  const Waveform out = step && r->engine == Engine::Transient ? r->wave.resampled(*step) : r->wave;
-  if (a.output.empty() || a.output == "-") {
-    std::printf("time");
-    for (const auto& n : out.names) std::printf(",%s", n.c_str());
-    std::printf("\n");
-    for (size_t i = 0; i < out.samples(); ++i) {
-      std::printf("%.12g", out.time[i]);
-      for (const auto& c : out.columns) std::printf(",%.9g", c[i]);
-      std::printf("\n");
+  if (step && !r->wave.time.empty()) {
+    // Refused before allocating: 1e-14 over 5 us would be 5e8 rows (bad_alloc), 1e-30 overflows.
+    const double span = r->wave.time.back() - r->wave.time.front();
+    const double rows = span / *step + 1;
+    if (!(rows <= static_cast<double>(kMaxResampledRows))) {
+      std::cerr << fmt::format(
+          "isolink sim: error: --step {} over the {:.6g} s run asks for {:.3g} rows; the limit is "
+          "{} rows (use a larger --step, or no --step for the solver's own time points)\n",
+          a.step, span, rows, kMaxResampledRows);
+      return 2;
     }
-  } else if (Status s = write_waveform_csv(out, a.output); !s.ok()) {
-    std::cerr << "isolink sim: error: " << s.message() << "\n";
+  }
+  // The LTI engine already wrote its rows on the --step grid.
+  const Waveform out = step && r->engine == Engine::Transient ? r->wave.resampled(*step) : r->wave;
+  if (Status s = write_waveform_csv(out, a.output.empty() ? "-" : a.output); !s.ok()) {
+    const std::string& m = s.message();
+    std::cerr << (m.find(": error: ") == std::string::npos ? "isolink sim: error: " : "") << m
+              << "\n";
     return 2;
   }
   if (!a.quiet && r->engine == Engine::Lti)

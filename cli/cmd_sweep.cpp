@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "base/csv.h"
+#include "base/file_io.h"
 #include "cli/commands.h"
 #include "reports/sweep_report.h"
 #include "analysis/sweep_run.h"
@@ -95,7 +96,7 @@ int run_sweep_command(const SweepArgs& a) {
   if (!parts) return report(parts.status());
 
   sweep::SweepOptions opt;
-  opt.out_dir = a.out_dir.empty() ? "reports/out/" + spec->name : a.out_dir;
+  opt.out_dir = a.out_dir.empty() ? "reports/out/" + safe_path_component(spec->name) : a.out_dir;
   opt.jobs = a.jobs;
   opt.resume = a.resume;
   opt.keep_waves = a.keep_waves;

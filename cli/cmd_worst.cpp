@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "analysis/worst.h"
-#include "base/atomic_file.h"
+#include "base/file_io.h"
 #include "cli/commands.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"

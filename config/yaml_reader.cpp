@@ -5,8 +5,9 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
-#include <fstream>
-#include <sstream>
+
+#include "base/file_io.h"
+#include "base/utf8.h"
 
 namespace isolink::config {
 
@@ -155,23 +156,68 @@ std::string node_text(const YAML::Node& node) {
 }
 
 StatusOr<YamlDoc> YamlDoc::load_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status::Error(fmt::format("{}: error: cannot open the file", path));
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return from_text(ss.str(), path);
+  StatusOr<std::string> text = read_input_file(path);  // size-limited; refuses folders
+  if (!text) return text.status();
+  return from_text(*text, path);
 }
+
+namespace {
+
+// Every map in the tree: a key given twice is an error (yaml-cpp keeps both, and the reader
+// would silently take the last).
+Status check_duplicate_keys(const YamlDoc& doc, const YAML::Node& node) {
+  if (node.IsMap()) {
+    std::vector<std::pair<std::string, YAML::Node>> seen;
+    for (auto it = node.begin(); it != node.end(); ++it) {
+      const std::string key = it->first.IsScalar() ? it->first.Scalar() : std::string();
+      if (it->first.IsScalar())
+        for (const auto& [k, first] : seen)
+          if (k == key)
+            return doc.error(it->first,
+                             fmt::format("key '{}' is given twice (first at line {}); give it once",
+                                         key, doc.loc(first).line));
+      seen.emplace_back(key, it->first);
+      if (Status s = check_duplicate_keys(doc, it->second); !s.ok()) return s;
+    }
+  } else if (node.IsSequence()) {
+    for (const YAML::Node& item : node)
+      if (Status s = check_duplicate_keys(doc, item); !s.ok()) return s;
+  }
+  return Status::Ok();
+}
+
+}  // namespace
 
 StatusOr<YamlDoc> YamlDoc::from_text(const std::string& text, const std::string& name) {
   YamlDoc doc;
   doc.file_ = SourceFile::FromText(name, text);
+  // YAML is UTF-8 text; names read here reach JSON and file names, so invalid bytes stop here.
+  if (const size_t bad = invalid_utf8_at(text); bad != std::string::npos) {
+    int line = 1, col = 1;
+    for (size_t i = 0; i < bad; ++i) {
+      if (text[i] == '\n') ++line, col = 0;
+      ++col;
+    }
+    return error_at(SourceLoc{doc.file_, line, col},
+                    fmt::format("byte 0x{:02X} is not UTF-8 text (save the file as UTF-8)",
+                                static_cast<unsigned char>(text[bad])));
+  }
+  if (const size_t nul = text.find('\0'); nul != std::string::npos)
+    return Status::Error(
+        fmt::format("{}: error: a NUL byte at offset {} (is this a text file?)", name, nul));
   try {
-    doc.root_ = YAML::Load(text);
+    std::vector<YAML::Node> docs = YAML::LoadAll(text);
+    if (docs.size() > 1)
+      return doc.error(docs[1],
+                       "a second YAML document ('---') in the file: isolink reads one "
+                       "document per file; remove it or move it to its own file");
+    if (!docs.empty()) doc.root_ = docs[0];
   } catch (const YAML::Exception& e) {
     SourceLoc loc{doc.file_, e.mark.line + 1, e.mark.column + 1};
     if (e.mark.line < 0) loc.line = 0;
     return error_at(loc, "YAML syntax: " + e.msg);
   }
+  if (Status s = check_duplicate_keys(doc, doc.root_); !s.ok()) return s;
   return doc;
 }
 

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "base/csv.h"
+#include "base/file_io.h"
 
 namespace isolink::eye {
 namespace {
@@ -289,8 +290,11 @@ json to_json(const CheckResult& r) {
                   {"edge_max_ns", opt_num(r.edge_max(), 1e9)},
                   {"worst", worst}};
 
+  // Memory linear in what is printed: at most kMaxJsonPulses pulses in detail (a JSON node per
+  // field costs far more than the pulse; 2M pulses took 3.6 GB). --pulses-csv streams them all.
   json pulses = json::array();
   for (const PulseMetrics& p : r.pulses) {
+    if (pulses.size() == kMaxJsonPulses) break;
     json cls = p.truncated ? json(nullptr) : (p.idle ? json("idle") : json(p.k));
     json dips = json::array();
     for (const Dip& d : p.dips)
@@ -313,24 +317,27 @@ json to_json(const CheckResult& r) {
                       {"warnings", p.warnings}});
   }
   j["pulses"] = std::move(pulses);
+  j["pulses_omitted"] = r.pulses.size() - std::min(r.pulses.size(), kMaxJsonPulses);
 
   json ringing = json::array();
   for (const Ringing& g : r.ringing)
-    ringing.push_back({{"start_s", g.start},
-                       {"end_s", g.end},
-                       {"duration_ns", ns(g.end - g.start)},
-                       {"sign", g.sign},
-                       {"peak", g.peak},
-                       {"peak_s", g.peak_t}});
+    if (ringing.size() < kMaxJsonPulses)
+      ringing.push_back({{"start_s", g.start},
+                         {"end_s", g.end},
+                         {"duration_ns", ns(g.end - g.start)},
+                         {"sign", g.sign},
+                         {"peak", g.peak},
+                         {"peak_s", g.peak_t}});
   j["ringing"] = std::move(ringing);
   json idle = json::array();
   for (const IdleUndershoot& u : r.idle)
-    idle.push_back({{"start_s", u.start},
-                    {"end_s", u.end},
-                    {"sign", u.sign},
-                    {"peak", u.peak},
-                    {"peak_s", u.peak_t},
-                    {"after_pulse", u.after_pulse}});
+    if (idle.size() < kMaxJsonPulses)
+      idle.push_back({{"start_s", u.start},
+                      {"end_s", u.end},
+                      {"sign", u.sign},
+                      {"peak", u.peak},
+                      {"peak_s", u.peak_t},
+                      {"after_pulse", u.after_pulse}});
   j["idle"] = std::move(idle);
 
   json frames = json::array();
@@ -422,9 +429,8 @@ std::string summary_text(const CheckResult& r, const std::string& source) {
 }
 
 Status write_pulses_csv(const CheckResult& r, const std::string& path) {
-  const std::string tmp = path + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "w");
-  if (!f) return Status::Error(path + ": error: cannot write the file");
+  StatusOr<OutputFile> f = OutputFile::open(path);
+  if (!f) return f.status();
   auto cell = [](double x, double scale = 1) {
     return std::isnan(x) ? std::string() : fmt::format("{:.9g}", x * scale);
   };
@@ -433,10 +439,11 @@ Status write_pulses_csv(const CheckResult& r, const std::string& path) {
     for (const std::string& i : items) s += (s.empty() ? "" : " | ") + i;
     return csv_field(s);
   };
-  std::fputs(
-      "index,sign,start_s,end_s,width_ns,class,edge_ns,vstart,vend,droop,frame,bit,fails,"
-      "warnings\n",
-      f);
+  if (Status s = f->write(
+          "index,sign,start_s,end_s,width_ns,class,edge_ns,vstart,vend,droop,frame,bit,fails,"
+          "warnings\n");
+      !s.ok())
+    return s;
   for (const PulseMetrics& p : r.pulses) {
     const std::string cls = p.truncated ? "" : (p.idle ? "idle" : std::to_string(p.k));
     const std::string line = fmt::format(
@@ -444,21 +451,9 @@ Status write_pulses_csv(const CheckResult& r, const std::string& path) {
         cell(p.width.value, 1e9), cls, cell(p.edge.value, 1e9), cell(p.vstart.value),
         cell(p.vend.value), cell(p.droop.value), p.frame >= 0 ? std::to_string(p.frame) : "",
         p.role, joined(p.fails), joined(p.warnings));
-    std::fputs(line.c_str(), f);
+    if (Status s = f->write(line); !s.ok()) return s;
   }
-  bool ok = std::fflush(f) == 0;
-  ok = std::fclose(f) == 0 && ok;
-  std::error_code ec;
-  if (!ok) {
-    std::filesystem::remove(tmp, ec);
-    return Status::Error(path + ": error: write failed");
-  }
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    return Status::Error(path + ": error: cannot rename the temp file: " + ec.message());
-  }
-  return Status::Ok();
+  return f->commit();
 }
 
 }  // namespace isolink::eye

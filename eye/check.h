@@ -84,6 +84,9 @@ StatusOr<CheckResult> check_waveform(const Waveform& w, const Rules& rules,
 
 // The JSON object, keys in a fixed order (verdict, reasons, rules, ..., summary, pulses, ringing,
 // idle, decoded).
+// Pulses (and ringing, idle undershoots) listed in detail are capped at kMaxJsonPulses each;
+// "pulses_omitted" counts the pulses left out (write_pulses_csv has every one).
+inline constexpr size_t kMaxJsonPulses = 10'000;
 nlohmann::ordered_json to_json(const CheckResult& r);
 // A few lines for people: verdict, worst margin per metric with place, counts, failures.
 std::string summary_text(const CheckResult& r, const std::string& source = "");

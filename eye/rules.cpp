@@ -7,11 +7,11 @@
 #include <charconv>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <map>
 #include <optional>
-#include <sstream>
+
+#include "base/file_io.h"
 
 namespace isolink::eye {
 namespace detail {
@@ -413,8 +413,7 @@ StatusOr<Rules> parse_rules(std::string_view yaml_text, const std::string& sourc
 StatusOr<Rules> load_rules(const std::string& name_or_path) {
   if (std::string_view text = builtin_rule_text(name_or_path); !text.empty())
     return parse_rules(text, "eye/rules/" + name_or_path + ".yaml");
-  std::ifstream in(name_or_path, std::ios::binary);
-  if (!in) {
+  if (!std::filesystem::exists(name_or_path)) {
     std::string names;
     for (const auto& n : builtin_rule_names()) names += (names.empty() ? "" : ", ") + n;
     return Status::Error(
@@ -422,9 +421,9 @@ StatusOr<Rules> load_rules(const std::string& name_or_path) {
                     "not a readable file",
                     name_or_path, names));
   }
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_rules(ss.str(), name_or_path);
+  StatusOr<std::string> text = read_input_file(name_or_path);  // size-limited; refuses folders
+  if (!text) return text.status();
+  return parse_rules(*text, name_or_path);
 }
 
 Status validate_rules(const Rules& r) {

@@ -188,6 +188,8 @@ std::optional<ScannedNumber> scan_number(std::string_view s) {
       }
       exponent += neg ? -e : e;
       i = j;
+    } else {
+      return std::nullopt;  // "1e", "1e+": an exponent with no digits is not a unit letter
     }
   }
   double scale = 1.0;

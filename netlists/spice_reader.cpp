@@ -1,16 +1,18 @@
 #include "netlists/spice_reader.h"
 
+#include <fmt/format.h>
+
 #include <cctype>
 #include <cmath>
 #include <deque>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <numbers>
 #include <sstream>
 #include <unordered_map>
 #include <unordered_set>
 
+#include "base/file_io.h"
 #include "netlists/expression.h"
 #include "netlists/lexer.h"
 #include "solver/elements/element.h"
@@ -30,6 +32,11 @@ std::string unflatten(const std::string& name) {
 }
 
 namespace fs = std::filesystem;
+
+// .include chains and subcircuit instances nest at most this deep (a 10,000-deep chain would
+// otherwise overflow the stack).
+constexpr size_t kMaxIncludeDepth = 64;
+constexpr size_t kMaxSubcktDepth = 64;
 using spice::LogicalLine;
 using spice::lower;
 using spice::Token;
@@ -108,14 +115,6 @@ struct Ctx {
   std::vector<const SubcktDef*> stack;
 };
 
-StatusOr<std::string> read_whole_file(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  if (!in) return Status::Error("cannot open");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 std::string canonical_key(const std::string& path) {
   std::error_code ec;
   fs::path c = fs::weakly_canonical(fs::path(path), ec);
@@ -127,6 +126,7 @@ class Reader {
   Status read(const std::shared_ptr<const SourceFile>& top) {
     if (!top->lines.empty()) out_.title = trim(top->lines[0]);
     if (top->path != "<string>") include_stack_.push_back(canonical_key(top->path));
+    for (const std::string& l : top->lines) total_bytes_ += l.size() + 1;
     if (Status s = collect(top, 2); !s.ok()) return s;
     if (!open_.empty())
       return error_at(open_.back()->card_loc,
@@ -143,6 +143,9 @@ class Reader {
     auto lines = spice::join_lines(file, first_line);
     if (!lines) return lines.status();
     for (LogicalLine& ll : *lines) {
+      // A NUL byte would end up inside a node or element name (a binary file, a bad editor).
+      if (const size_t nul = ll.text.find('\0'); nul != std::string::npos)
+        return error_at(ll.loc(nul), "a NUL byte in the netlist (is this a text file?)");
       std::size_t a = 0;
       while (a < ll.text.size() && is_blank(ll.text[a])) ++a;
       std::size_t b = a;
@@ -208,10 +211,27 @@ class Reader {
       if (include_stack_[k] != key) continue;
       return error_at(where, "recursive include of '" + p.string() + "'");
     }
-    auto text = read_whole_file(p);
-    if (!text)
+    if (include_stack_.size() >= kMaxIncludeDepth)
+      return error_at(
+          where, fmt::format("includes nest deeper than the limit of {} files", kMaxIncludeDepth));
+    if (fs::is_directory(p))
+      return error_at(where, "include file '" + name + "' is a folder ('" + p.string() + "')");
+    auto text = read_input_file(p.string());
+    if (!text) {
+      if (!fs::exists(p))
+        return error_at(
+            where, "cannot open include file '" + name + "' (looked for '" + p.string() + "')");
+      const std::string& m = text.status().message();  // "PATH: error: REASON"
+      const size_t at = m.find(": error: ");
+      return error_at(where, "include file '" + name +
+                                 "': " + (at == std::string::npos ? m : m.substr(at + 9)));
+    }
+    total_bytes_ += text->size();
+    if (total_bytes_ > kMaxInputFileBytes)
       return error_at(where,
-                      "cannot open include file '" + name + "' (looked for '" + p.string() + "')");
+                      fmt::format("include file '{}' takes the netlist and its includes past "
+                                  "the {} MiB limit",
+                                  name, kMaxInputFileBytes >> 20));
     auto file = SourceFile::FromText(p.string(), *text, std::make_shared<const SourceLoc>(where));
     include_stack_.push_back(key);
     Status s = collect(file, 1);
@@ -523,6 +543,10 @@ class Reader {
     if (it == subckts_.end())
       return error_at(line.at(name_tok), "unknown subcircuit '" + sub + "'");
     const SubcktDef* def = it->second.get();
+    if (ctx.stack.size() >= kMaxSubcktDepth)
+      return error_at(line.at(name_tok), fmt::format("subcircuits nest deeper than the limit of {} "
+                                                     "levels",
+                                                     kMaxSubcktDepth));
     for (const SubcktDef* d : ctx.stack) {
       if (d != def) continue;
       std::string chain;
@@ -598,6 +622,7 @@ class Reader {
     TranSpec spec;
     spec.loc = line.at(0);
     std::vector<double> v;
+    std::vector<std::size_t> at;  // the token of each value, for errors
     const std::size_t n = line.toks.size();
     for (std::size_t i = 1; i < n; ++i) {
       const Token& t = line.toks[i];
@@ -605,6 +630,7 @@ class Reader {
         spec.uic = true;
         continue;
       }
+      at.push_back(i);
       if (v.size() == 4)
         return error_at(line.at(i),
                         "too many values: expected .tran TSTEP TSTOP [TSTART [TMAX]] "
@@ -615,6 +641,16 @@ class Reader {
     }
     if (v.size() < 2)
       return error_at(line.end(), "expected .tran TSTEP TSTOP [TSTART [TMAX]] [UIC]");
+    // Checked here, where the card's position is known (the solver's checks have none).
+    const char* what[] = {"TSTEP", "TSTOP", "TSTART", "TMAX"};
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      const bool ok = k == 2 ? (v[k] >= 0 && v[k] < v[1]) : v[k] > 0;
+      if (!ok || !std::isfinite(v[k]))
+        return error_at(
+            line.at(at[k]),
+            fmt::format(".tran {} must be {}, got {:g}", what[k],
+                        k == 2 ? "zero or positive and below TSTOP" : "positive", v[k]));
+    }
     spec.tstep = v[0], spec.tstop = v[1];
     if (v.size() > 2) spec.tstart = v[2];
     if (v.size() > 3) spec.tmax = v[3];
@@ -668,6 +704,7 @@ class Reader {
   std::unordered_map<std::string, std::unique_ptr<SubcktDef>> subckts_;
   std::vector<SubcktDef*> open_;
   std::vector<std::string> include_stack_;
+  size_t total_bytes_ = 0;  // the netlist and its includes, against kMaxInputFileBytes
   bool in_control_ = false;
   std::unordered_set<std::string> warned_;
   std::unordered_map<std::string, SourceLoc> names_;
@@ -683,8 +720,8 @@ StatusOr<Netlist> read(const std::shared_ptr<const SourceFile>& file) {
 }  // namespace
 
 StatusOr<Netlist> read_spice_file(const std::string& path) {
-  auto text = read_whole_file(path);
-  if (!text) return Status::Error("cannot open netlist '" + path + "'");
+  auto text = read_input_file(path);
+  if (!text) return text.status();
   return read(SourceFile::FromText(path, *text));
 }
 

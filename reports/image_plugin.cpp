@@ -4,10 +4,14 @@
 #include "reports/image_plugin.h"
 
 #include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <cstring>
+#include <memory>
+#include <vector>
 #include <string>
 
 namespace {
@@ -31,11 +35,21 @@ int render_text(float* mask, int w, int h, int x, int y, const char* text, int s
              : 0;
 }
 
-int write_png(const char* path, int w, int h, const unsigned char* rgb, char* err, size_t errlen) {
-  OIIO::ImageBuf out(OIIO::ImageSpec(w, h, 3, OIIO::TypeDesc::UINT8));
-  out.set_pixels(OIIO::ROI(0, w, 0, h, 0, 1, 0, 3), OIIO::TypeDesc::UINT8, rgb);
-  if (out.write(path, OIIO::TypeDesc::UINT8, "png")) return 0;
-  std::string msg = out.geterror();
+int encode_png(int w, int h, const unsigned char* rgb,
+               void (*sink)(void* ctx, const unsigned char* data, size_t n), void* ctx, char* err,
+               size_t errlen) {
+  OIIO::ImageBuf img(OIIO::ImageSpec(w, h, 3, OIIO::TypeDesc::UINT8));
+  img.set_pixels(OIIO::ROI(0, w, 0, h, 0, 1, 0, 3), OIIO::TypeDesc::UINT8, rgb);
+  std::vector<unsigned char> bytes;
+  OIIO::Filesystem::IOVecOutput proxy(bytes);
+  std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create("image.png", &proxy);
+  if (out && out->open("image.png", img.spec()) && img.write(out.get()) && out->close()) {
+    out.reset();
+    sink(ctx, bytes.data(), bytes.size());
+    return 0;
+  }
+  std::string msg = out ? out->geterror() : std::string();
+  if (msg.empty()) msg = img.geterror();
   if (msg.empty()) msg = OIIO::geterror();
   if (errlen > 0) {
     const size_t n = std::min(msg.size(), errlen - 1);
@@ -45,7 +59,7 @@ int write_png(const char* path, int w, int h, const unsigned char* rgb, char* er
   return 1;
 }
 
-const IsolinkImageApi kApi{kImagePluginVersion, &text_size, &render_text, &write_png};
+const IsolinkImageApi kApi{kImagePluginVersion, &text_size, &render_text, &encode_png};
 
 }  // namespace
 

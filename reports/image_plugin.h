@@ -10,7 +10,7 @@
 
 extern "C" {
 
-inline constexpr int kImagePluginVersion = 1;
+inline constexpr int kImagePluginVersion = 2;
 
 struct IsolinkImageApi {
   int version;  // kImagePluginVersion
@@ -21,10 +21,13 @@ struct IsolinkImageApi {
   // single-channel float mask, row-major. Returns 0 on failure.
   int (*render_text)(float* mask, int w, int h, int x, int y, const char* text, int size,
                      const char* font);
-  // Writes w x h 8-bit RGB pixels (row-major, 3 bytes per pixel) as a PNG to path. Returns 0 on
-  // success, else copies OIIO's message (NUL-terminated, truncated to errlen) to err.
-  int (*write_png)(const char* path, int w, int h, const unsigned char* rgb, char* err,
-                   size_t errlen);
+  // Encodes w x h 8-bit RGB pixels (row-major, 3 bytes per pixel) as a PNG in memory and hands
+  // the bytes to sink(ctx, data, n) (OpenImageIO reports success when a disk fills up under it,
+  // so the caller does the checked file write). Returns 0 on success, else copies OIIO's message
+  // (NUL-terminated, truncated to errlen) to err.
+  int (*encode_png)(int w, int h, const unsigned char* rgb,
+                    void (*sink)(void* ctx, const unsigned char* data, size_t n), void* ctx,
+                    char* err, size_t errlen);
 };
 
 // The plug-in's one exported symbol.

@@ -7,7 +7,7 @@
 #include <filesystem>
 
 #include "analysis/sweep_run.h"
-#include "base/atomic_file.h"
+#include "base/file_io.h"
 #include "reports/pack_png.h"
 #include "reports/run_images.h"
 #include "reports/run_report.h"

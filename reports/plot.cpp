@@ -9,6 +9,9 @@
 #include <filesystem>
 #include <mutex>
 #include <system_error>
+#include <vector>
+
+#include "base/file_io.h"
 
 #include "reports/image_plugin.h"
 
@@ -485,22 +488,18 @@ Rect Canvas::text(double x, double y, std::string_view s, int size, Color c, Fon
 }
 
 Status Canvas::write_png(const std::string& path) const {
-  const std::string tmp = path + ".tmp.png";
+  // OpenImageIO reports success when the disk fills up under it, so the plug-in encodes the PNG
+  // into memory and base/file_io.h does the checked, atomic write.
+  std::vector<unsigned char> bytes;
   char err[512] = "";
-  if (image_plugin().api->write_png(tmp.c_str(), w_, h_, px_.data(), err, sizeof err) != 0) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    return Status::Error(fmt::format("cannot write {}: {}", path, err));
+  auto sink = [](void* ctx, const unsigned char* data, size_t n) {
+    static_cast<std::vector<unsigned char>*>(ctx)->assign(data, data + n);
+  };
+  if (image_plugin().api->encode_png(w_, h_, px_.data(), sink, &bytes, err, sizeof err) != 0) {
+    return Status::Error(fmt::format("{}: error: cannot encode the PNG: {}", path, err));
   }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    std::error_code ec2;
-    fs::remove(tmp, ec2);
-    return Status::Error(
-        fmt::format("cannot write {}: rename from {}: {}", path, tmp, ec.message()));
-  }
-  return Status::Ok();
+  return write_file_atomic(
+      path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
 Rect draw_runs(Canvas& c, double x, double y, const std::vector<TextRun>& runs, int size,

@@ -172,7 +172,7 @@ class Canvas {
   };
   TextExtent measure(std::string_view s, int size, FontFace face = FontFace::kSans) const;
 
-  // Writes a PNG to path + ".tmp.png" and renames it to path; errors name the path.
+  // Encodes the PNG in memory, then write_file_atomic (base/file_io.h); errors name the path.
   Status write_png(const std::string& path) const;
 
  private:

@@ -38,6 +38,11 @@ Status TransientOptions::set_option(const std::string& key, const CardArg& value
   auto number = [&](double* field) -> Status {
     if (value.kind != CardArg::Kind::Number)
       return error_at(value.loc, "option " + key + " expects a number");
+    // Checked here, where the .options card's position is known (validate() has none).
+    const bool ok = key == "reltol" ? value.number > 0 && value.number < 1 : value.number > 0;
+    if (!ok || !std::isfinite(value.number))
+      return error_at(value.loc, fmt::format("option {} = {:g}: must be {}", key, value.number,
+                                             key == "reltol" ? "in (0, 1)" : "positive"));
     *field = value.number;
     return Status::Ok();
   };
@@ -168,8 +173,10 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
 
   auto ladder = [&](double h) {  // largest hmax / 2^k not above h (up to rounding)
     if (h >= hmax) return hmax;
-    const int k = static_cast<int>(std::ceil(std::log2(hmax / h) - 1e-9));
-    return std::ldexp(hmax, -k);
+    // h of 0 (or below hmax * 2^-1074) makes log2 infinite; converting that to int was UB
+    // (UBSan: negation of INT_MIN). Clamp to the double range: the step-size floor then reports.
+    const double k = std::ceil(std::log2(hmax / h) - 1e-9);
+    return std::ldexp(hmax, k < 1100 ? -static_cast<int>(k) : -1100);
   };
 
   double t = 0.0;

@@ -68,6 +68,10 @@ Status read_isolation(const YamlDoc& doc, const YAML::Node& node, const std::str
           {"esd", read_quantity(doc, Unit::kFarad, Rule::kNonNegative, &iso->esd)},
       });
   if (!s.ok()) return s;
+  if (node.IsMap() && node["chokes"] && iso->chokes.empty())
+    return doc.error(node["chokes"], fmt::format("key '{}.chokes': one or two chokes, found none "
+                                                 "(leave the key out for the default choke)",
+                                                 path));
   if (iso->chokes.size() > 2 && node["chokes"])
     return doc.error(node["chokes"], fmt::format("key '{}.chokes': one or two chokes, found {}",
                                                  path, iso->chokes.size()));
@@ -76,6 +80,13 @@ Status read_isolation(const YamlDoc& doc, const YAML::Node& node, const std::str
     return doc.error(node["chokes"],
                      fmt::format("key '{}.chokes': type {} has no chokes (use capchoke or "
                                  "transformer_choke)",
+                                 path, iso->type));
+  // Every key that has no effect is an error: the isolation cap exists only in cap and capchoke.
+  const bool has_cap = iso->type == "cap" || iso->type == "capchoke";
+  if (!has_cap && node.IsMap() && node["cap"])
+    return doc.error(node["cap"],
+                     fmt::format("key '{}.cap': only for type cap or capchoke (type is "
+                                 "{})",
                                  path, iso->type));
   const bool has_xfmr = iso->type == "transformer" || iso->type == "transformer_choke";
   if (!has_xfmr && node.IsMap())
@@ -194,7 +205,7 @@ StatusOr<LinkSpec> read_link_spec(const YamlDoc& doc) {
            }},
           {"sim",
            [&](const YAML::Node& n, const std::string& p) {
-             return read_map(
+             Status st = read_map(
                  doc, n, p,
                  {
                      {"tstep", read_quantity(doc, Unit::kSecond, Rule::kPositive, &spec.sim.tstep)},
@@ -202,6 +213,14 @@ StatusOr<LinkSpec> read_link_spec(const YamlDoc& doc) {
                      {"method", read_choice(doc, {"trap", "gear"}, &spec.sim.method)},
                      {"reltol", read_quantity(doc, Unit::kNone, Rule::kPositive, &spec.sim.reltol)},
                  });
+             if (!st.ok()) return st;
+             // The solver's own checks come too late to point at the file: check here.
+             if (const std::optional<double> rt = spec.sim.reltol;
+                 rt && !(*rt >= 1e-9 && *rt <= 0.1))
+               return doc.error(n["reltol"], fmt::format("key 'sim.reltol' = {:g}: must be from "
+                                                         "1e-9 to 0.1",
+                                                         *rt));
+             return Status::Ok();
            }},
       });
   if (!s.ok()) return s;

@@ -210,7 +210,14 @@ StatusOr<Drive> build_drive(std::string_view script, const StimulusOptions& opt)
     pos = next + 1;
   }
   if (index == 0) return Status::Error("stimulus is empty: no command, tone or pattern given");
-  return b.finish();
+  Drive d = b.finish();
+  // Bounded before anything is simulated ('idle 1e30' asked the solver for 1e30 s of steps).
+  if (!(d.duration() <= kMaxDriveSeconds))
+    return Status::Error(
+        fmt::format("stimulus: the traffic lasts {:g} s; the limit is {:g} s "
+                    "(about 12,000 stack writes)",
+                    d.duration(), kMaxDriveSeconds));
+  return d;
 }
 
 }  // namespace isolink::traffic

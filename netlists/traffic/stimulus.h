@@ -26,6 +26,9 @@
 
 namespace isolink::traffic {
 
+// The longest traffic build_drive accepts, in seconds of simulated time.
+inline constexpr double kMaxDriveSeconds = 1.0;
+
 struct StimulusOptions {
   EncodingOptions encoding;  // byte frame format
   Timing timing;             // lead, gaps, tail

@@ -1,5 +1,6 @@
 // `isolink sim` end to end: the CSV contract, exit codes, and nothing written on bad input.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -19,8 +20,18 @@ struct Result {
   std::string err;
 };
 
+// This test's own folder: ctest -j2 runs the tests of this file as separate processes at once,
+// so nothing may be shared between them (one fixed file made the suite nondeterministic).
+std::string test_dir() {
+  const ::testing::TestInfo* t = ::testing::UnitTest::GetInstance()->current_test_info();
+  const std::string dir = ::testing::TempDir() + "/sim_command_" + t->test_suite_name() + "_" +
+                          t->name() + "_" + std::to_string(::getpid());
+  fs::create_directories(dir);
+  return dir;
+}
+
 Result run(const std::string& args) {
-  const std::string err_file = ::testing::TempDir() + "/sim_stderr.txt";
+  const std::string err_file = test_dir() + "/stderr.txt";
   const std::string cmd = kBinary + " " + args + " >/dev/null 2>" + err_file;
   int status = std::system(cmd.c_str());
   std::ifstream in(err_file);
@@ -30,13 +41,13 @@ Result run(const std::string& args) {
 }
 
 std::string write_temp(const std::string& name, const std::string& text) {
-  const std::string path = ::testing::TempDir() + "/" + name;
+  const std::string path = test_dir() + "/" + name;
   std::ofstream(path) << text;
   return path;
 }
 
 TEST(SimCommand, WritesHeaderAndStrictlyIncreasingTimes) {
-  const std::string out = ::testing::TempDir() + "/wave.csv";
+  const std::string out = test_dir() + "/wave.csv";
   fs::remove(out);
   Result r =
       run("sim " + kData + "/floating_cable.cir --probe 'v(rxp,rxn)' --probe 'v(txp)' -o " + out);
@@ -59,7 +70,7 @@ TEST(SimCommand, WritesHeaderAndStrictlyIncreasingTimes) {
 }
 
 TEST(SimCommand, StepResamplesOnAUniformGrid) {
-  const std::string out = ::testing::TempDir() + "/wave_step.csv";
+  const std::string out = test_dir() + "/wave_step.csv";
   Result r = run("sim " + kExamples + "/cap_link_2m.cir -p 'v(rxp,rxn)' --step 10n -q -o " + out);
   ASSERT_EQ(r.code, 0) << r.err;
   std::ifstream in(out);
@@ -76,7 +87,7 @@ TEST(SimCommand, StepResamplesOnAUniformGrid) {
 }
 
 TEST(SimCommand, BadNetlistExitsTwoAndWritesNothing) {
-  const std::string out = ::testing::TempDir() + "/never.csv";
+  const std::string out = test_dir() + "/never.csv";
   fs::remove(out);
   std::string path =
       write_temp("bad_r.cir", "bad value\nV1 a 0 1\nR1 a 0 -5\n.tran 1n 10n\n.end\n");
@@ -109,15 +120,14 @@ TEST(SimCommand, UnknownProbeAndMissingTranAreErrors) {
   r = run("sim " + path + " -p 'v(b)'");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("no .tran card"), std::string::npos) << r.err;
-  EXPECT_EQ(
-      run("sim " + path + " -p 'v(b)' --tstop 1u -o " + ::testing::TempDir() + "/rc.csv").code, 0);
+  EXPECT_EQ(run("sim " + path + " -p 'v(b)' --tstop 1u -o " + test_dir() + "/rc.csv").code, 0);
 }
 
 TEST(SimCommand, UnknownOptionIsWarnedAndIgnored) {
   std::string path = write_temp("opt.cir",
                                 "opt\nV1 a 0 1\nR1 a 0 1k\n.options foo=3 reltol=1e-4\n"
                                 ".tran 1n 10n\n.end\n");
-  Result r = run("sim " + path + " -p 'v(a)' -o " + ::testing::TempDir() + "/opt.csv");
+  Result r = run("sim " + path + " -p 'v(a)' -o " + test_dir() + "/opt.csv");
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("opt.cir:4:10: warning: option 'foo' is not used by isolink; ignored"),
             std::string::npos)

@@ -222,5 +222,18 @@ TEST(Check, SummaryTextAndPulsesCsv) {
   std::filesystem::remove_all(dir);
 }
 
+// check --json on a capture with millions of pulses used 3.6 GB (issue 15): the JSON lists at
+// most kMaxJsonPulses of them and counts the rest.
+TEST(CheckJson, PulseDetailsAreCapped) {
+  CheckResult r;
+  r.pulses.resize(kMaxJsonPulses + 5);
+  for (size_t i = 0; i < r.pulses.size(); ++i) r.pulses[i].index = i;
+  const nlohmann::ordered_json j = to_json(r);
+  ASSERT_EQ(j["pulses"].size(), kMaxJsonPulses);
+  EXPECT_EQ(j["pulses"].back()["index"], kMaxJsonPulses - 1);
+  EXPECT_EQ(j["pulses_omitted"], 5);
+  EXPECT_EQ(j["summary"]["pulses"], kMaxJsonPulses + 5);  // the summary still counts them all
+}
+
 }  // namespace
 }  // namespace isolink::eye

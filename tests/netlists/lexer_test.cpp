@@ -54,6 +54,12 @@ TEST(SpiceNumber, Malformed) {
   EXPECT_FALSE(parse_number(".", v));
   EXPECT_FALSE(parse_number("1k5", v));
   EXPECT_FALSE(parse_number("1_0", v));
+  // An 'e' with no exponent digits was read as 1 with a unit letter (issue 15).
+  EXPECT_FALSE(parse_number("1e", v));
+  EXPECT_FALSE(parse_number("1e+", v));
+  EXPECT_FALSE(parse_number("2.2E-", v));
+  EXPECT_TRUE(parse_number("1e3", v));
+  EXPECT_EQ(v, 1000.0);
 }
 
 TEST(SpiceNumber, ScanStopsAfterUnit) {
