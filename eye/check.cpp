@@ -464,7 +464,10 @@ std::string summary_text(const CheckResult& r, const std::string& source) {
       r.pulses.size(), nf, r.ringing.size(), r.idle.size(), r.frames.size(),
       r.tone ? "runs" : "frames", frames_failing);
   if (!r.tone) {
-    out += "decoded: " + (r.bytes.empty() ? std::string("(none)") : to_hex(r.bytes));
+    constexpr size_t kShown = 64;  // a long record decodes thousands: the JSON has them all
+    const std::span<const uint8_t> shown(r.bytes.data(), std::min(r.bytes.size(), kShown));
+    out += "decoded: " + (r.bytes.empty() ? std::string("(none)") : to_hex(shown));
+    if (r.bytes.size() > kShown) out += fmt::format(" ... ({} bytes in all)", r.bytes.size());
     if (r.expect)
       out += r.expect_match ? "  (as expected)"
                             : "  (expected " + to_hex(*r.expect) + ": " + r.expect_detail + ")";

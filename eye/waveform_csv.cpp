@@ -539,7 +539,7 @@ std::string capture_text(const CaptureInfo& info) {
   out += "\n";
   for (const CaptureColumn& c : info.columns) {
     std::string scale;
-    if (c.role == "time" && !c.unit.empty() && c.unit != "s")
+    if (c.role == "time" && c.scale != 1)
       scale = fmt::format(", x{:g} to s", c.scale);
     else if (c.role != "time" && c.scale != 1)
       scale = fmt::format(", x{:g} to V", c.scale);
