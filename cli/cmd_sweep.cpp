@@ -1,6 +1,6 @@
 // isolink sweep: a link spec over a grid of key values and / or Monte Carlo tolerances, every point
-// simulated and checked, into results.csv, summary.json and plots (cli/sweep_spec.h,
-// cli/sweep_run.h; across machines with mpirun: cli/sweep_mpi.h).
+// simulated and checked, into results.csv, summary.json and plots (analysis/sweep_spec.h,
+// analysis/sweep_run.h; across machines with mpirun: analysis/sweep_mpi.h).
 // Exit status: 0 every point passes, 1 some point fails or could not be simulated, 2 bad input.
 #include <fmt/format.h>
 
@@ -10,15 +10,18 @@
 #include <string>
 #include <vector>
 
+#include "base/csv.h"
 #include "cli/commands.h"
-#include "cli/sweep_run.h"
-#include "cli/sweep_spec.h"
+#include "reports/sweep_report.h"
+#include "analysis/sweep_run.h"
+#include "analysis/sweep_spec.h"
 #include "netlists/link/parts.h"
 #ifdef ISOLINK_HAVE_MPI
-#include "cli/sweep_mpi.h"
+#include "analysis/sweep_mpi.h"
 #endif
 
 namespace isolink::cli {
+using namespace isolink::analysis;  // sweep::
 namespace {
 
 struct SweepArgs {
@@ -39,16 +42,17 @@ int fail(const Status& s) {
 }
 
 int list_points(const sweep::SweepSpec& s) {
-  std::string header = "point";
-  for (const std::string& c : s.point_columns()) header += "," + c;
-  std::printf("%s,spec\n", header.c_str());
+  std::vector<std::string> header{"point"};
+  for (const std::string& c : s.point_columns()) header.push_back(c);
+  header.push_back("spec");
+  std::fputs(csv_row(header).c_str(), stdout);
   for (size_t i = 0; i < s.size(); ++i) {
     const sweep::PointOutcome p = sweep::make_point(s, i);
-    std::string line = fmt::format("{}", i);
-    for (const std::string& c : p.point.cells) line += "," + c;
-    std::string st = p.status.ok() ? "ok" : p.status.message();
-    st = st.substr(0, st.find('\n'));
-    std::printf("%s,%s\n", line.c_str(), st.c_str());
+    std::vector<std::string> row{fmt::format("{}", i)};
+    for (const std::string& c : p.point.cells) row.push_back(c);
+    const std::string st = p.status.ok() ? "ok" : p.status.message();
+    row.push_back(st.substr(0, st.find('\n')));
+    std::fputs(csv_row(row).c_str(), stdout);
   }
   return 0;
 }
@@ -95,6 +99,7 @@ int run_sweep_command(const SweepArgs& a) {
   opt.resume = a.resume;
   opt.keep_waves = a.keep_waves;
   opt.plots = !a.no_plots;
+  opt.render_plots = reports::render_sweep_plots;
   opt.quiet = a.quiet;
   if (!a.quiet && rank == 0) {
     std::fprintf(stderr, "sweep: %s: %zu points (%zu grid point%s%s)%s -> %s\n", spec->path.c_str(),

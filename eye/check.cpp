@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "base/csv.h"
+
 namespace isolink::eye {
 namespace {
 
@@ -510,12 +512,10 @@ Status write_pulses_csv(const CheckResult& r, const std::string& path) {
   auto cell = [](double x, double scale = 1) {
     return std::isnan(x) ? std::string() : fmt::format("{:.9g}", x * scale);
   };
-  auto quoted = [](const std::vector<std::string>& items) {
+  auto joined = [](const std::vector<std::string>& items) {
     std::string s;
     for (const std::string& i : items) s += (s.empty() ? "" : " | ") + i;
-    std::string q = "\"";
-    for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-    return q + "\"";
+    return csv_field(s);
   };
   std::fputs(
       "index,sign,start_s,end_s,width_ns,class,edge_ns,vstart,vend,droop,frame,bit,fails,"
@@ -527,7 +527,7 @@ Status write_pulses_csv(const CheckResult& r, const std::string& path) {
         "{},{},{:.12g},{:.12g},{},{},{},{},{},{},{},{},{},{}\n", p.index, p.sign, p.a, p.b,
         cell(p.width.value, 1e9), cls, cell(p.edge.value, 1e9), cell(p.vstart.value),
         cell(p.vend.value), cell(p.droop.value), p.frame >= 0 ? std::to_string(p.frame) : "",
-        p.role, quoted(p.fails), quoted(p.warnings));
+        p.role, joined(p.fails), joined(p.warnings));
     std::fputs(line.c_str(), f);
   }
   bool ok = std::fflush(f) == 0;

@@ -19,8 +19,8 @@
 #include <string_view>
 #include <vector>
 
-#include "solver/status.h"
-#include "solver/waveform.h"
+#include "base/status.h"
+#include "base/waveform.h"
 
 namespace isolink::eye {
 

@@ -22,8 +22,8 @@
 #include <string>
 #include <string_view>
 
-#include "solver/source_loc.h"
-#include "solver/status.h"
+#include "base/source_loc.h"
+#include "base/status.h"
 
 namespace isolink::spice {
 

@@ -1,9 +1,10 @@
-// A small drawing layer over OpenImageIO for report images: an RGB canvas, plot areas with
+// A small drawing layer for report images: an RGB canvas, plot areas with
 // data -> pixel axis mappings, nice ticks with SI units, grid, lines (solid / dashed,
 // anti-aliased), min/max column envelopes for long series, translucent rectangles, text (DejaVu via
-// OIIO's render_text, horizontal or vertical), legends, colour maps (viridis, inferno) with a log
-// scale and colour bars. eye_png and wave_png are built from it; a line chart, heatmap with contour
-// or histogram needs only these pieces.
+// OIIO's render_text, in the plug-in image_plugin.h loads on the first Canvas::create, horizontal
+// or vertical), legends, colour maps (viridis, inferno) with a log scale and colour bars. eye_png
+// and wave_png are built from it; a line chart, heatmap with contour or histogram needs only these
+// pieces.
 //
 // Usage:
 //   StatusOr<Canvas> c = Canvas::create(1920, 1080);            // white, fonts found or an error
@@ -21,8 +22,6 @@
 // spellings, since OIIO 2.4's renderer garbles non-ASCII characters.
 #pragma once
 
-#include <OpenImageIO/imagebuf.h>
-
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -33,7 +32,7 @@
 #include <string_view>
 #include <vector>
 
-#include "solver/status.h"
+#include "base/status.h"
 
 namespace isolink::reports {
 
@@ -137,8 +136,8 @@ class Canvas {
   int height() const { return h_; }
   Rect bounds() const { return {0, 0, w_, h_}; }
   const Fonts& fonts() const { return fonts_; }
-  OIIO::ImageBuf image() const;     // a copy as an 8-bit RGB ImageBuf
-  Color pixel(int x, int y) const;  // opaque colour at (x, y)
+  const std::vector<uint8_t>& rgb() const { return px_; }  // 8-bit RGB, row-major
+  Color pixel(int x, int y) const;                         // opaque colour at (x, y)
 
   // "Over" compositing of c (its alpha times coverage) at one pixel; ignored outside.
   void blend(int x, int y, Color c, float coverage = 1.0f);

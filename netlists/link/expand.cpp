@@ -136,6 +136,13 @@ StatusOr<std::pair<std::string, std::string>> add_end(std::vector<Card>& cards, 
     cards.push_back(make_card('c', "c" + side + "esdp", {ep, "0"}, {number_arg(iso.esd)}));
     cards.push_back(make_card('c', "c" + side + "esdn", {en, "0"}, {number_arg(iso.esd)}));
   }
+  if (type != "none") {
+    // Behind the isolation the cable has no DC path of its own: give each line the leakage a real
+    // board has there (kCableBleed, see expand.h), so the DC point is defined by the circuit and
+    // not by the solver's tie for floating nodes, and the solver's warning stays for mistakes.
+    cards.push_back(make_card('r', "r" + side + "bleedp", {p, "0"}, {number_arg(kCableBleed)}));
+    cards.push_back(make_card('r', "r" + side + "bleedn", {n, "0"}, {number_arg(kCableBleed)}));
+  }
   return std::pair{p, n};
 }
 

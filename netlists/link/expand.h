@@ -3,11 +3,12 @@
 //
 //   StatusOr<PartLibrary> parts = PartLibrary::load({});
 //   StatusOr<ExpandedLink> down = expand_link(spec, *parts, Direction::kDown);
-//   // down->netlist: simulate (cli/simulate.h) or write_spice() it (export-spice)
+//   // down->netlist: simulate (analysis/simulate.h) or write_spice() it (export-spice)
 //   // probe v(rxp,rxn): the receiver's pins; v(txp,txn): the transmitter's.
 // Topology, from the transmitting device to the receiving one (netlists/link/README.md):
 //   TX driver -> txp/txn -> board (series R, bypass C, termination) -> tx_lp/tx_ln
 //   -> isolation (cap | cap + chokes | transformer | transformer + chokes) -> tx_cp/tx_cn
+//      (+ kCableBleed to ground per line)
 //   -> cable -> rx_cp/rx_cn -> isolation -> rx_lp/rx_ln -> board -> rxp/rxn -> RX load.
 // Node names follow the role in this direction: txp/txn always drive, rxp/rxn always receive.
 #pragma once
@@ -25,22 +26,31 @@
 
 namespace isolink::link {
 
+// Bleed resistance (ohm) from each cable line to ground at every end with isolation (cards
+// r<end>bleedp / r<end>bleedn, at the connector nodes <end>_..p / <end>_..n). The isolation caps or
+// transformer leave the cable, and the parts on its side, with no DC path; on a board the
+// isolation barrier's insulation resistance and the cable-side ESD / TVS parts' leakage (tens of
+// nA at a few volts) set its DC level. 10 Mohm per line is that order; with both ends, 5 Mohm per
+// line against the two 2.2 nF isolation caps gives a time constant of 22 ms, over 100 times the
+// longest frame train, so no edge or level the receiver sees moves (tests/link/dc_path_test.cpp).
+inline constexpr double kCableBleed = 10e6;
+
 struct ExpandOptions {
-  TxDriverModel driver;                 // the transmitting pins
-  RxLoadModel load;                     // the receiving pins
-  traffic::StimulusOptions stimulus;    // encoding and timing of the traffic
+  TxDriverModel driver;               // the transmitting pins
+  RxLoadModel load;                   // the receiving pins
+  traffic::StimulusOptions stimulus;  // encoding and timing of the traffic
 };
 
 struct ExpandedLink {
   Direction direction = Direction::kDown;
-  std::string transmitter, receiver;    // device names
-  std::string rules;                    // rule set the receiver is scored with
-  std::string description;              // "down: bq79600 -> bq7961x"
-  Netlist netlist;                      // cards, .tran, options
-  traffic::Drive drive;                 // what the transmitter sends
-  std::vector<uint8_t> expected;        // data bytes sent, in order
-  int cable_segments = 0;               // sections the cable was split into
-  std::string tx_bom, rx_bom;           // each spec end's parts as built, in words
+  std::string transmitter, receiver;  // device names
+  std::string rules;                  // rule set the receiver is scored with
+  std::string description;            // "down: bq79600 -> bq7961x"
+  Netlist netlist;                    // cards, .tran, options
+  traffic::Drive drive;               // what the transmitter sends
+  std::vector<uint8_t> expected;      // data bytes sent, in order
+  int cable_segments = 0;             // sections the cable was split into
+  std::string tx_bom, rx_bom;         // each spec end's parts as built, in words
 };
 
 StatusOr<ExpandedLink> expand_link(const LinkSpec& spec, const PartLibrary& parts, Direction d,

@@ -1,11 +1,11 @@
 // `isolink sim` end to end: the CSV contract, exit codes, and nothing written on bad input.
+#include <gtest/gtest.h>
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
-
-#include <gtest/gtest.h>
 
 namespace {
 
@@ -38,12 +38,13 @@ std::string write_temp(const std::string& name, const std::string& text) {
 TEST(SimCommand, WritesHeaderAndStrictlyIncreasingTimes) {
   const std::string out = ::testing::TempDir() + "/wave.csv";
   fs::remove(out);
-  Result r = run("sim " + kData + "/floating_cable.cir --probe 'v(rxp,rxn)' --probe 'v(txp)' -o " + out);
+  Result r =
+      run("sim " + kData + "/floating_cable.cir --probe 'v(rxp,rxn)' --probe 'v(txp)' -o " + out);
   ASSERT_EQ(r.code, 0) << r.err;
   std::ifstream in(out);
   std::string line;
   std::getline(in, line);
-  EXPECT_EQ(line, "time,v(rxp,rxn),v(txp)");
+  EXPECT_EQ(line, "time,\"v(rxp,rxn)\",v(txp)");  // RFC 4180: the comma is quoted
   double prev = -1;
   int rows = 0;
   while (std::getline(in, line)) {
@@ -77,7 +78,8 @@ TEST(SimCommand, StepResamplesOnAUniformGrid) {
 TEST(SimCommand, BadNetlistExitsTwoAndWritesNothing) {
   const std::string out = ::testing::TempDir() + "/never.csv";
   fs::remove(out);
-  std::string path = write_temp("bad_r.cir", "bad value\nV1 a 0 1\nR1 a 0 -5\n.tran 1n 10n\n.end\n");
+  std::string path =
+      write_temp("bad_r.cir", "bad value\nV1 a 0 1\nR1 a 0 -5\n.tran 1n 10n\n.end\n");
   Result r = run("sim " + path + " -p 'v(a)' -o " + out);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("bad_r.cir:3:8: error: resistance of r1 must be positive, got -5"),
@@ -99,19 +101,22 @@ TEST(SimCommand, SingularCircuitNamesTheNodes) {
 }
 
 TEST(SimCommand, UnknownProbeAndMissingTranAreErrors) {
-  std::string path = write_temp("rc.cir", "rc\nV1 a 0 PULSE(0 1 0 1n)\nR1 a b 1k\nC1 b 0 1n\n.end\n");
+  std::string path =
+      write_temp("rc.cir", "rc\nV1 a 0 PULSE(0 1 0 1n)\nR1 a b 1k\nC1 b 0 1n\n.end\n");
   Result r = run("sim " + path + " -p 'v(zz)' --tstop 1u");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("no node named 'zz'"), std::string::npos) << r.err;
   r = run("sim " + path + " -p 'v(b)'");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("no .tran card"), std::string::npos) << r.err;
-  EXPECT_EQ(run("sim " + path + " -p 'v(b)' --tstop 1u -o " + ::testing::TempDir() + "/rc.csv").code, 0);
+  EXPECT_EQ(
+      run("sim " + path + " -p 'v(b)' --tstop 1u -o " + ::testing::TempDir() + "/rc.csv").code, 0);
 }
 
 TEST(SimCommand, UnknownOptionIsWarnedAndIgnored) {
-  std::string path = write_temp("opt.cir", "opt\nV1 a 0 1\nR1 a 0 1k\n.options foo=3 reltol=1e-4\n"
-                                           ".tran 1n 10n\n.end\n");
+  std::string path = write_temp("opt.cir",
+                                "opt\nV1 a 0 1\nR1 a 0 1k\n.options foo=3 reltol=1e-4\n"
+                                ".tran 1n 10n\n.end\n");
   Result r = run("sim " + path + " -p 'v(a)' -o " + ::testing::TempDir() + "/opt.csv");
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("opt.cir:4:10: warning: option 'foo' is not used by isolink; ignored"),

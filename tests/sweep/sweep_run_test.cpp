@@ -2,7 +2,7 @@
 // columns of results.csv, verdicts equal to `isolink run` on the same spec, a point that cannot
 // run, --resume, Monte Carlo, and the MPI run with 2 ranks against the threaded one. Every test
 // here simulates: the names carry "Sim" (ctest label sweep-sim).
-#include "cli/sweep_run.h"
+#include "analysis/sweep_run.h"
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-namespace isolink::cli::sweep {
+namespace isolink::analysis::sweep {
 namespace {
 
 namespace fs = std::filesystem;
@@ -192,7 +192,8 @@ TEST(SweepSim, ResumeSkipsThePointsAlreadyDone) {
   // --keep-waves: the point that ran has its waveforms.
   EXPECT_FALSE(fs::exists(dir + "/out/waves/point_00000.csv"));
   ASSERT_TRUE(fs::exists(dir + "/out/waves/point_00001.csv"));
-  EXPECT_EQ(slurp(dir + "/out/waves/point_00001.csv").substr(0, 24), "time,down v(rxp,rxn),dow");
+  EXPECT_EQ(slurp(dir + "/out/waves/point_00001.csv").substr(0, 26),
+            "time,\"down v(rxp,rxn)\",dow");
 }
 
 TEST(SweepSim, MonteCarloWritesTheHistogramAndYield) {
@@ -255,4 +256,4 @@ TEST(SweepSim, MpiTwoRanksGiveTheThreadedResults) {
 }
 
 }  // namespace
-}  // namespace isolink::cli::sweep
+}  // namespace isolink::analysis::sweep

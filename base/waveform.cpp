@@ -1,8 +1,10 @@
-#include "solver/waveform.h"
+#include "base/waveform.h"
 
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+
+#include "base/csv.h"
 
 namespace isolink {
 
@@ -58,12 +60,9 @@ Status write_waveform_csv(const Waveform& w, const std::string& path) {
   const std::string tmp = path + ".tmp";
   std::FILE* f = std::fopen(tmp.c_str(), "w");
   if (!f) return Status::Error("cannot write '" + path + "'");
-  std::fputs("time", f);
-  for (const auto& n : w.names) {
-    std::fputc(',', f);
-    std::fputs(n.c_str(), f);
-  }
-  std::fputc('\n', f);
+  std::vector<std::string> header{"time"};
+  header.insert(header.end(), w.names.begin(), w.names.end());
+  std::fputs(csv_row(header).c_str(), f);
   for (size_t i = 0; i < w.time.size(); ++i) {
     std::fprintf(f, "%.12g", w.time[i]);
     for (const auto& c : w.columns) std::fprintf(f, ",%.9g", c[i]);

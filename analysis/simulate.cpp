@@ -1,10 +1,10 @@
-#include "cli/simulate.h"
+#include "analysis/simulate.h"
 
 #include <chrono>
 
 #include "solver/circuit.h"
 
-namespace isolink::cli {
+namespace isolink::analysis {
 
 StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const SimulationRequest& req) {
   SimulationResult result;
@@ -60,4 +60,4 @@ StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const Simula
   return result;
 }
 
-}  // namespace isolink::cli
+}  // namespace isolink::analysis

@@ -1,4 +1,4 @@
-#include "cli/sweep_run.h"
+#include "analysis/sweep_run.h"
 
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
@@ -16,10 +16,10 @@
 #include <map>
 #include <sstream>
 
-#include "cli/run_report.h"
-#include "reports/sweep_plots.h"
+#include "base/atomic_file.h"
+#include "base/csv.h"
 
-namespace isolink::cli::sweep {
+namespace isolink::analysis::sweep {
 
 namespace {
 
@@ -37,14 +37,12 @@ double now_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"') out += '"';
-    out += (c == '\n' || c == '\r') ? ' ' : c;
-  }
-  return out + "\"";
+// One line per CSV record (results.csv is read back line by line on --resume).
+std::string cell(const std::string& s) {
+  std::string flat = s;
+  for (char& c : flat)
+    if (c == '\n' || c == '\r') c = ' ';
+  return csv_field(flat);
 }
 
 std::string num(double v) {
@@ -75,37 +73,6 @@ std::string duration_text(double s) {
   return fmt::format("{} h {:02} min", t / 3600, (t % 3600) / 60);
 }
 
-std::vector<std::string> split_csv_line(std::string_view line) {
-  std::vector<std::string> out;
-  std::string cur;
-  bool quoted = false, was_quoted = false;
-  for (size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted) {
-      if (c == '"') {
-        if (i + 1 < line.size() && line[i + 1] == '"') {
-          cur += '"';
-          ++i;
-        } else {
-          quoted = false;
-        }
-      } else {
-        cur += c;
-      }
-    } else if (c == '"' && cur.empty() && !was_quoted) {
-      quoted = was_quoted = true;
-    } else if (c == ',') {
-      out.push_back(cur);
-      cur.clear();
-      was_quoted = false;
-    } else if (c != '\r' && c != '\n') {
-      cur += c;
-    }
-  }
-  out.push_back(cur);
-  return out;
-}
-
 std::vector<std::string> results_header(const SweepSpec& s) {
   std::vector<std::string> h{"point"};
   for (const std::string& c : s.point_columns()) h.push_back(c);
@@ -115,7 +82,7 @@ std::vector<std::string> results_header(const SweepSpec& s) {
 
 std::string results_row(const PointResult& r) {
   std::string line = fmt::format("{}", r.index);
-  auto add = [&line](const std::string& f) { line += "," + csv_field(f); };
+  auto add = [&line](const std::string& f) { line += "," + cell(f); };
   for (const std::string& c : r.cells) add(c);
   add(r.verdict);
   add(r.worst_metric);
@@ -273,8 +240,7 @@ StatusOr<std::unique_ptr<ResultLog>> ResultLog::open(const SweepSpec& s, const S
   log->ncolumns_ = header.size();
   log->path_ = opt.out_dir + "/results.csv";
   std::string header_line;
-  for (const std::string& h : header)
-    header_line += (header_line.empty() ? "" : ",") + csv_field(h);
+  for (const std::string& h : header) header_line += (header_line.empty() ? "" : ",") + cell(h);
   header_line += "\n";
 
   std::string keep = header_line;
@@ -398,6 +364,13 @@ std::vector<PointResult> ResultLog::results() const {
   return out;
 }
 
+std::vector<size_t> varying_axes(const SweepSpec& s) {
+  std::vector<size_t> v;
+  for (size_t k = 0; k < s.axes.size(); ++k)
+    if (s.axes[k].values.size() > 1) v.push_back(k);
+  return v;
+}
+
 // --- summary.json and plots --------------------------------------------------------------------
 
 namespace {
@@ -432,12 +405,6 @@ std::vector<GridCell> grid_cells(const SweepSpec& s, const std::vector<PointResu
 }
 
 // The axes with more than one value (a key given one value is a fixed override).
-std::vector<size_t> varying_axes(const SweepSpec& s) {
-  std::vector<size_t> v;
-  for (size_t k = 0; k < s.axes.size(); ++k)
-    if (s.axes[k].values.size() > 1) v.push_back(k);
-  return v;
-}
 
 // Row-major grid index of a value index per axis.
 size_t grid_index(const SweepSpec& s, const std::vector<size_t>& idx) {
@@ -517,55 +484,6 @@ ordered_json boundary_json(const SweepSpec& s, const std::vector<PointResult>& r
   return ordered_json{{"axis", x.key}, {"along", along}};
 }
 
-reports::SweepPlotData plot_data(const SweepSpec& s, const std::vector<PointResult>& results) {
-  reports::SweepPlotData d;
-  d.title = s.name;
-  d.source = s.path;
-  d.samples = s.mc.samples;
-  // Only the keys that vary are axes; the fixed ones are named in the charts' note.
-  std::vector<size_t> vary = varying_axes(s);
-  for (const Axis& a : s.axes)
-    if (a.values.size() == 1)
-      d.note += (d.note.empty() ? "fixed: " : ", ") + a.key + " = " + a.values[0].label;
-  // zip: the keys move together, so the first one is the x axis and the others ride along.
-  if (s.mode == Mode::kZip && vary.size() > 1) {
-    std::string with;
-    for (size_t k = 1; k < vary.size(); ++k)
-      with += (with.empty() ? "" : ", ") + s.axes[vary[k]].key;
-    d.note += (d.note.empty() ? "" : "; ") + ("zip: " + with + " with " + s.axes[vary[0]].key);
-    vary.resize(1);
-  }
-  for (size_t k : vary) {
-    const Axis& a = s.axes[k];
-    reports::SweepPlotAxis pa;
-    pa.name = a.key;
-    pa.unit = a.unit == config::Unit::kNone ? "" : config::unit_symbol(a.unit);
-    pa.log = a.log;
-    bool numeric = !a.variants;
-    for (const AxisValue& v : a.values) {
-      pa.labels.push_back(v.label);
-      numeric = numeric && v.number.has_value();
-    }
-    if (numeric)
-      for (const AxisValue& v : a.values) pa.values.push_back(*v.number);
-    // Wide positive ranges read better on a log axis.
-    if (numeric && !pa.values.empty()) {
-      const auto [lo, hi] = std::minmax_element(pa.values.begin(), pa.values.end());
-      if (*lo > 0 && *hi / *lo >= 20) pa.log = true;
-    }
-    d.axes.push_back(std::move(pa));
-  }
-  for (const PointResult& r : results) {
-    reports::SweepPlotPoint p;
-    const std::vector<size_t> idx = s.grid_indices(r.index / s.samples());
-    for (size_t k : vary) p.axis.push_back(idx[k]);
-    p.margin = r.worst_rel;
-    p.verdict = r.verdict;
-    p.reason = r.reason;
-    d.points.push_back(std::move(p));
-  }
-  return d;
-}
 
 }  // namespace
 
@@ -658,25 +576,8 @@ Status finish_sweep(const SweepSpec& s, const std::vector<PointResult>& results,
     return st;
   out->files.push_back("results.csv");
   out->files.push_back("summary.json");
-  if (!opt.plots) return Status::Ok();
-  const reports::SweepPlotData d = plot_data(s, results);
-  if (!d.axes.empty()) {
-    if (Status st = reports::render_margin_png(d, opt.out_dir + "/sweep_margin.png"); !st.ok())
-      return st;
-    out->files.push_back("sweep_margin.png");
-  }
-  if (d.axes.size() >= 2 && s.mode == Mode::kGrid) {
-    if (Status st = reports::render_heatmap_png(d, opt.out_dir + "/sweep_heatmap.png"); !st.ok())
-      return st;
-    out->files.push_back("sweep_heatmap.png");
-  }
-  if (s.mc.samples > 0) {
-    if (Status st = reports::render_mc_histogram_png(d, opt.out_dir + "/mc_histogram.png");
-        !st.ok())
-      return st;
-    out->files.push_back("mc_histogram.png");
-  }
-  return Status::Ok();
+  if (!opt.plots || !opt.render_plots) return Status::Ok();
+  return opt.render_plots(s, results, opt.out_dir, &out->files);
 }
 
 StatusOr<SweepOutcome> run_sweep(const SweepSpec& s, const link::PartLibrary& parts,
@@ -719,4 +620,4 @@ StatusOr<SweepOutcome> run_sweep(const SweepSpec& s, const link::PartLibrary& pa
   return out;
 }
 
-}  // namespace isolink::cli::sweep
+}  // namespace isolink::analysis::sweep
