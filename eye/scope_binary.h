@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-#include "solver/status.h"
+#include "base/status.h"
 
 namespace isolink::eye {
 

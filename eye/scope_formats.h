@@ -22,7 +22,7 @@
 #include <utility>
 #include <vector>
 
-#include "solver/status.h"
+#include "base/status.h"
 
 namespace isolink::eye {
 
