@@ -100,7 +100,7 @@ TEST(Check, BadSamplesAreErrors) {
   EXPECT_NE(r.status().message().find("vth = -1"), std::string::npos) << r.status().message();
 }
 
-TEST(Check, RecordCutMidFrameIsTruncatedNotFailing) {
+TEST(Check, RecordCutMidFrameIsTruncatedAndInconclusive) {
   Waveform full = synth::ideal_frames({0x15, 0x0B}, FrameFormat{});
   // start the record in the middle of the first frame's first pulse
   Waveform w;
@@ -119,7 +119,10 @@ TEST(Check, RecordCutMidFrameIsTruncatedNotFailing) {
   EXPECT_EQ(r->frames[0].fault, "truncated");
   EXPECT_FALSE(r->frames[0].fails());
   EXPECT_EQ(r->bytes, std::vector<uint8_t>{0x0B});
-  EXPECT_TRUE(r->pass);
+  // the cut pulse cannot be judged: no verdict of pass (issue 14), and no failure either
+  EXPECT_FALSE(r->pass);
+  EXPECT_TRUE(r->inconclusive);
+  EXPECT_EQ(r->failing(), 0u);
 }
 
 // Tone rules: 1 us pulses +/- 8 % (920..1080 ns); nothing is decoded.
