@@ -18,7 +18,6 @@
 #include <sstream>
 #include <system_error>
 
-#include "base/atomic_file.h"
 #include "base/csv.h"
 #include "base/file_io.h"
 

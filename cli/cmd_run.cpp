@@ -13,7 +13,6 @@
 #include "base/file_io.h"
 #include "analysis/link_run.h"
 #include "analysis/worst.h"
-#include "base/atomic_file.h"
 #include "cli/commands.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
