@@ -84,20 +84,25 @@ StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const Simula
       LtiOptions lo;
       lo.horizon = opt.tstop;
       StatusOr<LtiResponses> responses = LtiResponses::compute(circuit, probes, lo);
-      if (!responses) return responses.status();
-      LtiResponses::GridOptions grid;
-      grid.tstart = opt.tstart;
-      grid.tstop = opt.tstop;
-      grid.step = req.grid_step;
-      grid.grid_probes = req.grid_probes;
-      result.wave = responses->waveform(responses->netlist_inputs(opt.tstop), grid, &result.grid);
-      if (!result.grid.warning.empty())
-        result.warnings.push_back("warning: " + result.grid.warning);
-      result.lti = responses->stats();
-      result.engine = Engine::Lti;
-      result.seconds =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      return result;
+      // auto: a response march that cannot meet its error control falls back to the transient
+      // engine (the cross-check) and says why; a forced `lti` reports the failure.
+      if (!responses && req.engine == Engine::Lti) return responses.status();
+      if (responses) {
+        LtiResponses::GridOptions grid;
+        grid.tstart = opt.tstart;
+        grid.tstop = opt.tstop;
+        grid.step = req.grid_step;
+        grid.grid_probes = req.grid_probes;
+        result.wave = responses->waveform(responses->netlist_inputs(opt.tstop), grid, &result.grid);
+        if (!result.grid.warning.empty())
+          result.warnings.push_back("warning: " + result.grid.warning);
+        result.lti = responses->stats();
+        result.engine = Engine::Lti;
+        result.seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        return result;
+      }
+      lti_ok = Status::Error("the LTI response march failed: " + responses.status().message());
     }
     result.engine_note = lti_ok.message();
   }

@@ -111,7 +111,7 @@ TEST(LtiVsNgspice, TransformerLink20m) {
       "tx: {device: bq7961x, isolation: {type: transformer, part: HMU1228NL}}\n"
       "rx: {device: bq7961x, isolation: {type: transformer, part: HMU1228NL}}\n"
       "cable: {length: 20, material: pp, gauge: 24}\n"
-      "stimulus: {frames: [\"single-read dev=1 reg=0x0100\"]}\n",
+      "stimulus: {frames: [\"single-read dev=1 reg=0x0100 n=1\"]}\n",
       "xfmr_20m", 4e-6);
 }
 TEST(LtiVsNgspice, TransformerLink40m) {
@@ -120,7 +120,7 @@ TEST(LtiVsNgspice, TransformerLink40m) {
       "tx: {device: bq7961x, isolation: {type: transformer, part: HMU1228NL}}\n"
       "rx: {device: bq7961x, isolation: {type: transformer, part: HMU1228NL}}\n"
       "cable: {length: 40, material: pp, gauge: 24}\n"
-      "stimulus: {frames: [\"single-read dev=1 reg=0x0100\"]}\n",
+      "stimulus: {frames: [\"single-read dev=1 reg=0x0100 n=1\"]}\n",
       "xfmr_40m", 4e-6);
 }
 TEST(LtiVsNgspice, HybridLinkExampleSpec) {
