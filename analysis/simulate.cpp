@@ -1,5 +1,7 @@
 #include "analysis/simulate.h"
 
+#include <fmt/format.h>
+
 #include <chrono>
 
 #include "solver/circuit.h"
@@ -52,6 +54,16 @@ StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const Simula
     return Status::Error("no .tran card in the netlist and no --tstop given: nothing to simulate");
   if (opt.tstep <= 0 && opt.tstop > 0) opt.tstep = opt.tstop / 1000;
   if (Status s = opt.validate(); !s.ok()) return s;
+  if (req.grid_step > 0) {
+    // Refused before any work: --step 1e-30 over 5 us asks for 5e24 rows (the LTI grid and the
+    // transient's resampling would both allocate them).
+    const double rows = (opt.tstop - opt.tstart) / req.grid_step + 1;
+    if (!(rows <= static_cast<double>(kMaxGridRows)))
+      return Status::Error(fmt::format(
+          "--step {:g} over the {:.6g} s run asks for {:.3g} rows; the limit is {} rows (use a "
+          "larger --step, or no --step for the engine's own time points)",
+          req.grid_step, opt.tstop - opt.tstart, rows, kMaxGridRows));
+  }
 
   Circuit circuit;
   for (const Card& card : netlist.cards)

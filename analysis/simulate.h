@@ -25,6 +25,9 @@ const char* engine_name(Engine e);
 // "auto", "lti", "transient" -> Engine; an error names the value and the choices.
 StatusOr<Engine> parse_engine(const std::string& text);
 
+// The most output rows a --step grid may ask for.
+inline constexpr size_t kMaxGridRows = 10'000'000;
+
 struct SimulationRequest {
   std::vector<std::string> probes;           // v(a), v(a,b), i(name)
   std::optional<double> tstop, tstep, tmax;  // override the netlist's .tran
