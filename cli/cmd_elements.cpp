@@ -1,9 +1,9 @@
 // isolink elements: the element kinds and their parameters, from the kinds' own tables.
 // The README's "Element reference" section is this command's --markdown output.
+#include <fmt/format.h>
+
 #include <cmath>
 #include <cstdio>
-
-#include <fmt/format.h>
 
 #include "cli/commands.h"
 #include "solver/elements/element.h"
@@ -18,13 +18,15 @@ std::string cell(std::string s) {  // a Markdown table cell: escape the column b
 }  // namespace
 
 std::string element_reference_markdown() {
-  std::string out = "| kind | usage | parameter | default | unit | meaning |\n|---|---|---|---|---|---|\n";
+  std::string out =
+      "| kind | usage | parameter | default | unit | meaning |\n|---|---|---|---|---|---|\n";
   for (const ElementKind& k : element_kinds()) {
     bool first = true;
     for (const ParamSpec& p : k.params) {
       out += fmt::format("| {} | {} | {} | {} | {} | {} |\n", first ? k.name : "",
                          first ? cell(fmt::format("`{}`", k.usage)) : "", p.name,
-                         std::isnan(p.default_value) ? "required" : fmt::format("{:g}", p.default_value),
+                         std::isnan(p.default_value) ? (p.optional ? "none" : "required")
+                                                     : fmt::format("{:g}", p.default_value),
                          p.unit, cell(p.doc));
       first = false;
     }
@@ -34,7 +36,8 @@ std::string element_reference_markdown() {
 
 void add_elements_command(CLI::App& app, int* exit_code) {
   auto markdown = std::make_shared<bool>(false);
-  CLI::App* cmd = app.add_subcommand("elements", "List the netlist element kinds and their parameters");
+  CLI::App* cmd =
+      app.add_subcommand("elements", "List the netlist element kinds and their parameters");
   cmd->add_flag("--markdown", *markdown, "print the table as Markdown (as in the README)");
   cmd->callback([markdown, exit_code] {
     if (*markdown) {
@@ -44,7 +47,8 @@ void add_elements_command(CLI::App& app, int* exit_code) {
         std::printf("%c  %-18s %s\n", k.letter, k.name, k.usage);
         for (const ParamSpec& p : k.params)
           std::printf("     %-6s %-10s %-4s %s\n", p.name,
-                      std::isnan(p.default_value) ? "required" : fmt::format("{:g}", p.default_value).c_str(),
+                      std::isnan(p.default_value) ? (p.optional ? "none" : "required")
+                                                  : fmt::format("{:g}", p.default_value).c_str(),
                       p.unit, p.doc);
       }
     }

@@ -1,4 +1,5 @@
-// SourceFunction: the time dependence of an independent source (DC, PULSE, PWL, SIN).
+// SourceFunction: the time dependence of an independent source (DC, PULSE, PWL, SIN, EXP).
+// PWL takes ngspice's td= (delay) and r= (repeat from that time to the last) as card params.
 //
 //   auto f = SourceFunction::Parse(card);   // from "DC 2.5", "PULSE(...)", "PWL(...)", "SIN(...)"
 //   f->bind_time(tstep, tstop);             // ngspice defaults that depend on the analysis
@@ -14,7 +15,7 @@ namespace isolink {
 
 class SourceFunction {
  public:
-  enum class Kind { Dc, Pulse, Pwl, Sin };
+  enum class Kind { Dc, Pulse, Pwl, Sin, Exp };
 
   // Reads the card's positional values; errors point at the offending value.
   static StatusOr<SourceFunction> Parse(const Card& card);
@@ -30,7 +31,9 @@ class SourceFunction {
   double dc_ = 0.0;
   std::vector<double> p_;              // PULSE / SIN parameters as given (missing = NaN)
   std::vector<double> pwl_t_, pwl_v_;  // PWL corners
-  // PULSE resolved: v1 v2 td tr tf pw per np
+  double pwl_td_ = 0.0;                // PWL td=
+  int pwl_repeat_ = -1;                // PWL r=: index of the time the repeat starts from
+  // PULSE resolved: v1 v2 td tr tf pw per np (EXP: v1 v2 td1 tau1 td2 tau2 in v1 v2 td tr pw tf)
   double v1_ = 0, v2_ = 0, td_ = 0, tr_ = 0, tf_ = 0, pw_ = 0, per_ = 0, np_ = 0;
 };
 
