@@ -10,30 +10,6 @@
 
 namespace isolink::cli {
 
-namespace {
-std::string cell(std::string s) {  // a Markdown table cell: escape the column bar
-  for (size_t i = 0; (i = s.find('|', i)) != std::string::npos; i += 2) s.insert(i, "\\");
-  return s;
-}
-}  // namespace
-
-std::string element_reference_markdown() {
-  std::string out =
-      "| kind | usage | parameter | default | unit | meaning |\n|---|---|---|---|---|---|\n";
-  for (const ElementKind& k : element_kinds()) {
-    bool first = true;
-    for (const ParamSpec& p : k.params) {
-      out += fmt::format("| {} | {} | {} | {} | {} | {} |\n", first ? k.name : "",
-                         first ? cell(fmt::format("`{}`", k.usage)) : "", p.name,
-                         std::isnan(p.default_value) ? (p.optional ? "none" : "required")
-                                                     : fmt::format("{:g}", p.default_value),
-                         p.unit, cell(p.doc));
-      first = false;
-    }
-  }
-  return out;
-}
-
 void add_elements_command(CLI::App& app, int* exit_code) {
   auto markdown = std::make_shared<bool>(false);
   CLI::App* cmd =

@@ -9,13 +9,16 @@
 #include <fmt/format.h>
 
 #include "cli/commands.h"
-#include "cli/link_run.h"
-#include "cli/run_images.h"
-#include "cli/run_report.h"
+#include "base/atomic_file.h"
+#include "analysis/link_run.h"
+#include "reports/run_images.h"
+#include "reports/run_report.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
 
 namespace isolink::cli {
+using namespace isolink::analysis;  // run_link, LinkRun, run_waveforms
+using namespace isolink::reports;   // report.json / report.md, images
 namespace {
 
 struct RunArgs {

@@ -6,10 +6,11 @@
 #include <fmt/format.h>
 
 #include "cli/commands.h"
-#include "cli/simulate.h"
+#include "analysis/simulate.h"
 #include "netlists/lexer.h"
 
 namespace isolink::cli {
+using namespace isolink::analysis;  // simulate_netlist
 
 namespace {
 struct SimArgs {

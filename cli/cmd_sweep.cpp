@@ -1,6 +1,6 @@
 // isolink sweep: a link spec over a grid of key values and / or Monte Carlo tolerances, every point
-// simulated and checked, into results.csv, summary.json and plots (cli/sweep_spec.h,
-// cli/sweep_run.h; across machines with mpirun: cli/sweep_mpi.h).
+// simulated and checked, into results.csv, summary.json and plots (analysis/sweep_spec.h,
+// analysis/sweep_run.h; across machines with mpirun: analysis/sweep_mpi.h).
 // Exit status: 0 every point passes, 1 some point fails or could not be simulated, 2 bad input.
 #include <fmt/format.h>
 
@@ -11,14 +11,16 @@
 #include <vector>
 
 #include "cli/commands.h"
-#include "cli/sweep_run.h"
-#include "cli/sweep_spec.h"
+#include "reports/sweep_report.h"
+#include "analysis/sweep_run.h"
+#include "analysis/sweep_spec.h"
 #include "netlists/link/parts.h"
 #ifdef ISOLINK_HAVE_MPI
-#include "cli/sweep_mpi.h"
+#include "analysis/sweep_mpi.h"
 #endif
 
 namespace isolink::cli {
+using namespace isolink::analysis;  // sweep::
 namespace {
 
 struct SweepArgs {
@@ -95,6 +97,7 @@ int run_sweep_command(const SweepArgs& a) {
   opt.resume = a.resume;
   opt.keep_waves = a.keep_waves;
   opt.plots = !a.no_plots;
+  opt.render_plots = reports::render_sweep_plots;
   opt.quiet = a.quiet;
   if (!a.quiet && rank == 0) {
     std::fprintf(stderr, "sweep: %s: %zu points (%zu grid point%s%s)%s -> %s\n", spec->path.c_str(),

@@ -17,6 +17,5 @@ void add_export_command(CLI::App& app, int* exit_code);
 void add_sweep_command(CLI::App& app, int* exit_code);
 
 // The element table of the README (`isolink elements --markdown`).
-std::string element_reference_markdown();
 
 }  // namespace isolink::cli

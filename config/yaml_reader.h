@@ -24,8 +24,8 @@
 #include <string>
 #include <vector>
 
-#include "solver/source_loc.h"
-#include "solver/status.h"
+#include "base/source_loc.h"
+#include "base/status.h"
 
 namespace isolink::config {
 

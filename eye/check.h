@@ -23,8 +23,8 @@
 #include "eye/metrics.h"
 #include "eye/pulses.h"
 #include "eye/rules.h"
-#include "solver/status.h"
-#include "solver/waveform.h"
+#include "base/status.h"
+#include "base/waveform.h"
 
 namespace isolink::eye {
 

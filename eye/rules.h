@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "eye/decode.h"
-#include "solver/status.h"
+#include "base/status.h"
 
 namespace isolink::eye {
 

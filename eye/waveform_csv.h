@@ -15,8 +15,8 @@
 #include <string>
 #include <string_view>
 
-#include "solver/status.h"
-#include "solver/waveform.h"
+#include "base/status.h"
+#include "base/waveform.h"
 
 namespace isolink::eye {
 

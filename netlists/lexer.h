@@ -15,8 +15,8 @@
 #include <string_view>
 #include <vector>
 
-#include "solver/source_loc.h"
-#include "solver/status.h"
+#include "base/source_loc.h"
+#include "base/status.h"
 
 namespace isolink::spice {
 

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "solver/card.h"
-#include "solver/source_loc.h"
-#include "solver/status.h"
+#include "base/source_loc.h"
+#include "base/status.h"
 
 namespace isolink {
 

@@ -27,7 +27,7 @@
 #include "eye/eye_diagram.h"
 #include "eye/rules.h"
 #include "reports/plot.h"
-#include "solver/status.h"
+#include "base/status.h"
 
 namespace isolink::reports {
 

@@ -33,7 +33,7 @@
 #include <string_view>
 #include <vector>
 
-#include "solver/status.h"
+#include "base/status.h"
 
 namespace isolink::reports {
 

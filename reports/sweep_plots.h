@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "reports/plot.h"
-#include "solver/status.h"
+#include "base/status.h"
 
 namespace isolink::reports {
 

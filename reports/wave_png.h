@@ -26,7 +26,7 @@
 #include "eye/check.h"
 #include "eye/rules.h"
 #include "reports/plot.h"
-#include "solver/status.h"
+#include "base/status.h"
 
 namespace isolink::reports {
 

@@ -17,7 +17,7 @@
 
 #include "solver/circuit.h"
 #include "solver/probe.h"
-#include "solver/status.h"
+#include "base/status.h"
 
 namespace isolink {
 

@@ -15,7 +15,7 @@
 #include <utility>
 #include <vector>
 
-#include "solver/source_loc.h"
+#include "base/source_loc.h"
 
 namespace isolink {
 

@@ -27,7 +27,7 @@
 #include <string>
 
 #include "solver/mna.h"
-#include "solver/status.h"
+#include "base/status.h"
 
 namespace isolink {
 

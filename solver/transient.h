@@ -24,7 +24,7 @@
 #include "solver/card.h"
 #include "solver/circuit.h"
 #include "solver/probe.h"
-#include "solver/waveform.h"
+#include "base/waveform.h"
 
 namespace isolink {
 

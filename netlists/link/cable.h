@@ -32,7 +32,7 @@
 #include <vector>
 
 #include "solver/card.h"
-#include "solver/status.h"
+#include "base/status.h"
 
 namespace isolink::link {
 

@@ -3,7 +3,7 @@
 //
 //   StatusOr<PartLibrary> parts = PartLibrary::load({});
 //   StatusOr<ExpandedLink> down = expand_link(spec, *parts, Direction::kDown);
-//   // down->netlist: simulate (cli/simulate.h) or write_spice() it (export-spice)
+//   // down->netlist: simulate (analysis/simulate.h) or write_spice() it (export-spice)
 //   // probe v(rxp,rxn): the receiver's pins; v(txp,txn): the transmitter's.
 // Topology, from the transmitting device to the receiving one (netlists/link/README.md):
 //   TX driver -> txp/txn -> board (series R, bypass C, termination) -> tx_lp/tx_ln

@@ -19,8 +19,8 @@
 
 #include "config/yaml_reader.h"
 #include "netlists/link/cable.h"
-#include "solver/source_loc.h"
-#include "solver/status.h"
+#include "base/source_loc.h"
+#include "base/status.h"
 
 namespace isolink::link {
 

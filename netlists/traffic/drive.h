@@ -28,7 +28,7 @@
 
 #include "netlists/traffic/encoding.h"
 #include "netlists/traffic/tones.h"
-#include "solver/status.h"
+#include "base/status.h"
 
 namespace isolink::traffic {
 

@@ -19,7 +19,7 @@
 #include "netlists/traffic/drive.h"
 #include "netlists/traffic/encoding.h"
 #include "netlists/traffic/tones.h"
-#include "solver/status.h"
+#include "base/status.h"
 
 namespace isolink::traffic {
 

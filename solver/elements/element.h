@@ -19,8 +19,8 @@
 #include <vector>
 
 #include "solver/card.h"
-#include "solver/source_loc.h"
-#include "solver/status.h"
+#include "base/source_loc.h"
+#include "base/status.h"
 
 namespace isolink {
 
@@ -111,6 +111,9 @@ struct ElementKind {
 
 // All element kinds, in letter order.
 std::span<const ElementKind> element_kinds();
+// The kinds and their parameters as a Markdown table (the README's element reference and
+// `isolink elements --markdown`).
+std::string element_reference_markdown();
 // nullptr when no kind has that letter (any case).
 const ElementKind* find_element_kind(char letter);
 

@@ -1,4 +1,6 @@
 // The one explicit table of element kinds (no static self-registration).
+#include <cmath>
+#include <fmt/format.h>
 #include <array>
 #include <cctype>
 
@@ -19,6 +21,29 @@ const ElementKind* find_element_kind(char letter) {
   for (const auto& k : element_kinds())
     if (k.letter == l) return &k;
   return nullptr;
+}
+
+namespace {
+std::string cell(std::string s) {  // a Markdown table cell: escape the column bar
+  for (size_t i = 0; (i = s.find('|', i)) != std::string::npos; i += 2) s.insert(i, "\\");
+  return s;
+}
+}  // namespace
+
+std::string element_reference_markdown() {
+  std::string out = "| kind | usage | parameter | default | unit | meaning |\n|---|---|---|---|---|---|\n";
+  for (const ElementKind& k : element_kinds()) {
+    bool first = true;
+    for (const ParamSpec& p : k.params) {
+      out += fmt::format("| {} | {} | {} | {} | {} | {} |\n", first ? k.name : "",
+                         first ? cell(fmt::format("`{}`", k.usage)) : "", p.name,
+                         std::isnan(p.default_value) ? (p.optional ? "none" : "required")
+                                                     : fmt::format("{:g}", p.default_value),
+                         p.unit, cell(p.doc));
+      first = false;
+    }
+  }
+  return out;
 }
 
 }  // namespace isolink

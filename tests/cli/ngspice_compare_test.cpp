@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "cli/simulate.h"
+#include "analysis/simulate.h"
 #include "ngspice_runner.h"
 
 namespace isolink {
@@ -22,8 +22,8 @@ struct Case {
 void compare(const Case& c, IntegrationMethod method) {
   auto netlist = read_spice_file(c.netlist);
   ASSERT_TRUE(netlist.ok()) << netlist.status().message();
-  cli::SimulationRequest req{.probes = c.probes, .method = method, .reltol = 1e-4};
-  auto mine = cli::simulate_netlist(*netlist, req);
+  analysis::SimulationRequest req{.probes = c.probes, .method = method, .reltol = 1e-4};
+  auto mine = analysis::simulate_netlist(*netlist, req);
   ASSERT_TRUE(mine.ok()) << mine.status().message();
   const std::string work = ::testing::TempDir() + "/ngspice_compare";
   auto ng = testing::run_ngspice(
@@ -64,7 +64,7 @@ void compare_example(const std::string& name, double tstop = 0) {
   const std::vector<std::string> probes = {"v(rxp,rxn)"};
   auto netlist = read_spice_file(path);
   ASSERT_TRUE(netlist.ok()) << netlist.status().message();
-  cli::SimulationRequest req{.probes = probes};
+  analysis::SimulationRequest req{.probes = probes};
   std::string tran;
   if (tstop > 0) {
     req.tstop = tstop;
@@ -72,7 +72,7 @@ void compare_example(const std::string& name, double tstop = 0) {
     std::snprintf(card, sizeof card, ".tran %.9g %.9g", netlist->tran->tstep, tstop);
     tran = card;
   }
-  auto mine = cli::simulate_netlist(*netlist, req);
+  auto mine = analysis::simulate_netlist(*netlist, req);
   ASSERT_TRUE(mine.ok()) << mine.status().message();
   const std::string work = ::testing::TempDir() + "/ngspice_examples";
   auto ng = testing::run_ngspice(path, probes, work, testing::kNgspiceTight, tran);

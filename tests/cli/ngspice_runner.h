@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "solver/waveform.h"
+#include "base/waveform.h"
 
 namespace isolink::testing {
 

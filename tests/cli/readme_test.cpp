@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "cli/commands.h"
+#include "solver/elements/element.h"
 
 TEST(Readme, ElementReferenceMatchesTheParameterTables) {
   std::ifstream in(std::string(ISOLINK_SOURCE_DIR) + "/README.md");
@@ -16,6 +16,6 @@ TEST(Readme, ElementReferenceMatchesTheParameterTables) {
   ASSERT_NE(a, std::string::npos);
   ASSERT_NE(b, std::string::npos);
   EXPECT_EQ(text.substr(a + begin.size(), b - a - begin.size()),
-            isolink::cli::element_reference_markdown())
+            isolink::element_reference_markdown())
       << "regenerate with: build/cli/isolink elements --markdown";
 }

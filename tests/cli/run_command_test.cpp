@@ -12,7 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "ngspice_runner.h"
-#include "solver/waveform.h"
+#include "base/waveform.h"
 
 namespace {
 

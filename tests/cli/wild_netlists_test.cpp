@@ -10,7 +10,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "cli/simulate.h"
+#include "analysis/simulate.h"
 #include "ngspice_runner.h"
 
 namespace isolink {
@@ -68,8 +68,8 @@ TEST_P(WildNetlist, MatchesNgspiceOrIsRefused) {
   const Header h = read_header(path);
   ASSERT_TRUE(!h.probes.empty() || !h.refused.empty()) << path << ": no isolink-test header";
   StatusOr<Netlist> netlist = read_spice_file(path);
-  StatusOr<cli::SimulationResult> mine = Status::Error("not run");
-  if (netlist) mine = cli::simulate_netlist(*netlist, cli::SimulationRequest{.probes = h.probes});
+  StatusOr<analysis::SimulationResult> mine = Status::Error("not run");
+  if (netlist) mine = analysis::simulate_netlist(*netlist, analysis::SimulationRequest{.probes = h.probes});
   const Status& status = !netlist ? netlist.status() : mine.status();
   if (!h.refused.empty()) {
     ASSERT_FALSE(status.ok()) << path << " ran, but must be refused with: " << h.refused;

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "eye/decode.h"
-#include "solver/waveform.h"
+#include "base/waveform.h"
 
 namespace synth {
 

@@ -22,7 +22,7 @@
 #include "eye/check.h"
 #include "eye/decode.h"
 #include "eye/rules.h"
-#include "solver/waveform.h"
+#include "base/waveform.h"
 #include "tests/eye/synth.h"
 
 namespace isolink::reports::fixtures {

@@ -1,4 +1,4 @@
-#include "solver/waveform.h"
+#include "base/waveform.h"
 
 #include <cstdio>
 #include <fstream>

@@ -6,10 +6,10 @@
 #include <fstream>
 #include <sstream>
 
-#include "cli/sweep_run.h"
-#include "cli/sweep_spec.h"
+#include "analysis/sweep_run.h"
+#include "analysis/sweep_spec.h"
 
-namespace isolink::cli::sweep {
+namespace isolink::analysis::sweep {
 namespace {
 
 const std::string kSweep = R"(base:
@@ -259,4 +259,4 @@ TEST(SweepResults, DurationText) {
 }
 
 }  // namespace
-}  // namespace isolink::cli::sweep
+}  // namespace isolink::analysis::sweep

@@ -2,7 +2,7 @@
 // columns of results.csv, verdicts equal to `isolink run` on the same spec, a point that cannot
 // run, --resume, Monte Carlo, and the MPI run with 2 ranks against the threaded one. Every test
 // here simulates: the names carry "Sim" (ctest label sweep-sim).
-#include "cli/sweep_run.h"
+#include "analysis/sweep_run.h"
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-namespace isolink::cli::sweep {
+namespace isolink::analysis::sweep {
 namespace {
 
 namespace fs = std::filesystem;
@@ -255,4 +255,4 @@ TEST(SweepSim, MpiTwoRanksGiveTheThreadedResults) {
 }
 
 }  // namespace
-}  // namespace isolink::cli::sweep
+}  // namespace isolink::analysis::sweep

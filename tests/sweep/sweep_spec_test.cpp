@@ -1,5 +1,5 @@
 // The sweep file: keys, ranges, grid / zip points, Monte Carlo draws, and errors with file:line.
-#include "cli/sweep_spec.h"
+#include "analysis/sweep_spec.h"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <fstream>
 #include <set>
 
-namespace isolink::cli::sweep {
+namespace isolink::analysis::sweep {
 namespace {
 
 // An inline base: a capacitor link, 1 m, one frame down.
@@ -381,4 +381,4 @@ TEST(SweepSpec, KeyUnitsAndNumbers) {
 }
 
 }  // namespace
-}  // namespace isolink::cli::sweep
+}  // namespace isolink::analysis::sweep

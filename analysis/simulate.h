@@ -11,9 +11,9 @@
 
 #include "netlists/spice_reader.h"
 #include "solver/transient.h"
-#include "solver/waveform.h"
+#include "base/waveform.h"
 
-namespace isolink::cli {
+namespace isolink::analysis {
 
 struct SimulationRequest {
   std::vector<std::string> probes;            // v(a), v(a,b), i(name)
@@ -32,4 +32,4 @@ struct SimulationResult {
 
 StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const SimulationRequest& req);
 
-}  // namespace isolink::cli
+}  // namespace isolink::analysis

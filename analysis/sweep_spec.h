@@ -50,9 +50,9 @@
 
 #include "config/yaml_reader.h"
 #include "netlists/link/link_spec.h"
-#include "solver/status.h"
+#include "base/status.h"
 
-namespace isolink::cli::sweep {
+namespace isolink::analysis::sweep {
 
 // One replacement: the dotted spec path and the value as YAML text.
 struct Assignment {
@@ -161,4 +161,4 @@ std::optional<double> key_number(const std::string& path, const std::string& tex
 // numeric or is not set (e.g. an inductance taken from the part).
 std::optional<double> spec_number(const link::LinkSpec& spec, const std::string& path);
 
-}  // namespace isolink::cli::sweep
+}  // namespace isolink::analysis::sweep

@@ -1,4 +1,4 @@
-#include "solver/status.h"
+#include "base/status.h"
 
 namespace isolink {
 

@@ -1,4 +1,4 @@
-#include "solver/source_loc.h"
+#include "base/source_loc.h"
 
 #include <sstream>
 

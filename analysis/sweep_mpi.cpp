@@ -1,4 +1,4 @@
-#include "cli/sweep_mpi.h"
+#include "analysis/sweep_mpi.h"
 
 #include <fmt/format.h>
 #include <mpi.h>
@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <thread>
 
-namespace isolink::cli::sweep {
+namespace isolink::analysis::sweep {
 
 namespace {
 
@@ -137,4 +137,4 @@ StatusOr<SweepOutcome> run_sweep_mpi(const SweepSpec& s, const link::PartLibrary
   return out;
 }
 
-}  // namespace isolink::cli::sweep
+}  // namespace isolink::analysis::sweep

@@ -1,9 +1,9 @@
-#include "cli/run_images.h"
+#include "reports/run_images.h"
 
 #include "reports/eye_png.h"
 #include "reports/wave_png.h"
 
-namespace isolink::cli {
+namespace isolink::reports {
 
 Status render_run_images(const link::LinkSpec& spec, const LinkRun& run, const std::string& dir,
                          std::vector<std::string>* images) {
@@ -42,4 +42,4 @@ Status render_run_images(const link::LinkSpec& spec, const LinkRun& run, const s
   return Status::Ok();
 }
 
-}  // namespace isolink::cli
+}  // namespace isolink::reports

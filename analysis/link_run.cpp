@@ -1,10 +1,10 @@
-#include "cli/link_run.h"
+#include "analysis/link_run.h"
 
 #include <chrono>
 
 #include <fmt/format.h>
 
-namespace isolink::cli {
+namespace isolink::analysis {
 
 namespace {
 
@@ -87,4 +87,26 @@ StatusOr<LinkRun> run_link(const link::LinkSpec& spec, const link::PartLibrary& 
   return run;
 }
 
-}  // namespace isolink::cli
+Waveform run_waveforms(const LinkRun& run, double dt) {
+  Waveform out;
+  std::vector<Waveform> parts;
+  double t_end = 1e300;
+  for (const DirectionRun& d : run.directions) {
+    parts.push_back(d.sim.wave.resampled(dt));
+    t_end = std::min(t_end, parts.back().time.empty() ? 0.0 : parts.back().time.back());
+  }
+  if (parts.empty()) return out;
+  size_t n = 0;
+  while (n < parts[0].time.size() && parts[0].time[n] <= t_end) ++n;
+  out.time.assign(parts[0].time.begin(), parts[0].time.begin() + n);
+  for (size_t k = 0; k < parts.size(); ++k) {
+    const char* dir = link::direction_name(run.directions[k].link.direction);
+    for (size_t c = 0; c < parts[k].columns.size(); ++c) {
+      std::vector<double> col(parts[k].columns[c].begin(), parts[k].columns[c].begin() + n);
+      out.add_column(fmt::format("{} {}", dir, parts[k].names[c]), std::move(col));
+    }
+  }
+  return out;
+}
+
+}  // namespace isolink::analysis

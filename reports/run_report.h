@@ -11,11 +11,14 @@
 #include <string>
 #include <vector>
 
-#include "cli/link_run.h"
+#include "analysis/link_run.h"
 #include "netlists/link/link_spec.h"
-#include "solver/waveform.h"
+#include "base/waveform.h"
 
-namespace isolink::cli {
+namespace isolink::reports {
+
+using analysis::DirectionRun;
+using analysis::LinkRun;
 
 // The spec with every default filled in (what was simulated).
 nlohmann::ordered_json link_spec_json(const link::LinkSpec& spec);
@@ -24,11 +27,7 @@ nlohmann::ordered_json run_report_json(const link::LinkSpec& spec, const LinkRun
 // A reviewer's page: verdict, worst margins per direction, BOM, cable, run time, the images.
 std::string run_report_markdown(const link::LinkSpec& spec, const LinkRun& run,
                                 const std::vector<std::string>& images);
-// The probes of every direction, resampled onto one uniform axis, columns "down v(rxp,rxn)", ...
-Waveform run_waveforms(const LinkRun& run, double dt);
-// Writes text to path through path + ".tmp" and a rename.
-Status write_file_atomic(const std::string& path, const std::string& text);
 // "pass" / "FAIL" lines for the terminal: one per direction, with the worst margins.
 std::string run_summary_text(const link::LinkSpec& spec, const LinkRun& run);
 
-}  // namespace isolink::cli
+}  // namespace isolink::reports

@@ -5,13 +5,16 @@
 #include <string>
 #include <vector>
 
-#include "cli/link_run.h"
+#include "analysis/link_run.h"
 #include "netlists/link/link_spec.h"
 
-namespace isolink::cli {
+namespace isolink::reports {
+
+using analysis::DirectionRun;
+using analysis::LinkRun;
 
 // Writes dir/eye.png and dir/wave.png; appends the file names written to *images.
 Status render_run_images(const link::LinkSpec& spec, const LinkRun& run, const std::string& dir,
                          std::vector<std::string>* images);
 
-}  // namespace isolink::cli
+}  // namespace isolink::reports

@@ -11,9 +11,9 @@
 // Outside mpirun (or with one rank) `isolink sweep` is the threaded run.
 #pragma once
 
-#include "cli/sweep_run.h"
+#include "analysis/sweep_run.h"
 
-namespace isolink::cli::sweep {
+namespace isolink::analysis::sweep {
 
 // True when the process was started by an MPI launcher (OpenMPI's or a PMI environment).
 bool mpi_launched();
@@ -32,4 +32,4 @@ void mpi_stop();
 StatusOr<SweepOutcome> run_sweep_mpi(const SweepSpec& s, const link::PartLibrary& parts,
                                      const SweepOptions& opt, const MpiWorld& world);
 
-}  // namespace isolink::cli::sweep
+}  // namespace isolink::analysis::sweep

@@ -1,4 +1,4 @@
-// Running a sweep: each point through run_link (cli/link_run.h), scored to one row of
+// Running a sweep: each point through run_link (analysis/link_run.h), scored to one row of
 // results.csv; the points in parallel on all cores (oneTBB) or across MPI ranks (sweep_mpi.h);
 // then summary.json and the plots (reports/sweep_plots.h).
 //
@@ -29,6 +29,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -38,12 +39,12 @@
 #include <string_view>
 #include <vector>
 
-#include "cli/link_run.h"
-#include "cli/sweep_spec.h"
+#include "analysis/link_run.h"
+#include "analysis/sweep_spec.h"
 #include "netlists/link/parts.h"
-#include "solver/status.h"
+#include "base/status.h"
 
-namespace isolink::cli::sweep {
+namespace isolink::analysis::sweep {
 
 inline constexpr std::array<const char*, 4> kMetrics = {"vstart", "vend", "width", "edge"};
 
@@ -91,6 +92,11 @@ struct SweepOptions {
   bool resume = false;      // skip points already in results.csv
   bool keep_waves = false;  // out_dir/waves/point_NNNNN.csv per point
   bool plots = true;
+  // Draws the charts into out_dir and appends their names to *files (reports/sweep_report.h
+  // provides one; analysis/ draws nothing itself).
+  std::function<Status(const SweepSpec&, const std::vector<PointResult>&, const std::string& dir,
+                       std::vector<std::string>* files)>
+      render_plots;
   bool quiet = false;  // no progress
   PointOptions point;  // waves_dir is filled in from keep_waves
 };
@@ -146,7 +152,10 @@ Status finish_sweep(const SweepSpec& s, const std::vector<PointResult>& results,
 StatusOr<SweepOutcome> run_sweep(const SweepSpec& s, const link::PartLibrary& parts,
                                  const SweepOptions& opt);
 
+// The axes with more than one value (the fixed keys are not axes of a chart).
+std::vector<size_t> varying_axes(const SweepSpec& s);
+
 // "12.3 s", "4 min 05 s", "1 h 02 min" for progress lines.
 std::string duration_text(double seconds);
 
-}  // namespace isolink::cli::sweep
+}  // namespace isolink::analysis::sweep

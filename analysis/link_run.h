@@ -13,14 +13,14 @@
 #include <string>
 #include <vector>
 
-#include "cli/simulate.h"
+#include "analysis/simulate.h"
 #include "eye/check.h"
 #include "eye/rules.h"
 #include "netlists/link/expand.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
 
-namespace isolink::cli {
+namespace isolink::analysis {
 
 struct DirectionRun {
   link::ExpandedLink link;
@@ -49,4 +49,7 @@ const std::vector<std::string>& run_probes();
 StatusOr<LinkRun> run_link(const link::LinkSpec& spec, const link::PartLibrary& parts,
                            const RunOptions& opt = {});
 
-}  // namespace isolink::cli
+// The probes of every direction, resampled onto one uniform axis, columns "down v(rxp,rxn)", ...
+Waveform run_waveforms(const LinkRun& run, double dt);
+
+}  // namespace isolink::analysis

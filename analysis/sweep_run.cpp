@@ -1,4 +1,4 @@
-#include "cli/sweep_run.h"
+#include "analysis/sweep_run.h"
 
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
@@ -16,10 +16,9 @@
 #include <map>
 #include <sstream>
 
-#include "cli/run_report.h"
-#include "reports/sweep_plots.h"
+#include "base/atomic_file.h"
 
-namespace isolink::cli::sweep {
+namespace isolink::analysis::sweep {
 
 namespace {
 
@@ -398,6 +397,13 @@ std::vector<PointResult> ResultLog::results() const {
   return out;
 }
 
+std::vector<size_t> varying_axes(const SweepSpec& s) {
+  std::vector<size_t> v;
+  for (size_t k = 0; k < s.axes.size(); ++k)
+    if (s.axes[k].values.size() > 1) v.push_back(k);
+  return v;
+}
+
 // --- summary.json and plots --------------------------------------------------------------------
 
 namespace {
@@ -432,12 +438,6 @@ std::vector<GridCell> grid_cells(const SweepSpec& s, const std::vector<PointResu
 }
 
 // The axes with more than one value (a key given one value is a fixed override).
-std::vector<size_t> varying_axes(const SweepSpec& s) {
-  std::vector<size_t> v;
-  for (size_t k = 0; k < s.axes.size(); ++k)
-    if (s.axes[k].values.size() > 1) v.push_back(k);
-  return v;
-}
 
 // Row-major grid index of a value index per axis.
 size_t grid_index(const SweepSpec& s, const std::vector<size_t>& idx) {
@@ -517,55 +517,6 @@ ordered_json boundary_json(const SweepSpec& s, const std::vector<PointResult>& r
   return ordered_json{{"axis", x.key}, {"along", along}};
 }
 
-reports::SweepPlotData plot_data(const SweepSpec& s, const std::vector<PointResult>& results) {
-  reports::SweepPlotData d;
-  d.title = s.name;
-  d.source = s.path;
-  d.samples = s.mc.samples;
-  // Only the keys that vary are axes; the fixed ones are named in the charts' note.
-  std::vector<size_t> vary = varying_axes(s);
-  for (const Axis& a : s.axes)
-    if (a.values.size() == 1)
-      d.note += (d.note.empty() ? "fixed: " : ", ") + a.key + " = " + a.values[0].label;
-  // zip: the keys move together, so the first one is the x axis and the others ride along.
-  if (s.mode == Mode::kZip && vary.size() > 1) {
-    std::string with;
-    for (size_t k = 1; k < vary.size(); ++k)
-      with += (with.empty() ? "" : ", ") + s.axes[vary[k]].key;
-    d.note += (d.note.empty() ? "" : "; ") + ("zip: " + with + " with " + s.axes[vary[0]].key);
-    vary.resize(1);
-  }
-  for (size_t k : vary) {
-    const Axis& a = s.axes[k];
-    reports::SweepPlotAxis pa;
-    pa.name = a.key;
-    pa.unit = a.unit == config::Unit::kNone ? "" : config::unit_symbol(a.unit);
-    pa.log = a.log;
-    bool numeric = !a.variants;
-    for (const AxisValue& v : a.values) {
-      pa.labels.push_back(v.label);
-      numeric = numeric && v.number.has_value();
-    }
-    if (numeric)
-      for (const AxisValue& v : a.values) pa.values.push_back(*v.number);
-    // Wide positive ranges read better on a log axis.
-    if (numeric && !pa.values.empty()) {
-      const auto [lo, hi] = std::minmax_element(pa.values.begin(), pa.values.end());
-      if (*lo > 0 && *hi / *lo >= 20) pa.log = true;
-    }
-    d.axes.push_back(std::move(pa));
-  }
-  for (const PointResult& r : results) {
-    reports::SweepPlotPoint p;
-    const std::vector<size_t> idx = s.grid_indices(r.index / s.samples());
-    for (size_t k : vary) p.axis.push_back(idx[k]);
-    p.margin = r.worst_rel;
-    p.verdict = r.verdict;
-    p.reason = r.reason;
-    d.points.push_back(std::move(p));
-  }
-  return d;
-}
 
 }  // namespace
 
@@ -658,25 +609,8 @@ Status finish_sweep(const SweepSpec& s, const std::vector<PointResult>& results,
     return st;
   out->files.push_back("results.csv");
   out->files.push_back("summary.json");
-  if (!opt.plots) return Status::Ok();
-  const reports::SweepPlotData d = plot_data(s, results);
-  if (!d.axes.empty()) {
-    if (Status st = reports::render_margin_png(d, opt.out_dir + "/sweep_margin.png"); !st.ok())
-      return st;
-    out->files.push_back("sweep_margin.png");
-  }
-  if (d.axes.size() >= 2 && s.mode == Mode::kGrid) {
-    if (Status st = reports::render_heatmap_png(d, opt.out_dir + "/sweep_heatmap.png"); !st.ok())
-      return st;
-    out->files.push_back("sweep_heatmap.png");
-  }
-  if (s.mc.samples > 0) {
-    if (Status st = reports::render_mc_histogram_png(d, opt.out_dir + "/mc_histogram.png");
-        !st.ok())
-      return st;
-    out->files.push_back("mc_histogram.png");
-  }
-  return Status::Ok();
+  if (!opt.plots || !opt.render_plots) return Status::Ok();
+  return opt.render_plots(s, results, opt.out_dir, &out->files);
 }
 
 StatusOr<SweepOutcome> run_sweep(const SweepSpec& s, const link::PartLibrary& parts,
@@ -719,4 +653,4 @@ StatusOr<SweepOutcome> run_sweep(const SweepSpec& s, const link::PartLibrary& pa
   return out;
 }
 
-}  // namespace isolink::cli::sweep
+}  // namespace isolink::analysis::sweep

@@ -1,10 +1,10 @@
-#include "cli/simulate.h"
+#include "analysis/simulate.h"
 
 #include <chrono>
 
 #include "solver/circuit.h"
 
-namespace isolink::cli {
+namespace isolink::analysis {
 
 namespace {
 StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequest& req,
@@ -80,4 +80,4 @@ StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const Simula
   return Status::Error(text + r.status().message());
 }
 
-}  // namespace isolink::cli
+}  // namespace isolink::analysis

@@ -1,4 +1,4 @@
-#include "cli/sweep_spec.h"
+#include "analysis/sweep_spec.h"
 
 #include <fmt/format.h>
 
@@ -12,7 +12,7 @@
 
 #include "netlists/lexer.h"
 
-namespace isolink::cli::sweep {
+namespace isolink::analysis::sweep {
 
 using config::Unit;
 using config::YamlDoc;
@@ -757,4 +757,4 @@ StatusOr<SweepSpec> read_sweep_text(const std::string& text, const std::string& 
   return s;
 }
 
-}  // namespace isolink::cli::sweep
+}  // namespace isolink::analysis::sweep

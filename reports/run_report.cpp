@@ -1,4 +1,4 @@
-#include "cli/run_report.h"
+#include "reports/run_report.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,7 @@
 #include "netlists/link/cable.h"
 #include "netlists/link/cards.h"
 
-namespace isolink::cli {
+namespace isolink::reports {
 
 namespace {
 
@@ -167,45 +167,6 @@ std::string run_report_markdown(const link::LinkSpec& spec, const LinkRun& run,
   return md;
 }
 
-Waveform run_waveforms(const LinkRun& run, double dt) {
-  Waveform out;
-  std::vector<Waveform> parts;
-  double t_end = 1e300;
-  for (const DirectionRun& d : run.directions) {
-    parts.push_back(d.sim.wave.resampled(dt));
-    t_end = std::min(t_end, parts.back().time.empty() ? 0.0 : parts.back().time.back());
-  }
-  if (parts.empty()) return out;
-  size_t n = 0;
-  while (n < parts[0].time.size() && parts[0].time[n] <= t_end) ++n;
-  out.time.assign(parts[0].time.begin(), parts[0].time.begin() + n);
-  for (size_t k = 0; k < parts.size(); ++k) {
-    const char* dir = link::direction_name(run.directions[k].link.direction);
-    for (size_t c = 0; c < parts[k].columns.size(); ++c) {
-      std::vector<double> col(parts[k].columns[c].begin(), parts[k].columns[c].begin() + n);
-      out.add_column(fmt::format("{} {}", dir, parts[k].names[c]), std::move(col));
-    }
-  }
-  return out;
-}
-
-Status write_file_atomic(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out << text;
-    out.flush();
-    if (!out) {
-      std::remove(tmp.c_str());
-      return Status::Error(fmt::format("{}: error: cannot write", path));
-    }
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    return Status::Error(fmt::format("{}: error: cannot rename {} into place", path, tmp));
-  }
-  return Status::Ok();
-}
 
 std::string run_summary_text(const link::LinkSpec& spec, const LinkRun& run) {
   std::string s = fmt::format("{}: {} ({:.2f} s)\n", spec.name, run.pass ? "PASS" : "FAIL",
@@ -228,4 +189,4 @@ std::string run_summary_text(const link::LinkSpec& spec, const LinkRun& run) {
   return s;
 }
 
-}  // namespace isolink::cli
+}  // namespace isolink::reports
