@@ -26,10 +26,10 @@ StatusOr<Engine> parse_engine(const std::string& text) {
   return Status::Error("engine '" + text + "' is not one of auto, lti, transient");
 }
 
-StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const SimulationRequest& req) {
-  SimulationResult result;
-  result.warnings = netlist.warnings;
+namespace {
 
+StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequest& req,
+                                    SimulationResult& result) {
   TransientOptions opt;
   if (netlist.tran) {
     opt.tstep = netlist.tran->tstep;
@@ -70,6 +70,14 @@ StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const Simula
     if (Status s = circuit.add(card); !s.ok()) return s;
   if (Status s = circuit.finalize(); !s.ok()) return s;
   for (const auto& w : circuit.warnings()) result.warnings.push_back(w);
+  for (const InitialVoltage& ic : netlist.initial_voltages) {
+    const int node = circuit.find_node(ic.node);
+    if (node <= 0)
+      return error_at(ic.loc,
+                      node == 0 ? "'.ic' on the ground node"
+                                : "'.ic' names node '" + ic.node + "', which no element connects");
+    opt.node_ic.emplace_back(node, ic.value);
+  }
 
   std::vector<Probe> probes;
   for (const auto& text : req.probes) {
@@ -89,7 +97,11 @@ StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const Simula
     Status lti_ok = opt.uic ? Status::Error(
                                   ".tran uic starts from zero, not from the DC operating "
                                   "point: the LTI engine needs the operating point")
-                            : check_lti(circuit);
+                    : !opt.node_ic.empty()
+                        ? Status::Error(
+                              "'.ic' holds nodes for the DC point: the LTI engine starts from "
+                              "the circuit's own operating point")
+                        : check_lti(circuit);
     if (!lti_ok.ok() && req.engine == Engine::Lti) return lti_ok;
     if (lti_ok.ok()) {
       for (const auto& e : circuit.elements()) e->bind_time(opt.tstep, opt.tstop);
@@ -124,6 +136,19 @@ StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const Simula
   result.wave = std::move(*wave);
   result.engine = Engine::Transient;
   return result;
+}
+
+}  // namespace
+
+StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const SimulationRequest& req) {
+  SimulationResult result;
+  result.warnings = netlist.warnings;
+  StatusOr<SimulationResult> r = simulate(netlist, req, result);
+  if (r.ok() || result.warnings.empty()) return r;
+  // Warnings first: a skipped card or a tied node may be why the run failed.
+  std::string text;
+  for (const std::string& w : result.warnings) text += w + "\n";
+  return Status::Error(text + r.status().message());
 }
 
 }  // namespace isolink::analysis

@@ -176,7 +176,17 @@ std::optional<ScannedNumber> scan_number(std::string_view s) {
   }
   if (!digits) return std::nullopt;
   long exponent = dropped_int_digits;
-  if (i < n && (s[i] == 'e' || s[i] == 'E')) {
+  // RKM notation (IEC 60062): the scale letter stands for the decimal point, "4k7" = 4.7e3,
+  // "2r2" = 2.2 ('r': no scale), "1u5" = 1.5e-6. Only after plain integer digits.
+  char rkm = 0;
+  if (i + 1 < n && i > 0 && is_digit(s[i - 1]) && is_digit(s[i + 1]) &&
+      std::string_view("fpnumkgtrFPNUMKGTR").find(s[i]) != std::string_view::npos &&
+      s.substr(0, i).find('.') == std::string_view::npos) {
+    rkm = to_lower(s[i++]);
+    put('.');
+    while (i < n && is_digit(s[i])) put(s[i++]);
+  }
+  if (!rkm && i < n && (s[i] == 'e' || s[i] == 'E')) {
     std::size_t j = i + 1;
     bool neg = false;
     if (j < n && (s[j] == '+' || s[j] == '-')) neg = s[j++] == '-';
@@ -193,7 +203,13 @@ std::optional<ScannedNumber> scan_number(std::string_view s) {
     }
   }
   double scale = 1.0;
-  if (i < n && is_alpha(s[i])) {
+  if (rkm) {
+    static constexpr std::string_view kLetters = "fpnumkgt";
+    static constexpr int kExponents[] = {-15, -12, -9, -6, -3, 3, 9, 12};
+    const std::size_t k = kLetters.find(rkm);
+    if (k != std::string_view::npos) exponent += kExponents[k];
+    while (i < n && is_alpha(s[i])) ++i;  // unit letters
+  } else if (i < n && is_alpha(s[i])) {
     auto starts = [&](const char* w) {
       for (std::size_t k = 0; w[k]; ++k)
         if (i + k >= n || to_lower(s[i + k]) != w[k]) return false;

@@ -65,8 +65,9 @@ StatusOr<std::vector<Token>> tokenize(const LogicalLine& line);
 
 // Scans a SPICE number at the start of s (no sign): digits, optional fraction and exponent, then
 // an optional scale suffix (f p n u m k g t meg mil, any case) and ignored unit letters
-// ("2.2nF", "1kohm", "10Meg"). Returns the value and the number of characters used, or nullopt
-// when s does not start with a digit or '.' followed by a digit, or when an 'e' after the
+// ("2.2nF", "1kohm", "10Meg"), or RKM notation where the letter is the decimal point ("4k7" =
+// 4700, "2r2" = 2.2, "1u5" = 1.5e-6). Returns the value and the number of characters used, or
+// nullopt when s does not start with a digit or '.' followed by a digit, or when an 'e' after the
 // mantissa has no exponent digits ("1e" is refused, not read as 1 with a unit letter).
 struct ScannedNumber {
   double value;

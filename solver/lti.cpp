@@ -48,9 +48,15 @@ Status check_lti(const Circuit& circuit) {
     const SourceFunction* f = e->source_function();
     if (f && !f->piecewise_linear())
       return error_at(e->loc(), "source '" + e->name() +
-                                    "' is not piecewise linear (SIN): the LTI engine takes DC, "
+                                    "' is not a continuous piecewise-linear function (SIN, EXP, "
+                                    "or a PWL whose r= repeat jumps): the LTI engine takes DC, "
                                     "PULSE and PWL sources (use --engine transient)");
   }
+  if (!circuit.dc_open_branches().empty())
+    return Status::Error(
+        "an inductor closes a loop of voltage sources and inductors and is opened for the DC "
+        "point: the LTI engine needs a DC operating point of the circuit as it is (use --engine "
+        "transient)");
   return Status::Ok();
 }
 
@@ -424,6 +430,35 @@ Waveform LtiResponses::waveform(const std::vector<SourceInput>& inputs, const Gr
       if (grid.step <= 0 && ramp.t > grid.tstart && ramp.t < grid.tstop) corners.push_back(ramp.t);
   std::sort(corners.begin(), corners.end());
   corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+  // Any probe at any time in O(ramps inside the march window): the ramps older than the march's
+  // end respond affinely, summed from prefix sums of slope and slope * time.
+  const double end = tau_.back();
+  std::vector<std::vector<double>> sum_s(inputs.size()), sum_st(inputs.size());
+  for (size_t k = 0; k < inputs.size(); ++k) {
+    sum_s[k].assign(inputs[k].ramps.size() + 1, 0.0);
+    sum_st[k].assign(inputs[k].ramps.size() + 1, 0.0);
+    for (size_t j = 0; j < inputs[k].ramps.size(); ++j) {
+      sum_s[k][j + 1] = sum_s[k][j] + inputs[k].ramps[j].slope;
+      sum_st[k][j + 1] = sum_st[k][j] + inputs[k].ramps[j].slope * inputs[k].ramps[j].t;
+    }
+  }
+  auto value_at = [&](size_t p, double t) {
+    double y = base[p];
+    for (size_t k = 0; k < sources_.size() && k < inputs.size(); ++k) {
+      const auto& ramps = inputs[k].ramps;
+      auto before = [&](double x) {  // ramps with t_j < x
+        return static_cast<size_t>(
+            std::lower_bound(ramps.begin(), ramps.end(), x,
+                             [](const Ramp& r, double v) { return r.t < v; }) -
+            ramps.begin());
+      };
+      const size_t hi = before(t), lo = std::min(hi, before(t - end));
+      const double rend = r_[k][p].back(), send = end_slope_[k][p];
+      y += (rend - send * end) * sum_s[k][lo] + send * (t * sum_s[k][lo] - sum_st[k][lo]);
+      for (size_t j = lo; j < hi; ++j) y += ramps[j].slope * ramp_response(k, p, t - ramps[j].t);
+    }
+    return y;
+  };
   auto rows_at = [&](double t0, double dt, long count) {
     std::vector<std::vector<double>> v(np, std::vector<double>(count, 0.0));
     for (size_t p = 0; p < np; ++p) std::fill(v[p].begin(), v[p].end(), base[p]);
@@ -459,6 +494,25 @@ Waveform LtiResponses::waveform(const std::vector<SourceInput>& inputs, const Gr
           if (!has_corner[i])
             worst = std::max(worst,
                              scale * std::fabs(mids[p][i] - 0.5 * (rows[p][i] + rows[p][i + 1])));
+        // A cell holding corners is tested piece by piece between them (the corners are rows of
+        // their own): a fast response just after a corner is as visible as anywhere else.
+        for (size_t c = 0; c < corners.size();) {
+          const long i = static_cast<long>(std::floor((corners[c] - grid.tstart) / dt));
+          if (i < 0 || i + 1 >= count) {
+            ++c;
+            continue;
+          }
+          double a = grid.tstart + static_cast<double>(i) * dt, ya = rows[p][i];
+          for (; c < corners.size() && corners[c] < a + dt; ++c) {
+            const double yc = value_at(p, corners[c]);
+            const double ym = value_at(p, 0.5 * (a + corners[c]));
+            worst = std::max(worst, scale * std::fabs(ym - 0.5 * (ya + yc)));
+            a = corners[c], ya = yc;
+          }
+          const double b = grid.tstart + static_cast<double>(i + 1) * dt;
+          const double ym = value_at(p, 0.5 * (a + b));
+          worst = std::max(worst, scale * std::fabs(ym - 0.5 * (ya + rows[p][i + 1])));
+        }
       }
       if (worst <= 0.5 * grid.interp_tol) break;
       if (2 * count - 1 > grid.max_rows) {
@@ -488,7 +542,7 @@ Waveform LtiResponses::waveform(const std::vector<SourceInput>& inputs, const Gr
     for (; c < corners.size() && corners[c] < t; ++c) {
       if (corners[c] <= t - tiny && (w.time.empty() || corners[c] >= w.time.back() + tiny)) {
         w.time.push_back(corners[c]);
-        for (size_t p = 0; p < np; ++p) cols[p].push_back(value(p, corners[c], inputs));
+        for (size_t p = 0; p < np; ++p) cols[p].push_back(value_at(p, corners[c]));
       }
     }
     if (!w.time.empty() && t <= w.time.back()) continue;

@@ -10,6 +10,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
+#include <utility>
 #include <vector>
 
 #include "solver/circuit.h"
@@ -97,20 +99,61 @@ struct MnaSystem {
   // Factors G (the DC matrix) into dc_klu. It has its own KluSolver with KLU's default ordering:
   // at DC the inductor branches have no diagonal and KLU pivots away from a fill-reducing order,
   // so this matrix says nothing about which ordering suits the transient matrices; the transient
-  // KluSolver decides on its first (transient) factorization instead.
-  Status factor_dc(const Circuit& circuit, KluSolver& dc_klu) const {
+  // KluSolver decides on its first (transient) factorization instead. The rows of `held` unknowns
+  // and of the inductors the circuit opened at DC (Circuit::dc_open_branches) are replaced by
+  // unknown = value; dc() puts the values in the right-hand side.
+  Status factor_dc(const Circuit& circuit, KluSolver& dc_klu,
+                   const std::vector<std::pair<int, double>>& held = {}) const {
+    std::vector<double> gd;
+    const double* values = g.data();
+    if (!held.empty() || !circuit.dc_open_branches().empty()) {
+      gd = g;
+      const auto& cp = pattern.col_start();
+      const auto& ri = pattern.row_index();
+      std::vector<bool> replaced(n + 1, false);
+      for (const auto& r : held) replaced[r.first] = true;
+      for (int br : circuit.dc_open_branches()) replaced[br] = true;
+      for (int col = 0; col < n; ++col)
+        for (int k = cp[col]; k < cp[col + 1]; ++k)
+          if (replaced[ri[k] + 1]) gd[k] = ri[k] == col ? 1.0 : 0.0;
+      values = gd.data();
+    }
     if (Status s = dc_klu.analyze(pattern, KluSolver::Ordering::Amd); !s.ok()) return s;
-    return name_singular(circuit, dc_klu, dc_klu.factor(0.0, g.data()));
+    return name_singular(circuit, dc_klu, dc_klu.factor(0.0, values));
   }
 
-  // The DC operating point into x (n + 1 entries).
-  Status dc(const Circuit& circuit, std::vector<double>& x) const {
+  // The DC operating point into x (n + 1 entries), `held` unknowns at their values (.ic nodes),
+  // the opened inductors at 0 A; a non-finite solution is an error naming the unknown.
+  Status dc(const Circuit& circuit, std::vector<double>& x,
+            const std::vector<std::pair<int, double>>& held = {}) const {
     KluSolver dc_klu;
-    if (Status s = factor_dc(circuit, dc_klu); !s.ok()) return s;
+    if (Status s = factor_dc(circuit, dc_klu, held); !s.ok()) return s;
     rhs(0.0, x);
+    for (const auto& [u, v] : held) x[u] = v;
+    for (int br : circuit.dc_open_branches()) x[br] = 0.0;
     Status s = dc_klu.solve(x.data() + 1);
     x[0] = 0.0;
+    if (s.ok()) s = check_finite(circuit, x, 0.0, "the DC operating point");
     return s;
+  }
+
+  // Exit-worthy error when x has a NaN or infinity, naming the unknown and the likely cause.
+  static Status check_finite(const Circuit& circuit, const std::vector<double>& x, double t,
+                             const char* where) {
+    for (std::size_t u = 1; u < x.size(); ++u) {
+      if (std::isfinite(x[u])) continue;
+      const int ui = static_cast<int>(u);
+      const char* cause =
+          circuit.unknown_is_state(ui) && !circuit.unknown_is_node(ui)
+              ? "an inductor whose coupling (K) or value makes the circuit unstable, or element "
+                "values many decades apart"
+              : "element values many decades apart (a near-singular matrix), or a source "
+                "value that is not finite";
+      return Status::Error(fmt::format(
+          "non-finite value ({}) in the solution at t={:g} s ({}): {}; likely cause: {}", x[u], t,
+          where, circuit.unknown_name(ui), cause));
+    }
+    return Status::Ok();
   }
 
   static Status name_singular(const Circuit& circuit, const KluSolver& k, Status s) {

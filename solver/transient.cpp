@@ -30,6 +30,10 @@ Status TransientOptions::validate() const {
   if (!(abstol > 0)) return bad("abstol", abstol, "must be positive");
   if (!(trtol > 0)) return bad("trtol", trtol, "must be positive");
   if (max_steps <= 0) return bad("max_steps", static_cast<double>(max_steps), "must be positive");
+  for (const auto& [node, v] : node_ic) {
+    if (node <= 0) return bad("node_ic node", node, "must be a node unknown (> 0)");
+    if (!std::isfinite(v)) return bad("node_ic value", v, "must be finite");
+  }
   return Status::Ok();
 }
 
@@ -128,10 +132,23 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
 
   // Initial state.
   std::vector<double> x(n + 1, 0.0), xdot(n + 1, 0.0), hist_part(n + 1, 0.0), xnew(n + 1);
+  for (const auto& [node, v] : opt.node_ic)
+    if (node > n) return Status::Error(fmt::format("node_ic: unknown {} is out of range", node));
+  // UIC: the charge the capacitors' ic= add beyond C x0, applied on the first step only.
+  std::vector<double> uic_dq;
   if (!opt.uic) {
-    if (Status s = sys.dc(circuit, x); !s.ok()) return s.with_context("DC operating point");
+    if (Status s = sys.dc(circuit, x, opt.node_ic); !s.ok())
+      return s.with_context("DC operating point");
     ++stats.solves;
     ++stats.factorizations;
+  } else {
+    for (const auto& [node, v] : opt.node_ic) x[node] = v;
+    for (const auto& e : circuit.elements()) e->uic_state(x.data());
+    uic_dq.assign(n + 1, 0.0);
+    for (const auto& e : circuit.elements()) e->uic_charge(x.data(), uic_dq.data());
+    uic_dq[0] = 0.0;
+    if (std::all_of(uic_dq.begin(), uic_dq.end(), [](double v) { return v == 0.0; }))
+      uic_dq.clear();
   }
 
   Waveform w;
@@ -182,6 +199,8 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
   double t = 0.0;
   size_t next_bp = 0;
   double h = ladder(0.1 * std::min(hmax, bps[0]));
+  // The UIC step that puts the capacitors' ic= charge in place is not error-checked: keep it short.
+  if (!uic_dq.empty()) h = ladder(1e-3 * h);
   double last_regular_h = hmax;
   bool after_bp = true;  // the next step is the first after a breakpoint (or t = 0)
   int worst_unknown = 0;
@@ -222,11 +241,15 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
     }
     sys.rhs(t + step, xnew);
     sys.sub_c_times(hist_part.data(), xnew.data());
+    if (!uic_dq.empty())  // Euler: C x1 / h = C x0 / h + dq / h + ...
+      for (int u = 1; u <= n; ++u) xnew[u] += uic_dq[u] * inv_step;
     if (Status s = sys.select_or_factor(circuit, a0); !s.ok())
       return s.with_context(fmt::format("transient at t={:g} s", t + step));
     if (Status s = sys.solve(xnew); !s.ok())
       return s.with_context(fmt::format("t={:g} s", t + step));
     ++stats.solves;
+    if (Status s = MnaSystem::check_finite(circuit, xnew, t + step, "transient step"); !s.ok())
+      return s;
 
     // Truncation error h^3 * coef * x''' with x''' = 6 x the third divided difference over the
     // last four points, written as weights on the three successive differences (no division in
@@ -249,6 +272,45 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
           ratio = r;
           worst_unknown = u;
         }
+      }
+    }
+
+    // The first step after a breakpoint (backward Euler, from a history of one point) is checked
+    // one step late: with the second step's point, the second divided difference over the three
+    // points gives x'' and the Euler truncation error h1^2 x'' / 2. When it is too large both
+    // steps are undone and the first one is retried smaller (the second step, at most twice the
+    // first, is then accurate too: its trapezoidal error is third order).
+    if (hist.count == 2 && !watched.empty()) {
+      const double t0 = hist.t(0), t1 = hist.t(1), t2 = t + step;
+      const auto &x0 = hist.x(0), &x1 = hist.x(1);
+      const double h1 = t1 - t0;
+      const double i21 = 1.0 / (t2 - t1), i10 = 1.0 / h1, i20 = 1.0 / (t2 - t0);
+      double ratio1 = 0.0;
+      for (size_t k = 0; k < watched.size(); ++k) {
+        const int u = watched[k];
+        const double dd2 = ((xnew[u] - x1[u]) * i21 - (x1[u] - x0[u]) * i10) * i20;
+        const double r = inv_tol[k] * h1 * h1 * std::fabs(dd2);
+        if (r > ratio1) ratio1 = r, worst_unknown = u;
+      }
+      if (ratio1 > 1.0) {
+        stats.rejected += 2;
+        --stats.accepted;
+        const double h_retry = h1 * std::max(0.1, 0.9 * std::sqrt(1.0 / ratio1));
+        if (h_retry < hmin)
+          return Status::Error(fmt::format(
+              "time step too small at t={:g} s (h={:g} s): the truncation error of {} does not "
+              "converge",
+              t0, h_retry, circuit.unknown_name(worst_unknown)));
+        if (!w.time.empty() && w.time.back() == t1) {  // t1 was written out: take it back
+          w.time.pop_back();
+          for (auto& c : w.columns) c.pop_back();
+        }
+        t = t0;
+        std::copy(x0.begin(), x0.end(), x.begin());
+        hist.reset(t0, x);
+        after_bp = true;
+        h = ladder(h_retry);
+        continue;
       }
     }
 
@@ -280,6 +342,13 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
     if (!lands) last_regular_h = step;
     h = ladder(std::max(step * std::max(grow, 0.5), hmin));
     after_bp = false;
+    if (!uic_dq.empty()) {
+      // The UIC step moved the capacitors' charge to their ic=: restart the formula from here,
+      // as at a breakpoint (x is consistent from now on).
+      uic_dq.clear();
+      after_bp = true;
+      hist.reset(t, x);
+    }
     if (lands) {
       // Restart the formula at the corner: small Euler step, fresh history.
       after_bp = true;

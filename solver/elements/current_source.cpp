@@ -10,7 +10,9 @@ namespace isolink {
 namespace {
 
 constexpr ParamSpec kParams[] = {
-    {"dc", 0.0, "A", "DC value, or PULSE(...) | PWL(...) | SIN(...) as for V"},
+    {"dc", 0.0, "A", "DC value, or PULSE | PWL | SIN | EXP as for V"},
+    {"td", 0.0, "s", "PWL only: delay of the whole PWL"},
+    {"r", -1.0, "s", "PWL only: repeat from this time point, as for V; -1: no repeat"},
 };
 
 class CurrentSource final : public Element {
@@ -48,13 +50,14 @@ StatusOr<std::unique_ptr<Element>> parse(const Card& card) {
 }  // namespace
 
 const ElementKind& current_source_kind() {
-  static const ElementKind kind{'i',
-                                "current source",
-                                "Iname n+ n- [DC] value | PULSE(...) | PWL(...) | SIN(...)",
-                                2,
-                                0,
-                                kParams,
-                                parse};
+  static const ElementKind kind{
+      'i',
+      "current source",
+      "Iname n+ n- [DC] value | PULSE(...) | PWL(...) [td=T] [r=T] | SIN(...) | EXP(...)",
+      2,
+      0,
+      kParams,
+      parse};
   return kind;
 }
 

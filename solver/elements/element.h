@@ -3,7 +3,8 @@
 // Lifecycle (driven by Circuit and the engines, never by users of a kind):
 //   1. parse:   ElementKind::parse(card) -> Element, values checked, nodes still names.
 //   2. connect: Circuit maps node names to unknown indices (0 = ground) and hands out branch
-//               unknowns (branch_count()); link() resolves references to other elements (K -> L).
+//               unknowns (branch_count()); link() resolves references to other elements (K -> L),
+//               then check() tests what needs them all linked.
 //   3. declare: declare(pattern) asks for every matrix entry it will touch, once, and keeps the
 //               slot handles. Entries in the ground row or column come back as the write-only
 //               trash slot, so stamps never test for ground.
@@ -30,7 +31,9 @@ class SourceFunction;
 using Slot = int;  // index into a matrix value array; MnaPattern::kTrash for ground entries
 
 // How an element joins two nodes at DC, for the topology checks before the operating point.
-enum class DcLink { Conductive, VoltageDefining, CurrentSource };
+// Inductive: an inductor, a short at DC; one that would close a loop of voltage sources and
+// inductors is opened instead (its current starts at 0, as ngspice's operating point gives).
+enum class DcLink { Conductive, VoltageDefining, Inductive, CurrentSource };
 struct DcEdge {
   int a, b;
   DcLink link;
@@ -53,6 +56,8 @@ class Element {
   virtual bool branch_is_state() const { return false; }
   // Resolves references to other elements once every element is connected.
   virtual Status link(const Circuit& circuit) { return Status::Ok(); }
+  // Checks that need every element linked (K: the coupled group's inductance matrix).
+  virtual Status check(const Circuit& circuit) const { return Status::Ok(); }
   virtual void declare(MnaPattern& pattern) = 0;
   // Constant values into G and C (value arrays over the declared pattern).
   virtual void stamp(double* g, double* c) const = 0;
@@ -74,6 +79,11 @@ class Element {
   virtual void breakpoints(double tstop, std::vector<double>& out) const {}
   // DC connectivity for the topology checks.
   virtual void dc_edges(std::vector<DcEdge>& out) const {}
+  // .tran ... UIC: the element's initial condition (ic=). uic_state writes a state unknown of
+  // x0 (inductor current); uic_charge adds, for each node, the charge its ic= puts on the
+  // node beyond C x0 (capacitor: c (ic - (v+ - v-)) at n+, the negative at n-).
+  virtual void uic_state(double* x0) const {}
+  virtual void uic_charge(const double* x0, double* dq) const {}
 
   // Called by Circuit while connecting.
   void set_node_names(std::vector<std::string> names) { node_names_ = std::move(names); }
@@ -90,10 +100,11 @@ class Element {
 
 // One row of an element kind's parameter table: feeds the parser, --help and the README.
 struct ParamSpec {
-  const char* name;      // lower case, as written in key=value or as the positional value
-  double default_value;  // NaN when required
-  const char* unit;      // SI unit symbol, "" when dimensionless
-  const char* doc;       // one line
+  const char* name;       // lower case, as written in key=value or as the positional value
+  double default_value;   // NaN when required (or optional, below)
+  const char* unit;       // SI unit symbol, "" when dimensionless
+  const char* doc;        // one line
+  bool optional = false;  // default NaN and optional: absent means not given ("none" in docs)
 };
 
 // One element kind: the registry in elements/registry.cpp lists them all explicitly.

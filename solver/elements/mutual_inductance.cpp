@@ -1,7 +1,10 @@
 // K: magnetic coupling between two inductors, M = k sqrt(L1 L2), dots on the first nodes.
-#include <cmath>
-
+// Several K's may share inductors (a multi-winding transformer); check() tests each group.
 #include <fmt/format.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
 
 #include "solver/circuit.h"
 #include "solver/elements/card_values.h"
@@ -13,7 +16,10 @@ namespace isolink {
 namespace {
 
 constexpr ParamSpec kParams[] = {
-    {"k", NAN, "", "coupling coefficient, 0 < |k| < 1"},
+    {"k", NAN, "",
+     "coupling coefficient, |k| <= 1 (k = 0: no coupling; |k| = 1: ideal coupling, "
+     "the transformer idiom); the inductance matrix of every coupled group must be "
+     "positive semi-definite"},
 };
 
 class MutualInductance final : public Element {
@@ -35,6 +41,48 @@ class MutualInductance final : public Element {
     m_ = k_ * std::sqrt(l_[0]->inductance() * l_[1]->inductance());
     return Status::Ok();
   }
+  // The inductance matrix of the group of inductors this K couples (directly or through other
+  // K's) must be positive semi-definite, or the magnetic energy i'Li / 2 could be negative and
+  // the transient grows without bound (NaN). Reported once per group, by its first K.
+  Status check(const Circuit& circuit) const override {
+    std::vector<const MutualInductance*> ks;
+    for (const auto& e : circuit.elements())
+      if (auto* k = dynamic_cast<const MutualInductance*>(e.get())) ks.push_back(k);
+    // The group: inductors reachable from l_[0] through K's (a fixed point; groups are small).
+    std::vector<const Inductor*> group{l_[0]};
+    auto index = [&](const Inductor* l) {
+      return static_cast<int>(std::find(group.begin(), group.end(), l) - group.begin());
+    };
+    for (bool grew = true; grew;) {
+      grew = false;
+      for (const MutualInductance* k : ks) {
+        const bool in0 = index(k->l_[0]) < static_cast<int>(group.size());
+        const bool in1 = index(k->l_[1]) < static_cast<int>(group.size());
+        if (in0 != in1) group.push_back(in0 ? k->l_[1] : k->l_[0]), grew = true;
+      }
+    }
+    const int n = static_cast<int>(group.size());
+    Eigen::MatrixXd l = Eigen::MatrixXd::Zero(n, n);
+    std::string names;
+    for (int i = 0; i < n; ++i) l(i, i) = group[i]->inductance();
+    for (const MutualInductance* k : ks) {
+      const int a = index(k->l_[0]), b = index(k->l_[1]);
+      if (a >= n || b >= n) continue;
+      if (k != this && names.empty()) return Status::Ok();  // not the group's first K
+      names += (names.empty() ? "" : ", ") + k->name();
+      l(a, b) += k->m_, l(b, a) += k->m_;
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(l, Eigen::EigenvaluesOnly);
+    const double lo = eig.eigenvalues().minCoeff(), hi = eig.eigenvalues().maxCoeff();
+    if (lo >= -1e-9 * hi) return Status::Ok();
+    std::string inductors;
+    for (const Inductor* x : group) inductors += (inductors.empty() ? "" : ", ") + x->name();
+    return error_at(loc_, fmt::format("the couplings {} make the inductance matrix of {} not "
+                                      "positive semi-definite (smallest eigenvalue {:.4g} H): "
+                                      "these k values cannot all hold at once, and the "
+                                      "transient would grow without bound",
+                                      names, inductors, lo));
+  }
   void declare(MnaPattern& p) override {
     s12_ = p.slot(l_[0]->branch(), l_[1]->branch());
     s21_ = p.slot(l_[1]->branch(), l_[0]->branch());
@@ -53,16 +101,16 @@ StatusOr<std::unique_ptr<Element>> parse(const Card& card) {
   if (Status s = check_params(card, kParams); !s.ok()) return s;
   StatusOr<double> k = card_value(card, kParams, "k", 0);
   if (!k) return k.status();
-  if (!(std::fabs(*k) > 0 && std::fabs(*k) < 1))
+  if (!(std::fabs(*k) <= 1))
     return error_at(value_loc(card, "k", 0),
-                    fmt::format("coupling of {} must satisfy 0 < |k| < 1, got {:g}", card.name, *k));
+                    fmt::format("coupling of {} must satisfy |k| <= 1, got {:g}", card.name, *k));
   return std::unique_ptr<Element>(std::make_unique<MutualInductance>(card, *k));
 }
 
 }  // namespace
 
 const ElementKind& mutual_inductance_kind() {
-  static const ElementKind kind{'k', "mutual inductance", "Kname Lname1 Lname2 k", 0, 2, kParams,
+  static const ElementKind kind{'k',  "mutual inductance", "Kname Lname1 Lname2 k", 0, 2, kParams,
                                 parse};
   return kind;
 }

@@ -11,8 +11,13 @@ namespace {
 
 constexpr ParamSpec kParams[] = {
     {"dc", 0.0, "V",
-     "DC value, or PULSE(V1 V2 TD TR TF PW PER NP) | PWL(t v ...) | "
-     "SIN(VO VA F TD THETA PHASE)"},
+     "DC value (positional, DC VALUE or dc=VALUE); a PULSE(V1 V2 TD TR TF PW PER "
+     "NP), PWL(t v ...), SIN(VO VA F TD THETA PHASE) or EXP(V1 V2 TD1 TAU1 TD2 "
+     "TAU2) function, parentheses optional, sets the transient"},
+    {"td", 0.0, "s", "PWL only: delay of the whole PWL"},
+    {"r", -1.0, "s",
+     "PWL only: repeat the PWL from this time point (one of its times) to its "
+     "last time, for ever; -1: no repeat"},
 };
 
 class VoltageSource final : public Element {
@@ -54,13 +59,14 @@ StatusOr<std::unique_ptr<Element>> parse(const Card& card) {
 }  // namespace
 
 const ElementKind& voltage_source_kind() {
-  static const ElementKind kind{'v',
-                                "voltage source",
-                                "Vname n+ n- [DC] value | PULSE(...) | PWL(...) | SIN(...)",
-                                2,
-                                0,
-                                kParams,
-                                parse};
+  static const ElementKind kind{
+      'v',
+      "voltage source",
+      "Vname n+ n- [DC] value | PULSE(...) | PWL(...) [td=T] [r=T] | SIN(...) | EXP(...)",
+      2,
+      0,
+      kParams,
+      parse};
   return kind;
 }
 

@@ -42,6 +42,16 @@ StatusOr<Waveform> run_ngspice(const std::string& netlist, const std::vector<std
       path.erase(path.find_last_not_of(" \t\"") + 1);
       line = ".include " + (fs::absolute(fs::path(netlist).parent_path() / path)).string();
     }
+    if (l.rfind(".lib", 0) == 0 && l.size() > 4 && std::isspace(static_cast<unsigned char>(l[4]))) {
+      std::istringstream ws(line.substr(4));  // .lib FILE SECTION: make FILE absolute
+      std::string file, section;
+      if (ws >> file >> section) {
+        if (file.size() > 1 && (file[0] == '"' || file[0] == '\''))
+          file = file.substr(1, file.size() - 2);
+        line =
+            ".lib " + fs::absolute(fs::path(netlist).parent_path() / file).string() + " " + section;
+      }
+    }
     out << line << "\n";
   }
   out << extra << "\n.control\nset wr_singlescale\nset wr_vecnames\noption numdgt=12\nrun\nwrdata "

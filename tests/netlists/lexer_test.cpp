@@ -52,7 +52,8 @@ TEST(SpiceNumber, Malformed) {
   EXPECT_FALSE(parse_number("", v));
   EXPECT_FALSE(parse_number("-", v));
   EXPECT_FALSE(parse_number(".", v));
-  EXPECT_FALSE(parse_number("1k5", v));
+  EXPECT_FALSE(parse_number("1k5.2", v));
+  EXPECT_FALSE(parse_number("1.5k2", v));
   EXPECT_FALSE(parse_number("1_0", v));
   // An 'e' with no exponent digits was read as 1 with a unit letter (issue 15).
   EXPECT_FALSE(parse_number("1e", v));
@@ -60,6 +61,23 @@ TEST(SpiceNumber, Malformed) {
   EXPECT_FALSE(parse_number("2.2E-", v));
   EXPECT_TRUE(parse_number("1e3", v));
   EXPECT_EQ(v, 1000.0);
+}
+
+// RKM (IEC 60062): the letter is the decimal point and the scale.
+TEST(SpiceNumber, RkmNotation) {
+  double v = 0;
+  ASSERT_TRUE(parse_number("4K7", v));
+  EXPECT_EQ(v, 4.7e3);
+  ASSERT_TRUE(parse_number("2R2", v));
+  EXPECT_EQ(v, 2.2);
+  ASSERT_TRUE(parse_number("1u5", v));
+  EXPECT_EQ(v, 1.5e-6);
+  ASSERT_TRUE(parse_number("4m7ohm", v));
+  EXPECT_EQ(v, 4.7e-3);
+  ASSERT_TRUE(parse_number("10k25", v));
+  EXPECT_EQ(v, 10.25e3);
+  ASSERT_TRUE(parse_number("1meg", v));  // not RKM: no digit after the letter
+  EXPECT_EQ(v, 1e6);
 }
 
 TEST(SpiceNumber, ScanStopsAfterUnit) {

@@ -217,10 +217,66 @@ TEST(Lti, RefusesASinSourceNamingIt) {
   Status s = check_lti(b->circuit);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("'vsin'"), std::string::npos) << s.message();
-  EXPECT_NE(s.message().find("not piecewise linear"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("not a continuous piecewise-linear"), std::string::npos)
+      << s.message();
   LtiOptions opt;
   opt.horizon = 1e-6;
   EXPECT_FALSE(LtiResponses::compute(b->circuit, b->probes, opt).ok());
+}
+
+TEST(Lti, RefusesExpAndAJumpingPwlRepeatButTakesAContinuousOne) {
+  auto refused = [](std::vector<CardArg> args, const char* name) {
+    auto b = make({card(name, {"in", "0"}, std::move(args)), card("r1", {"in", "0"}, {num(1e3)})},
+                  {"v(in)"});
+    Status s = check_lti(b->circuit);
+    return !s.ok() && s.message().find(std::string("'") + name + "'") != std::string::npos;
+  };
+  EXPECT_TRUE(refused({call("exp", {0, 1, 0, 1e-9, 5e-9, 1e-9})}, "vexp"));
+  // r=0: repeats from t=0 (value 0) after t=1u (value 1): a jump of 1 V every microsecond.
+  Card jump = card("vjump", {"in", "0"}, {call("pwl", {0, 0, 1e-6, 1})});
+  CardArg r0 = num(0.0);
+  jump.params.emplace_back("r", r0);
+  auto bj = make({jump, card("r1", {"in", "0"}, {num(1e3)})}, {"v(in)"});
+  EXPECT_FALSE(check_lti(bj->circuit).ok());
+  // A triangle that ends where it starts repeats without a jump: a sum of ramps.
+  Card tri = card("vtri", {"in", "0"}, {call("pwl", {0, 0, 1e-6, 1, 2e-6, 0})});
+  tri.params.emplace_back("r", r0);
+  auto bt = make({tri, card("r1", {"in", "0"}, {num(1e3)})}, {"v(in)"});
+  EXPECT_TRUE(check_lti(bt->circuit).ok()) << check_lti(bt->circuit).message();
+}
+
+TEST(Lti, RefusesAnInductorOpenedForTheDcPoint) {
+  auto b = make({card("v1", {"in", "0"}, {call("pwl", {0, 0, 1e-9, 1})}),
+                 card("l1", {"in", "0"}, {num(1e-6)})},
+                {"i(l1)"});
+  Status s = check_lti(b->circuit);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("opened for the DC"), std::string::npos) << s.message();
+}
+
+// The output grid rule holds its 1 uA promise in the cell just after a corner too: an RL lag
+// of tau = 0.5 ns, driven by a 10 ns ramp whose end is inside the first 20 ns cell, read by
+// linear interpolation between the rows against the closed-form ramp response.
+TEST(Lti, GridRuleMeetsItsToleranceRightAfterACorner) {
+  const double r = 2e3, l = 1e-6, tau = l / r, a = 1.0 / 10e-9;  // input slope V/s
+  auto b = make({card("v1", {"in", "0"}, {call("pwl", {0, 0, 10e-9, 1, 1e-6, 1})}),
+                 card("r1", {"in", "x"}, {num(r)}), card("l1", {"x", "0"}, {num(l)})},
+                {"i(l1)"});
+  LtiResponses lti = responses(*b, 1e-6);
+  LtiResponses::GridOptions grid;
+  grid.tstop = 1e-6;
+  Waveform w = lti.waveform(lti.netlist_inputs(1e-6), grid);
+  auto exact = [&](double t) {  // i = (a / r) * (lag_ramp(t) - lag_ramp(t - 10 ns))
+    return a / r * (lag_ramp(t, tau) - lag_ramp(t - 10e-9, tau));
+  };
+  double worst = 0;
+  for (size_t i = 0; i + 1 < w.time.size(); ++i)
+    for (double f : {0.25, 0.5, 0.75}) {
+      const double t = w.time[i] + f * (w.time[i + 1] - w.time[i]);
+      const double lin = w.columns[0][i] + f * (w.columns[0][i + 1] - w.columns[0][i]);
+      worst = std::max(worst, std::fabs(lin - exact(t)));
+    }
+  EXPECT_LT(worst, 1.2e-6) << "rows: " << w.time.size();  // 1 uA target, 20 % for the march
 }
 
 TEST(Lti, OptionsAreValidatedByName) {
