@@ -531,6 +531,18 @@ Waveform LtiResponses::waveform(const std::vector<SourceInput>& inputs, const Gr
         }
       }
       if (worst <= 0.5 * grid.interp_tol) break;
+      // Budgeted: a smooth response's interpolation error falls as dt^2, so the step that meets
+      // the tolerance is about dt sqrt(tol / worst); when even that level would be over budget,
+      // stop now instead of computing the levels on the way (a kink needs finer still).
+      if (grid.max_evaluations > 0) {
+        const double final_dt = dt * std::sqrt(0.5 * grid.interp_tol / worst);
+        const double predicted = static_cast<double>(np) * reach / final_dt;
+        if (predicted > grid.max_evaluations) {
+          gi.evaluations += predicted;
+          gi.over_budget = true;
+          return Waveform{};
+        }
+      }
       if (2 * count - 1 > grid.max_rows) {
         gi.warning = fmt::format(
             "LTI output grid stopped at {} rows (step {:g} s): linear interpolation between rows "

@@ -128,10 +128,11 @@ class LtiResponses {
     double interp_tol = 1e-3;       // V for voltage probes (A/1000 for currents: 1 uA)
     std::vector<bool> grid_probes;  // which probes the rule looks at (empty = all)
     long max_rows = 4'000'000;      // the rule stops refining here (a warning says so)
-    // 0: no limit. Otherwise the most probe evaluations the superposition may take: before each
-    // grid level the rule predicts them (probes x sum over ramps of the rows inside the march
-    // window) and, over the limit, stops with GridInfo::over_budget and an empty waveform (the
-    // `auto` engine then runs the transient, which is cheaper there).
+    // 0: no limit. Otherwise the most probe evaluations one grid level's superposition may take:
+    // before each level the rule predicts them (probes x sum over ramps of the rows inside the
+    // march window), and after each it predicts the level that will meet interp_tol (the error
+    // of a smooth response falls as step^2); over the limit it stops with
+    // GridInfo::over_budget and an empty waveform (`auto` then runs the transient, cheaper there).
     double max_evaluations = 0.0;
   };
   struct GridInfo {
