@@ -1,8 +1,8 @@
 #include "analysis/link_run.h"
 
-#include <chrono>
-
 #include <fmt/format.h>
+
+#include <chrono>
 
 namespace isolink::analysis {
 
@@ -28,62 +28,71 @@ const std::vector<std::string>& run_probes() {
   return probes;
 }
 
+StatusOr<DirectionRun> run_direction(link::ExpandedLink link, const RunOptions& opt) {
+  DirectionRun dr;
+  dr.link = std::move(link);
+  SimulationRequest req;
+  req.probes = run_probes();
+  req.reltol = opt.reltol;
+  req.engine = opt.engine;
+  // The LTI grid follows the receiver probes; v(txp,txn) is the ideal PWL drive, whose corners
+  // a uniform grid could only meet within 1 mV at a few ps (it is only plotted).
+  req.grid_probes = {true, true, true, false};
+  StatusOr<SimulationResult> sim = simulate_netlist(dr.link.netlist, req);
+  if (!sim) return sim.status().with_context(dr.link.description);
+  dr.sim = std::move(*sim);
+
+  StatusOr<eye::Rules> rules = eye::load_rules(dr.link.rules);
+  if (!rules) return rules.status();
+  dr.rules = *rules;
+
+  // Tone windows: from each tone's first edge to 4.5 us after its last (tblank + margin).
+  std::vector<std::pair<double, double>> tone_windows;
+  bool any_data = false;
+  for (const traffic::DriveFrame& f : dr.link.drive.frames) {
+    if (f.kind == traffic::FrameKind::kTone)
+      tone_windows.push_back({f.start - 0.5e-6, f.end + 4.5e-6});
+    else
+      any_data = true;
+  }
+  std::vector<double> t, v;
+  dr.pass = true;
+  if (any_data) {
+    filter(dr.sim.wave, tone_windows, false, t, v);
+    eye::CheckOptions co;
+    co.expect = dr.link.expected;
+    StatusOr<eye::CheckResult> r = eye::check_samples(t, v, dr.rules, co);
+    if (!r) return r.status().with_context(dr.link.description + ", data check");
+    dr.data = std::move(*r);
+    dr.pass = dr.pass && dr.data->pass;
+  }
+  if (!tone_windows.empty()) {
+    StatusOr<eye::Rules> tone_rules = eye::load_rules("tone");
+    if (!tone_rules) return tone_rules.status();
+    dr.tone_rules = *tone_rules;
+    filter(dr.sim.wave, tone_windows, true, t, v);
+    StatusOr<eye::CheckResult> r = eye::check_samples(t, v, dr.tone_rules, {});
+    if (!r) return r.status().with_context(dr.link.description + ", tone check");
+    dr.tones = std::move(*r);
+    dr.pass = dr.pass && dr.tones->pass;
+  }
+  return dr;
+}
+
 StatusOr<LinkRun> run_link(const link::LinkSpec& spec, const link::PartLibrary& parts,
                            const RunOptions& opt) {
   LinkRun run;
   const auto start = std::chrono::steady_clock::now();
   run.pass = true;
   for (link::Direction d : spec.stimulus.directions) {
-    DirectionRun dr;
     StatusOr<link::ExpandedLink> ex = link::expand_link(spec, parts, d, opt.expand);
     if (!ex) return ex.status();
-    dr.link = std::move(*ex);
-    SimulationRequest req;
-    req.probes = run_probes();
-    req.reltol = opt.reltol;
-    StatusOr<SimulationResult> sim = simulate_netlist(dr.link.netlist, req);
-    if (!sim) return sim.status().with_context(dr.link.description);
-    dr.sim = std::move(*sim);
-
-    StatusOr<eye::Rules> rules = eye::load_rules(dr.link.rules);
-    if (!rules) return rules.status();
-    dr.rules = *rules;
-
-    // Tone windows: from each tone's first edge to 4.5 us after its last (tblank + margin).
-    std::vector<std::pair<double, double>> tone_windows;
-    bool any_data = false;
-    for (const traffic::DriveFrame& f : dr.link.drive.frames) {
-      if (f.kind == traffic::FrameKind::kTone)
-        tone_windows.push_back({f.start - 0.5e-6, f.end + 4.5e-6});
-      else
-        any_data = true;
-    }
-    std::vector<double> t, v;
-    dr.pass = true;
-    if (any_data) {
-      filter(dr.sim.wave, tone_windows, false, t, v);
-      eye::CheckOptions co;
-      co.expect = dr.link.expected;
-      StatusOr<eye::CheckResult> r = eye::check_samples(t, v, dr.rules, co);
-      if (!r) return r.status().with_context(dr.link.description + ", data check");
-      dr.data = std::move(*r);
-      dr.pass = dr.pass && dr.data->pass;
-    }
-    if (!tone_windows.empty()) {
-      StatusOr<eye::Rules> tone_rules = eye::load_rules("tone");
-      if (!tone_rules) return tone_rules.status();
-      dr.tone_rules = *tone_rules;
-      filter(dr.sim.wave, tone_windows, true, t, v);
-      StatusOr<eye::CheckResult> r = eye::check_samples(t, v, dr.tone_rules, {});
-      if (!r) return r.status().with_context(dr.link.description + ", tone check");
-      dr.tones = std::move(*r);
-      dr.pass = dr.pass && dr.tones->pass;
-    }
-    run.pass = run.pass && dr.pass;
-    run.directions.push_back(std::move(dr));
+    StatusOr<DirectionRun> dr = run_direction(std::move(*ex), opt);
+    if (!dr) return dr.status();
+    run.pass = run.pass && dr->pass;
+    run.directions.push_back(std::move(*dr));
   }
-  run.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return run;
 }
 

@@ -5,7 +5,8 @@
 //   StatusOr<LinkRun> run = run_link(spec, *parts, {});
 //   for (const DirectionRun& d : run->directions) ... d.data_check->pass, d.sim.wave ...
 //   return run->pass ? 0 : 1;
-// Each direction is its own transient (the link is half-duplex). Data frames are scored with the
+// Each direction is its own simulation (the link is half-duplex): LTI engine by default, the
+// transient on request (RunOptions::engine). Data frames are scored with the
 // receiving device's rule set and tones with the tone rules, each over its own time windows.
 #pragma once
 
@@ -24,23 +25,24 @@ namespace isolink::analysis {
 
 struct DirectionRun {
   link::ExpandedLink link;
-  SimulationResult sim;                     // columns: v(rxp,rxn), v(rxp), v(rxn), v(txp,txn)
-  eye::Rules rules;                         // the receiver's data rules
-  eye::Rules tone_rules;                    // the tone rules (when tones were sent)
-  std::optional<eye::CheckResult> data;     // the data frames' check (when any were sent)
-  std::optional<eye::CheckResult> tones;    // the tones' check (when any were sent)
+  SimulationResult sim;                   // columns: v(rxp,rxn), v(rxp), v(rxn), v(txp,txn)
+  eye::Rules rules;                       // the receiver's data rules
+  eye::Rules tone_rules;                  // the tone rules (when tones were sent)
+  std::optional<eye::CheckResult> data;   // the data frames' check (when any were sent)
+  std::optional<eye::CheckResult> tones;  // the tones' check (when any were sent)
   bool pass = false;
 };
 
 struct LinkRun {
   std::vector<DirectionRun> directions;
-  bool pass = false;                        // every direction passes
-  double seconds = 0;                       // wall time, all directions
+  bool pass = false;   // every direction passes
+  double seconds = 0;  // wall time, all directions
 };
 
 struct RunOptions {
   link::ExpandOptions expand;
-  std::optional<double> reltol;             // overrides the spec's sim.reltol
+  std::optional<double> reltol;  // overrides the spec's sim.reltol
+  Engine engine = Engine::Auto;  // LTI when the link allows it (every link today)
 };
 
 // The probes recorded per direction, in column order.
@@ -48,6 +50,9 @@ const std::vector<std::string>& run_probes();
 
 StatusOr<LinkRun> run_link(const link::LinkSpec& spec, const link::PartLibrary& parts,
                            const RunOptions& opt = {});
+// One expanded direction simulated and scored: run_link's work per direction (packs expand every
+// hop first and simulate each distinct circuit once).
+StatusOr<DirectionRun> run_direction(link::ExpandedLink link, const RunOptions& opt = {});
 
 // The probes of every direction, resampled onto one uniform axis, columns "down v(rxp,rxn)", ...
 Waveform run_waveforms(const LinkRun& run, double dt);

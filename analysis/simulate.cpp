@@ -1,15 +1,36 @@
 #include "analysis/simulate.h"
 
+#include <fmt/format.h>
+
+#include <algorithm>
 #include <chrono>
 
 #include "solver/circuit.h"
 
 namespace isolink::analysis {
 
-StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const SimulationRequest& req) {
-  SimulationResult result;
-  result.warnings = netlist.warnings;
+const char* engine_name(Engine e) {
+  switch (e) {
+    case Engine::Auto:
+      return "auto";
+    case Engine::Lti:
+      return "lti";
+    case Engine::Transient:
+      return "transient";
+  }
+  return "auto";
+}
 
+StatusOr<Engine> parse_engine(const std::string& text) {
+  for (Engine e : {Engine::Auto, Engine::Lti, Engine::Transient})
+    if (text == engine_name(e)) return e;
+  return Status::Error("engine '" + text + "' is not one of auto, lti, transient");
+}
+
+namespace {
+
+StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequest& req,
+                                    SimulationResult& result) {
   TransientOptions opt;
   if (netlist.tran) {
     opt.tstep = netlist.tran->tstep;
@@ -22,8 +43,8 @@ StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const Simula
     bool known = true;
     if (Status s = opt.set_option(o.key, o.value, &known); !s.ok()) return s;
     if (!known)
-      result.warnings.push_back(
-          format_diagnostic(o.loc, "warning", "option '" + o.key + "' is not used by isolink; ignored"));
+      result.warnings.push_back(format_diagnostic(
+          o.loc, "warning", "option '" + o.key + "' is not used by isolink; ignored"));
   }
   if (req.tstop) opt.tstop = *req.tstop;
   if (req.tstep) opt.tstep = *req.tstep;
@@ -34,12 +55,30 @@ StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const Simula
     return Status::Error("no .tran card in the netlist and no --tstop given: nothing to simulate");
   if (opt.tstep <= 0 && opt.tstop > 0) opt.tstep = opt.tstop / 1000;
   if (Status s = opt.validate(); !s.ok()) return s;
+  if (req.grid_step > 0) {
+    // Refused before any work: --step 1e-30 over 5 us asks for 5e24 rows (the LTI grid and the
+    // transient's resampling would both allocate them).
+    const double rows = (opt.tstop - opt.tstart) / req.grid_step + 1;
+    if (!(rows <= static_cast<double>(kMaxGridRows)))
+      return Status::Error(fmt::format(
+          "--step {:g} over the {:.6g} s run asks for {:.3g} rows; the limit is {} rows (use a "
+          "larger --step, or no --step for the engine's own time points)",
+          req.grid_step, opt.tstop - opt.tstart, rows, kMaxGridRows));
+  }
 
   Circuit circuit;
   for (const Card& card : netlist.cards)
     if (Status s = circuit.add(card); !s.ok()) return s;
   if (Status s = circuit.finalize(); !s.ok()) return s;
   for (const auto& w : circuit.warnings()) result.warnings.push_back(w);
+  for (const InitialVoltage& ic : netlist.initial_voltages) {
+    const int node = circuit.find_node(ic.node);
+    if (node <= 0)
+      return error_at(ic.loc,
+                      node == 0 ? "'.ic' on the ground node"
+                                : "'.ic' names node '" + ic.node + "', which no element connects");
+    opt.node_ic.emplace_back(node, ic.value);
+  }
 
   std::vector<Probe> probes;
   for (const auto& text : req.probes) {
@@ -47,17 +86,87 @@ StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const Simula
     if (!p) return p.status();
     probes.push_back(*p);
   }
-  if (probes.empty()) return Status::Error("no --probe given: say what to record, e.g. --probe 'v(rxp,rxn)'");
+  if (probes.empty())
+    return Status::Error("no --probe given: say what to record, e.g. --probe 'v(rxp,rxn)'");
+
+  result.nodes = circuit.node_count() - 1;
+  result.unknowns = circuit.unknown_count();
+  result.elements = static_cast<int>(circuit.elements().size());
 
   const auto start = std::chrono::steady_clock::now();
+  if (req.engine != Engine::Transient) {
+    Status lti_ok = opt.uic ? Status::Error(
+                                  ".tran uic starts from zero, not from the DC operating "
+                                  "point: the LTI engine needs the operating point")
+                    : !opt.node_ic.empty()
+                        ? Status::Error(
+                              "'.ic' holds nodes for the DC point: the LTI engine starts from "
+                              "the circuit's own operating point")
+                        : check_lti(circuit);
+    if (!lti_ok.ok() && req.engine == Engine::Lti) return lti_ok;
+    if (lti_ok.ok()) {
+      for (const auto& e : circuit.elements()) e->bind_time(opt.tstep, opt.tstop);
+      LtiOptions lo;
+      lo.horizon = opt.tstop;
+      // auto: a march longer than kAutoLtiMaxSteps costs more than the transient of any example
+      // link (the longest takes 190k steps), so auto stops there and runs the transient.
+      if (req.engine == Engine::Auto) lo.max_steps = std::min(lo.max_steps, kAutoLtiMaxSteps);
+      StatusOr<LtiResponses> responses = LtiResponses::compute(circuit, probes, lo);
+      // auto: a response march that cannot meet its error control falls back to the transient
+      // engine (the cross-check) and says why; a forced `lti` reports the failure.
+      if (!responses && req.engine == Engine::Lti) return responses.status();
+      if (responses) {
+        LtiResponses::GridOptions grid;
+        grid.tstart = opt.tstart;
+        grid.tstop = opt.tstop;
+        grid.step = req.grid_step;
+        grid.grid_probes = req.grid_probes;
+        // auto: the LTI output only when it costs about what the transient would (a transient
+        // step costs about an unknown's worth of work per unknown, as does a probe evaluation).
+        if (req.engine == Engine::Auto)
+          grid.max_evaluations =
+              kAutoLtiBudget * static_cast<double>(responses->stats().steps) * result.unknowns;
+        result.wave = responses->waveform(responses->netlist_inputs(opt.tstop), grid, &result.grid);
+      }
+      if (responses && result.grid.over_budget) {
+        lti_ok = Status::Error(fmt::format(
+            "the LTI output grid would take {:.3g} probe evaluations, more than the transient "
+            "costs here ({} march steps x {} unknowns x {:g})",
+            result.grid.evaluations, responses->stats().steps, result.unknowns, kAutoLtiBudget));
+        result.grid = {};
+      } else if (responses) {
+        if (!result.grid.warning.empty())
+          result.warnings.push_back("warning: " + result.grid.warning);
+        result.lti = responses->stats();
+        result.engine = Engine::Lti;
+        result.seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        return result;
+      } else {
+        lti_ok = Status::Error("the LTI response march failed: " + responses.status().message());
+      }
+    }
+    result.engine_note = lti_ok.message();
+  }
   StatusOr<Waveform> wave = run_transient(circuit, opt, probes, &result.stats);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!wave) return wave.status();
   result.wave = std::move(*wave);
-  result.nodes = circuit.node_count() - 1;
-  result.unknowns = circuit.unknown_count();
-  result.elements = static_cast<int>(circuit.elements().size());
+  result.engine = Engine::Transient;
   return result;
+}
+
+}  // namespace
+
+StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const SimulationRequest& req) {
+  SimulationResult result;
+  result.warnings = netlist.warnings;
+  StatusOr<SimulationResult> r = simulate(netlist, req, result);
+  if (r.ok() || result.warnings.empty()) return r;
+  // Warnings first: a skipped card or a tied node may be why the run failed.
+  std::string text;
+  for (const std::string& w : result.warnings) text += w + "\n";
+  return Status::Error(text + r.status().message());
 }
 
 }  // namespace isolink::analysis

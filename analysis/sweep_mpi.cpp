@@ -122,7 +122,7 @@ StatusOr<SweepOutcome> run_sweep_mpi(const SweepSpec& s, const link::PartLibrary
         std::fprintf(stderr, "sweep: rank %d sent a row that does not parse (%s): %s\n", from,
                      r.status().message().c_str(), line.c_str());
     }
-    if (todo.empty()) {
+    if (todo.empty() || !L.status().ok()) {  // a row that could not be written stops the sweep
       send_index(-1, from);
       --active;
     } else {
@@ -130,6 +130,7 @@ StatusOr<SweepOutcome> run_sweep_mpi(const SweepSpec& s, const link::PartLibrary
       todo.pop_front();
     }
   }
+  if (Status st = L.status(); !st.ok()) return st;
   SweepOutcome out;
   out.skipped = L.skipped();
   if (Status st = finish_sweep(s, L.results(), opt, &out); !st.ok()) return st;

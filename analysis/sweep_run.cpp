@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -15,8 +16,10 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <system_error>
 
-#include "base/atomic_file.h"
+#include "base/csv.h"
+#include "base/file_io.h"
 
 namespace isolink::analysis::sweep {
 
@@ -36,14 +39,12 @@ double now_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"') out += '"';
-    out += (c == '\n' || c == '\r') ? ' ' : c;
-  }
-  return out + "\"";
+// One line per CSV record (results.csv is read back line by line on --resume).
+std::string cell(const std::string& s) {
+  std::string flat = s;
+  for (char& c : flat)
+    if (c == '\n' || c == '\r') c = ' ';
+  return csv_field(flat);
 }
 
 std::string num(double v) {
@@ -74,37 +75,6 @@ std::string duration_text(double s) {
   return fmt::format("{} h {:02} min", t / 3600, (t % 3600) / 60);
 }
 
-std::vector<std::string> split_csv_line(std::string_view line) {
-  std::vector<std::string> out;
-  std::string cur;
-  bool quoted = false, was_quoted = false;
-  for (size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted) {
-      if (c == '"') {
-        if (i + 1 < line.size() && line[i + 1] == '"') {
-          cur += '"';
-          ++i;
-        } else {
-          quoted = false;
-        }
-      } else {
-        cur += c;
-      }
-    } else if (c == '"' && cur.empty() && !was_quoted) {
-      quoted = was_quoted = true;
-    } else if (c == ',') {
-      out.push_back(cur);
-      cur.clear();
-      was_quoted = false;
-    } else if (c != '\r' && c != '\n') {
-      cur += c;
-    }
-  }
-  out.push_back(cur);
-  return out;
-}
-
 std::vector<std::string> results_header(const SweepSpec& s) {
   std::vector<std::string> h{"point"};
   for (const std::string& c : s.point_columns()) h.push_back(c);
@@ -114,7 +84,7 @@ std::vector<std::string> results_header(const SweepSpec& s) {
 
 std::string results_row(const PointResult& r) {
   std::string line = fmt::format("{}", r.index);
-  auto add = [&line](const std::string& f) { line += "," + csv_field(f); };
+  auto add = [&line](const std::string& f) { line += "," + cell(f); };
   for (const std::string& c : r.cells) add(c);
   add(r.verdict);
   add(r.worst_metric);
@@ -272,8 +242,7 @@ StatusOr<std::unique_ptr<ResultLog>> ResultLog::open(const SweepSpec& s, const S
   log->ncolumns_ = header.size();
   log->path_ = opt.out_dir + "/results.csv";
   std::string header_line;
-  for (const std::string& h : header)
-    header_line += (header_line.empty() ? "" : ",") + csv_field(h);
+  for (const std::string& h : header) header_line += (header_line.empty() ? "" : ",") + cell(h);
   header_line += "\n";
 
   std::string keep = header_line;
@@ -353,10 +322,18 @@ void ResultLog::add(const PointResult& in) {
   const PointResult r = round_trip(padded, ncells_, ncolumns_);
   const std::string row = results_row(r);
   std::lock_guard<std::mutex> lock(mu_);
-  if (r.index >= total_ || have_[r.index]) return;
+  if (r.index >= total_ || have_[r.index] || !write_error_.ok()) return;
+  // Checked: a row the disk did not take is not counted, and the sweep stops (status()).
+  if (std::fputs(row.c_str(), file_) < 0 || std::fflush(file_) != 0) {
+    const int err = errno;
+    write_error_ = Status::Error(fmt::format(
+        "{}: error: cannot append the row of point {}: {}; {} of {} points are recorded: free "
+        "some space and run again with --resume",
+        path_, r.index, std::error_code(err, std::generic_category()).message(),
+        skipped_ + done_now_, total_));
+    return;
+  }
   have_[r.index] = true;
-  std::fputs(row.c_str(), file_);
-  std::fflush(file_);
   results_.push_back(r);
   ++done_now_;
   if (r.verdict == "pass") ++pass_;
@@ -642,10 +619,11 @@ StatusOr<SweepOutcome> run_sweep(const SweepSpec& s, const link::PartLibrary& pa
         tbb::blocked_range<size_t>(0, todo.size(), 1),
         [&](const tbb::blocked_range<size_t>& range) {
           for (size_t i = range.begin(); i != range.end(); ++i)
-            L.add(run_point(s, parts, todo[i], opt.point));
+            if (L.status().ok()) L.add(run_point(s, parts, todo[i], opt.point));
         },
         tbb::simple_partitioner());
   });
+  if (Status st = L.status(); !st.ok()) return st;
   SweepOutcome out;
   out.skipped = L.skipped();
   if (Status st = finish_sweep(s, L.results(), opt, &out); !st.ok()) return st;

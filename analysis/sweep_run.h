@@ -41,6 +41,7 @@
 
 #include "analysis/link_run.h"
 #include "analysis/sweep_spec.h"
+#include "base/csv.h"
 #include "netlists/link/parts.h"
 #include "base/status.h"
 
@@ -72,8 +73,8 @@ std::string results_row(const PointResult& r);
 StatusOr<PointResult> parse_results_row(std::string_view line, size_t ncells, size_t ncolumns);
 // The result as the CSV stores it (numbers rounded to what is written).
 PointResult round_trip(const PointResult& r, size_t ncells, size_t ncolumns);
-// Splits one CSV line (RFC 4180 quoting, no newlines inside fields).
-std::vector<std::string> split_csv_line(std::string_view line);
+// One CSV line back into its fields (base/csv.h; results.csv has no newlines inside fields).
+using isolink::split_csv_line;
 
 // Scores a finished run: verdict, margins, decoded_ok.
 PointResult score_run(const LinkRun& run);
@@ -120,8 +121,13 @@ class ResultLog {
   // Point indices still to run, ascending.
   std::vector<size_t> todo() const;
   size_t skipped() const { return skipped_; }
-  // Records a result (thread-safe): appends its row, prints progress.
+  // Records a result (thread-safe): appends its row (checked), prints progress. After a failed
+  // write nothing more is recorded and status() says why.
   void add(const PointResult& r);
+  Status status() const {
+    std::lock_guard<std::mutex> lock(mu_);
+    return write_error_;
+  }
   // Every result so far, by point index.
   std::vector<PointResult> results() const;
   const std::string& path() const { return path_; }
@@ -138,6 +144,7 @@ class ResultLog {
   double start_ = 0, last_print_ = -1;
   std::vector<PointResult> results_;
   std::vector<bool> have_;
+  Status write_error_;
   mutable std::mutex mu_;
 };
 

@@ -4,13 +4,12 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <numbers>
 #include <random>
-#include <sstream>
 
-#include "netlists/lexer.h"
+#include "base/file_io.h"
+#include "base/si_number.h"
 
 namespace isolink::analysis::sweep {
 
@@ -172,7 +171,7 @@ bool parse_number_for(const std::string& path, const std::string& text, double* 
   const Unit u = key_unit(path);
   if (u != Unit::kNone) return config::parse_quantity(text, u, out);
   double v = 0;
-  if (!spice::parse_number(text, v)) return false;
+  if (!parse_si_number(text, v)) return false;
   *out = v;
   return true;
 }
@@ -251,8 +250,8 @@ Status read_axis(const SweepSpec& s, const YamlDoc& doc, const YAML::Node& key_n
                char* end = nullptr;
                const long x = std::strtol(t.c_str(), &end, 10);
                if (t.empty() || *end != '\0' || x < 1 || x > 100000)
-                 return doc.error(n, fmt::format("key '{}': steps must be a whole number >= 1, "
-                                                 "found '{}'",
+                 return doc.error(n, fmt::format("key '{}': steps must be a whole number from 1 "
+                                                 "to 100000, found '{}'",
                                                  p, config::node_text(n)));
                steps = static_cast<int>(x);
                return Status::Ok();
@@ -620,11 +619,9 @@ PointOutcome make_point(const SweepSpec& s, size_t index) {
 }
 
 StatusOr<SweepSpec> read_sweep_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status::Error(fmt::format("{}: error: cannot open the file", path));
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return read_sweep_text(ss.str(), path);
+  StatusOr<std::string> text = read_input_file(path);  // size-limited; refuses folders
+  if (!text) return text.status();
+  return read_sweep_text(*text, path);
 }
 
 StatusOr<SweepSpec> read_sweep_text(const std::string& text, const std::string& name) {
@@ -672,14 +669,16 @@ StatusOr<SweepSpec> read_sweep_text(const std::string& text, const std::string& 
   if (base_node.IsScalar()) {
     std::filesystem::path p(base_node.Scalar());
     if (p.is_relative()) p = std::filesystem::path(name).parent_path() / p;
-    std::ifstream in(p, std::ios::binary);
-    if (!in)
+    StatusOr<std::string> base_text = read_input_file(p.string());
+    if (!base_text) {
+      const std::string& m = base_text.status().message();  // "PATH: error: REASON"
+      const size_t at = m.find(": error: ");
       return doc->error(base_node,
-                        fmt::format("key 'base': cannot open the link spec '{}'", p.string()));
-    std::stringstream ss;
-    ss << in.rdbuf();
+                        fmt::format("key 'base': cannot read the link spec '{}': {}", p.string(),
+                                    at == std::string::npos ? m : m.substr(at + 9)));
+    }
     s.base_path = p.lexically_normal().string();
-    s.base_text = ss.str();
+    s.base_text = std::move(*base_text);
   } else if (base_node.IsMap()) {
     s.base_path = name;
     s.base_text = text;
@@ -754,6 +753,22 @@ StatusOr<SweepSpec> read_sweep_text(const std::string& text, const std::string& 
   }
   if (s.axes.empty() && s.mc.samples == 0)
     return doc->error(root, "nothing to sweep: give 'sweep' keys or 'monte_carlo'");
+  // The point count, with overflow checks, before anything is sized by it (64 two-valued axes
+  // are 2^64 points: size_t wraps to 0).
+  size_t points = 1;
+  bool over = false;
+  if (s.mode == Mode::kZip && !s.axes.empty())
+    points = s.axes.front().values.size();
+  else
+    for (const Axis& a : s.axes)
+      over = over || __builtin_mul_overflow(points, a.values.size(), &points);
+  over = over || __builtin_mul_overflow(points, s.samples(), &points);
+  if (over || points > kMaxSweepPoints)
+    return doc->error(sweep_node.IsDefined() ? sweep_node : root,
+                      fmt::format("the sweep has {} points; the limit is {} (fewer values per key, "
+                                  "fewer keys, or fewer Monte Carlo samples)",
+                                  over ? std::string("2^64 or more") : std::to_string(points),
+                                  kMaxSweepPoints));
   return s;
 }
 

@@ -54,6 +54,10 @@
 
 namespace isolink::analysis::sweep {
 
+// A sweep has at most this many points (grid x Monte Carlo samples); more is refused when the
+// file is read, with the count (counted with overflow checks).
+inline constexpr size_t kMaxSweepPoints = 10'000'000;
+
 // One replacement: the dotted spec path and the value as YAML text.
 struct Assignment {
   std::string path;  // "cable.length" (never "ends.": expanded to tx. and rx.)

@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <filesystem>
+
+#include "base/file_io.h"
+
+#include "base/csv.h"
 
 namespace isolink {
 
@@ -55,30 +58,25 @@ Waveform Waveform::resampled(double dt) const {
 }
 
 Status write_waveform_csv(const Waveform& w, const std::string& path) {
-  const std::string tmp = path + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "w");
-  if (!f) return Status::Error("cannot write '" + path + "'");
-  std::fputs("time", f);
-  for (const auto& n : w.names) {
-    std::fputc(',', f);
-    std::fputs(n.c_str(), f);
-  }
-  std::fputc('\n', f);
+  StatusOr<OutputFile> f = OutputFile::open(path);
+  if (!f) return f.status();
+  std::vector<std::string> header{"time"};
+  header.insert(header.end(), w.names.begin(), w.names.end());
+  std::string line = csv_row(header);
+  if (Status s = f->write(line); !s.ok()) return s;
+  char cell[64];
   for (size_t i = 0; i < w.time.size(); ++i) {
-    std::fprintf(f, "%.12g", w.time[i]);
-    for (const auto& c : w.columns) std::fprintf(f, ",%.9g", c[i]);
-    std::fputc('\n', f);
+    line.clear();
+    std::snprintf(cell, sizeof cell, "%.12g", w.time[i]);
+    line += cell;
+    for (const auto& c : w.columns) {
+      std::snprintf(cell, sizeof cell, ",%.9g", c[i]);
+      line += cell;
+    }
+    line += '\n';
+    if (Status s = f->write(line); !s.ok()) return s;
   }
-  bool ok = std::fflush(f) == 0;
-  ok = (std::fclose(f) == 0) && ok;
-  if (!ok) {
-    std::filesystem::remove(tmp);
-    return Status::Error("write failed for '" + path + "'");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) return Status::Error("cannot rename '" + tmp + "' to '" + path + "': " + ec.message());
-  return Status::Ok();
+  return f->commit();
 }
 
 }  // namespace isolink

@@ -31,7 +31,8 @@ struct Waveform {
   Waveform resampled(double dt) const;
 };
 
-// Writes "time,<names...>" then one row per sample, %.9g; temp file + rename (never half-written).
+// Writes "time,<names...>" then one row per sample, %.9g, through base/file_io.h's OutputFile
+// (temp file + rename, never half-written; "-" is stdout; devices and FIFOs written in place).
 Status write_waveform_csv(const Waveform& w, const std::string& path);
 
 }  // namespace isolink

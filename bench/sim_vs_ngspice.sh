@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
-# isolink sim against ngspice on the example link netlists, all in one run:
+# isolink sim (LTI engine and transient engine) against ngspice, all in one run:
 #   bash bench/sim_vs_ngspice.sh [ISOLINK_BINARY] [N] [EXAMPLE...]
-# (defaults: build/cli/isolink, N=5, every netlists/examples/*.cir). For each example:
-#   - `isolink sim` with its default options, wall time best of N;
+# (defaults: build/cli/isolink, N=5, every netlists/examples/*.cir, then the link specs
+# netlists/examples/{transformer_15m,hybrid_xfmr_cap_12m}.yaml and bench/links/*.yaml exported with
+# `isolink export-spice` (down direction)). An EXAMPLE is a .cir or a link spec .yaml. For each:
+#   - `isolink sim --engine lti` and `isolink sim --engine transient`, each with its default
+#     options, wall time best of N (process start-up included);
 #   - ngspice with its default options plus `.options rshunt=1e12` (it cannot solve the floating
 #     nodes otherwise), wall time best of N;
 #   - ngspice once at tight tolerances (reltol 1e-6, abstol 1e-12, vntol 1e-9) as the reference;
@@ -15,7 +18,12 @@ cd "$(dirname "$0")/.."
 ISOLINK=${1:-build/cli/isolink}
 N=${2:-5}
 shift $(($# < 2 ? $# : 2))
-if (($# > 0)); then examples=("$@"); else examples=(netlists/examples/*.cir); fi
+if (($# > 0)); then
+  examples=("$@")
+else
+  examples=(netlists/examples/*.cir netlists/examples/transformer_15m.yaml
+    netlists/examples/hybrid_xfmr_cap_12m.yaml bench/links/*.yaml)
+fi
 PROBE='v(rxp,rxn)'
 TIGHT='.options reltol=1e-6 abstol=1e-12 vntol=1e-9 rshunt=1e12'
 work=$(mktemp -d)
@@ -50,29 +58,37 @@ maxdev() {
       while (j < m - 2 && t[j + 1] < x) j++
       y = v[j] + (v[j + 1] - v[j]) * (x - t[j]) / (t[j + 1] - t[j])
       d = y - (f[2] + 0); if (d < 0) d = -d; if (d > worst) worst = d }
-    END { printf "%.1f", worst * 1000 }' "$1" "$2"
+    END { printf "%.2f", worst * 1000 }' "$1" "$2"
 }
 
 rows() { awk 'NF && $1 ~ /^[-+0-9.eE]+,?/' "$1" | wc -l; }
 
 echo "<!-- $(date -u +%Y-%m-%d), $(nproc) cores, $(uname -m), load $(cut -d' ' -f1-3 /proc/loadavg), N=$N -->"
-printf '| example | unknowns | isolink ms | ngspice ms | speed ratio (ngspice/isolink) | isolink max dev (mV) | ngspice max dev (mV) | isolink steps | ngspice points | reference points |\n'
-printf '|---|---|---|---|---|---|---|---|---|---|\n'
+printf '| example | unknowns | LTI ms | transient ms | ngspice ms | ngspice / LTI | ngspice / transient | LTI max dev (mV) | transient max dev (mV) | ngspice max dev (mV) | LTI rows | transient steps | ngspice points | reference points |\n'
+printf '|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n'
+ratio() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.1f", (b > 0 ? a / b : 0) }'; }
 for file in "${examples[@]}"; do
   name=$(basename "$file" .cir)
-  summary=$("$ISOLINK" sim "$file" --probe "$PROBE" -o "$work/iso.csv" 2>&1 >/dev/null || true)
+  if [[ "$file" == *.yaml ]]; then  # a link spec: its exported netlist (down direction)
+    name=$(basename "$file" .yaml)
+    "$ISOLINK" export-spice "$file" -o "$work/$name.cir"
+    file="$work/$name.cir"
+  fi
+  summary=$("$ISOLINK" sim "$file" --probe "$PROBE" --engine transient -o "$work/tr.csv" 2>&1 >/dev/null || true)
   unknowns=$(sed -n 's/.* \([0-9]*\) unknowns.*/\1/p' <<<"$summary" | head -1)
-  t_iso=$(best "$ISOLINK" sim "$file" --probe "$PROBE" -q -o "$work/iso.csv")
+  t_lti=$(best "$ISOLINK" sim "$file" --probe "$PROBE" --engine lti -q -o "$work/lti.csv")
+  t_tr=$(best "$ISOLINK" sim "$file" --probe "$PROBE" --engine transient -q -o "$work/tr.csv")
   ngdeck "$file" '.options rshunt=1e12' "$work/ng.cir" "$work/ng.txt"
   t_ng=$(best ngspice -b "$work/ng.cir")
   ngdeck "$file" "$TIGHT" "$work/ref.cir" "$work/ref.txt"
   ngspice -b "$work/ref.cir" >"$work/ref.log" 2>&1 || true
-  if [[ ! -s "$work/ref.txt" || ! -s "$work/ng.txt" || ! -s "$work/iso.csv" ]]; then
-    printf '| %s | run failed | | | | | | | | |\n' "$name"
+  if [[ ! -s "$work/ref.txt" || ! -s "$work/ng.txt" || ! -s "$work/lti.csv" || ! -s "$work/tr.csv" ]]; then
+    printf '| %s | run failed | | | | | | | | | | | | |\n' "$name"
     continue
   fi
-  ratio=$(awk -v a="$t_ng" -v b="$t_iso" 'BEGIN { printf "%.2f", (b > 0 ? a / b : 0) }')
-  printf '| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n' "$name" "$unknowns" "$t_iso" "$t_ng" \
-    "$ratio" "$(maxdev "$work/iso.csv" "$work/ref.txt")" "$(maxdev "$work/ng.txt" "$work/ref.txt")" \
-    "$(($(rows "$work/iso.csv") - 1))" "$(($(rows "$work/ng.txt") - 1))" "$(($(rows "$work/ref.txt") - 1))"
+  printf '| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n' "$name" "$unknowns" \
+    "$t_lti" "$t_tr" "$t_ng" "$(ratio "$t_ng" "$t_lti")" "$(ratio "$t_ng" "$t_tr")" \
+    "$(maxdev "$work/lti.csv" "$work/ref.txt")" "$(maxdev "$work/tr.csv" "$work/ref.txt")" \
+    "$(maxdev "$work/ng.txt" "$work/ref.txt")" "$(($(rows "$work/lti.csv") - 1))" \
+    "$(($(rows "$work/tr.csv") - 1))" "$(($(rows "$work/ng.txt") - 1))" "$(($(rows "$work/ref.txt") - 1))"
 done

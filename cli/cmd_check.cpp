@@ -1,22 +1,23 @@
-// isolink check WAVE.csv: score a waveform (simulated or a scope capture) against a rule set.
-// The work is in eye/check.h; this file maps flags and prints.
+// isolink check WAVE.csv [N.csv]: score a waveform (simulated or a scope capture) against a rule
+// set. The work is in eye/check.h and eye/waveform_csv.h; this file maps flags and prints.
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 
+#include "base/hex.h"
 #include "cli/commands.h"
 #include "eye/check.h"
-#include "eye/decode.h"
 #include "eye/rules.h"
 #include "eye/waveform_csv.h"
+#include "protocol/frame.h"
 
 namespace isolink::cli {
 namespace {
 
 struct CheckArgs {
-  std::string wave;
+  std::vector<std::string> files;
   std::string rules = "bq7961x";
   eye::CsvColumns cols;
   bool json = false;
@@ -39,23 +40,30 @@ int run_check(const CheckArgs& a) {
   eye::CheckOptions opt;
   if (a.sof) opt.sof = *a.sof;
   if (a.sof_value) opt.sof_value = *a.sof_value;
-  if (a.msb_first) opt.bit_order = eye::BitOrder::kMsbFirst;
-  if (a.lsb_first) opt.bit_order = eye::BitOrder::kLsbFirst;
+  if (a.msb_first) opt.bit_order = BitOrder::kMsbFirst;
+  if (a.lsb_first) opt.bit_order = BitOrder::kLsbFirst;
   if (!a.expect.empty()) {
-    StatusOr<std::vector<uint8_t>> e = eye::parse_hex_bytes(a.expect);
+    StatusOr<std::vector<uint8_t>> e = parse_hex_bytes(a.expect);
     if (!e) return fail_input("--expect: error: " + e.status().message());
     opt.expect = *e;
   }
-  StatusOr<Waveform> w = eye::read_differential_csv(a.wave, a.cols);
+  eye::CaptureInfo info;
+  StatusOr<Waveform> w = eye::read_capture(a.files, a.cols, &info);
   if (!w) return fail_input(w.status().message());
   StatusOr<eye::CheckResult> r = eye::check_waveform(*w, *rules, opt);
-  if (!r) return fail_input(a.wave + ": error: " + r.status().message());
+  if (!r) return fail_input(a.files[0] + ": error: " + r.status().message());
   if (!a.pulses_csv.empty())
     if (Status s = eye::write_pulses_csv(*r, a.pulses_csv); !s.ok()) return fail_input(s.message());
-  if (a.json)
-    std::printf("%s\n", eye::to_json(*r).dump(2).c_str());
-  else
-    std::fputs(eye::summary_text(*r, a.wave).c_str(), stdout);
+  if (a.json) {
+    nlohmann::ordered_json j = eye::to_json(*r);
+    j["input"] = eye::capture_json(info);
+    std::printf("%s\n", j.dump(2).c_str());
+  } else {
+    std::string source = a.files[0];
+    if (a.files.size() > 1) source += " - " + a.files[1];
+    std::fputs(eye::summary_text(*r, source).c_str(), stdout);
+    std::fputs(eye::capture_text(info).c_str(), stdout);
+  }
   return r->pass ? 0 : 1;
 }
 
@@ -65,20 +73,25 @@ void add_check_command(CLI::App& app, int* exit_code) {
   auto args = std::make_shared<CheckArgs>();
   auto* cmd = app.add_subcommand(
       "check",
-      "Score a waveform CSV against the receiver rules (exit 0 pass, 1 fail, 2 bad input)");
-  cmd->add_option("wave", args->wave,
-                  "WAVE.csv: time column and a differential (or P and N) column")
-      ->required();
+      "Score a waveform CSV or scope export against the receiver rules (exit 0 pass, 1 fail or "
+      "inconclusive, 2 bad input)");
+  cmd->add_option("wave", args->files,
+                  "WAVE.csv: time and a differential (or P and N) column; or P.csv N.csv: P from "
+                  "the first file, N from the second")
+      ->required()
+      ->expected(1, 2);
   cmd->add_option("--rules", args->rules,
                   "a shipped rule set (bq7961x, bq79600, tone) or a YAML rule file")
       ->capture_default_str();
-  cmd->add_option("--time", args->cols.time, "time column (name or 1-based index; default first)");
+  cmd->add_option("--time", args->cols.time,
+                  "time column (name, channel, #K or 1-based index; default: the time column)");
   cmd->add_option("--diff", args->cols.diff,
-                  "differential column (name or 1-based index; default second)");
-  auto* p = cmd->add_option("--p", args->cols.p, "P column: the differential is P - N");
-  auto* n = cmd->add_option("--n", args->cols.n, "N column");
-  p->needs(n);
-  n->needs(p);
+                  "differential column (name, channel such as CH1, #K or 1-based index; default: "
+                  "the first channel)");
+  auto* p = cmd->add_option("--p", args->cols.p,
+                            "P column: the differential is P - N (with two files: P's column in "
+                            "the first)");
+  auto* n = cmd->add_option("--n", args->cols.n, "N column (with two files: in the second)");
   cmd->get_option("--diff")->excludes(p)->excludes(n);
   cmd->add_flag("--json", args->json, "print one JSON object instead of the summary");
   cmd->add_option("--pulses-csv", args->pulses_csv, "write the per-pulse table to this CSV file");

@@ -1,9 +1,9 @@
 // isolink elements: the element kinds and their parameters, from the kinds' own tables.
 // The README's "Element reference" section is this command's --markdown output.
+#include <fmt/format.h>
+
 #include <cmath>
 #include <cstdio>
-
-#include <fmt/format.h>
 
 #include "cli/commands.h"
 #include "solver/elements/element.h"
@@ -12,7 +12,8 @@ namespace isolink::cli {
 
 void add_elements_command(CLI::App& app, int* exit_code) {
   auto markdown = std::make_shared<bool>(false);
-  CLI::App* cmd = app.add_subcommand("elements", "List the netlist element kinds and their parameters");
+  CLI::App* cmd =
+      app.add_subcommand("elements", "List the netlist element kinds and their parameters");
   cmd->add_flag("--markdown", *markdown, "print the table as Markdown (as in the README)");
   cmd->callback([markdown, exit_code] {
     if (*markdown) {
@@ -22,7 +23,8 @@ void add_elements_command(CLI::App& app, int* exit_code) {
         std::printf("%c  %-18s %s\n", k.letter, k.name, k.usage);
         for (const ParamSpec& p : k.params)
           std::printf("     %-6s %-10s %-4s %s\n", p.name,
-                      std::isnan(p.default_value) ? "required" : fmt::format("{:g}", p.default_value).c_str(),
+                      std::isnan(p.default_value) ? (p.optional ? "none" : "required")
+                                                  : fmt::format("{:g}", p.default_value).c_str(),
                       p.unit, p.doc);
       }
     }

@@ -1,12 +1,12 @@
 // isolink export-spice: a link spec expanded into the ngspice-dialect netlist that `isolink sim`
 // also reads (one direction per file; down by default).
+#include <fmt/format.h>
+
 #include <cstdio>
-#include <fstream>
 #include <string>
 #include <vector>
 
-#include <fmt/format.h>
-
+#include "base/file_io.h"
 #include "cli/commands.h"
 #include "netlists/link/expand.h"
 #include "netlists/link/link_spec.h"
@@ -41,27 +41,14 @@ int run_export(const ExportArgs& a) {
     return 2;
   }
   std::string text = write_spice(ex->netlist);
-  if (a.output.empty() || a.output == "-") {
-    std::fputs(text.c_str(), stdout);
-    return 0;
-  }
-  const std::string tmp = a.output + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out << text;
-    if (!out) {
-      std::fprintf(stderr, "%s: error: cannot write the netlist\n", a.output.c_str());
-      std::remove(tmp.c_str());
-      return 2;
-    }
-  }
-  if (std::rename(tmp.c_str(), a.output.c_str()) != 0) {
-    std::fprintf(stderr, "%s: error: cannot rename %s into place\n", a.output.c_str(), tmp.c_str());
-    std::remove(tmp.c_str());
+  const std::string out = a.output.empty() ? "-" : a.output;
+  if (Status s = write_file_atomic(out, text); !s.ok()) {
+    std::fprintf(stderr, "%s\n", s.message().c_str());
     return 2;
   }
-  std::fprintf(stderr, "wrote %s (%s, %zu elements)\n", a.output.c_str(),
-               ex->description.c_str(), ex->netlist.cards.size());
+  if (out == "-") return 0;
+  std::fprintf(stderr, "wrote %s (%s, %zu elements)\n", a.output.c_str(), ex->description.c_str(),
+               ex->netlist.cards.size());
   return 0;
 }
 

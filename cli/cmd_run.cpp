@@ -1,20 +1,25 @@
 // isolink run: a link spec simulated with its traffic, each receiver scored, and the report
 // bundle (eye.png, wave.png, report.json, report.md, wave.csv) written to a folder.
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
-#include <fmt/format.h>
-
-#include "cli/commands.h"
-#include "base/atomic_file.h"
+#include "analysis/pack_spec.h"
+#include "base/file_io.h"
 #include "analysis/link_run.h"
-#include "reports/run_images.h"
-#include "reports/run_report.h"
+#include "analysis/worst.h"
+#include "cli/commands.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
+#include "reports/run_images.h"
+#include "reports/run_report.h"
+#include "reports/worst_png.h"
+#include "netlists/traffic/stimulus.h"
 
 namespace isolink::cli {
 using namespace isolink::analysis;  // run_link, LinkRun, run_waveforms
@@ -26,9 +31,25 @@ struct RunArgs {
   std::string out_dir;
   std::vector<std::string> part_dirs;
   std::string direction;
+  std::string engine = "auto";
   bool no_images = false;
+  bool no_worst = false;
   bool quiet = false;
 };
+
+// Traffic longer than this gets a warning before the run (simulated seconds; about 250 commands).
+constexpr double kLongTrafficSeconds = 20e-3;
+
+// What a report folder holds: an existing folder with anything else in it is not replaced.
+// What a report folder holds: the bundle's files and the worst-case images
+// (worst_<direction>_<metric>.png, reports/worst_png.h).
+const std::vector<std::string> kBundleFiles = [] {
+  std::vector<std::string> names = {"eye.png", "wave.png", "report.json", "report.md", "wave.csv"};
+  for (const char* d : {"down", "up"})
+    for (const char* m : {"vstart", "vend", "width_min", "width_max", "edge"})
+      names.push_back(fmt::format("worst_{}_{}.png", d, m));
+  return names;
+}();
 
 int fail(const Status& s) {
   std::fprintf(stderr, "%s\n", s.message().c_str());
@@ -36,6 +57,16 @@ int fail(const Status& s) {
 }
 
 int run_run(const RunArgs& a) {
+  // A pack spec (a file with `hops:`) runs as `isolink pack`.
+  if (StatusOr<config::YamlDoc> doc = config::YamlDoc::load_file(a.spec);
+      doc && analysis::is_pack_spec(*doc)) {
+    if (!a.direction.empty())
+      return fail(
+          Status::Error(fmt::format("{}: error: --direction is for link specs; a pack "
+                                    "runs each hop in the directions it carries",
+                                    a.spec)));
+    return run_pack_command({a.spec, a.out_dir, a.part_dirs, 0, a.no_images, a.quiet});
+  }
   StatusOr<link::LinkSpec> spec = link::read_link_spec_file(a.spec);
   if (!spec) return fail(spec.status());
   if (a.direction == "down") spec->stimulus.directions = {link::Direction::kDown};
@@ -45,27 +76,57 @@ int run_run(const RunArgs& a) {
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load(a.part_dirs);
   if (!parts) return fail(parts.status());
 
-  StatusOr<LinkRun> run = run_link(*spec, *parts);
+  // The spec's name becomes a folder name: made safe (no "..", separators or control bytes).
+  const std::string dir =
+      a.out_dir.empty() ? "reports/out/" + safe_path_component(spec->name) : a.out_dir;
+  // The bundle appears whole or not at all (base/file_io.h OutputBundle); opened before the
+  // simulation so that a bad -o is reported at once.
+  StatusOr<OutputBundle> bundle = OutputBundle::open(dir, kBundleFiles);
+  if (!bundle) return fail(bundle.status());
+  // A size check before obviously huge work (10,000 frames ran for minutes without a word).
+  if (StatusOr<traffic::Drive> d = traffic::build_drive(spec->stimulus.to_script()); d) {
+    if (d->duration() > kLongTrafficSeconds)
+      std::fprintf(stderr,
+                   "isolink run: warning: the stimulus is %.3g ms of traffic (%zu frames) per "
+                   "direction, above %.0f ms: long work (each direction is simulated in full); "
+                   "shorten it to iterate faster\n",
+                   d->duration() * 1e3, d->frames.size(), kLongTrafficSeconds * 1e3);
+  }
+  RunOptions ro;
+  ro.engine = *parse_engine(a.engine);  // CLI11 checked the choice
+  StatusOr<LinkRun> run = run_link(*spec, *parts, ro);
   if (!run) return fail(run.status().with_context(a.spec));
+  // The worst case over all legal traffic, beside the spec's traffic (its own verdict).
+  std::optional<analysis::WorstResult> worst;
+  if (!a.no_worst) {
+    StatusOr<analysis::WorstResult> w = analysis::worst_case(*spec, *parts);
+    if (!w) return fail(w.status().with_context(a.spec + ", worst case"));
+    worst = std::move(*w);
+  }
 
-  const std::string dir = a.out_dir.empty() ? "reports/out/" + spec->name : a.out_dir;
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) return fail(Status::Error(fmt::format("{}: error: cannot create the folder: {}", dir,
-                                                ec.message())));
   std::vector<std::string> images;
   if (!a.no_images) {
-    if (Status s = render_run_images(*spec, *run, dir, &images); !s.ok()) return fail(s);
+    if (Status s = render_run_images(*spec, *run, bundle->staging(), &images); !s.ok())
+      return fail(s);
   }
   const Waveform wave = run_waveforms(*run, spec->sim.tstep);
-  if (Status s = write_waveform_csv(wave, dir + "/wave.csv"); !s.ok()) return fail(s);
-  if (Status s = write_file_atomic(dir + "/report.json", run_report_json(*spec, *run).dump(2) +
-                                                             "\n");
-      !s.ok())
+  if (Status s = write_waveform_csv(wave, bundle->path("wave.csv")); !s.ok()) return fail(s);
+  nlohmann::ordered_json json = run_report_json(*spec, *run);
+  std::string md = run_report_markdown(*spec, *run, images);
+  if (worst) {
+    json["worst_case"] = analysis::worst_json(*worst);
+    md += "\n## Worst case over all traffic\n\n" + analysis::worst_markdown(*worst);
+    if (!a.no_images) {
+      std::vector<std::string> files;
+      if (Status s = reports::render_worst_pngs(*worst, spec->name, {}, bundle->staging(), &files); !s.ok())
+        return fail(s);
+      for (const std::string& f : files) md += fmt::format("![{}]({})\n\n", f, f);
+    }
+  }
+  if (Status s = write_file_atomic(bundle->path("report.json"), json.dump(2) + "\n"); !s.ok())
     return fail(s);
-  if (Status s = write_file_atomic(dir + "/report.md", run_report_markdown(*spec, *run, images));
-      !s.ok())
-    return fail(s);
+  if (Status s = write_file_atomic(bundle->path("report.md"), md); !s.ok()) return fail(s);
+  if (Status s = bundle->commit(); !s.ok()) return fail(s);
   std::vector<std::string> warned;  // both directions share most warnings: print each once
   for (const DirectionRun& d : run->directions)
     for (const std::string& w : d.sim.warnings)
@@ -75,6 +136,7 @@ int run_run(const RunArgs& a) {
       }
   if (!a.quiet) {
     std::fputs(run_summary_text(*spec, *run).c_str(), stdout);
+    if (worst) std::fputs(analysis::worst_summary_text(*worst).c_str(), stdout);
     std::printf("report: %s/report.md\n", dir.c_str());
   }
   return run->pass ? 0 : 1;
@@ -85,15 +147,21 @@ int run_run(const RunArgs& a) {
 void add_run_command(CLI::App& app, int* exit_code) {
   auto args = std::make_shared<RunArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "run", "Simulate a link spec with its traffic, score each receiver and write the report "
-             "(eye.png, wave.png, report.json, report.md, wave.csv)");
+      "run",
+      "Simulate a link spec with its traffic, score each receiver and write the report "
+      "(eye.png, wave.png, report.json, report.md, wave.csv)");
   cmd->add_option("spec", args->spec, "Link spec (YAML), e.g. netlists/examples/xfmr_12m.yaml")
       ->required();
   cmd->add_option("-o,--output", args->out_dir, "Report folder (default reports/out/<name>)");
   cmd->add_option("--parts", args->part_dirs, "Extra part-library folder (repeatable)");
   cmd->add_option("--direction", args->direction, "Override the spec: down | up | both")
       ->check(CLI::IsMember({"down", "up", "both"}));
+  cmd->add_option("--engine", args->engine,
+                  "auto (LTI, the default: every link is linear), lti, transient (the cross-check)")
+      ->check(CLI::IsMember({"auto", "lti", "transient"}));
   cmd->add_flag("--no-images", args->no_images, "Skip eye.png and wave.png");
+  cmd->add_flag("--no-worst", args->no_worst,
+                "Skip the worst case over all traffic (its report section and verdict)");
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing but errors");
   cmd->callback([args, exit_code] { *exit_code = run_run(*args); });
 }

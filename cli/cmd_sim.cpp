@@ -1,24 +1,30 @@
-// isolink sim NETLIST.cir --probe 'v(rxp,rxn)' [-o wave.csv]: plain transient of a SPICE netlist.
+// isolink sim NETLIST.cir --probe 'v(rxp,rxn)' [-o wave.csv] [--engine auto|lti|transient]: the
+// response of a SPICE netlist, by the LTI engine when the circuit allows it (see
+// analysis/simulate.h).
+#include <fmt/format.h>
+
 #include <cstdio>
 #include <iostream>
 #include <optional>
 
-#include <fmt/format.h>
-
-#include "cli/commands.h"
 #include "analysis/simulate.h"
-#include "netlists/lexer.h"
+#include "base/si_number.h"
+#include "cli/commands.h"
 
 namespace isolink::cli {
 using namespace isolink::analysis;  // simulate_netlist
 
 namespace {
+// The most rows --step may ask for (about 300 MB of CSV with one probe).
+constexpr size_t kMaxResampledRows = 10'000'000;
+
 struct SimArgs {
   std::string netlist;
   std::vector<std::string> probes;
   std::string output;
   std::string step, tstop, tmax;  // SPICE numbers: 10n, 1u
   std::string method;
+  std::string engine = "auto";
   double reltol = 0;
   bool quiet = false;
 };
@@ -27,7 +33,7 @@ struct SimArgs {
 std::optional<double> si_option(const char* flag, const std::string& text, bool* bad) {
   if (text.empty()) return std::nullopt;
   double v = 0;
-  if (!spice::parse_number(text, v) || !(v > 0)) {
+  if (!parse_si_number(text, v) || !(v > 0)) {
     std::cerr << "isolink sim: error: " << flag << " expects a positive time such as 10n, got '"
               << text << "'\n";
     *bad = true;
@@ -51,31 +57,49 @@ int run_sim(const SimArgs& a) {
   req.probes = a.probes;
   req.tstop = tstop;
   req.tmax = tmax;
+  req.engine = *parse_engine(a.engine);  // CLI11 checked the choice
+  if (step) req.grid_step = *step;
   if (a.reltol > 0) req.reltol = a.reltol;
   if (a.method == "trap") req.method = IntegrationMethod::Trapezoidal;
   if (a.method == "gear") req.method = IntegrationMethod::Gear2;
   StatusOr<SimulationResult> r = simulate_netlist(*netlist, req);
   if (!r) {
     const std::string& m = r.status().message();  // diagnostics already say file:line:col
-    std::cerr << (m.find(": error: ") == std::string::npos ? "isolink sim: error: " : "") << m << "\n";
+    std::cerr << (m.find(": error: ") == std::string::npos ? "isolink sim: error: " : "") << m
+              << "\n";
     return 2;
   }
   for (const auto& w : r->warnings) std::cerr << w << "\n";
-  const Waveform out = step ? r->wave.resampled(*step) : r->wave;
-  if (a.output.empty() || a.output == "-") {
-    std::printf("time");
-    for (const auto& n : out.names) std::printf(",%s", n.c_str());
-    std::printf("\n");
-    for (size_t i = 0; i < out.samples(); ++i) {
-      std::printf("%.12g", out.time[i]);
-      for (const auto& c : out.columns) std::printf(",%.9g", c[i]);
-      std::printf("\n");
+  if (step && !r->wave.time.empty()) {
+    // Refused before allocating: 1e-14 over 5 us would be 5e8 rows (bad_alloc), 1e-30 overflows.
+    const double span = r->wave.time.back() - r->wave.time.front();
+    const double rows = span / *step + 1;
+    if (!(rows <= static_cast<double>(kMaxResampledRows))) {
+      std::cerr << fmt::format(
+          "isolink sim: error: --step {} over the {:.6g} s run asks for {:.3g} rows; the limit is "
+          "{} rows (use a larger --step, or no --step for the solver's own time points)\n",
+          a.step, span, rows, kMaxResampledRows);
+      return 2;
     }
-  } else if (Status s = write_waveform_csv(out, a.output); !s.ok()) {
-    std::cerr << "isolink sim: error: " << s.message() << "\n";
+  }
+  // The LTI engine already wrote its rows on the --step grid.
+  const Waveform out = step && r->engine == Engine::Transient ? r->wave.resampled(*step) : r->wave;
+  if (Status s = write_waveform_csv(out, a.output.empty() ? "-" : a.output); !s.ok()) {
+    const std::string& m = s.message();
+    std::cerr << (m.find(": error: ") == std::string::npos ? "isolink sim: error: " : "") << m
+              << "\n";
     return 2;
   }
-  if (!a.quiet)
+  if (!a.quiet && r->engine == Engine::Lti)
+    std::cerr << fmt::format(
+        "isolink sim: LTI engine: {} nodes, {} unknowns; responses to {:g} s in {} steps ({} "
+        "rejected, {} factorizations){}; {} corners; {:.3f} s; {} rows every {:g} s{}\n",
+        r->nodes, r->unknowns, r->lti.settled_at, r->lti.steps, r->lti.rejected,
+        r->lti.factorizations, r->lti.settled ? ", settled" : "", r->grid.corners, r->seconds,
+        out.samples(), r->grid.step, a.output.empty() || a.output == "-" ? "" : " -> " + a.output);
+  if (!a.quiet && r->engine == Engine::Transient && !r->engine_note.empty())
+    std::cerr << "isolink sim: transient engine (not LTI: " << r->engine_note << ")\n";
+  if (!a.quiet && r->engine == Engine::Transient)
     std::cerr << fmt::format(
         "isolink sim: {} nodes, {} unknowns; {} steps accepted, {} rejected, {} factorizations "
         "({} reused), {:.3f} s; {} rows{}\n",
@@ -88,13 +112,19 @@ int run_sim(const SimArgs& a) {
 
 void add_sim_command(CLI::App& app, int* exit_code) {
   auto args = std::make_shared<SimArgs>();
-  CLI::App* cmd = app.add_subcommand("sim", "Transient simulation of a SPICE netlist (ngspice dialect)");
+  CLI::App* cmd =
+      app.add_subcommand("sim", "Simulate a SPICE netlist (ngspice dialect): LTI or transient");
   cmd->add_option("netlist", args->netlist, "SPICE netlist (.cir)")->required();
   cmd->add_option("--probe,-p", args->probes,
                   "signal to record: v(node), v(node,node) or i(Vname|Lname); repeatable")
       ->required();
   cmd->add_option("-o,--output", args->output, "CSV file to write (default: stdout)");
-  cmd->add_option("--step", args->step, "resample the output on a uniform grid of DT seconds (10n)");
+  cmd->add_option("--step", args->step,
+                  "output on a uniform grid of DT seconds (10n); default: LTI picks a grid where "
+                  "linear interpolation is within 1 mV, the transient writes its steps");
+  cmd->add_option("--engine", args->engine,
+                  "auto (LTI when the circuit allows it), lti (error if not), transient")
+      ->check(CLI::IsMember({"auto", "lti", "transient"}));
   cmd->add_option("--tstop", args->tstop, "end time in seconds (overrides .tran)");
   cmd->add_option("--tmax", args->tmax, "largest time step in seconds (overrides .tran)");
   cmd->add_option("--method", args->method, "integration method (overrides .options method)")

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "base/csv.h"
+#include "base/file_io.h"
 #include "cli/commands.h"
 #include "reports/sweep_report.h"
 #include "analysis/sweep_run.h"
@@ -33,6 +35,7 @@ struct SweepArgs {
   bool no_plots = false;
   bool quiet = false;
   bool list = false;
+  std::string engine = "auto";
 };
 
 int fail(const Status& s) {
@@ -41,16 +44,17 @@ int fail(const Status& s) {
 }
 
 int list_points(const sweep::SweepSpec& s) {
-  std::string header = "point";
-  for (const std::string& c : s.point_columns()) header += "," + c;
-  std::printf("%s,spec\n", header.c_str());
+  std::vector<std::string> header{"point"};
+  for (const std::string& c : s.point_columns()) header.push_back(c);
+  header.push_back("spec");
+  std::fputs(csv_row(header).c_str(), stdout);
   for (size_t i = 0; i < s.size(); ++i) {
     const sweep::PointOutcome p = sweep::make_point(s, i);
-    std::string line = fmt::format("{}", i);
-    for (const std::string& c : p.point.cells) line += "," + c;
-    std::string st = p.status.ok() ? "ok" : p.status.message();
-    st = st.substr(0, st.find('\n'));
-    std::printf("%s,%s\n", line.c_str(), st.c_str());
+    std::vector<std::string> row{fmt::format("{}", i)};
+    for (const std::string& c : p.point.cells) row.push_back(c);
+    const std::string st = p.status.ok() ? "ok" : p.status.message();
+    row.push_back(st.substr(0, st.find('\n')));
+    std::fputs(csv_row(row).c_str(), stdout);
   }
   return 0;
 }
@@ -92,13 +96,14 @@ int run_sweep_command(const SweepArgs& a) {
   if (!parts) return report(parts.status());
 
   sweep::SweepOptions opt;
-  opt.out_dir = a.out_dir.empty() ? "reports/out/" + spec->name : a.out_dir;
+  opt.out_dir = a.out_dir.empty() ? "reports/out/" + safe_path_component(spec->name) : a.out_dir;
   opt.jobs = a.jobs;
   opt.resume = a.resume;
   opt.keep_waves = a.keep_waves;
   opt.plots = !a.no_plots;
   opt.render_plots = reports::render_sweep_plots;
   opt.quiet = a.quiet;
+  opt.point.run.engine = *parse_engine(a.engine);  // CLI11 checked the choice
   if (!a.quiet && rank == 0) {
     std::fprintf(stderr, "sweep: %s: %zu points (%zu grid point%s%s)%s -> %s\n", spec->path.c_str(),
                  spec->size(), spec->grid_size(), spec->grid_size() == 1 ? "" : "s",
@@ -143,6 +148,8 @@ void add_sweep_command(CLI::App& app, int* exit_code) {
   cmd->add_option("-j,--jobs", args->jobs, "Points run at once (default: all cores)")
       ->check(CLI::Range(1, 4096));
   cmd->add_option("--parts", args->part_dirs, "Extra part-library folder (repeatable)");
+  cmd->add_option("--engine", args->engine, "auto (LTI, the default), lti, transient")
+      ->check(CLI::IsMember({"auto", "lti", "transient"}));
   cmd->add_flag("--resume", args->resume, "Skip the points already in DIR/results.csv");
   cmd->add_flag("--keep-waves", args->keep_waves,
                 "Write every point's waveforms to DIR/waves/point_NNNNN.csv");

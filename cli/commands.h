@@ -4,6 +4,8 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <string>
+#include <vector>
 
 namespace isolink::cli {
 
@@ -16,6 +18,19 @@ void add_run_command(CLI::App& app, int* exit_code);
 void add_export_command(CLI::App& app, int* exit_code);
 void add_sweep_command(CLI::App& app, int* exit_code);
 void add_noise_command(CLI::App& app, int* exit_code);
+void add_worst_command(CLI::App& app, int* exit_code);
+void add_pack_command(CLI::App& app, int* exit_code);
+
+// isolink pack's options; `isolink run` passes a pack spec on with its own -o, --parts, -q.
+struct PackArgs {
+  std::string spec;
+  std::string out_dir;
+  std::vector<std::string> part_dirs;
+  int jobs = 0;
+  bool no_images = false;
+  bool quiet = false;
+};
+int run_pack_command(const PackArgs& a);
 
 // The element table of the README (`isolink elements --markdown`).
 

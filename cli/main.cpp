@@ -1,7 +1,6 @@
 // isolink: signal-integrity analyzer for BMS daisy-chain links.
-#include <cstdio>
-
 #include <CLI/CLI.hpp>
+#include <cstdio>
 
 #include "cli/commands.h"
 
@@ -18,6 +17,8 @@ int main(int argc, char** argv) {
   isolink::cli::add_export_command(app, &exit_code);
   isolink::cli::add_sweep_command(app, &exit_code);
   isolink::cli::add_noise_command(app, &exit_code);
+  isolink::cli::add_worst_command(app, &exit_code);
+  isolink::cli::add_pack_command(app, &exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -57,9 +57,25 @@ class YamlDoc {
   // "file:line:col: error: MESSAGE" with the source line and a caret, or "file: error: ..."
   Status error(const YAML::Node& node, const std::string& message) const;
 
+  // Deep merge of the map `overlay`, a node of document `from`, into the root: where both sides
+  // hold a map the keys merge one by one, anything else (a value, a list) replaces. Errors about
+  // the merged nodes then name `from`'s file, line and column. (Pack specs: a hop's overrides.)
+  Status merge(const YAML::Node& overlay, const YamlDoc& from);
+  // root[key] = value (a node of `from`), replacing what was there.
+  void replace(const std::string& key, const YAML::Node& value, const YamlDoc& from);
+
  private:
+  struct Overlay {
+    YAML::Node node;
+    std::shared_ptr<const SourceFile> file;
+  };
+  Status merge_map(YAML::Node target, const YAML::Node& overlay, const YamlDoc& from,
+                   const std::string& path);
+  std::shared_ptr<const SourceFile> file_of(const YAML::Node& node) const;
+
   std::shared_ptr<const SourceFile> file_;
   YAML::Node root_;
+  std::vector<Overlay> overlays_;  // subtrees merged in from other documents
 };
 
 // Reads one value; the handler gets the node and its dotted key path ("tx.isolation.cap").

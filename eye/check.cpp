@@ -8,10 +8,18 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "base/csv.h"
+#include "base/file_io.h"
+#include "base/hex.h"
+
 namespace isolink::eye {
 namespace {
 
 using json = nlohmann::ordered_json;
+
+// Levels over this many thresholds (120 V for the 1.2 V data threshold) are no daisy-chain
+// signal: the units are wrong (mV read as V), so the record gets no verdict of pass.
+constexpr double kImplausible = 100;
 
 json num(double x) {
   return std::isnan(x) ? json(nullptr) : json(x);
@@ -134,6 +142,8 @@ StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const d
   const FrameFormat& fmt_ = r.frame_format;
 
   // Item 12: decode each run of joined pulses.
+  size_t structural = 0;  // frames whose couplets form a byte (metrics aside)
+  size_t inverted = 0;    // runs that decode only with every sign flipped (P and N swapped?)
   for (const FrameSpan& fs : seg.frames) {
     std::vector<int> hb;
     std::vector<size_t> hb_pulse;
@@ -151,6 +161,15 @@ StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const d
       decoded.push_back(d);
     } else {
       decoded = decode_half_bits(hb, fmt_);
+      const size_t ok = static_cast<size_t>(std::count_if(
+          decoded.begin(), decoded.end(), [](const DecodedByte& d) { return d.byte.has_value(); }));
+      structural += ok;
+      if (ok == 0) {
+        std::vector<int> flipped(hb.size());
+        std::transform(hb.begin(), hb.end(), flipped.begin(), [](int x) { return -x; });
+        const std::vector<DecodedByte> alt = decode_half_bits(flipped, fmt_);
+        if (!alt.empty() && alt.front().byte) ++inverted;
+      }
     }
     for (const DecodedByte& d : decoded) {
       FrameResult fr;
@@ -225,10 +244,17 @@ StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const d
 
   r.worst = worst_margins(r.pulses);
 
-  // Item 11: the verdict.
+  // Item 11: the verdict. Failures measured on the link come first; then what keeps the record
+  // from showing that the link works (no verdict of pass without it).
+  std::vector<std::string> open;  // reasons for "inconclusive"
+  double peak = 0;
+  for (double x : v) peak = std::max(peak, std::abs(x));
+  if (peak > kImplausible * rules.vth)
+    open.push_back(fmt::format("levels up to {:.4g} V: no daisy-chain signal as read", peak));
   if (r.pulses.empty())
-    r.reasons.push_back(fmt::format("no pulses: nothing stays past +/-{:g} V for {:g} ns",
-                                    rules.vth, ns(rules.min_pulse)));
+    open.push_back(
+        fmt::format("no pulses: nothing stays past +/-{:g} V for {:g} ns (largest |v| {:.4g} V)",
+                    rules.vth, ns(rules.min_pulse), peak));
   if (size_t nf = r.failing())
     r.reasons.push_back(fmt::format("{} of {} pulses fail", nf, r.pulses.size()));
   for (size_t i = 0; i < r.frames.size(); ++i)
@@ -236,8 +262,62 @@ StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const d
       r.reasons.push_back(fmt::format("frame {} at {:.4f} us does not decode: {} ({})", i,
                                       r.frames[i].start * 1e6, r.frames[i].fault,
                                       r.frames[i].detail));
+  if (!rules.tone && !r.pulses.empty() && structural == 0)
+    open.push_back(fmt::format("no frame decodes: {} pulses in {} runs, none forms a byte",
+                               r.pulses.size(), seg.frames.size()));
+  size_t cut = 0;
+  for (const PulseMetrics& p : r.pulses) cut += p.truncated ? 1 : 0;
+  if (cut > 0)
+    open.push_back(fmt::format(
+        "the record cuts {} pulse{} (first: {}): {} not judged", cut, cut == 1 ? "" : "s",
+        place(*std::find_if(r.pulses.begin(), r.pulses.end(),
+                            [](const PulseMetrics& p) { return p.truncated; })),
+        cut == 1 ? "it is" : "they are"));
   if (!r.expect_match)
     r.reasons.push_back("decoded bytes differ from the expected: " + r.expect_detail);
+
+  // Hints: the samples look like the wrong units, the wrong column or swapped P and N.
+  const bool decoded_nothing = !rules.tone && structural == 0;
+  if (peak > kImplausible * rules.vth)
+    r.hints.push_back(fmt::format(
+        "|v| reaches {:.4g} V, over {:g}x the {:g} V threshold: a column in mV read as volts? "
+        "(a units row such as \"s,mV\" under the names sets the scale)",
+        peak, kImplausible, rules.vth));
+  else if (r.pulses.empty() && peak > 0 && peak < rules.vth / 100)
+    r.hints.push_back(fmt::format(
+        "|v| stays under {:.4g} V, 1/100 of the threshold: the wrong column (an idle channel, a "
+        "trigger or math trace), or volts read as kV?",
+        peak));
+  else if (r.pulses.empty() && peak < rules.vth)
+    r.hints.push_back(
+        fmt::format("|v| peaks at {:.4g} V, under the {:g} V threshold: the wrong column, a probe "
+                    "attenuation not applied, or one leg (P or N) alone instead of P - N?",
+                    peak, rules.vth));
+  if (decoded_nothing && !r.pulses.empty()) {
+    std::vector<double> widths;
+    for (const PulseMetrics& p : r.pulses)
+      if (!p.truncated) widths.push_back(p.b - p.a);
+    if (!widths.empty()) {
+      std::nth_element(widths.begin(), widths.begin() + widths.size() / 2, widths.end());
+      const double w = widths[widths.size() / 2];
+      if (w > 20 * rules.pulse_time || w < rules.pulse_time / 20)
+        r.hints.push_back(fmt::format(
+            "the median pulse lasts {:.4g} s against a {:g} ns half bit: time in us or ms read "
+            "as seconds (or the reverse)? A units row such as \"(us)\" sets the scale",
+            w, ns(rules.pulse_time)));
+    }
+    if (inverted > 0)
+      r.hints.push_back(fmt::format(
+          "{} run{} decode{} with the signs flipped: P and N swapped (or the probe inverted)?",
+          inverted, inverted == 1 ? "" : "s", inverted == 1 ? "s" : ""));
+  }
+
+  // A record with no pulses, or none that forms a byte, shows nothing about the link (an
+  // unrelated capture, the wrong column): inconclusive whatever its pulses measure. Otherwise a
+  // measured failure fails, and a record that cuts a pulse cannot pass.
+  const bool nothing = r.pulses.empty() || decoded_nothing || peak > kImplausible * rules.vth;
+  r.inconclusive = nothing || (r.reasons.empty() && !open.empty());
+  r.reasons.insert(r.reasons.end(), open.begin(), open.end());
   r.pass = r.reasons.empty();
   return r;
 }
@@ -251,8 +331,9 @@ StatusOr<CheckResult> check_waveform(const Waveform& w, const Rules& rules, cons
 
 json to_json(const CheckResult& r) {
   json j;
-  j["verdict"] = r.pass ? "pass" : "fail";
+  j["verdict"] = r.verdict();
   j["reasons"] = r.reasons;
+  j["hints"] = r.hints;
   j["rules"] = r.rules;
   j["rules_source"] = r.rules_source;
   j["samples"] = r.samples;
@@ -287,8 +368,11 @@ json to_json(const CheckResult& r) {
                   {"edge_max_ns", opt_num(r.edge_max(), 1e9)},
                   {"worst", worst}};
 
+  // Memory linear in what is printed: at most kMaxJsonPulses pulses in detail (a JSON node per
+  // field costs far more than the pulse; 2M pulses took 3.6 GB). --pulses-csv streams them all.
   json pulses = json::array();
   for (const PulseMetrics& p : r.pulses) {
+    if (pulses.size() == kMaxJsonPulses) break;
     json cls = p.truncated ? json(nullptr) : (p.idle ? json("idle") : json(p.k));
     json dips = json::array();
     for (const Dip& d : p.dips)
@@ -311,24 +395,27 @@ json to_json(const CheckResult& r) {
                       {"warnings", p.warnings}});
   }
   j["pulses"] = std::move(pulses);
+  j["pulses_omitted"] = r.pulses.size() - std::min(r.pulses.size(), kMaxJsonPulses);
 
   json ringing = json::array();
   for (const Ringing& g : r.ringing)
-    ringing.push_back({{"start_s", g.start},
-                       {"end_s", g.end},
-                       {"duration_ns", ns(g.end - g.start)},
-                       {"sign", g.sign},
-                       {"peak", g.peak},
-                       {"peak_s", g.peak_t}});
+    if (ringing.size() < kMaxJsonPulses)
+      ringing.push_back({{"start_s", g.start},
+                         {"end_s", g.end},
+                         {"duration_ns", ns(g.end - g.start)},
+                         {"sign", g.sign},
+                         {"peak", g.peak},
+                         {"peak_s", g.peak_t}});
   j["ringing"] = std::move(ringing);
   json idle = json::array();
   for (const IdleUndershoot& u : r.idle)
-    idle.push_back({{"start_s", u.start},
-                    {"end_s", u.end},
-                    {"sign", u.sign},
-                    {"peak", u.peak},
-                    {"peak_s", u.peak_t},
-                    {"after_pulse", u.after_pulse}});
+    if (idle.size() < kMaxJsonPulses)
+      idle.push_back({{"start_s", u.start},
+                      {"end_s", u.end},
+                      {"sign", u.sign},
+                      {"peak", u.peak},
+                      {"peak_s", u.peak_t},
+                      {"after_pulse", u.after_pulse}});
   j["idle"] = std::move(idle);
 
   json frames = json::array();
@@ -363,8 +450,12 @@ std::string summary_text(const CheckResult& r, const std::string& source) {
   size_t frames_failing = 0;
   for (const FrameResult& f : r.frames) frames_failing += f.fails() ? 1 : 0;
   out += fmt::format("{}{} (rules {})\n", source.empty() ? "" : source + ": ",
-                     r.pass ? "PASS" : "FAIL", r.rules);
+                     r.pass           ? "PASS"
+                     : r.inconclusive ? "INCONCLUSIVE"
+                                      : "FAIL",
+                     r.rules);
   for (const std::string& why : r.reasons) out += "  " + why + "\n";
+  for (const std::string& hint : r.hints) out += "  hint: " + hint + "\n";
   if (!r.worst.empty()) {
     out += "worst margin per metric:\n";
     for (const WorstMargin& w : r.worst) {
@@ -383,7 +474,10 @@ std::string summary_text(const CheckResult& r, const std::string& source) {
       r.pulses.size(), nf, r.ringing.size(), r.idle.size(), r.frames.size(),
       r.tone ? "runs" : "frames", frames_failing);
   if (!r.tone) {
-    out += "decoded: " + (r.bytes.empty() ? std::string("(none)") : to_hex(r.bytes));
+    constexpr size_t kShown = 64;  // a long record decodes thousands: the JSON has them all
+    const std::span<const uint8_t> shown(r.bytes.data(), std::min(r.bytes.size(), kShown));
+    out += "decoded: " + (r.bytes.empty() ? std::string("(none)") : to_hex(shown));
+    if (r.bytes.size() > kShown) out += fmt::format(" ... ({} bytes in all)", r.bytes.size());
     if (r.expect)
       out += r.expect_match ? "  (as expected)"
                             : "  (expected " + to_hex(*r.expect) + ": " + r.expect_detail + ")";
@@ -420,45 +514,31 @@ std::string summary_text(const CheckResult& r, const std::string& source) {
 }
 
 Status write_pulses_csv(const CheckResult& r, const std::string& path) {
-  const std::string tmp = path + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "w");
-  if (!f) return Status::Error(path + ": error: cannot write the file");
+  StatusOr<OutputFile> f = OutputFile::open(path);
+  if (!f) return f.status();
   auto cell = [](double x, double scale = 1) {
     return std::isnan(x) ? std::string() : fmt::format("{:.9g}", x * scale);
   };
-  auto quoted = [](const std::vector<std::string>& items) {
+  auto joined = [](const std::vector<std::string>& items) {
     std::string s;
     for (const std::string& i : items) s += (s.empty() ? "" : " | ") + i;
-    std::string q = "\"";
-    for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-    return q + "\"";
+    return csv_field(s);
   };
-  std::fputs(
-      "index,sign,start_s,end_s,width_ns,class,edge_ns,vstart,vend,droop,frame,bit,fails,"
-      "warnings\n",
-      f);
+  if (Status s = f->write(
+          "index,sign,start_s,end_s,width_ns,class,edge_ns,vstart,vend,droop,frame,bit,fails,"
+          "warnings\n");
+      !s.ok())
+    return s;
   for (const PulseMetrics& p : r.pulses) {
     const std::string cls = p.truncated ? "" : (p.idle ? "idle" : std::to_string(p.k));
     const std::string line = fmt::format(
         "{},{},{:.12g},{:.12g},{},{},{},{},{},{},{},{},{},{}\n", p.index, p.sign, p.a, p.b,
         cell(p.width.value, 1e9), cls, cell(p.edge.value, 1e9), cell(p.vstart.value),
         cell(p.vend.value), cell(p.droop.value), p.frame >= 0 ? std::to_string(p.frame) : "",
-        p.role, quoted(p.fails), quoted(p.warnings));
-    std::fputs(line.c_str(), f);
+        p.role, joined(p.fails), joined(p.warnings));
+    if (Status s = f->write(line); !s.ok()) return s;
   }
-  bool ok = std::fflush(f) == 0;
-  ok = std::fclose(f) == 0 && ok;
-  std::error_code ec;
-  if (!ok) {
-    std::filesystem::remove(tmp, ec);
-    return Status::Error(path + ": error: write failed");
-  }
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    return Status::Error(path + ": error: cannot rename the temp file: " + ec.message());
-  }
-  return Status::Ok();
+  return f->commit();
 }
 
 }  // namespace isolink::eye

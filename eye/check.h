@@ -19,12 +19,12 @@
 #include <string>
 #include <vector>
 
-#include "eye/decode.h"
+#include "base/status.h"
+#include "base/waveform.h"
 #include "eye/metrics.h"
 #include "eye/pulses.h"
 #include "eye/rules.h"
-#include "base/status.h"
-#include "base/waveform.h"
+#include "protocol/frame.h"
 
 namespace isolink::eye {
 
@@ -54,7 +54,9 @@ struct CheckResult {
   bool tone = false;                           // tone rules: nothing is decoded
   FrameFormat frame_format;                    // decoding options in effect
   bool pass = false;                           // the verdict
-  std::vector<std::string> reasons;            // why it fails, one line each (empty on pass)
+  bool inconclusive = false;                   // no verdict: nothing decodes, or a pulse is cut
+  std::vector<std::string> reasons;            // why it fails / is inconclusive (empty on pass)
+  std::vector<std::string> hints;              // what to check when the data look misread
   size_t samples = 0;                          // samples in the waveform
   double t_begin = 0, t_end = 0;               // its time span (s)
   std::vector<PulseMetrics> pulses;            // in time order
@@ -73,9 +75,14 @@ struct CheckResult {
   std::optional<double> width_min() const;   // over pulses ending in an opposite edge (s)
   std::optional<double> width_max() const;   // same (s)
   std::optional<double> edge_max() const;    // over all edges (s)
+  const char* verdict() const { return pass ? "pass" : inconclusive ? "inconclusive" : "fail"; }
 };
 
-// Checks time/value samples (t strictly increasing) against rules.
+// Checks time/value samples (t strictly increasing) against rules. The verdict is never pass when
+// the record cannot show the link works: no pulses, no frame whose structure decodes (data rules),
+// or a pulse cut by the record's start or end. With no failure measured such a record is
+// "inconclusive" (pass = false, inconclusive = true), with hints when the samples look like the
+// wrong units (levels 1000x off, pulses far from the half bit) or swapped P and N.
 StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const double> v,
                                     const Rules& rules, const CheckOptions& opt = {});
 // Checks column `column` of w.
@@ -84,6 +91,9 @@ StatusOr<CheckResult> check_waveform(const Waveform& w, const Rules& rules,
 
 // The JSON object, keys in a fixed order (verdict, reasons, rules, ..., summary, pulses, ringing,
 // idle, decoded).
+// Pulses (and ringing, idle undershoots) listed in detail are capped at kMaxJsonPulses each;
+// "pulses_omitted" counts the pulses left out (write_pulses_csv has every one).
+inline constexpr size_t kMaxJsonPulses = 10'000;
 nlohmann::ordered_json to_json(const CheckResult& r);
 // A few lines for people: verdict, worst margin per metric with place, counts, failures.
 std::string summary_text(const CheckResult& r, const std::string& source = "");

@@ -50,8 +50,10 @@ std::vector<PulseMetrics> measure_pulses(std::span<const double> t, std::span<co
 
     // Item 5-6: width and class.
     const double width = joined ? seg.pulses[i + 1].a - ps.a : ps.b - ps.a;
-    m.k = static_cast<int>(std::lround(width / T));
-    m.half_bits = std::max(1, m.k);
+    // A pulse far longer than a frame (a DC level, a 10 s pulse in the wrong units) carries at most
+    // kMaxHalfBits half bits for decoding: memory stays linear in samples, not in pulse length.
+    m.k = static_cast<int>(std::lround(std::min(width / T, 1e9)));
+    m.half_bits = std::clamp(m.k, 1, kMaxHalfBits);
     if (!m.truncated) m.width.value = width;
     if (joined && !m.truncated) {
       const WidthWindow* best = nullptr;

@@ -22,6 +22,10 @@
 namespace isolink::eye {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// Half bits a single pulse may carry into decoding (a frame has 26 with SOF): a longer pulse is
+// decoded as this many, which breaks the frame just the same, so memory never grows with the
+// pulse's length.
+constexpr int kMaxHalfBits = 64;
 
 // One judged quantity.
 struct Judged {
@@ -39,7 +43,7 @@ struct PulseMetrics {
   bool idle = false;         // no transition after it: runs into idle (width = b - a, not judged)
   bool truncated = false;    // cut by the record: nothing judged
   int k = 0;                 // class round(width / T)
-  int half_bits = 0;         // half bits it carries for decoding (>= 1)
+  int half_bits = 0;         // half bits it carries for decoding (1..kMaxHalfBits)
   Judged width;              // thigh / tlow (s)
   Judged edge;               // trise / tfall into this pulse (s); not measured for a frame's first
   Judged vstart;             // max of s*v over [a, (a+b)/2] (V)

@@ -3,274 +3,557 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cctype>
-#include <charconv>
 #include <cmath>
-#include <fstream>
-#include <sstream>
-#include <vector>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "eye/csv_lines.h"
+#include "eye/scope_binary.h"
+#include "eye/scope_formats.h"
 
 namespace isolink::eye {
 namespace {
 
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t' || s.front() == '\r'))
-    s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r'))
-    s.remove_suffix(1);
-  return s;
-}
+constexpr size_t kHeadLines = 256;   // lines looked at to find the layout
+constexpr double kOverrange = 1e30;  // Tektronix writes 9.9E37 for a clipped sample
 
-std::string_view unquote(std::string_view s) {
-  s = trim(s);
-  if (s.size() >= 2 && (s.front() == '"' || s.front() == '\'') && s.back() == s.front())
-    s = trim(s.substr(1, s.size() - 2));
-  return s;
-}
+// A column read with a sign: the value is the sum of sign * scale * field.
+struct Term {
+  std::string role;
+  std::string ref;
+};
 
-bool parse_number(std::string_view s, double* out) {
-  s = unquote(s);
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  if (s.empty()) return false;
-  auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), *out);
-  return ec == std::errc() && ptr == s.data() + s.size() && std::isfinite(*out);
-}
-
-// ' ' stands for "runs of blanks".
-char detect_delimiter(std::string_view line) {
-  std::string outside;
-  int depth = 0;
-  bool quoted = false;
-  for (char c : line) {
-    if (c == '"')
-      quoted = !quoted;
-    else if (!quoted && c == '(')
-      ++depth;
-    else if (!quoted && c == ')' && depth > 0)
-      --depth;
-    else if (!quoted && depth == 0)
-      outside += c;
-  }
-  for (char d : {',', '\t', ';'})
-    if (outside.find(d) != std::string::npos) return d;
-  return ' ';
-}
-
-void split(std::string_view line, char delim, std::vector<std::string_view>* out) {
-  out->clear();
-  if (delim == ' ') {
-    size_t i = 0;
-    while (i < line.size()) {
-      while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
-      if (i >= line.size()) break;
-      size_t j = i;
-      while (j < line.size() && line[j] != ' ' && line[j] != '\t' && line[j] != '\r') ++j;
-      out->push_back(line.substr(i, j - i));
-      i = j;
-    }
-    return;
-  }
-  if (line.find('"') == std::string_view::npos && line.find('(') == std::string_view::npos) {
-    size_t start = 0;
-    for (;;) {
-      size_t k = line.find(delim, start);
-      if (k == std::string_view::npos) {
-        out->push_back(line.substr(start));
-        break;
-      }
-      out->push_back(line.substr(start, k - start));
-      start = k + 1;
-    }
-  } else {  // names like v(rxp,rxn) or "a,b": no split inside parentheses or quotes
-    size_t start = 0;
-    int depth = 0;
-    bool quoted = false;
-    for (size_t k = 0; k < line.size(); ++k) {
-      const char c = line[k];
-      if (c == '"')
-        quoted = !quoted;
-      else if (!quoted && c == '(')
-        ++depth;
-      else if (!quoted && c == ')' && depth > 0)
-        --depth;
-      else if (!quoted && depth == 0 && c == delim) {
-        out->push_back(line.substr(start, k - start));
-        start = k + 1;
-      }
-    }
-    out->push_back(line.substr(start));
-  }
-  while (!out->empty() && trim(out->back()).empty()) out->pop_back();  // trailing delimiters
-}
-
-bool all_numeric(const std::vector<std::string_view>& f) {
-  double x;
-  for (auto s : f)
-    if (!parse_number(s, &x)) return false;
-  return !f.empty();
-}
-
-// Line-by-line cursor over the text with 1-based line numbers.
-struct Lines {
-  std::string_view text;
-  size_t pos = 0;
-  int number = 0;
-  bool next(std::string_view* line) {
-    if (pos >= text.size()) return false;
-    size_t e = text.find('\n', pos);
-    if (e == std::string_view::npos) e = text.size();
-    *line = text.substr(pos, e - pos);
-    if (!line->empty() && line->back() == '\r') line->remove_suffix(1);
-    pos = e + 1;
-    ++number;
-    return true;
-  }
+struct OneFile {
+  std::vector<double> t, v;
+  std::string name;  // the value column's name ("CH1-CH2")
 };
 
 std::string lower(std::string_view s) {
   std::string r(s);
-  std::transform(r.begin(), r.end(), r.begin(), [](char c) {
-    return static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  });
+  for (char& c : r) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return r;
+}
+
+// R&S RTx exports NAME.Wfm.csv (data) beside NAME.csv ("Key:value:" lines).
+std::vector<std::pair<std::string, std::string>> rs_sibling_header(const std::string& path) {
+  std::vector<std::pair<std::string, std::string>> out;
+  const std::string lo = lower(path);
+  const std::string tail = ".wfm.csv";
+  if (lo.size() <= tail.size() || lo.compare(lo.size() - tail.size(), tail.size(), tail) != 0)
+    return out;
+  const std::string header = path.substr(0, path.size() - tail.size()) + ".csv";
+  StatusOr<LineReader> in = LineReader::open(header);
+  if (!in) return out;
+  std::string_view line;
+  for (int i = 0; i < 500 && in->next(&line); ++i) {
+    const size_t c = line.find(':');
+    if (c == std::string_view::npos || c == 0) continue;
+    std::string_view v = line.substr(c + 1);
+    const size_t c2 = v.find(':');
+    if (c2 != std::string_view::npos) v = v.substr(0, c2);
+    out.emplace_back(std::string(trim_cell(line.substr(0, c))), std::string(trim_cell(v)));
+  }
+  return out;
+}
+
+// Resolves the P/N/diff references against the layout; refuses time columns, Start/Increment,
+// non-volt units and P = N.
+Status pick_terms(const ScopeLayout& l, const std::vector<Term>& terms, const std::string& source,
+                  std::vector<size_t>* picked_out, std::vector<double>* sign_out,
+                  std::vector<std::string>* how_out, std::vector<std::string>* notes) {
+  auto err = [&](int line, const std::string& msg) {
+    return Status::Error(line > 0 ? fmt::format("{}:{}: error: {}", source, line, msg)
+                                  : fmt::format("{}: error: {}", source, msg));
+  };
+  auto describe = [&](size_t k) {
+    return fmt::format("column {} ('{}')", l.columns[k].field + 1, l.columns[k].name);
+  };
+  std::vector<size_t>& picked = *picked_out;
+  std::vector<double>& sign = *sign_out;
+  std::vector<std::string>& how = *how_out;
+  for (size_t i = 0; i < terms.size(); ++i) {
+    const Term& tm = terms[i];
+    const std::string flag = tm.role == "diff" ? "differential column" : tm.role + " column";
+    size_t k = 0;
+    if (tm.ref.empty()) {
+      std::optional<size_t> c = first_channel(l);
+      if (!c)
+        return err(l.header_line ? l.header_line : l.data_line,
+                   fmt::format("no signal column besides time: the {} needs one", flag));
+      k = *c;
+      how.push_back("default (first channel)");
+    } else {
+      StatusOr<ColumnPick> p = pick_column(l, tm.ref, flag.c_str(), source);
+      if (!p) return p.status();
+      if (!p->note.empty()) notes->push_back(p->note);
+      k = p->column;
+      how.push_back(p->how);
+    }
+    const ScopeColumn& c = l.columns[k];
+    const int at = l.header_line ? l.header_line : l.data_line;
+    if (static_cast<int>(k) == l.time || c.time_like)
+      return err(at, fmt::format("{} '{}' is {}, a time column: choose a signal column", flag,
+                                 tm.ref.empty() ? "(default)" : tm.ref, describe(k)));
+    if (c.meta)
+      return err(at, fmt::format("{} '{}' is {}, which holds Rigol's Start/Increment, not a "
+                                 "signal",
+                                 flag, tm.ref, describe(k)));
+    if (c.unit.kind == UnitKind::kOther)
+      return err(at, fmt::format("{} '{}' is {}, in {}, not volts", flag, tm.ref, describe(k),
+                                 c.unit.text));
+    for (size_t j = 0; j < picked.size(); ++j)
+      if (picked[j] == k)
+        return err(at, fmt::format("P and N are both {}: P - N would be zero; choose two "
+                                   "different columns",
+                                   describe(k)));
+    picked.push_back(k);
+    sign.push_back(i == 0 ? 1.0 : -1.0);
+  }
+
+  return Status::Ok();
+}
+
+StatusOr<OneFile> read_one(LineReader& in, const std::string& source, const std::string& time_ref,
+                           const std::vector<Term>& terms, const std::string& other_file_p,
+                           const std::vector<std::pair<std::string, std::string>>& extra,
+                           CaptureInfo* info) {
+  auto err = [&](int line, const std::string& msg) {
+    return Status::Error(line > 0 ? fmt::format("{}:{}: error: {}", source, line, msg)
+                                  : fmt::format("{}: error: {}", source, msg));
+  };
+  (void)other_file_p;
+  std::vector<std::string> head;
+  std::string_view line;
+  bool more = false;
+  while (in.next(&line)) {
+    head.emplace_back(line);
+    if (head.size() >= kHeadLines) {
+      more = true;
+      break;
+    }
+  }
+  if (!in.error().empty()) return err(0, in.error());
+  StatusOr<ScopeLayout> lay = detect_layout(head, source, more, extra);
+  if (!lay) return lay.status();
+  ScopeLayout& l = *lay;
+  std::vector<std::string> notes;
+
+  // Columns.
+  auto describe = [&](size_t k) {
+    return fmt::format("column {} ('{}')", l.columns[k].field + 1, l.columns[k].name);
+  };
+  if (!time_ref.empty()) {
+    StatusOr<ColumnPick> p = pick_column(l, time_ref, "time column", source);
+    if (!p) return p.status();
+    if (!p->note.empty()) notes.push_back(p->note);
+    l.time = static_cast<int>(p->column);
+    l.time_is_index = l.columns[p->column].unit.kind == UnitKind::kIndex && l.dt > 0;
+    l.columns[p->column].time_like = true;
+    l.time_from = "--time " + describe(p->column);
+  }
+  std::vector<size_t> picked;
+  std::vector<double> sign;
+  std::vector<std::string> how;
+  if (Status st = pick_terms(l, terms, source, &picked, &sign, &how, &notes); !st.ok()) return st;
+
+  // Fields to read and their scales.
+  const int tcol = l.time;
+  const size_t tfield = tcol >= 0 ? l.columns[static_cast<size_t>(tcol)].field : 0;
+  const double tscale =
+      tcol >= 0 && !l.time_is_index ? l.columns[static_cast<size_t>(tcol)].unit.scale : 1;
+  std::vector<size_t> vfield;
+  std::vector<double> vscale;
+  for (size_t i = 0; i < picked.size(); ++i) {
+    vfield.push_back(l.columns[picked[i]].field);
+    vscale.push_back(sign[i] * l.columns[picked[i]].unit.scale);
+  }
+  size_t need = tcol >= 0 ? tfield + 1 : 0;
+  for (size_t f : vfield) need = std::max(need, f + 1);
+
+  // Rows.
+  OneFile out;
+  {
+    // reserve from the file's size and the first data rows' length: no doubling past the file
+    size_t bytes = 0, rows = 0;
+    for (size_t i = static_cast<size_t>(l.data_line - 1); i < head.size() && rows < 64; ++i)
+      if (!trim_cell(head[i]).empty()) {
+        bytes += head[i].size() + 1;
+        ++rows;
+      }
+    if (rows > 0 && in.size() > 0) {
+      const size_t est = static_cast<size_t>(static_cast<double>(in.size()) /
+                                             (static_cast<double>(bytes) / rows) * 1.02) +
+                         16;
+      out.t.reserve(est);
+      out.v.reserve(est);
+    }
+  }
+  std::vector<std::string_view> f;
+  int prev_row_line = 0, footer_line = 0;
+  std::string footer_text;
+  size_t row = 0;
+  Status bad = Status::Ok();
+  auto take = [&](std::string_view text, int number) -> bool {
+    if (trim_cell(text).empty()) return true;
+    split_fields(text, l.delim, &f);
+    double x;
+    bool any = false;
+    for (auto s : f)
+      if (parse_cell(s, l.decimal_comma, &x)) {
+        any = true;
+        break;
+      }
+    if (!any) {  // a footer (",,", "End of data"): the data end here
+      if (!footer_line) {
+        footer_line = number;
+        footer_text = std::string(trim_cell(text).substr(0, 40));
+      }
+      return true;
+    }
+    if (footer_line) {
+      bad = err(number, fmt::format("data after line {} ('{}'), which is no data row: expected "
+                                    "the data to end there (a footer) or to go on as numbers",
+                                    footer_line, footer_text));
+      return false;
+    }
+    if (f.size() != l.data_fields || f.size() < need) {
+      const bool like_header = l.header_line > 0 && l.columns.size() == l.data_fields;
+      bad = err(number, fmt::format("expected {} fields like {} (line {}), found {}", l.data_fields,
+                                    like_header ? "the header" : "the first data row",
+                                    like_header ? l.header_line : l.data_line, f.size()));
+      return false;
+    }
+    auto get = [&](size_t field, size_t col_hint, double* y) -> bool {
+      if (parse_cell(f[field], l.decimal_comma, y)) {
+        if (std::abs(*y) < kOverrange) return true;
+        bad = err(number, fmt::format("field {}: {} is the scope's overrange marker: the "
+                                      "channel clipped; capture again with more volts/div",
+                                      field + 1, std::string(trim_cell(f[field]))));
+        return false;
+      }
+      std::string name = fmt::format("column {}", field + 1);
+      for (const ScopeColumn& c : l.columns)
+        if (c.field == field) name = c.name;
+      (void)col_hint;
+      bad = err(number, fmt::format("column {} ('{}'): expected a number, found '{}'", field + 1,
+                                    name, std::string(trim_cell(f[field]))));
+      return false;
+    };
+    double t = 0;
+    if (tcol >= 0) {
+      if (!get(tfield, 0, &t)) return false;
+      t = l.time_is_index ? l.t0 + t * l.dt : t * tscale;
+    } else {
+      t = l.t0 + static_cast<double>(row) * l.dt;
+    }
+    double v = 0;
+    for (size_t i = 0; i < vfield.size(); ++i) {
+      if (!get(vfield[i], i, &x)) return false;
+      v += vscale[i] * x;
+    }
+    if (!out.t.empty() && !(t > out.t.back())) {
+      bad = err(number, fmt::format("time {:g} is not after {:g} on line {}: time must increase "
+                                    "from row to row",
+                                    t, out.t.back(), prev_row_line));
+      return false;
+    }
+    out.t.push_back(t);
+    out.v.push_back(v);
+    prev_row_line = number;
+    ++row;
+    return true;
+  };
+  for (size_t i = static_cast<size_t>(l.data_line - 1); i < head.size(); ++i)
+    if (!take(head[i], static_cast<int>(i) + 1)) return bad;
+  if (more)
+    while (in.next(&line))
+      if (!take(line, in.number())) return bad;
+  if (!in.error().empty()) return err(0, in.error());
+  if (out.t.size() < 2)
+    return err(l.data_line,
+               fmt::format("fewer than two samples in the data from line {}", l.data_line));
+
+  // What was read.
+  if (info) {
+    info->files.push_back(source);
+    info->layouts.push_back(l.name);
+    if (info->time_from.empty()) info->time_from = l.time_from;
+    if (tcol >= 0 && info->columns.empty()) {
+      const ScopeColumn& c = l.columns[static_cast<size_t>(tcol)];
+      const bool assumed = c.unit.kind == UnitKind::kNone;
+      info->columns.push_back({"time", source, c.name, c.channel, c.field + 1,
+                               time_ref.empty() ? "default" : "by --time",
+                               assumed ? "" : c.unit.text, l.time_is_index ? l.dt : tscale});
+      if (assumed && !l.time_is_index)
+        info->notes.push_back(
+            fmt::format("{}: no unit for the time column: read as seconds", source));
+    }
+    for (size_t i = 0; i < picked.size(); ++i) {
+      const ScopeColumn& c = l.columns[picked[i]];
+      info->columns.push_back({terms[i].role, source, c.name, c.channel, c.field + 1, how[i],
+                               c.unit.text, c.unit.scale});
+      if (c.unit.kind == UnitKind::kNone)
+        info->notes.push_back(
+            fmt::format("{}: no unit for {} ('{}'): read as volts", source, terms[i].role, c.name));
+    }
+    info->notes.insert(info->notes.end(), notes.begin(), notes.end());
+  }
+  out.name = l.columns[picked[0]].name;
+  if (picked.size() == 2) out.name += "-" + l.columns[picked[1]].name;
+  return out;
+}
+
+void finish_info(const Waveform& w, CaptureInfo* info) {
+  if (!info) return;
+  info->samples = w.time.size();
+  info->t_begin = w.time.front();
+  info->t_end = w.time.back();
+  // median interval from a bounded sample of steps
+  std::vector<double> steps;
+  const size_t n = w.time.size() - 1;
+  const size_t stride = std::max<size_t>(1, n / 4096);
+  for (size_t i = 0; i < n; i += stride) steps.push_back(w.time[i + 1] - w.time[i]);
+  std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2),
+                   steps.end());
+  info->interval = steps[steps.size() / 2];
+  info->uniform = true;
+  for (size_t i = 0; i < n && info->uniform; ++i)
+    info->uniform = std::abs(w.time[i + 1] - w.time[i] - info->interval) <= 0.01 * info->interval;
+}
+
+StatusOr<std::vector<Term>> terms_for(const CsvColumns& cols, const std::string& source) {
+  auto err = [&](const std::string& msg) {
+    return Status::Error(fmt::format("{}: error: {}", source, msg));
+  };
+  if (!cols.diff.empty() && (!cols.p.empty() || !cols.n.empty()))
+    return err("give either a differential column or a P and an N column, not both");
+  if (cols.p.empty() != cols.n.empty())
+    return err("a P column needs an N column (and the reverse): the differential is P - N");
+  if (!cols.p.empty()) return std::vector<Term>{{"P", cols.p}, {"N", cols.n}};
+  return std::vector<Term>{{"diff", cols.diff}};
+}
+
+// A binary capture: its traces stand for columns, so the same choices and refusals apply.
+StatusOr<OneFile> read_binary_one(const std::string& path, const std::string& kind,
+                                  const std::vector<Term>& terms, CaptureInfo* info) {
+  StatusOr<std::vector<BinaryTrace>> traces = read_binary(path);
+  if (!traces) return traces.status();
+  ScopeLayout l;
+  l.name = kind;
+  for (size_t k = 0; k < traces->size(); ++k) {
+    ScopeColumn c;
+    c.name = (*traces)[k].name;
+    c.channel = canonical_channel(c.name);
+    c.field = k;
+    if (auto u = parse_unit((*traces)[k].y_unit)) c.unit = *u;
+    l.columns.push_back(c);
+  }
+  std::vector<size_t> picked;
+  std::vector<double> sign;
+  std::vector<std::string> how, notes;
+  if (Status st = pick_terms(l, terms, path, &picked, &sign, &how, &notes); !st.ok()) return st;
+  const BinaryTrace& first = (*traces)[picked[0]];
+  OneFile out;
+  out.t = first.t;
+  out.v.assign(first.v.size(), 0.0);
+  for (size_t i = 0; i < picked.size(); ++i) {
+    const BinaryTrace& tr = (*traces)[picked[i]];
+    if (tr.t != first.t)
+      return Status::Error(
+          fmt::format("{}: error: waveforms '{}' and '{}' have different time "
+                      "bases: P and N must come from one acquisition",
+                      path, first.name, tr.name));
+    for (size_t j = 0; j < tr.v.size(); ++j) out.v[j] += sign[i] * tr.v[j];
+  }
+  for (size_t j = 1; j < out.t.size(); ++j)
+    if (!(out.t[j] > out.t[j - 1]))
+      return Status::Error(fmt::format("{}: error: time does not increase at point {}", path, j));
+  if (info) {
+    info->files.push_back(path);
+    info->layouts.push_back(kind);
+    if (info->time_from.empty()) info->time_from = first.time_from;
+    for (size_t i = 0; i < picked.size(); ++i) {
+      const ScopeColumn& c = l.columns[picked[i]];
+      info->columns.push_back(
+          {terms[i].role, path, c.name, c.channel, c.field + 1, how[i], c.unit.text, c.unit.scale});
+    }
+    info->notes.insert(info->notes.end(), notes.begin(), notes.end());
+  }
+  out.name = l.columns[picked[0]].name;
+  if (picked.size() == 2) out.name += "-" + l.columns[picked[1]].name;
+  return out;
+}
+
+StatusOr<OneFile> read_path(const std::string& path, const std::string& time_ref,
+                            const std::vector<Term>& terms, CaptureInfo* info) {
+  if (std::optional<std::string> kind = binary_kind(path)) {
+    if (!time_ref.empty())
+      return Status::Error(
+          fmt::format("{}: error: --time '{}': a {} capture carries its own "
+                      "time base",
+                      path, time_ref, *kind));
+    return read_binary_one(path, *kind, terms, info);
+  }
+  StatusOr<LineReader> in = LineReader::open(path);
+  if (!in) return in.status();
+  return read_one(*in, path, time_ref, terms, "", rs_sibling_header(path), info);
+}
+
+Waveform to_waveform(OneFile&& one, CaptureInfo* info) {
+  Waveform w;
+  w.time = std::move(one.t);
+  w.add_column(one.name, std::move(one.v));
+  finish_info(w, info);
+  return w;
 }
 
 }  // namespace
 
 StatusOr<Waveform> parse_differential_csv(std::string_view text, const std::string& source,
-                                          const CsvColumns& cols) {
-  auto err = [&](int line, const std::string& msg) {
-    return Status::Error(line > 0 ? fmt::format("{}:{}: error: {}", source, line, msg)
-                                  : fmt::format("{}: error: {}", source, msg));
-  };
-  if (!cols.diff.empty() && (!cols.p.empty() || !cols.n.empty()))
-    return err(0, "give either a differential column or a P and an N column, not both");
-  if (cols.p.empty() != cols.n.empty())
-    return err(0, "a P column needs an N column (and the reverse): the differential is P - N");
+                                          const CsvColumns& cols, CaptureInfo* info) {
+  StatusOr<std::vector<Term>> terms = terms_for(cols, source);
+  if (!terms) return terms.status();
+  LineReader in(text);
+  StatusOr<OneFile> one = read_one(in, source, cols.time, *terms, "", {}, info);
+  if (!one) return one.status();
+  return to_waveform(std::move(*one), info);
+}
 
-  // 1. Find the header: a non-numeric line followed by a numeric row with as many fields.
-  Lines lines{text};
-  std::string_view line, prev;
-  int prev_number = 0;
-  char delim = ',';
-  std::vector<std::string_view> header, fields;
-  bool found = false;
-  size_t data_pos = 0;
-  int data_line = 0;
-  for (;;) {
-    const size_t start = lines.pos;
-    if (!lines.next(&line)) break;
-    if (trim(line).empty()) continue;
-    if (prev_number > 0) {
-      char d = detect_delimiter(prev);
-      split(prev, d, &header);
-      split(line, d, &fields);
-      if (header.size() >= 2 && !all_numeric(header) && fields.size() == header.size() &&
-          all_numeric(fields)) {
-        delim = d;
-        found = true;
-        data_pos = start;  // re-read this row as data
-        data_line = lines.number - 1;
-        break;
-      }
-    }
-    prev = line;
-    prev_number = lines.number;
+StatusOr<Waveform> read_differential_csv(const std::string& path, const CsvColumns& cols,
+                                         CaptureInfo* info) {
+  StatusOr<std::vector<Term>> terms = terms_for(cols, path);
+  if (!terms) return terms.status();
+  StatusOr<OneFile> one = read_path(path, cols.time, *terms, info);
+  if (!one) return one.status();
+  return to_waveform(std::move(*one), info);
+}
+
+StatusOr<Waveform> read_capture(const std::vector<std::string>& paths, const CsvColumns& cols,
+                                CaptureInfo* info) {
+  if (paths.size() == 1) return read_differential_csv(paths[0], cols, info);
+  if (paths.size() != 2)
+    return Status::Error(
+        fmt::format("give one capture file or two (P and N), not {}", paths.size()));
+  if (!cols.diff.empty())
+    return Status::Error(fmt::format(
+        "{}: error: --diff '{}' with two files: the first file gives P (--p) and the second N "
+        "(--n)",
+        paths[1], cols.diff));
+  OneFile leg[2];
+  for (int i = 0; i < 2; ++i) {
+    StatusOr<OneFile> one =
+        read_path(paths[i], cols.time, {{i == 0 ? "P" : "N", i == 0 ? cols.p : cols.n}}, info);
+    if (!one) return one.status();
+    leg[i] = std::move(*one);
   }
-  if (!found)
-    return err(0,
-               "no header found: expected a line of column names (e.g. \"time,v\") followed by "
-               "rows of numbers with as many fields");
-  const int header_line = prev_number;
-  std::vector<std::string> names;
-  for (auto h : header) names.emplace_back(unquote(h));
-
-  auto resolve = [&](const std::string& ref, const char* flag, int fallback,
-                     size_t* idx) -> Status {
-    if (ref.empty()) {
-      *idx = static_cast<size_t>(fallback);
-      return Status::Ok();
-    }
-    for (size_t k = 0; k < names.size(); ++k)
-      if (names[k] == ref) return (*idx = k, Status::Ok());
-    for (size_t k = 0; k < names.size(); ++k)
-      if (lower(names[k]) == lower(ref)) return (*idx = k, Status::Ok());
-    int n = 0;
-    auto [ptr, ec] = std::from_chars(ref.data(), ref.data() + ref.size(), n);
-    if (ec == std::errc() && ptr == ref.data() + ref.size() && n >= 1 &&
-        static_cast<size_t>(n) <= names.size())
-      return (*idx = static_cast<size_t>(n - 1), Status::Ok());
-    std::string list;
-    for (const auto& nm : names) list += (list.empty() ? "" : ", ") + nm;
-    return err(header_line, fmt::format("{} '{}': no such column (columns: {}; or a 1-based index "
-                                        "up to {})",
-                                        flag, ref, list, names.size()));
-  };
-  size_t it = 0, id = 1, ip = 0, in = 0;
-  const bool pn = !cols.p.empty();
-  if (Status s = resolve(cols.time, "time column", 0, &it); !s.ok()) return s;
-  if (pn) {
-    if (Status s = resolve(cols.p, "P column", 0, &ip); !s.ok()) return s;
-    if (Status s = resolve(cols.n, "N column", 0, &in); !s.ok()) return s;
-  } else if (Status s = resolve(cols.diff, "differential column", it == 1 ? 0 : 1, &id); !s.ok()) {
-    return s;
-  }
-
-  // 2. Rows.
+  std::error_code ec;
+  if (std::filesystem::equivalent(paths[0], paths[1], ec) && cols.p == cols.n)
+    return Status::Error(
+        fmt::format("{}: error: P and N are the same column of the same file: P "
+                    "- N would be zero",
+                    paths[1]));
+  // Align: the same time base, or N interpolated onto P's samples inside the common span.
+  const std::vector<double>& tp = leg[0].t;
+  const std::vector<double>& tn = leg[1].t;
+  const double dt = (tp.back() - tp.front()) / static_cast<double>(tp.size() - 1);
+  bool same = tp.size() == tn.size();
+  for (size_t i = 0; same && i < tp.size(); ++i) same = std::abs(tp[i] - tn[i]) <= 1e-3 * dt;
   Waveform w;
   std::vector<double> v;
-  const size_t approx_rows =
-      std::count(text.begin() + static_cast<std::ptrdiff_t>(data_pos), text.end(), '\n') + 1;
-  w.time.reserve(approx_rows);
-  v.reserve(approx_rows);
-  Lines rows{text, data_pos, data_line};
-  int prev_row_line = 0;
-  while (rows.next(&line)) {
-    if (trim(line).empty()) continue;
-    split(line, delim, &fields);
-    if (fields.size() != names.size())
-      return err(rows.number, fmt::format("expected {} fields like the header (line {}), found {}",
-                                          names.size(), header_line, fields.size()));
-    auto get = [&](size_t k, double* x) -> Status {
-      if (parse_number(fields[k], x)) return Status::Ok();
-      return err(rows.number, fmt::format("column {} ('{}'): expected a number, found '{}'", k + 1,
-                                          names[k], std::string(trim(fields[k]))));
-    };
-    double t = 0, x = 0, y = 0;
-    if (Status s = get(it, &t); !s.ok()) return s;
-    if (pn) {
-      if (Status s = get(ip, &x); !s.ok()) return s;
-      if (Status s = get(in, &y); !s.ok()) return s;
-      x -= y;
-    } else if (Status s = get(id, &x); !s.ok()) {
-      return s;
+  std::string alignment;
+  if (same) {
+    w.time = std::move(leg[0].t);
+    v = std::move(leg[0].v);
+    for (size_t i = 0; i < v.size(); ++i) v[i] -= leg[1].v[i];
+    alignment = "the two files share one time base";
+  } else {
+    const double a = std::max(tp.front(), tn.front()), b = std::min(tp.back(), tn.back());
+    if (!(b > a))
+      return Status::Error(fmt::format(
+          "{}: error: its time span {:g} .. {:g} s does not overlap {}'s {:g} .. {:g} s: the "
+          "captures must come from one acquisition",
+          paths[1], tn.front(), tn.back(), paths[0], tp.front(), tp.back()));
+    size_t j = 0;
+    for (size_t i = 0; i < tp.size(); ++i) {
+      if (tp[i] < a || tp[i] > b) continue;
+      while (j + 1 < tn.size() && tn[j + 1] < tp[i]) ++j;
+      double nv = leg[1].v[j];
+      if (j + 1 < tn.size() && tn[j] <= tp[i]) {
+        const double u = (tp[i] - tn[j]) / (tn[j + 1] - tn[j]);
+        nv = leg[1].v[j] + std::clamp(u, 0.0, 1.0) * (leg[1].v[j + 1] - leg[1].v[j]);
+      }
+      w.time.push_back(tp[i]);
+      v.push_back(leg[0].v[i] - nv);
     }
-    if (!w.time.empty() && !(t > w.time.back()))
-      return err(rows.number, fmt::format("time {:g} is not after {:g} on line {}: time must "
-                                          "increase from row to row",
-                                          t, w.time.back(), prev_row_line));
-    w.time.push_back(t);
-    v.push_back(x);
-    prev_row_line = rows.number;
+    if (w.time.size() < 2)
+      return Status::Error(
+          fmt::format("{}: error: fewer than two samples of {} fall inside {}'s "
+                      "time span",
+                      paths[1], paths[0], paths[1]));
+    alignment = fmt::format(
+        "time bases differ: N interpolated onto P's samples over the common "
+        "span {:g} .. {:g} s ({} of {} P samples kept)",
+        a, b, w.time.size(), tp.size());
   }
-  if (w.time.size() < 2) return err(0, "fewer than two samples after the header");
-  w.add_column(pn ? names[ip] + "-" + names[in] : names[id], std::move(v));
+  w.add_column(leg[0].name + "-" + leg[1].name, std::move(v));
+  if (info) info->alignment = alignment;
+  finish_info(w, info);
   return w;
 }
 
-StatusOr<Waveform> read_differential_csv(const std::string& path, const CsvColumns& cols) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status::Error(path + ": error: cannot open the file");
-  std::string text;
-  in.seekg(0, std::ios::end);
-  const auto size = in.tellg();
-  if (size > 0) {
-    text.resize(static_cast<size_t>(size));
-    in.seekg(0);
-    in.read(text.data(), size);
+nlohmann::ordered_json capture_json(const CaptureInfo& info) {
+  nlohmann::ordered_json j;
+  j["files"] = info.files;
+  j["layouts"] = info.layouts;
+  nlohmann::ordered_json cols = nlohmann::ordered_json::array();
+  for (const CaptureColumn& c : info.columns)
+    cols.push_back({{"role", c.role},
+                    {"file", c.file},
+                    {"index", c.index},
+                    {"name", c.name},
+                    {"channel", c.channel.empty() ? nlohmann::ordered_json(nullptr)
+                                                  : nlohmann::ordered_json(c.channel)},
+                    {"selected", c.how},
+                    {"unit", c.unit.empty() ? nlohmann::ordered_json(nullptr)
+                                            : nlohmann::ordered_json(c.unit)},
+                    {"scale", c.scale}});
+  j["columns"] = std::move(cols);
+  j["time_from"] = info.time_from;
+  j["samples"] = info.samples;
+  j["t_begin_s"] = info.t_begin;
+  j["t_end_s"] = info.t_end;
+  j["span_s"] = info.t_end - info.t_begin;
+  j["interval_s"] = info.interval;
+  j["uniform"] = info.uniform;
+  j["alignment"] = info.alignment.empty() ? nlohmann::ordered_json(nullptr)
+                                          : nlohmann::ordered_json(info.alignment);
+  j["notes"] = info.notes;
+  return j;
+}
+
+std::string capture_text(const CaptureInfo& info) {
+  std::string out = "read:";
+  for (size_t i = 0; i < info.files.size(); ++i)
+    out += fmt::format(" {} ({})", info.files[i], info.layouts[i]);
+  out += "\n";
+  for (const CaptureColumn& c : info.columns) {
+    std::string scale;
+    if (c.role == "time" && c.scale != 1)
+      scale = fmt::format(", x{:g} to s", c.scale);
+    else if (c.role != "time" && c.scale != 1)
+      scale = fmt::format(", x{:g} to V", c.scale);
+    out += fmt::format("  {:<5} column {} '{}'{} ({}{}{})\n", c.role, c.index, c.name,
+                       info.files.size() > 1 ? " of " + c.file : "", c.how,
+                       c.unit.empty() ? "" : ", unit " + c.unit, scale);
   }
-  if (!in) return Status::Error(path + ": error: cannot read the file");
-  return parse_differential_csv(text, path, cols);
+  out += fmt::format("  {} samples, {:g} .. {:g} s (span {:g} s), interval {:g} s{}\n",
+                     info.samples, info.t_begin, info.t_end, info.t_end - info.t_begin,
+                     info.interval, info.uniform ? "" : " (median; not uniform)");
+  out += "  time: " + info.time_from + "\n";
+  if (!info.alignment.empty()) out += "  alignment: " + info.alignment + "\n";
+  for (const std::string& n : info.notes) out += "  note: " + n + "\n";
+  return out;
 }
 
 }  // namespace isolink::eye

@@ -5,6 +5,7 @@
 #include <numbers>
 #include <vector>
 
+#include "base/si_number.h"
 #include "netlists/lexer.h"
 
 namespace isolink::spice {
@@ -46,8 +47,9 @@ const Function kFunctions[] = {
 
 class Parser {
  public:
-  Parser(std::string_view s, const ParamLookup& lookup, const OffsetLoc& where)
-      : s_(s), lookup_(lookup), where_(where) {}
+  Parser(std::string_view s, const ParamLookup& lookup, const OffsetLoc& where,
+         const FunctionLookup& functions, int depth)
+      : s_(s), lookup_(lookup), where_(where), functions_(functions), depth_(depth) {}
 
   StatusOr<double> run() {
     double v = 0;
@@ -83,7 +85,96 @@ class Parser {
     return pos_ < s_.size() && s_[pos_] == c;
   }
 
-  bool expr(double& v) {
+  // Two-character operator at pos_ (after blanks)?
+  bool peek2(const char* op) {
+    skip();
+    return pos_ + 1 < s_.size() && s_[pos_] == op[0] && s_[pos_ + 1] == op[1];
+  }
+
+  bool expr(double& v) { return ternary(v); }  // every nesting passes through unary's depth count
+
+  bool ternary(double& v) {
+    if (!logical_or(v)) return false;
+    if (!peek('?')) return true;
+    ++pos_;
+    double a = 0, b = 0;
+    if (!expr(a)) return false;
+    if (!peek(':')) return fail(pos_, "expected ':' in 'cond ? a : b'");
+    ++pos_;
+    if (!expr(b)) return false;
+    v = v != 0.0 ? a : b;
+    return true;
+  }
+
+  bool logical_or(double& v) {
+    if (!logical_and(v)) return false;
+    while (peek2("||")) {
+      pos_ += 2;
+      double r = 0;
+      if (!logical_and(r)) return false;
+      v = (v != 0.0 || r != 0.0) ? 1.0 : 0.0;
+    }
+    return true;
+  }
+
+  bool logical_and(double& v) {
+    if (!compare(v)) return false;
+    while (peek2("&&")) {
+      pos_ += 2;
+      double r = 0;
+      if (!compare(r)) return false;
+      v = (v != 0.0 && r != 0.0) ? 1.0 : 0.0;
+    }
+    return true;
+  }
+
+  bool compare(double& v) {
+    if (!sum(v)) return false;
+    while (true) {
+      skip();
+      if (pos_ >= s_.size()) return true;
+      const char c = s_[pos_];
+      const bool eq_next = pos_ + 1 < s_.size() && s_[pos_ + 1] == '=';
+      int op = 0;  // 1 ==, 2 !=, 3 <, 4 >, 5 <=, 6 >=
+      if (c == '=' && eq_next)
+        op = 1;
+      else if (c == '!' && eq_next)
+        op = 2;
+      else if (c == '<')
+        op = eq_next ? 5 : 3;
+      else if (c == '>')
+        op = eq_next ? 6 : 4;
+      else
+        return true;
+      pos_ += (op == 3 || op == 4) ? 1 : 2;
+      double r = 0;
+      if (!sum(r)) return false;
+      bool t = false;
+      switch (op) {
+        case 1:
+          t = v == r;
+          break;
+        case 2:
+          t = v != r;
+          break;
+        case 3:
+          t = v < r;
+          break;
+        case 4:
+          t = v > r;
+          break;
+        case 5:
+          t = v <= r;
+          break;
+        default:
+          t = v >= r;
+          break;
+      }
+      v = t ? 1.0 : 0.0;
+    }
+  }
+
+  bool sum(double& v) {
     if (!term(v)) return false;
     while (true) {
       skip();
@@ -127,6 +218,12 @@ class Parser {
 
   bool unary_inner(double& v) {
     skip();
+    if (pos_ + 1 < s_.size() && s_[pos_] == '!' && s_[pos_ + 1] != '=') {
+      ++pos_;
+      if (!unary(v)) return false;
+      v = v == 0.0 ? 1.0 : 0.0;
+      return true;
+    }
     if (pos_ < s_.size() && (s_[pos_] == '-' || s_[pos_] == '+')) {
       const bool neg = s_[pos_++] == '-';
       if (!unary(v)) return false;
@@ -171,7 +268,7 @@ class Parser {
       ++pos_;
       return true;
     }
-    if (auto num = scan_number(s_.substr(pos_))) {
+    if (auto num = scan_si_number(s_.substr(pos_))) {
       pos_ += num->length;
       if (pos_ < s_.size() &&
           (s_[pos_] == '.' || std::isdigit(static_cast<unsigned char>(s_[pos_])) ||
@@ -209,10 +306,12 @@ class Parser {
   }
 
   bool call(const std::string& name, std::size_t start, double& v) {
+    const UserFunction* user = functions_ ? functions_(name) : nullptr;
     const Function* fn = nullptr;
-    for (const auto& f : kFunctions)
-      if (name == f.name) fn = &f;
-    if (!fn) {
+    if (!user)
+      for (const auto& f : kFunctions)
+        if (name == f.name) fn = &f;
+    if (!fn && !user) {
       fail(start, "unknown function '" + name + "'");
       return false;
     }
@@ -235,10 +334,28 @@ class Parser {
       return false;
     }
     ++pos_;
-    if (static_cast<int>(args.size()) != fn->arity) {
-      fail(start, name + "() takes " + std::to_string(fn->arity) + " argument" +
-                      (fn->arity == 1 ? "" : "s") + ", got " + std::to_string(args.size()));
+    const int arity = user ? static_cast<int>(user->params.size()) : fn->arity;
+    if (static_cast<int>(args.size()) != arity) {
+      fail(start, name + "() takes " + std::to_string(arity) + " argument" +
+                      (arity == 1 ? "" : "s") + ", got " + std::to_string(args.size()));
       return false;
+    }
+    if (user) {
+      if (depth_ + 10 > kMaxDepth)
+        return fail(start, "function calls nested too deeply in " + name + "()");
+      const ParamLookup inner = [&](const std::string& p) -> std::optional<double> {
+        for (std::size_t k = 0; k < user->params.size(); ++k)
+          if (user->params[k] == p) return args[k];
+        return lookup_(p);
+      };
+      StatusOr<double> r = Parser(user->body, inner, user->where, functions_, depth_ + 10).run();
+      if (!r) {
+        status_ = Status::Error(r.status().message() + "\n (in a call of " + name + "() at " +
+                                where_(start).str() + ")");
+        return false;
+      }
+      v = *r;
+      return true;
     }
     v = fn->f(args.data());
     if (!std::isfinite(v)) {
@@ -256,6 +373,7 @@ class Parser {
   std::string_view s_;
   const ParamLookup& lookup_;
   const OffsetLoc& where_;
+  const FunctionLookup& functions_;
   std::size_t pos_ = 0;
   int depth_ = 0;
   Status status_;
@@ -265,8 +383,8 @@ class Parser {
 }  // namespace
 
 StatusOr<double> evaluate_expression(std::string_view text, const ParamLookup& lookup,
-                                     const OffsetLoc& where) {
-  return Parser(text, lookup, where).run();
+                                     const OffsetLoc& where, const FunctionLookup& functions) {
+  return Parser(text, lookup, where, functions, 0).run();
 }
 
 }  // namespace isolink::spice

@@ -1,16 +1,19 @@
 #include "netlists/spice_reader.h"
 
+#include <fmt/format.h>
+
 #include <cctype>
 #include <cmath>
 #include <deque>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <numbers>
 #include <sstream>
 #include <unordered_map>
 #include <unordered_set>
 
+#include "base/file_io.h"
+#include "base/si_number.h"
 #include "netlists/expression.h"
 #include "netlists/lexer.h"
 #include "solver/elements/element.h"
@@ -18,18 +21,12 @@
 namespace isolink {
 namespace {
 
-// ngspice's flattened names: "r.x1.r3" is element "x1.r3" of kind r (as spice_writer writes
-// hierarchical names, and as K cards name such inductors: "l.x1.l3").
-std::string unflatten(const std::string& name) {
-  if (name.size() > 2 && name[1] == '.') {
-    const std::string rest = name.substr(2);
-    const std::size_t dot = rest.rfind('.');
-    if (dot != std::string::npos && dot + 1 < rest.size() && rest[dot + 1] == name[0]) return rest;
-  }
-  return name;
-}
-
 namespace fs = std::filesystem;
+
+// .include chains and subcircuit instances nest at most this deep (a 10,000-deep chain would
+// otherwise overflow the stack).
+constexpr size_t kMaxIncludeDepth = 64;
+constexpr size_t kMaxSubcktDepth = 64;
 using spice::LogicalLine;
 using spice::lower;
 using spice::Token;
@@ -91,6 +88,7 @@ struct SubcktDef {
 
 struct Scope {
   std::unordered_map<std::string, double> values;
+  std::unordered_map<std::string, spice::UserFunction> funcs;  // .func
   const Scope* parent = nullptr;
   std::optional<double> find(const std::string& name) const {
     for (const Scope* s = this; s; s = s->parent) {
@@ -99,7 +97,70 @@ struct Scope {
     }
     return std::nullopt;
   }
+  const spice::UserFunction* find_func(const std::string& name) const {
+    for (const Scope* s = this; s; s = s->parent) {
+      auto it = s->funcs.find(name);
+      if (it != s->funcs.end()) return &it->second;
+    }
+    return nullptr;
+  }
 };
+
+// Expression text evaluated in a scope (its parameters and .func functions).
+StatusOr<double> eval_in(const Scope& scope, std::string_view text, const spice::OffsetLoc& where) {
+  return spice::evaluate_expression(
+      text, [&](const std::string& name) { return scope.find(name); }, where,
+      [&](const std::string& name) { return scope.find_func(name); });
+}
+
+// Element letters isolink refuses, with the feature's name and what to do instead.
+struct RefusedLetter {
+  char letter;
+  const char* feature;
+  const char* hint;
+};
+constexpr const char* kSemiconductor =
+    "isolink simulates linear passive links; model an isolator or transceiver pin by its "
+    "R/C/L network, as the part library does";
+constexpr const char* kLine =
+    "for the cable, write a link spec: its 'cable:' key (length, material, gauge) builds the "
+    "RLGC ladder; see the README section on link specs";
+constexpr RefusedLetter kRefusedLetters[] = {
+    {'a', "XSPICE code model ('a' device)", "isolink has no XSPICE code models"},
+    {'b', "behavioural source (B)",
+     "write the waveform as PULSE, PWL, SIN or EXP on a V or I source"},
+    {'d', "diode (D)", kSemiconductor},
+    {'e', "voltage-controlled voltage source (E)", "controlled sources are out of scope"},
+    {'f', "current-controlled current source (F)", "controlled sources are out of scope"},
+    {'g', "voltage-controlled current source (G)", "controlled sources are out of scope"},
+    {'h', "current-controlled voltage source (H)", "controlled sources are out of scope"},
+    {'j', "JFET (J)", kSemiconductor},
+    {'m', "MOSFET (M)", kSemiconductor},
+    {'n', "OSDI / Verilog-A device (N)", kSemiconductor},
+    {'o', "lossy transmission line (O)", kLine},
+    {'p', "coupled multiconductor line (P)", kLine},
+    {'q', "bipolar transistor (Q)", kSemiconductor},
+    {'s', "voltage-controlled switch (S)", "switches are out of scope"},
+    {'t', "transmission line (T)", kLine},
+    {'u', "uniform RC line (U)", kLine},
+    {'w', "current-controlled switch (W)", "switches are out of scope"},
+    {'y', "transmission line (Y, TXL)", kLine},
+    {'z', "MESFET (Z)", kSemiconductor},
+};
+
+// Dot cards skipped with one warning: they ask for output or analyses isolink does not run, and
+// leave the transient of a linear circuit unchanged. Any other unknown dot card is an error.
+constexpr const char* kIgnoredCards[] = {
+    ".print", ".plot", ".save",  ".probe", ".meas",    ".measure",  ".op",
+    ".ac",    ".dc",   ".noise", ".four",  ".width",   ".model",    ".disto",
+    ".sens",  ".pz",   ".tf",    ".title", ".csparam", ".backanno", ".nodeset",
+};
+
+// Source functions that may be written without parentheses: "SIN 0 1 1K".
+bool is_source_function(const std::string& w) {
+  return w == "pulse" || w == "sin" || w == "pwl" || w == "exp" || w == "sffm" || w == "am" ||
+         w == "trnoise" || w == "trrandom";
+}
 
 struct Ctx {
   std::string prefix;                                                   // "" or "x1.x2."
@@ -107,14 +168,6 @@ struct Ctx {
   Scope* scope = nullptr;
   std::vector<const SubcktDef*> stack;
 };
-
-StatusOr<std::string> read_whole_file(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  if (!in) return Status::Error("cannot open");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 std::string canonical_key(const std::string& path) {
   std::error_code ec;
@@ -125,24 +178,44 @@ std::string canonical_key(const std::string& path) {
 class Reader {
  public:
   Status read(const std::shared_ptr<const SourceFile>& top) {
+    Status s = read_all(top);
+    if (s.ok() || out_.warnings.empty()) return s;
+    // Warnings first: a card skipped with a warning may be why the error happened.
+    std::string text;
+    for (const std::string& w : out_.warnings) text += w + "\n";
+    return Status::Error(text + s.message());
+  }
+  Netlist take() { return std::move(out_); }
+
+ private:
+  Status read_all(const std::shared_ptr<const SourceFile>& top) {
     if (!top->lines.empty()) out_.title = trim(top->lines[0]);
     if (top->path != "<string>") include_stack_.push_back(canonical_key(top->path));
-    if (Status s = collect(top, 2); !s.ok()) return s;
+    for (const std::string& l : top->lines) total_bytes_ += l.size() + 1;
+    if (Status s = collect(top, 2, nullptr); !s.ok()) return s;
     if (!open_.empty())
       return error_at(open_.back()->card_loc,
                       "missing '.ends' for subcircuit '" + open_.back()->name + "'");
     Ctx ctx;
     ctx.scope = &globals_;
-    return elaborate(top_, ctx);
+    if (Status s = elaborate(top_, ctx); !s.ok()) return s;
+    return apply_temperature();
   }
-  Netlist take() { return std::move(out_); }
 
- private:
-  // ---- pass 1: lines, includes, subcircuit bodies ----
-  Status collect(const std::shared_ptr<const SourceFile>& file, int first_line) {
+  // ---- pass 1: lines, includes, libraries, subcircuit bodies ----
+  // `section`: read only the lines inside `.lib SECTION` ... `.endl` (a call `.lib FILE
+  // SECTION`); otherwise the lines inside `.lib NAME` ... `.endl` blocks are skipped.
+  Status collect(const std::shared_ptr<const SourceFile>& file, int first_line,
+                 const std::string* section) {
     auto lines = spice::join_lines(file, first_line);
     if (!lines) return lines.status();
+    std::optional<std::string> block;  // the .lib NAME block we are in
+    SourceLoc block_loc;
+    bool found_section = false;
     for (LogicalLine& ll : *lines) {
+      // A NUL byte would end up inside a node or element name (a binary file, a bad editor).
+      if (const size_t nul = ll.text.find('\0'); nul != std::string::npos)
+        return error_at(ll.loc(nul), "a NUL byte in the netlist (is this a text file?)");
       std::size_t a = 0;
       while (a < ll.text.size() && is_blank(ll.text[a])) ++a;
       std::size_t b = a;
@@ -152,14 +225,40 @@ class Reader {
         if (key == ".endc") in_control_ = false;
         continue;
       }
+      if (key == ".endl") {
+        if (!block) return error_at(ll.loc(a), "'.endl' without '.lib SECTION' before it");
+        block.reset();
+        continue;
+      }
+      if (key == ".lib") {
+        const auto words = spice_words(ll, b);
+        if (words.size() == 1) {  // a section definition starts
+          if (block)
+            return error_at(ll.loc(a), "'.lib " + words[0].first + "' inside section '" + *block +
+                                           "' (missing '.endl')");
+          block = lower(words[0].first);
+          block_loc = ll.loc(a);
+          found_section = found_section || (section && *block == *section);
+          continue;
+        }
+        if (!(section ? (block && *block == *section) : !block)) continue;
+        if (words.size() != 2)
+          return error_at(ll.loc(a), "expected '.lib FILE SECTION', or '.lib SECTION' ... '.endl'");
+        const std::string wanted = lower(words[1].first);
+        if (Status s = include(ll, words[0], &wanted); !s.ok()) return s;
+        continue;
+      }
+      if (section ? !(block && *block == *section) : block.has_value()) continue;
       if (key == ".control") {
         warn_once(".control", ll.loc(a), "'.control' ... '.endc' block ignored");
         in_control_ = true;
         continue;
       }
-      if (key == ".end") return Status::Ok();
+      if (key == ".end") break;
       if (key == ".include" || key == ".inc") {
-        if (Status s = include(ll, b); !s.ok()) return s;
+        const auto words = spice_words(ll, b);
+        if (words.empty()) return error_at(ll.loc(b), "expected a file name after .include");
+        if (Status s = include(ll, words[0], nullptr); !s.ok()) return s;
         continue;
       }
       Line& line = lines_.emplace_back();
@@ -172,30 +271,58 @@ class Reader {
       } else if (key == ".ends") {
         if (open_.empty()) return error_at(line.at(0), "'.ends' without '.subckt'");
         open_.pop_back();
+      } else if (key == ".global") {
+        for (std::size_t k = 1; k < line.toks.size(); ++k) {
+          if (!line.word(k))
+            return error_at(line.at(k), "expected node names after .global, got '" +
+                                            describe(line.toks[k]) + "'");
+          global_nodes_.insert(lower(line.toks[k].text));
+        }
       } else {
         (open_.empty() ? top_ : open_.back()->body).push_back(&line);
       }
     }
+    if (block && !section) return error_at(block_loc, "missing '.endl' for '.lib " + *block + "'");
+    if (section && !found_section)
+      return error_at(section_call_loc_,
+                      "library '" + file->path + "' has no section '" + *section + "'");
     return Status::Ok();
   }
 
-  Status include(const LogicalLine& ll, std::size_t after_key) {
-    std::size_t a = after_key;
-    while (a < ll.text.size() && is_blank(ll.text[a])) ++a;
-    if (a >= ll.text.size()) return error_at(ll.loc(a), "expected a file name after .include");
-    std::string name;
-    const char q = ll.text[a];
-    if (q == '"' || q == '\'') {
-      const std::size_t e = ll.text.find(q, a + 1);
-      if (e == std::string::npos)
-        return error_at(ll.loc(a), std::string("unterminated file name: missing closing ") + q);
-      name = ll.text.substr(a + 1, e - a - 1);
-    } else {
-      std::size_t e = a;
-      while (e < ll.text.size() && !is_blank(ll.text[e])) ++e;
-      name = ll.text.substr(a, e - a);
+  // The blank-separated words after offset `from` ("..." and '...' quote a word), with offsets.
+  static std::vector<std::pair<std::string, std::size_t>> spice_words(const LogicalLine& ll,
+                                                                      std::size_t from) {
+    std::vector<std::pair<std::string, std::size_t>> out;
+    std::size_t a = from;
+    const std::string& t = ll.text;
+    while (true) {
+      while (a < t.size() && is_blank(t[a])) ++a;
+      if (a >= t.size()) break;
+      if (t[a] == '"' || t[a] == '\'') {
+        const std::size_t e = t.find(t[a], a + 1);
+        const std::size_t end = e == std::string::npos ? t.size() : e;
+        out.emplace_back(t.substr(a + 1, end - a - 1), a);
+        a = e == std::string::npos ? t.size() : e + 1;
+      } else {
+        std::size_t e = a;
+        while (e < t.size() && !is_blank(t[e])) ++e;
+        out.emplace_back(t.substr(a, e - a), a);
+        a = e;
+      }
     }
-    const SourceLoc where = ll.loc(a);
+    return out;
+  }
+
+  // .include FILE, or .lib FILE SECTION (section != nullptr).
+  Status include(const LogicalLine& ll, const std::pair<std::string, std::size_t>& word,
+                 const std::string* section) {
+    const std::string& name = word.first;
+    const SourceLoc where = ll.loc(word.second);
+    if (word.second < ll.text.size() &&
+        (ll.text[word.second] == '"' || ll.text[word.second] == '\'') &&
+        ll.text.find(ll.text[word.second], word.second + 1) == std::string::npos)
+      return error_at(
+          where, std::string("unterminated file name: missing closing ") + ll.text[word.second]);
     fs::path p(name);
     if (p.is_relative()) {
       const std::string& from = ll.file->path;
@@ -203,18 +330,39 @@ class Reader {
           from.empty() || from[0] == '<' ? fs::path() : fs::path(from).parent_path();
       p = (base / p).lexically_normal();
     }
-    const std::string key = canonical_key(p.string());
+    const std::string key = canonical_key(p.string()) + (section ? "#" + *section : "");
     for (std::size_t k = 0; k < include_stack_.size(); ++k) {
       if (include_stack_[k] != key) continue;
       return error_at(where, "recursive include of '" + p.string() + "'");
     }
-    auto text = read_whole_file(p);
-    if (!text)
+    if (include_stack_.size() >= kMaxIncludeDepth)
+      return error_at(
+          where, fmt::format("includes nest deeper than the limit of {} files", kMaxIncludeDepth));
+    if (fs::is_directory(p))
+      return error_at(where, std::string(section ? "library file '" : "include file '") + name + "' is a folder ('" + p.string() + "')");
+    auto text = read_input_file(p.string());
+    if (!text) {
+      if (!fs::exists(p))
+        return error_at(
+            where, std::string(section ? "cannot open library file '" : "cannot open include file '") +
+                       name + "' (looked for '" + p.string() + "')");
+      const std::string& m = text.status().message();  // "PATH: error: REASON"
+      const size_t at = m.find(": error: ");
+      return error_at(where, std::string(section ? "library file '" : "include file '") + name +
+                                 "': " + (at == std::string::npos ? m : m.substr(at + 9)));
+    }
+    total_bytes_ += text->size();
+    if (total_bytes_ > kMaxInputFileBytes)
       return error_at(where,
-                      "cannot open include file '" + name + "' (looked for '" + p.string() + "')");
+                      fmt::format("include file '{}' takes the netlist and its includes past "
+                                  "the {} MiB limit",
+                                  name, kMaxInputFileBytes >> 20));
     auto file = SourceFile::FromText(p.string(), *text, std::make_shared<const SourceLoc>(where));
     include_stack_.push_back(key);
-    Status s = collect(file, 1);
+    const SourceLoc saved = section_call_loc_;
+    section_call_loc_ = where;
+    Status s = collect(file, 1, section);
+    section_call_loc_ = saved;
     include_stack_.pop_back();
     return s;
   }
@@ -260,16 +408,14 @@ class Reader {
 
   // ---- values ----
   StatusOr<double> number(const Line& line, const Token& t, const Scope& scope) {
-    const auto lookup = [&](const std::string& name) { return scope.find(name); };
     if (t.kind == TokenKind::Expr) {
       const std::size_t base = t.offset + 1;
-      return spice::evaluate_expression(t.text, lookup,
-                                        [&](std::size_t o) { return line.ll.loc(base + o); });
+      return eval_in(scope, t.text, [&](std::size_t o) { return line.ll.loc(base + o); });
     }
     if (t.kind != TokenKind::Word)
       return error_at(line.ll.loc(t.offset), "expected a number, got '" + describe(t) + "'");
     double v = 0;
-    if (spice::parse_number(t.text, v)) return v;
+    if (parse_si_number(t.text, v)) return v;
     std::string_view body = t.text;
     if (!body.empty() && (body[0] == '+' || body[0] == '-')) body.remove_prefix(1);
     if (body.empty() || std::isdigit(static_cast<unsigned char>(body[0])) || body[0] == '.')
@@ -281,8 +427,7 @@ class Reader {
       return error_at(line.ll.loc(t.offset), "expected a number, got '" + std::string(t.text) +
                                                  "' (no parameter of that name is defined)");
     }
-    return spice::evaluate_expression(t.text, lookup,
-                                      [&](std::size_t o) { return line.ll.loc(t.offset + o); });
+    return eval_in(scope, t.text, [&](std::size_t o) { return line.ll.loc(t.offset + o); });
   }
 
   // NAME ( values... ) starting at toks[i] (NAME), toks[i+1] == '('. Advances i past ')'.
@@ -336,12 +481,11 @@ class Reader {
 
   // ---- pass 2: parameters, elements, instances, analysis cards ----
   Status elaborate(const std::vector<const Line*>& body, Ctx& ctx) {
-    for (const Line* l : body)
-      if (l->key() == ".param")
-        if (Status s = param_card(*l, *ctx.scope); !s.ok()) return s;
-    for (const Line* l : body) {
+    auto active = prepare(body, *ctx.scope);
+    if (!active) return active.status();
+    for (const Line* l : *active) {
       const std::string key = l->key();
-      if (key.empty() || key == ".param") continue;
+      if (key.empty()) continue;
       if (!l->word(0))
         return error_at(
             l->at(0), "expected an element name or a dot card, got '" + describe(l->toks[0]) + "'");
@@ -354,6 +498,99 @@ class Reader {
         s = element(*l, ctx);
       if (!s.ok()) return s;
     }
+    return Status::Ok();
+  }
+
+  // The lines of `body` that .if/.elseif/.else/.endif leave active, without the .param and
+  // .func cards, which are applied to `scope` in file order (all before any element is built,
+  // so an element may use a parameter defined below it). Conditions see the parameters
+  // defined above them.
+  StatusOr<std::vector<const Line*>> prepare(const std::vector<const Line*>& body, Scope& scope) {
+    struct Cond {
+      bool parent_active, taken, active, seen_else;
+      SourceLoc loc;
+    };
+    std::vector<Cond> stack;
+    std::vector<const Line*> out;
+    auto condition = [&](const Line& l) -> StatusOr<bool> {
+      if (l.toks.size() < 2) return error_at(l.end(), "expected a condition after " + l.key());
+      const std::size_t from = l.toks[1].offset;
+      auto v = eval_in(scope, std::string_view(l.ll.text).substr(from),
+                       [&](std::size_t o) { return l.ll.loc(from + o); });
+      if (!v) return v.status();
+      return *v != 0.0;
+    };
+    for (const Line* l : body) {
+      const std::string key = l->key();
+      const bool active = stack.empty() || stack.back().active;
+      if (key == ".if") {
+        bool c = false;
+        if (active) {
+          auto v = condition(*l);
+          if (!v) return v.status();
+          c = *v;
+        }
+        stack.push_back({active, c, active && c, false, l->at(0)});
+        continue;
+      }
+      if (key == ".elseif" || key == ".else" || key == ".endif") {
+        if (stack.empty()) return error_at(l->at(0), "'" + key + "' without '.if' before it");
+        Cond& c = stack.back();
+        if (key == ".endif") {
+          stack.pop_back();
+          continue;
+        }
+        if (c.seen_else) return error_at(l->at(0), "'" + key + "' after '.else'");
+        if (key == ".else") {
+          c.active = c.parent_active && !c.taken;
+          c.taken = c.seen_else = true;
+          continue;
+        }
+        c.active = false;
+        if (c.parent_active && !c.taken) {
+          auto v = condition(*l);
+          if (!v) return v.status();
+          c.active = c.taken = *v;
+        }
+        continue;
+      }
+      if (!active) continue;
+      if (key == ".param") {
+        if (Status s = param_card(*l, scope); !s.ok()) return s;
+      } else if (key == ".func") {
+        if (Status s = func_card(*l, scope); !s.ok()) return s;
+      } else {
+        out.push_back(l);
+      }
+    }
+    if (!stack.empty()) return error_at(stack.back().loc, "missing '.endif' for this '.if'");
+    return out;
+  }
+
+  // .func NAME(a, b) {body}  (also with '=' before the body, or an unbraced body)
+  Status func_card(const Line& line, Scope& scope) {
+    const std::size_t n = line.toks.size();
+    if (!line.word(1) || !is_identifier(line.toks[1].text) || !line.kind(2, TokenKind::LParen))
+      return error_at(line.at_or_end(1), "expected .func NAME(ARG, ...) {EXPRESSION}");
+    const std::string name = lower(line.toks[1].text);
+    spice::UserFunction f;
+    std::size_t i = 3;
+    for (; i < n && !line.kind(i, TokenKind::RParen); ++i) {
+      if (line.kind(i, TokenKind::Comma)) continue;
+      if (!line.word(i) || !is_identifier(line.toks[i].text))
+        return error_at(line.at(i), "expected an argument name in .func " + name + "(...), got '" +
+                                        describe(line.toks[i]) + "'");
+      f.params.push_back(lower(line.toks[i].text));
+    }
+    ++i;  // ')'
+    if (line.kind(i, TokenKind::Equals)) ++i;
+    if (i >= n) return error_at(line.end(), "missing body of .func " + name);
+    std::size_t from = line.toks[i].offset, to = line.toks[n - 1].end();
+    if (i + 1 == n && line.toks[i].kind == TokenKind::Expr) ++from, --to;
+    f.body = line.ll.text.substr(from, to - from);
+    const Line* lp = &line;
+    f.where = [lp, from](std::size_t o) { return lp->ll.loc(from + o); };
+    scope.funcs[name] = std::move(f);
     return Status::Ok();
   }
 
@@ -377,10 +614,8 @@ class Reader {
         v = number(line, line.toks[i + 2], scope);
       } else {  // an unbraced expression spread over several tokens: "a = 2 * b"
         const std::size_t from = line.toks[i + 2].offset, to = line.toks[j - 1].end();
-        v = spice::evaluate_expression(
-            std::string_view(line.ll.text).substr(from, to - from),
-            [&](const std::string& nm) { return scope.find(nm); },
-            [&](std::size_t o) { return line.ll.loc(from + o); });
+        v = eval_in(scope, std::string_view(line.ll.text).substr(from, to - from),
+                    [&](std::size_t o) { return line.ll.loc(from + o); });
       }
       if (!v) return v.status();
       scope.values[name] = *v;
@@ -396,6 +631,7 @@ class Reader {
       auto it = ctx.ports->find(n);
       if (it != ctx.ports->end()) return it->second;
     }
+    if (global_nodes_.count(n)) return n;  // .global: the same node in every subcircuit
     return ctx.prefix + n;
   }
 
@@ -412,6 +648,10 @@ class Reader {
       return error_at(line.at(0), "expected an element name, got '" + describe(line.toks[0]) + "'");
     std::string local = lower(line.toks[0].text);
     const char letter = local[0];
+    for (const RefusedLetter& r : kRefusedLetters)
+      if (r.letter == letter)
+        return error_at(line.at(0), std::string(r.feature) + " is not supported ('" + local +
+                                        "'; " + r.hint + ")");
     const ElementKind* kind = find_element_kind(letter);
     if (!kind) {
       std::string known;
@@ -419,7 +659,7 @@ class Reader {
       return error_at(line.at(0), "unknown element letter '" + std::string(1, letter) + "' in '" +
                                       local + "' (known: " + known + "x)");
     }
-    local = unflatten(local);
+    local = unflatten_name(local);
     Card card;
     card.letter = letter;
     card.name = ctx.prefix + local;
@@ -445,15 +685,58 @@ class Reader {
                                                " '" + local + "' needs " +
                                                std::to_string(kind->ref_count) +
                                                " (usage: " + kind->usage + ")");
-      card.refs.push_back(ctx.prefix + unflatten(lower(line.toks[i].text)));
+      card.refs.push_back(ctx.prefix + unflatten_name(lower(line.toks[i].text)));
       card.ref_locs.push_back(line.at(i));
     }
-    while (i < n && !line.assignment(i)) {
+    // V and I: dc=, ac= (acmag=, acphase=) may stand among the positional values, as in
+    // "V1 a 0 dc = 2 AC 1"; dc= reads as DC, the ac ones are dropped as AC is.
+    auto source_key = [&](std::size_t k) {
+      if ((letter != 'v' && letter != 'i') || !line.assignment(k)) return std::string();
+      const std::string w = lower(line.toks[k].text);
+      return w == "dc" || w == "ac" || w == "acmag" || w == "acphase" ? w : std::string();
+    };
+    while (i < n && (!line.assignment(i) || !source_key(i).empty())) {
+      if (const std::string key = source_key(i); !key.empty()) {
+        if (i + 2 >= n) return error_at(line.at_or_end(i + 2), "missing value for '" + key + "'");
+        if (key == "dc") {
+          CardArg a;
+          a.kind = CardArg::Kind::Word;
+          a.word = key;
+          a.loc = line.at(i);
+          card.args.push_back(std::move(a));
+          i += 2;
+          auto v = value(line, i, *ctx.scope, false);
+          if (!v) return v.status();
+          card.args.push_back(std::move(*v));
+        } else {
+          warn_once("ac", line.at(i), "AC specification ignored (isolink runs transient analyses)");
+          i += 3;
+        }
+        continue;
+      }
       const Token& t = line.toks[i];
       if (t.kind != TokenKind::Word && t.kind != TokenKind::Expr)
         return error_at(line.at(i), "unexpected '" + describe(t) + "'");
       if (t.kind == TokenKind::Word && !line.kind(i + 1, TokenKind::LParen)) {
         const std::string w = lower(t.text);
+        if (is_source_function(w) && !ctx.scope->find(w)) {  // "SIN 0 1 1K": no parentheses
+          CardArg a;
+          a.kind = CardArg::Kind::Call;
+          a.word = w;
+          a.loc = line.at(i++);
+          while (i < n && !line.assignment(i) &&
+                 (line.kind(i, TokenKind::Expr) ||
+                  (line.word(i) && !line.kind(i + 1, TokenKind::LParen) &&
+                   !is_source_function(lower(line.toks[i].text)) &&
+                   lower(line.toks[i].text) != "dc" && lower(line.toks[i].text) != "ac"))) {
+            auto v = number(line, line.toks[i], *ctx.scope);
+            if (!v) return v.status();
+            a.call.push_back(*v);
+            ++i;
+          }
+          card.args.push_back(std::move(a));
+          continue;
+        }
         if (w == "dc") {
           CardArg a;
           a.kind = CardArg::Kind::Word;
@@ -523,6 +806,10 @@ class Reader {
     if (it == subckts_.end())
       return error_at(line.at(name_tok), "unknown subcircuit '" + sub + "'");
     const SubcktDef* def = it->second.get();
+    if (ctx.stack.size() >= kMaxSubcktDepth)
+      return error_at(line.at(name_tok), fmt::format("subcircuits nest deeper than the limit of {} "
+                                                     "levels",
+                                                     kMaxSubcktDepth));
     for (const SubcktDef* d : ctx.stack) {
       if (d != def) continue;
       std::string chain;
@@ -586,11 +873,69 @@ class Reader {
     if (key == ".options" || key == ".option" || key == ".opt" || key == ".opts")
       return options(line, *ctx.scope);
     if (key == ".temp") {
-      warn_once(key, line.at(0),
-                "'.temp' ignored: isolink's elements do not depend on temperature");
+      if (line.toks.size() != 2) return error_at(line.at_or_end(1), "expected .temp DEGREES");
+      auto v = number(line, line.toks[1], *ctx.scope);
+      if (!v) return v.status();
+      temp_ = *v;
       return Status::Ok();
     }
-    warn_once(key, line.at(0), "unsupported card '" + key + "' ignored");
+    if (key == ".ic") return initial_conditions(line, ctx);
+    for (const char* c : kIgnoredCards) {
+      if (key != c) continue;
+      warn_once(key, line.at(0),
+                key == ".nodeset"
+                    ? "'.nodeset' ignored: a linear circuit has one DC operating point"
+                    : "unsupported card '" + key + "' ignored");
+      return Status::Ok();
+    }
+    return error_at(line.at(0), "'" + key +
+                                    "' is not supported (it could change the answer, so "
+                                    "isolink stops rather than skip it)");
+  }
+
+  // .ic v(n1)=1 v(n2)=0.5
+  Status initial_conditions(const Line& line, const Ctx& ctx) {
+    const std::size_t n = line.toks.size();
+    if (n == 1) return error_at(line.end(), "expected v(NODE)=VALUE after .ic");
+    for (std::size_t i = 1; i < n;) {
+      if (!(line.word(i) && lower(line.toks[i].text) == "v" &&
+            line.kind(i + 1, TokenKind::LParen) && line.word(i + 2) &&
+            line.kind(i + 3, TokenKind::RParen) && line.kind(i + 4, TokenKind::Equals) &&
+            i + 5 < n))
+        return error_at(line.at(i),
+                        "expected v(NODE)=VALUE in .ic, got '" + describe(line.toks[i]) + "'");
+      auto v = number(line, line.toks[i + 5], *ctx.scope);
+      if (!v) return v.status();
+      out_.initial_voltages.push_back({node(line.toks[i + 2].text, ctx), *v, line.at(i)});
+      i += 6;
+    }
+    return Status::Ok();
+  }
+
+  // .temp, .options temp= / tnom=: given to every resistor with a temperature coefficient (as
+  // its temp= / tnom= unless the card sets them). The options are consumed here.
+  Status apply_temperature() {
+    std::optional<double> tnom;
+    for (auto it = out_.options.begin(); it != out_.options.end();) {
+      if (it->key != "temp" && it->key != "tnom") {
+        ++it;
+        continue;
+      }
+      if (it->value.kind != CardArg::Kind::Number)
+        return error_at(it->value.loc, "option " + it->key + " expects degrees Celsius");
+      (it->key == "temp" ? temp_ : tnom) = it->value.number;
+      it = out_.options.erase(it);
+    }
+    for (Card& c : out_.cards) {
+      if (c.letter != 'r' || (!c.param("tc1") && !c.param("tc2"))) continue;
+      for (auto [key, value] : {std::pair{"temp", temp_}, std::pair{"tnom", tnom}}) {
+        if (!value || c.param(key)) continue;
+        CardArg a;
+        a.number = *value;
+        a.loc = c.loc;
+        c.params.emplace_back(key, std::move(a));
+      }
+    }
     return Status::Ok();
   }
 
@@ -598,6 +943,7 @@ class Reader {
     TranSpec spec;
     spec.loc = line.at(0);
     std::vector<double> v;
+    std::vector<std::size_t> at;  // the token of each value, for errors
     const std::size_t n = line.toks.size();
     for (std::size_t i = 1; i < n; ++i) {
       const Token& t = line.toks[i];
@@ -605,6 +951,7 @@ class Reader {
         spec.uic = true;
         continue;
       }
+      at.push_back(i);
       if (v.size() == 4)
         return error_at(line.at(i),
                         "too many values: expected .tran TSTEP TSTOP [TSTART [TMAX]] "
@@ -615,6 +962,19 @@ class Reader {
     }
     if (v.size() < 2)
       return error_at(line.end(), "expected .tran TSTEP TSTOP [TSTART [TMAX]] [UIC]");
+    // Checked here, where the card's position is known (the solver's checks have none).
+    const char* what[] = {"TSTEP", "TSTOP", "TSTART", "TMAX"};
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      // TSTEP 0 (Xyce's habit): the engine picks its own print step (TSTOP / 1000).
+      const bool ok = k == 2 ? (v[k] >= 0 && v[k] < v[1]) : k == 0 ? v[k] >= 0 : v[k] > 0;
+      if (!ok || !std::isfinite(v[k]))
+        return error_at(line.at(at[k]),
+                        fmt::format(".tran {} must be {}, got {:g}", what[k],
+                                    k == 2   ? "zero or positive and below TSTOP"
+                                    : k == 0 ? "zero or positive"
+                                             : "positive",
+                                    v[k]));
+    }
     spec.tstep = v[0], spec.tstop = v[1];
     if (v.size() > 2) spec.tstart = v[2];
     if (v.size() > 3) spec.tmax = v[3];
@@ -668,9 +1028,13 @@ class Reader {
   std::unordered_map<std::string, std::unique_ptr<SubcktDef>> subckts_;
   std::vector<SubcktDef*> open_;
   std::vector<std::string> include_stack_;
+  size_t total_bytes_ = 0;  // the netlist and its includes, against kMaxInputFileBytes
   bool in_control_ = false;
   std::unordered_set<std::string> warned_;
   std::unordered_map<std::string, SourceLoc> names_;
+  std::unordered_set<std::string> global_nodes_;  // .global
+  std::optional<double> temp_;                    // .temp
+  SourceLoc section_call_loc_;                    // the .lib FILE SECTION being read
   Scope globals_;
 };
 
@@ -683,8 +1047,8 @@ StatusOr<Netlist> read(const std::shared_ptr<const SourceFile>& file) {
 }  // namespace
 
 StatusOr<Netlist> read_spice_file(const std::string& path) {
-  auto text = read_whole_file(path);
-  if (!text) return Status::Error("cannot open netlist '" + path + "'");
+  auto text = read_input_file(path);
+  if (!text) return text.status();
   return read(SourceFile::FromText(path, *text));
 }
 

@@ -35,12 +35,21 @@ struct NetlistOption {
   SourceLoc loc;  // the key
 };
 
+// .ic v(NODE)=VALUE: without UIC the node is held at VALUE while the DC operating point is
+// solved (then released); with UIC it is the node's voltage at t = 0.
+struct InitialVoltage {
+  std::string node;  // flattened, lower case
+  double value = 0;  // V
+  SourceLoc loc;     // the v(...) entry
+};
+
 struct Netlist {
-  std::string title;                   // first line of the top file, as written (trimmed)
-  std::vector<Card> cards;             // flattened elements, in netlist order
-  std::optional<TranSpec> tran;        // the last .tran card
-  std::vector<NetlistOption> options;  // in netlist order
-  std::vector<std::string> warnings;   // formatted diagnostics ("file:line:col: warning: ...")
+  std::string title;                             // first line of the top file, as written (trimmed)
+  std::vector<Card> cards;                       // flattened elements, in netlist order
+  std::optional<TranSpec> tran;                  // the last .tran card
+  std::vector<NetlistOption> options;            // in netlist order
+  std::vector<InitialVoltage> initial_voltages;  // .ic, in netlist order
+  std::vector<std::string> warnings;  // formatted diagnostics ("file:line:col: warning: ...")
 };
 
 // Reads a netlist file; .include paths are relative to the including file.

@@ -65,6 +65,8 @@ std::string write_spice(const Netlist& n) {
     }
     out += '\n';
   }
+  for (const InitialVoltage& ic : n.initial_voltages)
+    out += fmt::format(".ic v({})={:.12g}\n", ic.node, ic.value);
   if (n.tran) {
     const TranSpec& t = *n.tran;
     out += fmt::format(".tran {:.12g} {:.12g}", t.tstep, t.tstop);

@@ -1,13 +1,19 @@
 #include "reports/plot.h"
 
-#include <OpenImageIO/imagebufalgo.h>
+#include <dlfcn.h>
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <mutex>
 #include <system_error>
+#include <vector>
+
+#include "base/file_io.h"
+
+#include "reports/image_plugin.h"
 
 namespace isolink::reports {
 namespace fs = std::filesystem;
@@ -139,6 +145,68 @@ bool dash_on(const LineStyle& s, double u) {
   return (m < 0 ? m + period : m) < s.dash;
 }
 
+// The image plug-in (image_plugin.h), loaded once, on the first Canvas::create: from
+// $ISOLINK_PLUGIN_DIR when set, else next to the executable, in ../lib/isolink beside it (an
+// installed tree), or in the build tree it was built in (tests, the Python module).
+struct ImagePlugin {
+  const IsolinkImageApi* api = nullptr;
+  std::string error;
+};
+
+const ImagePlugin& image_plugin() {
+  static const ImagePlugin plugin = [] {
+    ImagePlugin out;
+    std::vector<fs::path> dirs;
+    if (const char* env = std::getenv("ISOLINK_PLUGIN_DIR"); env && *env) dirs.emplace_back(env);
+    std::error_code ec;
+    const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+    if (!ec) {
+      dirs.push_back(exe.parent_path());
+      dirs.push_back((exe.parent_path() / "../lib/isolink").lexically_normal());
+    }
+    dirs.emplace_back(ISOLINK_IMAGE_PLUGIN_BUILD_DIR);
+    std::string looked;
+    for (const fs::path& d : dirs) {
+      const fs::path file = d / ISOLINK_IMAGE_PLUGIN_FILE;
+      looked += (looked.empty() ? "" : ", ") + d.string();
+      if (!fs::is_regular_file(file, ec)) continue;
+      void* handle = dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
+      if (!handle) {
+        out.error = fmt::format("cannot load the image plug-in {}: {}", file.string(), dlerror());
+        return out;
+      }
+      auto entry = reinterpret_cast<IsolinkImageApiFn>(dlsym(handle, "isolink_image_api"));
+      const IsolinkImageApi* api = entry ? entry() : nullptr;
+      if (!api || api->version != kImagePluginVersion) {
+        out.error =
+            fmt::format("image plug-in {} is from another isolink build (interface {}, need {})",
+                        file.string(), api ? api->version : 0, kImagePluginVersion);
+        return out;
+      }
+      out.api = api;
+      return out;
+    }
+    out.error = fmt::format(
+        "the image plug-in {} (built with isolink; it draws the PNGs) was not "
+        "found; looked in {} (or set ISOLINK_PLUGIN_DIR)",
+        ISOLINK_IMAGE_PLUGIN_FILE, looked);
+    return out;
+  }();
+  return plugin;
+}
+
+struct Box {
+  bool defined = false;
+  int xbegin = 0, xend = 0, ybegin = 0, yend = 0;
+};
+
+Box text_box(const std::string& text, int size, const std::string& font) {
+  const IsolinkImageApi* api = image_plugin().api;
+  int b[4] = {0, 0, 0, 0};
+  if (!api || !api->text_size(text.c_str(), size, font.c_str(), b)) return {};
+  return {true, b[0], b[1], b[2], b[3]};
+}
+
 }  // namespace
 
 StatusOr<Canvas> Canvas::create(int width, int height, Color background) {
@@ -146,6 +214,7 @@ StatusOr<Canvas> Canvas::create(int width, int height, Color background) {
     return Status::Error(fmt::format("bad image size {} x {}", width, height));
   StatusOr<Fonts> f = find_fonts();
   if (!f) return f.status();
+  if (!image_plugin().api) return Status::Error(image_plugin().error);
   Canvas c;
   c.w_ = width;
   c.h_ = height;
@@ -158,12 +227,6 @@ StatusOr<Canvas> Canvas::create(int width, int height, Color background) {
     c.px_[i + 2] = b;
   }
   return c;
-}
-
-OIIO::ImageBuf Canvas::image() const {
-  OIIO::ImageBuf out(OIIO::ImageSpec(w_, h_, 3, OIIO::TypeDesc::UINT8));
-  out.set_pixels(OIIO::ROI(0, w_, 0, h_, 0, 1, 0, 3), OIIO::TypeDesc::UINT8, px_.data());
-  return out;
 }
 
 Color Canvas::pixel(int x, int y) const {
@@ -314,8 +377,8 @@ Canvas::TextExtent Canvas::measure(std::string_view s, int size, FontFace face) 
   const std::string a = ascii_text(s);
   TextExtent e;
   // Ascent / descent from reference glyphs so that labels of one size align alike.
-  const OIIO::ROI ref = OIIO::ImageBufAlgo::text_size("Hg", size, font(face));
-  if (ref.defined()) {
+  const Box ref = text_box("Hg", size, font(face));
+  if (ref.defined) {
     e.ascent = -ref.ybegin;
     e.descent = ref.yend;
   }
@@ -327,8 +390,8 @@ Canvas::TextExtent Canvas::measure(std::string_view s, int size, FontFace face) 
     const std::string line =
         a.substr(start, nl == std::string::npos ? std::string::npos : nl - start);
     if (!line.empty()) {
-      const OIIO::ROI r = OIIO::ImageBufAlgo::text_size(line, size, font(face));
-      if (r.defined()) width = std::max(width, r.xend);
+      const Box r = text_box(line, size, font(face));
+      if (r.defined) width = std::max(width, r.xend);
     }
     if (nl == std::string::npos) break;
     ++lines;
@@ -372,22 +435,20 @@ Rect Canvas::text(double x, double y, std::string_view s, int size, Color c, Fon
   }
   if (a.empty()) return {};
   const std::string& fontfile = font(face);
-  const OIIO::ROI r = OIIO::ImageBufAlgo::text_size(a, size, fontfile);
-  if (!r.defined()) return {};
-  const OIIO::ROI ref = OIIO::ImageBufAlgo::text_size("Hg", size, fontfile);
-  const int ascent = ref.defined() ? -ref.ybegin : size;
-  const int descent = ref.defined() ? ref.yend : 0;
+  const Box r = text_box(a, size, fontfile);
+  if (!r.defined) return {};
+  const Box ref = text_box("Hg", size, fontfile);
+  const int ascent = ref.defined ? -ref.ybegin : size;
+  const int descent = ref.defined ? ref.yend : 0;
   // Mask box in baseline coordinates: x in [0, xend), y in [-ascent', descent').
   const int top = std::min(r.ybegin, -ascent), bottom = std::max(r.yend, descent);
   const int pad = 2;
   const int mw = std::max(r.xend, 1) + 2 * pad, mh = bottom - top + 2 * pad;
-  OIIO::ImageBuf mask(OIIO::ImageSpec(mw, mh, 1, OIIO::TypeDesc::FLOAT));
-  OIIO::ImageBufAlgo::zero(mask);
-  const float one = 1.0f;
-  OIIO::ImageBufAlgo::render_text(mask, pad, pad - top, a, size, fontfile,
-                                  OIIO::cspan<float>(&one, 1));
-  const float* m = static_cast<const float*>(mask.localpixels());
-  if (!m) return {};
+  std::vector<float> mask(static_cast<size_t>(mw) * static_cast<size_t>(mh), 0.0f);
+  if (!image_plugin().api->render_text(mask.data(), mw, mh, pad, pad - top, a.c_str(), size,
+                                       fontfile.c_str()))
+    return {};
+  const float* m = mask.data();
   // Where the mask's (0, 0) goes, for the box the alignment refers to.
   int ox = 0, oy = 0;
   if (!vertical) {
@@ -427,24 +488,18 @@ Rect Canvas::text(double x, double y, std::string_view s, int size, Color c, Fon
 }
 
 Status Canvas::write_png(const std::string& path) const {
-  const std::string tmp = path + ".tmp.png";
-  OIIO::ImageBuf out = image();
-  if (!out.write(tmp, OIIO::TypeDesc::UINT8, "png")) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    std::string err = out.geterror();
-    if (err.empty()) err = OIIO::geterror();
-    return Status::Error(fmt::format("cannot write {}: {}", path, err));
+  // OpenImageIO reports success when the disk fills up under it, so the plug-in encodes the PNG
+  // into memory and base/file_io.h does the checked, atomic write.
+  std::vector<unsigned char> bytes;
+  char err[512] = "";
+  auto sink = [](void* ctx, const unsigned char* data, size_t n) {
+    static_cast<std::vector<unsigned char>*>(ctx)->assign(data, data + n);
+  };
+  if (image_plugin().api->encode_png(w_, h_, px_.data(), sink, &bytes, err, sizeof err) != 0) {
+    return Status::Error(fmt::format("{}: error: cannot encode the PNG: {}", path, err));
   }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    std::error_code ec2;
-    fs::remove(tmp, ec2);
-    return Status::Error(
-        fmt::format("cannot write {}: rename from {}: {}", path, tmp, ec.message()));
-  }
-  return Status::Ok();
+  return write_file_atomic(
+      path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
 Rect draw_runs(Canvas& c, double x, double y, const std::vector<TextRun>& runs, int size,

@@ -1,9 +1,10 @@
-// A small drawing layer over OpenImageIO for report images: an RGB canvas, plot areas with
+// A small drawing layer for report images: an RGB canvas, plot areas with
 // data -> pixel axis mappings, nice ticks with SI units, grid, lines (solid / dashed,
 // anti-aliased), min/max column envelopes for long series, translucent rectangles, text (DejaVu via
-// OIIO's render_text, horizontal or vertical), legends, colour maps (viridis, inferno) with a log
-// scale and colour bars. eye_png and wave_png are built from it; a line chart, heatmap with contour
-// or histogram needs only these pieces.
+// OIIO's render_text, in the plug-in image_plugin.h loads on the first Canvas::create, horizontal
+// or vertical), legends, colour maps (viridis, inferno) with a log scale and colour bars. eye_png
+// and wave_png are built from it; a line chart, heatmap with contour or histogram needs only these
+// pieces.
 //
 // Usage:
 //   StatusOr<Canvas> c = Canvas::create(1920, 1080);            // white, fonts found or an error
@@ -20,8 +21,6 @@
 // Text is ASCII: common Unicode signs (micro, +/-, <=, >=, dashes, arrows) are replaced by ASCII
 // spellings, since OIIO 2.4's renderer garbles non-ASCII characters.
 #pragma once
-
-#include <OpenImageIO/imagebuf.h>
 
 #include <array>
 #include <cmath>
@@ -62,6 +61,7 @@ inline constexpr Color kLevel = rgb(0x333333);      // VSTART levels (dashed)
 inline constexpr Color kSeriesP = rgb(0x1F77B4);    // P line
 inline constexpr Color kSeriesN = rgb(0xFF7F0E);    // N line
 inline constexpr Color kSeriesCm = rgb(0x2CA02C);   // common mode
+inline constexpr Color kMark = rgb(0xF28E00);       // a marked pulse (the worst case's)
 
 enum class FontFace { kSans, kBold, kMono };
 enum class HAlign { kLeft, kCenter, kRight };
@@ -137,8 +137,8 @@ class Canvas {
   int height() const { return h_; }
   Rect bounds() const { return {0, 0, w_, h_}; }
   const Fonts& fonts() const { return fonts_; }
-  OIIO::ImageBuf image() const;     // a copy as an 8-bit RGB ImageBuf
-  Color pixel(int x, int y) const;  // opaque colour at (x, y)
+  const std::vector<uint8_t>& rgb() const { return px_; }  // 8-bit RGB, row-major
+  Color pixel(int x, int y) const;                         // opaque colour at (x, y)
 
   // "Over" compositing of c (its alpha times coverage) at one pixel; ignored outside.
   void blend(int x, int y, Color c, float coverage = 1.0f);
@@ -172,7 +172,7 @@ class Canvas {
   };
   TextExtent measure(std::string_view s, int size, FontFace face = FontFace::kSans) const;
 
-  // Writes a PNG to path + ".tmp.png" and renames it to path; errors name the path.
+  // Encodes the PNG in memory, then write_file_atomic (base/file_io.h); errors name the path.
   Status write_png(const std::string& path) const;
 
  private:

@@ -1,11 +1,11 @@
 #include "reports/run_report.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-
-#include <fmt/format.h>
 
 #include "netlists/link/cable.h"
 #include "netlists/link/cards.h"
@@ -42,37 +42,46 @@ ordered_json end_json(const link::EndSpec& e) {
                       {"isolation", iso}};
 }
 
-
 std::string margin_cell(const eye::CheckResult& r, const char* metric, const char* unit,
                         double scale) {
   for (const eye::WorstMargin& w : r.worst)
     if (w.metric == metric)
-      return fmt::format("{:.3g} {} (margin {:+.3g} {}, pulse {} at {:.3f} us)",
-                         w.j.value * scale, unit, w.j.margin * scale, unit, w.pulse,
-                         w.time * 1e6);
+      return fmt::format("{:.3g} {} (margin {:+.3g} {}, pulse {} at {:.3f} us)", w.j.value * scale,
+                         unit, w.j.margin * scale, unit, w.pulse, w.time * 1e6);
   return "-";
 }
 
 }  // namespace
 
 nlohmann::ordered_json link_spec_json(const link::LinkSpec& s) {
-  ordered_json cable{{"length", s.cable.length},           {"material", s.cable.material},
-                     {"gauge", s.cable.gauge},             {"temperature", s.cable.temperature},
-                     {"r", optional_json(s.cable.r)},      {"l", optional_json(s.cable.l)},
-                     {"c", optional_json(s.cable.c)},      {"g", optional_json(s.cable.g)},
-                     {"segments", s.cable.segments},       {"skin_effect", s.cable.skin_effect},
+  ordered_json cable{{"length", s.cable.length},
+                     {"material", s.cable.material},
+                     {"gauge", s.cable.gauge},
+                     {"temperature", s.cable.temperature},
+                     {"r", optional_json(s.cable.r)},
+                     {"l", optional_json(s.cable.l)},
+                     {"c", optional_json(s.cable.c)},
+                     {"g", optional_json(s.cable.g)},
+                     {"segments", s.cable.segments},
+                     {"skin_effect", s.cable.skin_effect},
                      {"dielectric_loss", s.cable.dielectric_loss}};
   ordered_json dirs = ordered_json::array();
   for (link::Direction d : s.stimulus.directions) dirs.push_back(link::direction_name(d));
-  ordered_json stim{{"frames", s.stimulus.frames},     {"tones", s.stimulus.tones},
-                    {"patterns", s.stimulus.patterns}, {"script", s.stimulus.script},
+  ordered_json stim{{"frames", s.stimulus.frames},
+                    {"tones", s.stimulus.tones},
+                    {"patterns", s.stimulus.patterns},
+                    {"script", s.stimulus.script},
                     {"directions", dirs}};
   ordered_json sim{{"tstep", s.sim.tstep},
                    {"tmax", optional_json(s.sim.tmax)},
                    {"method", s.sim.method},
                    {"reltol", optional_json(s.sim.reltol)}};
-  return ordered_json{{"name", s.name},          {"source", s.source}, {"tx", end_json(s.tx)},
-                      {"rx", end_json(s.rx)},    {"cable", cable},     {"stimulus", stim},
+  return ordered_json{{"name", s.name},
+                      {"source", s.source},
+                      {"tx", end_json(s.tx)},
+                      {"rx", end_json(s.rx)},
+                      {"cable", cable},
+                      {"stimulus", stim},
                       {"sim", sim}};
 }
 
@@ -80,12 +89,25 @@ nlohmann::ordered_json run_report_json(const link::LinkSpec& spec, const LinkRun
   ordered_json dirs = ordered_json::array();
   for (const DirectionRun& d : run.directions) {
     const TransientStats& st = d.sim.stats;
-    ordered_json solver{{"seconds", d.sim.seconds},       {"nodes", d.sim.nodes},
-                        {"unknowns", d.sim.unknowns},     {"elements", d.sim.elements},
-                        {"steps", st.accepted},           {"rejected", st.rejected},
-                        {"factorizations", st.factorizations},
-                        {"breakpoints", st.breakpoints},  {"cable_segments", d.link.cable_segments},
+    const bool lti = d.sim.engine == analysis::Engine::Lti;
+    ordered_json solver{{"engine", analysis::engine_name(d.sim.engine)},
+                        {"seconds", d.sim.seconds},
+                        {"nodes", d.sim.nodes},
+                        {"unknowns", d.sim.unknowns},
+                        {"elements", d.sim.elements},
+                        {"steps", lti ? d.sim.lti.steps : st.accepted},
+                        {"rejected", lti ? d.sim.lti.rejected : st.rejected},
+                        {"factorizations", lti ? d.sim.lti.factorizations : st.factorizations},
+                        {"breakpoints", lti ? d.sim.grid.corners : st.breakpoints},
+                        {"cable_segments", d.link.cable_segments},
                         {"warnings", d.sim.warnings}};
+    if (lti) {
+      solver["response_span_s"] = d.sim.lti.settled_at;
+      solver["grid_step_s"] = d.sim.grid.step;
+      solver["rows"] = d.sim.grid.rows;
+    } else if (!d.sim.engine_note.empty()) {
+      solver["engine_note"] = d.sim.engine_note;
+    }
     ordered_json j{{"direction", link::direction_name(d.link.direction)},
                    {"transmitter", d.link.transmitter},
                    {"receiver", d.link.receiver},
@@ -109,15 +131,16 @@ std::string run_report_markdown(const link::LinkSpec& spec, const LinkRun& run,
   md += fmt::format("# isolink report: {}\n\n", spec.name);
   md += fmt::format("**Verdict: {}**", run.pass ? "PASS" : "FAIL");
   md += fmt::format(" (spec `{}`, simulated in {:.2f} s)\n\n", spec.source, run.seconds);
-  md += "| direction | receiver rules | verdict | worst VSTART | worst VEND | worst width | "
-        "slowest edge | bytes |\n|---|---|---|---|---|---|---|---|\n";
+  md +=
+      "| direction | receiver rules | verdict | worst VSTART | worst VEND | worst width | "
+      "slowest edge | bytes |\n|---|---|---|---|---|---|---|---|\n";
   for (const DirectionRun& d : run.directions) {
     const eye::CheckResult* r = d.data ? &*d.data : d.tones ? &*d.tones : nullptr;
     if (r == nullptr) continue;
-    std::string bytes = d.data ? fmt::format("{} of {} decoded{}", d.data->bytes.size(),
-                                             d.link.expected.size(),
-                                             d.data->expect_match ? ", match" : ", MISMATCH")
-                               : "-";
+    std::string bytes =
+        d.data ? fmt::format("{} of {} decoded{}", d.data->bytes.size(), d.link.expected.size(),
+                             d.data->expect_match ? ", match" : ", MISMATCH")
+               : "-";
     md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", d.link.description, r->rules,
                       d.pass ? "pass" : "**FAIL**", margin_cell(*r, "vstart", "V", 1),
                       margin_cell(*r, "vend", "V", 1), margin_cell(*r, "width", "ns", 1e9),
@@ -149,39 +172,53 @@ std::string run_report_markdown(const link::LinkSpec& spec, const LinkRun& run,
     md += fmt::format(", {} sections", run.directions.front().link.cable_segments);
   if (StatusOr<link::CableModel> cm = link::cable_model(spec.cable); cm.ok()) {
     const double a10 = std::real(cm->gamma_diff(10e6)) * spec.cable.length * 8.685889638;
-    md += fmt::format(": differential impedance {:.0f} ohm, velocity {:.2f} c, delay {:.1f} ns, "
-                      "loss {:.2f} dB at 10 MHz",
-                      cm->z_diff(), cm->velocity() / 299792458.0,
-                      spec.cable.length / cm->velocity() * 1e9, a10);
+    md += fmt::format(
+        ": differential impedance {:.0f} ohm, velocity {:.2f} c, delay {:.1f} ns, "
+        "loss {:.2f} dB at 10 MHz",
+        cm->z_diff(), cm->velocity() / 299792458.0, spec.cable.length / cm->velocity() * 1e9, a10);
   }
   md += ".\n";
   md += "\n## Traffic\n\n";
   md += fmt::format("`{}`\n\n", spec.stimulus.to_script());
-  md += "## Solver\n\n| direction | unknowns | steps | rejected | factorizations | time |\n"
-        "|---|---|---|---|---|---|\n";
+  md +=
+      "## Solver\n\n| direction | engine | unknowns | steps | rejected | factorizations | time "
+      "|\n|---|---|---|---|---|---|---|\n";
+  for (const DirectionRun& d : run.directions) {
+    const bool lti = d.sim.engine == analysis::Engine::Lti;
+    md += fmt::format("| {} | {} | {} | {} | {} | {} | {:.3f} s |\n", d.link.description,
+                      lti ? "LTI (edge responses)" : "transient", d.sim.unknowns,
+                      lti ? d.sim.lti.steps : d.sim.stats.accepted,
+                      lti ? d.sim.lti.rejected : d.sim.stats.rejected,
+                      lti ? d.sim.lti.factorizations : d.sim.stats.factorizations, d.sim.seconds);
+  }
   for (const DirectionRun& d : run.directions)
-    md += fmt::format("| {} | {} | {} | {} | {} | {:.3f} s |\n", d.link.description,
-                      d.sim.unknowns, d.sim.stats.accepted, d.sim.stats.rejected,
-                      d.sim.stats.factorizations, d.sim.seconds);
+    if (d.sim.engine == analysis::Engine::Lti)
+      md += fmt::format(
+          "\n{}: waveform by the LTI engine, superposing {} source corners on step "
+          "responses marched to {:.3g} us; output every {:.3g} ns (linear "
+          "interpolation within 1 mV).\n",
+          d.link.description, d.sim.grid.corners, d.sim.lti.settled_at * 1e6,
+          d.sim.grid.step * 1e9);
+    else if (!d.sim.engine_note.empty())
+      md += fmt::format("\n{}: transient engine ({}).\n", d.link.description, d.sim.engine_note);
   md += "\nFiles: `report.json` (all figures), `wave.csv` (the probes of every direction).\n";
   return md;
 }
 
-
 std::string run_summary_text(const link::LinkSpec& spec, const LinkRun& run) {
-  std::string s = fmt::format("{}: {} ({:.2f} s)\n", spec.name, run.pass ? "PASS" : "FAIL",
-                              run.seconds);
+  std::string s =
+      fmt::format("{}: {} ({:.2f} s)\n", spec.name, run.pass ? "PASS" : "FAIL", run.seconds);
   for (const DirectionRun& d : run.directions) {
-    s += fmt::format("  {} [{}]: {}\n", d.link.description, d.link.rules,
-                     d.pass ? "pass" : "FAIL");
+    s += fmt::format("  {} [{}]: {}\n", d.link.description, d.link.rules, d.pass ? "pass" : "FAIL");
     for (const eye::CheckResult* r : {d.data ? &*d.data : nullptr, d.tones ? &*d.tones : nullptr}) {
       if (r == nullptr) continue;
       for (const eye::WorstMargin& w : r->worst) {
         const bool ns = w.metric == "width" || w.metric == "edge";
         const double k = ns ? 1e9 : 1;
-        s += fmt::format("    worst {:<6} {:>8.4g} {:<2} (limit {:.4g}, margin {:+.4g}{}) at {:.3f} us\n",
-                         w.metric, w.j.value * k, ns ? "ns" : "V", w.j.limit * k, w.j.margin * k,
-                         w.metric == "droop" ? ", a warning" : "", w.time * 1e6);
+        s += fmt::format(
+            "    worst {:<6} {:>8.4g} {:<2} (limit {:.4g}, margin {:+.4g}{}) at {:.3f} us\n",
+            w.metric, w.j.value * k, ns ? "ns" : "V", w.j.limit * k, w.j.margin * k,
+            w.metric == "droop" ? ", a warning" : "", w.time * 1e6);
       }
       for (size_t i = 0; i < r->reasons.size() && i < 5; ++i) s += "    " + r->reasons[i] + "\n";
     }

@@ -204,6 +204,16 @@ void draw_panel(Canvas& c, const WavePanelLayout& L, const WavePanel& p) {
   draw_failing(c, a, p, r, rules.pulse_time, "", &marks, &failed);
   if (p.tones) draw_failing(c, a, p, *p.tones, 1e-6, "tone ", &marks, &failed);
   label_failing(c, a, marks, &failed);
+  if (p.marked && *p.marked < r.pulses.size()) {
+    const eye::PulseMetrics& pm = r.pulses[*p.marked];
+    const double lead = pm.edge.measured() ? pm.edge.value : 0.1 * rules.pulse_time;
+    std::vector<double> xs, ys;
+    clip_series(p.time, p.diff, pm.a - lead, pm.b, &xs, &ys);
+    c.series(a, xs, ys, LineStyle{.color = kMark, .width = 4});
+    const double xm = a.px((pm.a + pm.b) / 2);
+    c.text(xm, a.rect.y1 - 8, p.mark_label.empty() ? "marked" : p.mark_label, style::kLabelSize,
+           kMark, FontFace::kBold, HAlign::kCenter, VAlign::kBottom);
+  }
   const bool last_plot = !L.pins;
   draw_axes(c, a, xt, yt, last_plot ? "time" : "", "differential v(P) - v(N)", style::kLabelSize);
 
@@ -217,6 +227,7 @@ void draw_panel(Canvas& c, const WavePanelLayout& L, const WavePanel& p) {
   std::vector<LegendEntry> legend{{"v(P) - v(N)", {.color = kTrace, .width = 2}}};
   if (!failed.names.empty())
     legend.push_back({"failing pulse #index", {.color = kFail, .width = 3}});
+  if (p.marked) legend.push_back({"worst pulse", {.color = kMark, .width = 4}});
   legend.push_back({fmt::format("+/-Vth {:g} V", rules.vth), {.color = kThreshold, .width = 2}});
   legend.push_back({r.tone ? "tone run" : "frame, decoded",
                     {.color = r.tone ? kFrameTone : kFrameDecoded},

@@ -15,7 +15,8 @@
 // there is room. A failing pulse (PulseMetrics.failing) is drawn in kFail red from the start of the
 // edge into it to its end b, marked at the top and labelled "#index" (its index in
 // CheckResult.pulses) where there is room; nothing else in the image is that red except a FAIL
-// verdict. Optional `tones` (a tone check of the same record) adds its failing pulses as "tone #i".
+// verdict. A `marked` pulse (isolink worst's worst pulse) is drawn in kMark orange with its label.
+// Optional `tones` (a tone check of the same record) adds its failing pulses as "tone #i".
 #pragma once
 
 #include <optional>
@@ -40,6 +41,8 @@ struct WavePanel {
   const eye::Rules* rules = nullptr;         // the rules result was judged with (not owned)
   const eye::CheckResult* result = nullptr;  // the data check of diff (not owned)
   const eye::CheckResult* tones = nullptr;   // optional: a tone check of diff (not owned)
+  std::optional<size_t> marked;              // a pulse of result to mark (the worst case's)
+  std::string mark_label;                    // its label, e.g. "lowest VSTART 1.83 V"
 };
 
 struct WaveReportInfo {

@@ -29,14 +29,14 @@ struct CardArg {
 };
 
 struct Card {
-  char letter = 0;                     // element kind letter, lower case ('r', 'c', ...)
-  std::string name;                    // full hierarchical name, lower case ("x1.r3")
-  SourceLoc loc;                       // where the element's name starts
-  std::vector<std::string> nodes;      // node names, lower case, "0" is ground
-  std::vector<SourceLoc> node_locs;    // one per node
-  std::vector<std::string> refs;       // other elements named by this one (K: two inductors)
-  std::vector<SourceLoc> ref_locs;     // one per ref
-  std::vector<CardArg> args;           // positional values after nodes and refs
+  char letter = 0;                   // element kind letter, lower case ('r', 'c', ...)
+  std::string name;                  // full hierarchical name, lower case ("x1.r3")
+  SourceLoc loc;                     // where the element's name starts
+  std::vector<std::string> nodes;    // node names, lower case, "0" is ground
+  std::vector<SourceLoc> node_locs;  // one per node
+  std::vector<std::string> refs;     // other elements named by this one (K: two inductors)
+  std::vector<SourceLoc> ref_locs;   // one per ref
+  std::vector<CardArg> args;         // positional values after nodes and refs
   std::vector<std::pair<std::string, CardArg>> params;  // key=value pairs, keys lower case
 
   const CardArg* param(const std::string& key) const {
@@ -45,5 +45,17 @@ struct Card {
     return nullptr;
   }
 };
+
+// ngspice's flattened names: "r.x1.r3" is element "x1.r3" of kind r (as spice_writer writes
+// hierarchical names, as K cards name such inductors, "l.x1.l3", and as ngspice names probes,
+// "i(v.x1.vm)"); any other name comes back unchanged.
+inline std::string unflatten_name(const std::string& name) {
+  if (name.size() > 2 && name[1] == '.') {
+    const std::string rest = name.substr(2);
+    const std::size_t dot = rest.rfind('.');
+    if (dot != std::string::npos && dot + 1 < rest.size() && rest[dot + 1] == name[0]) return rest;
+  }
+  return name;
+}
 
 }  // namespace isolink

@@ -1,9 +1,9 @@
 #include "solver/circuit.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <numeric>
-
-#include <fmt/format.h>
 
 namespace isolink {
 
@@ -29,8 +29,8 @@ Status Circuit::add(const Card& card) {
   if (!kind) return error_at(card.loc, fmt::format("unknown element kind '{}'", card.letter));
   if (static_cast<int>(card.nodes.size()) != kind->node_count ||
       static_cast<int>(card.refs.size()) != kind->ref_count)
-    return error_at(card.loc, fmt::format("{} needs {} nodes ({})", card.name, kind->node_count,
-                                          kind->usage));
+    return error_at(
+        card.loc, fmt::format("{} needs {} nodes ({})", card.name, kind->node_count, kind->usage));
   StatusOr<std::unique_ptr<Element>> e = kind->parse(card);
   if (!e) return e.status();
   (*e)->set_node_names(card.nodes);
@@ -91,6 +91,8 @@ Status Circuit::finalize() {
     for (int b : e->branches()) is_state_[b] = e->branch_is_state();
   for (auto& e : elements_)
     if (Status s = e->link(*this); !s.ok()) return s;
+  for (auto& e : elements_)
+    if (Status s = e->check(*this); !s.ok()) return s;
 
   // DC topology: voltage-defining loops are singular; components without a path to ground float.
   std::vector<DcEdge> edges;
@@ -103,8 +105,23 @@ Status Circuit::finalize() {
   }
   const int n = node_count();
   UnionFind vloop(n), conn(n);
-  for (size_t i = 0; i < edges.size(); ++i) {
+  // Voltage sources first, then inductors: an inductor that closes a loop of voltage sources and
+  // inductors is opened at DC (its current starts at 0), so only a loop of sources is an error.
+  std::vector<size_t> order(edges.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::stable_partition(order.begin(), order.end(),
+                        [&](size_t i) { return edges[i].link != DcLink::Inductive; });
+  std::string opened;
+  for (size_t i : order) {
     const DcEdge& d = edges[i];
+    if (d.link == DcLink::Inductive) {
+      if (!vloop.unite(d.a, d.b) && !owner[i]->branches().empty()) {
+        dc_open_.push_back(owner[i]->branches()[0]);
+        if (dc_open_.size() <= 8) opened += (opened.empty() ? "" : ", ") + owner[i]->name();
+      }
+      conn.unite(d.a, d.b);
+      continue;
+    }
     if (d.link == DcLink::VoltageDefining && !vloop.unite(d.a, d.b)) {
       // Name the loop: every voltage-defining element between the two joined sets.
       std::vector<std::string> names;
@@ -120,6 +137,12 @@ Status Circuit::finalize() {
     }
     if (d.link != DcLink::CurrentSource) conn.unite(d.a, d.b);
   }
+  if (!dc_open_.empty())
+    warnings_.push_back(fmt::format(
+        "warning: {} inductor(s) close a loop with voltage sources or other inductors, where the "
+        "DC current is not determined; they start at 0 A (as in ngspice): {}{}",
+        dc_open_.size(), opened,
+        dc_open_.size() > 8 ? fmt::format(" and {} more", dc_open_.size() - 8) : ""));
   std::vector<bool> grounded(n, false);
   for (int i = 0; i < n; ++i) grounded[i] = conn.find(i) == conn.find(0);
   for (size_t i = 0; i < edges.size(); ++i) {

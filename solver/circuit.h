@@ -30,7 +30,7 @@ class Circuit {
   // Numbers unknowns, links references, checks DC topology; call once after the last add.
   Status finalize();
 
-  int unknown_count() const { return unknowns_; }  // without ground
+  int unknown_count() const { return unknowns_; }                          // without ground
   int node_count() const { return static_cast<int>(node_names_.size()); }  // with ground
   // Unknown index of a node name (lower case), -1 if absent; "0" and "gnd" give 0.
   int find_node(std::string_view name) const;
@@ -43,6 +43,9 @@ class Circuit {
   std::vector<std::unique_ptr<Element>>& elements() { return elements_; }
   // Nodes tied to ground through kFloatingTie because nothing else gives them a DC path.
   const std::vector<int>& floating_nodes() const { return floating_; }
+  // Inductor branch unknowns held at 0 A in the DC operating point because the inductor closes
+  // a loop of voltage sources and inductors (a warning names them).
+  const std::vector<int>& dc_open_branches() const { return dc_open_; }
   const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
@@ -55,6 +58,7 @@ class Circuit {
   std::vector<std::string> branch_names_;  // per branch unknown: element name
   std::vector<bool> is_state_;
   std::vector<int> floating_;
+  std::vector<int> dc_open_;
   std::vector<std::string> warnings_;
   int unknowns_ = 0;
   bool finalized_ = false;

@@ -1,13 +1,14 @@
 #include "solver/transient.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 
-#include <fmt/format.h>
-
 #include "solver/klu_solver.h"
 #include "solver/mna.h"
+#include "solver/mna_system.h"
 
 namespace isolink {
 
@@ -29,6 +30,10 @@ Status TransientOptions::validate() const {
   if (!(abstol > 0)) return bad("abstol", abstol, "must be positive");
   if (!(trtol > 0)) return bad("trtol", trtol, "must be positive");
   if (max_steps <= 0) return bad("max_steps", static_cast<double>(max_steps), "must be positive");
+  for (const auto& [node, v] : node_ic) {
+    if (node <= 0) return bad("node_ic node", node, "must be a node unknown (> 0)");
+    if (!std::isfinite(v)) return bad("node_ic value", v, "must be finite");
+  }
   return Status::Ok();
 }
 
@@ -37,6 +42,11 @@ Status TransientOptions::set_option(const std::string& key, const CardArg& value
   auto number = [&](double* field) -> Status {
     if (value.kind != CardArg::Kind::Number)
       return error_at(value.loc, "option " + key + " expects a number");
+    // Checked here, where the .options card's position is known (validate() has none).
+    const bool ok = key == "reltol" ? value.number > 0 && value.number < 1 : value.number > 0;
+    if (!ok || !std::isfinite(value.number))
+      return error_at(value.loc, fmt::format("option {} = {:g}: must be {}", key, value.number,
+                                             key == "reltol" ? "in (0, 1)" : "positive"));
     *field = value.number;
     return Status::Ok();
   };
@@ -59,104 +69,6 @@ Status TransientOptions::set_option(const std::string& key, const CardArg& value
 }
 
 namespace {
-
-// The assembled linear system of a circuit.
-struct System {
-  MnaPattern pattern{0};
-  std::vector<double> g, c;  // value arrays (+ trash)
-  KluSolver klu;
-  int n = 0;                 // unknowns without ground
-  // The elements with an excitation (sources): the only ones stamp_rhs is called on.
-  std::vector<const Element*> sources;
-  // C without its zero entries, by rows, for C * v on every step: row r (unknown r + 1) has
-  // entries c_start[r] .. c_start[r + 1], columns as unknowns (1..n).
-  std::vector<int> c_start, c_col;
-  std::vector<double> c_val;
-  std::vector<double> a;     // G + alpha C, factorization input
-
-  Status build(const Circuit& circuit) {
-    n = circuit.unknown_count();
-    pattern = MnaPattern(n);
-    auto& elements = const_cast<Circuit&>(circuit).elements();
-    for (auto& e : elements) e->declare(pattern);
-    pattern.finalize();
-    for (auto& e : elements) e->declare(pattern);
-    g.assign(pattern.value_count(), 0.0);
-    c.assign(pattern.value_count(), 0.0);
-    for (auto& e : elements) e->stamp(g.data(), c.data());
-    for (int node : circuit.floating_nodes()) g[pattern.slot(node, node)] += Circuit::kFloatingTie;
-    for (const auto& e : elements)
-      if (e->has_excitation()) sources.push_back(e.get());
-    const auto& cp = pattern.col_start();
-    const auto& ri = pattern.row_index();
-    c_start.assign(n + 1, 0);
-    for (int col = 0; col < n; ++col)
-      for (int k = cp[col]; k < cp[col + 1]; ++k)
-        if (c[k] != 0.0) ++c_start[ri[k] + 1];
-    for (int r = 0; r < n; ++r) c_start[r + 1] += c_start[r];
-    c_col.assign(c_start[n], 0);
-    c_val.assign(c_start[n], 0.0);
-    std::vector<int> next(c_start.begin(), c_start.end() - 1);
-    for (int col = 0; col < n; ++col)
-      for (int k = cp[col]; k < cp[col + 1]; ++k)
-        if (c[k] != 0.0) c_col[next[ri[k]]] = col + 1, c_val[next[ri[k]]++] = c[k];
-    a.resize(pattern.nonzeros());
-    return klu.analyze(pattern);
-  }
-
-  // y -= C * v over unknowns 1..n (index 0 ignored).
-  void sub_c_times(const double* __restrict v, double* __restrict y) const {
-    const int* __restrict cs = c_start.data();
-    const int* __restrict cc = c_col.data();
-    const double* __restrict cv = c_val.data();
-    for (int r = 0; r < n; ++r) {
-      double s = 0.0;
-      for (int k = cs[r]; k < cs[r + 1]; ++k) s += cv[k] * v[cc[k]];
-      y[r + 1] -= s;
-    }
-  }
-
-  // b = excitation at time t (index 0 = ground, zero).
-  void rhs(double t, std::vector<double>& b) const {
-    std::fill(b.begin(), b.end(), 0.0);
-    for (const Element* e : sources) e->stamp_rhs(t, b.data());
-    b[0] = 0.0;
-  }
-
-  Status select_or_factor(const Circuit& circuit, double alpha) {
-    if (klu.select(alpha)) return Status::Ok();
-    for (int k = 0; k < pattern.nonzeros(); ++k) a[k] = g[k] + alpha * c[k];
-    return name_singular(circuit, klu, klu.factor(alpha, a.data()));
-  }
-
-  // Solves in place: b holds the right-hand side (index 0 ignored), then x.
-  Status solve(std::vector<double>& b) {
-    Status s = klu.solve(b.data() + 1);
-    b[0] = 0.0;
-    return s;
-  }
-
-  // The DC operating point into x (n + 1 entries). It has its own factorization with KLU's
-  // default ordering: at DC the inductor branches have no diagonal and KLU pivots away from a
-  // fill-reducing order, so this matrix says nothing about which ordering suits the transient
-  // matrices; the transient KluSolver decides on its first (transient) factorization instead.
-  Status dc(const Circuit& circuit, std::vector<double>& x) const {
-    KluSolver dc_klu;
-    if (Status s = dc_klu.analyze(pattern, KluSolver::Ordering::Amd); !s.ok()) return s;
-    if (Status s = name_singular(circuit, dc_klu, dc_klu.factor(0.0, g.data())); !s.ok()) return s;
-    rhs(0.0, x);
-    Status s = dc_klu.solve(x.data() + 1);
-    x[0] = 0.0;
-    return s;
-  }
-
-  static Status name_singular(const Circuit& circuit, const KluSolver& k, Status s) {
-    if (!s.ok() && k.singular_column() >= 0)
-      return Status::Error(fmt::format("singular matrix: {} is not determined by the circuit",
-                                       circuit.unknown_name(k.singular_column() + 1)));
-    return s;
-  }
-};
 
 // The last accepted points since a breakpoint, oldest first, in rotating fixed storage.
 struct History {
@@ -186,7 +98,7 @@ struct History {
 }  // namespace
 
 StatusOr<std::vector<double>> dc_operating_point(const Circuit& circuit) {
-  System sys;
+  MnaSystem sys;
   if (Status s = sys.build(circuit); !s.ok()) return s;
   std::vector<double> x(sys.n + 1);
   if (Status s = sys.dc(circuit, x); !s.ok()) return s.with_context("DC operating point");
@@ -199,7 +111,7 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
   TransientStats stats;
   for (const auto& e : circuit.elements()) const_cast<Element&>(*e).bind_time(opt.tstep, opt.tstop);
 
-  System sys;
+  MnaSystem sys;
   if (Status s = sys.build(circuit); !s.ok()) return s;
   const int n = sys.n;
   const double tstop = opt.tstop;
@@ -220,10 +132,23 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
 
   // Initial state.
   std::vector<double> x(n + 1, 0.0), xdot(n + 1, 0.0), hist_part(n + 1, 0.0), xnew(n + 1);
+  for (const auto& [node, v] : opt.node_ic)
+    if (node > n) return Status::Error(fmt::format("node_ic: unknown {} is out of range", node));
+  // UIC: the charge the capacitors' ic= add beyond C x0, applied on the first step only.
+  std::vector<double> uic_dq;
   if (!opt.uic) {
-    if (Status s = sys.dc(circuit, x); !s.ok()) return s.with_context("DC operating point");
+    if (Status s = sys.dc(circuit, x, opt.node_ic); !s.ok())
+      return s.with_context("DC operating point");
     ++stats.solves;
     ++stats.factorizations;
+  } else {
+    for (const auto& [node, v] : opt.node_ic) x[node] = v;
+    for (const auto& e : circuit.elements()) e->uic_state(x.data());
+    uic_dq.assign(n + 1, 0.0);
+    for (const auto& e : circuit.elements()) e->uic_charge(x.data(), uic_dq.data());
+    uic_dq[0] = 0.0;
+    if (std::all_of(uic_dq.begin(), uic_dq.end(), [](double v) { return v == 0.0; }))
+      uic_dq.clear();
   }
 
   Waveform w;
@@ -265,13 +190,17 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
 
   auto ladder = [&](double h) {  // largest hmax / 2^k not above h (up to rounding)
     if (h >= hmax) return hmax;
-    const int k = static_cast<int>(std::ceil(std::log2(hmax / h) - 1e-9));
-    return std::ldexp(hmax, -k);
+    // h of 0 (or below hmax * 2^-1074) makes log2 infinite; converting that to int was UB
+    // (UBSan: negation of INT_MIN). Clamp to the double range: the step-size floor then reports.
+    const double k = std::ceil(std::log2(hmax / h) - 1e-9);
+    return std::ldexp(hmax, k < 1100 ? -static_cast<int>(k) : -1100);
   };
 
   double t = 0.0;
   size_t next_bp = 0;
   double h = ladder(0.1 * std::min(hmax, bps[0]));
+  // The UIC step that puts the capacitors' ic= charge in place is not error-checked: keep it short.
+  if (!uic_dq.empty()) h = ladder(1e-3 * h);
   double last_regular_h = hmax;
   bool after_bp = true;  // the next step is the first after a breakpoint (or t = 0)
   int worst_unknown = 0;
@@ -312,10 +241,15 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
     }
     sys.rhs(t + step, xnew);
     sys.sub_c_times(hist_part.data(), xnew.data());
+    if (!uic_dq.empty())  // Euler: C x1 / h = C x0 / h + dq / h + ...
+      for (int u = 1; u <= n; ++u) xnew[u] += uic_dq[u] * inv_step;
     if (Status s = sys.select_or_factor(circuit, a0); !s.ok())
       return s.with_context(fmt::format("transient at t={:g} s", t + step));
-    if (Status s = sys.solve(xnew); !s.ok()) return s.with_context(fmt::format("t={:g} s", t + step));
+    if (Status s = sys.solve(xnew); !s.ok())
+      return s.with_context(fmt::format("t={:g} s", t + step));
     ++stats.solves;
+    if (Status s = MnaSystem::check_finite(circuit, xnew, t + step, "transient step"); !s.ok())
+      return s;
 
     // Truncation error h^3 * coef * x''' with x''' = 6 x the third divided difference over the
     // last four points, written as weights on the three successive differences (no division in
@@ -338,6 +272,45 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
           ratio = r;
           worst_unknown = u;
         }
+      }
+    }
+
+    // The first step after a breakpoint (backward Euler, from a history of one point) is checked
+    // one step late: with the second step's point, the second divided difference over the three
+    // points gives x'' and the Euler truncation error h1^2 x'' / 2. When it is too large both
+    // steps are undone and the first one is retried smaller (the second step, at most twice the
+    // first, is then accurate too: its trapezoidal error is third order).
+    if (hist.count == 2 && !watched.empty()) {
+      const double t0 = hist.t(0), t1 = hist.t(1), t2 = t + step;
+      const auto &x0 = hist.x(0), &x1 = hist.x(1);
+      const double h1 = t1 - t0;
+      const double i21 = 1.0 / (t2 - t1), i10 = 1.0 / h1, i20 = 1.0 / (t2 - t0);
+      double ratio1 = 0.0;
+      for (size_t k = 0; k < watched.size(); ++k) {
+        const int u = watched[k];
+        const double dd2 = ((xnew[u] - x1[u]) * i21 - (x1[u] - x0[u]) * i10) * i20;
+        const double r = inv_tol[k] * h1 * h1 * std::fabs(dd2);
+        if (r > ratio1) ratio1 = r, worst_unknown = u;
+      }
+      if (ratio1 > 1.0) {
+        stats.rejected += 2;
+        --stats.accepted;
+        const double h_retry = h1 * std::max(0.1, 0.9 * std::sqrt(1.0 / ratio1));
+        if (h_retry < hmin)
+          return Status::Error(fmt::format(
+              "time step too small at t={:g} s (h={:g} s): the truncation error of {} does not "
+              "converge",
+              t0, h_retry, circuit.unknown_name(worst_unknown)));
+        if (!w.time.empty() && w.time.back() == t1) {  // t1 was written out: take it back
+          w.time.pop_back();
+          for (auto& c : w.columns) c.pop_back();
+        }
+        t = t0;
+        std::copy(x0.begin(), x0.end(), x.begin());
+        hist.reset(t0, x);
+        after_bp = true;
+        h = ladder(h_retry);
+        continue;
       }
     }
 
@@ -369,10 +342,18 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
     if (!lands) last_regular_h = step;
     h = ladder(std::max(step * std::max(grow, 0.5), hmin));
     after_bp = false;
+    if (!uic_dq.empty()) {
+      // The UIC step moved the capacitors' charge to their ic=: restart the formula from here,
+      // as at a breakpoint (x is consistent from now on).
+      uic_dq.clear();
+      after_bp = true;
+      hist.reset(t, x);
+    }
     if (lands) {
       // Restart the formula at the corner: small Euler step, fresh history.
       after_bp = true;
-      h = ladder(0.1 * std::min(last_regular_h, (next_bp + 1 < bps.size() ? bps[next_bp + 1] : tstop) - t));
+      h = ladder(0.1 * std::min(last_regular_h,
+                                (next_bp + 1 < bps.size() ? bps[next_bp + 1] : tstop) - t));
       hist.reset(t, x);
     }
   }

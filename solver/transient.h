@@ -18,6 +18,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "solver/card.h"
@@ -35,14 +36,19 @@ struct TransientOptions {
   double tstart = 0.0;  // s, first time written out
   double tmax = 0.0;    // s, largest step; 0 = min(tstep, (tstop - tstart) / 50) as ngspice
   IntegrationMethod method = IntegrationMethod::Trapezoidal;
-  double reltol = 1e-3;  // relative tolerance of the truncation error
-  double vntol = 1e-6;   // V, absolute tolerance on node voltages
-  double abstol = 1e-12; // A, absolute tolerance on inductor currents
+  double reltol = 1e-3;   // relative tolerance of the truncation error
+  double vntol = 1e-6;    // V, absolute tolerance on node voltages
+  double abstol = 1e-12;  // A, absolute tolerance on inductor currents
   // Multiplies the truncation tolerance. The tolerance is relative to each unknown's peak |x| so
   // far (not to its value now, as ngspice), hence a default well below ngspice's 7; see the
   // README "Solver" section and bench/README.md for the accuracy and speed at this default.
   double trtol = 0.1;
-  bool uic = false;      // skip the DC operating point, start from zero
+  // Skip the DC operating point: start from node_ic (other nodes 0 V), the inductors' ic=
+  // (else 0 A) and the capacitors' ic= (else the voltage the nodes give), as ngspice's UIC.
+  bool uic = false;
+  // .ic: (node unknown, volts). Without uic each node is held at its value while the DC
+  // operating point is solved, then released; with uic it is the node's voltage at t = 0.
+  std::vector<std::pair<int, double>> node_ic;
   long max_steps = 20'000'000;  // accepted + rejected steps before giving up
 
   double effective_tmax() const;

@@ -11,6 +11,7 @@ PACKAGES=(
   libopenimageio-dev openimageio-tools libtbb-dev fonts-dejavu-core
   openmpi-bin libopenmpi-dev
   libgtest-dev libgmock-dev libbenchmark-dev ngspice
+  clang libclang-rt-14-dev  # libFuzzer targets (tests/fuzz) in CI
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -239,6 +239,13 @@ Card card(char letter, std::string name, std::vector<std::string> nodes, double 
 
 Status CableSpec::validate() const {
   if (!(length > 0) || !std::isfinite(length)) return field_error("length", length, "must be > 0");
+  // The model's valid range: below 1 cm the per-metre L and C vanish next to the board parts
+  // (a 1 nm cable made a singular matrix); above 100 m the segment count (at most 200 when
+  // automatic) no longer resolves 10 ns edges, and no daisy-chain hop is that long.
+  if (length < kMinCableLength || length > kMaxCableLength)
+    return field_error("length", length,
+                       fmt::format("the cable model is valid from {:g} m to {:g} m",
+                                   kMinCableLength, kMaxCableLength));
   if (material != "pp" && material != "pvc")
     return Status::Error(fmt::format("cable.material = '{}': must be pp or pvc", material));
   if (gauge < 18 || gauge > 30)

@@ -36,6 +36,10 @@
 
 namespace isolink::link {
 
+// The lengths the cable model is valid for (CableSpec::validate refuses others).
+inline constexpr double kMinCableLength = 0.01;  // m
+inline constexpr double kMaxCableLength = 100;   // m
+
 struct CableSpec {
   double length = 1.0;          // m, > 0
   std::string material = "pp";  // pp | pvc (insulation)

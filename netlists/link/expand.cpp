@@ -136,6 +136,13 @@ StatusOr<std::pair<std::string, std::string>> add_end(std::vector<Card>& cards, 
     cards.push_back(make_card('c', "c" + side + "esdp", {ep, "0"}, {number_arg(iso.esd)}));
     cards.push_back(make_card('c', "c" + side + "esdn", {en, "0"}, {number_arg(iso.esd)}));
   }
+  if (type != "none") {
+    // Behind the isolation the cable has no DC path of its own: give each line the leakage a real
+    // board has there (kCableBleed, see expand.h), so the DC point is defined by the circuit and
+    // not by the solver's tie for floating nodes, and the solver's warning stays for mistakes.
+    cards.push_back(make_card('r', "r" + side + "bleedp", {p, "0"}, {number_arg(kCableBleed)}));
+    cards.push_back(make_card('r', "r" + side + "bleedn", {n, "0"}, {number_arg(kCableBleed)}));
+  }
   return std::pair{p, n};
 }
 
@@ -185,9 +192,13 @@ StatusOr<ExpandedLink> expand_link(const LinkSpec& spec, const PartLibrary& part
   out.rules = device_rules(to.device);
   out.description = fmt::format("{}: {} -> {}", direction_name(d), from.device, to.device);
 
-  StatusOr<traffic::Drive> drive = traffic::build_drive(spec.stimulus.to_script(), opt.stimulus);
-  if (!drive) return at(spec.stimulus.loc, "stimulus: " + drive.status().message());
-  out.drive = std::move(*drive);
+  if (opt.drive) {
+    out.drive = *opt.drive;
+  } else {
+    StatusOr<traffic::Drive> drive = traffic::build_drive(spec.stimulus.to_script(), opt.stimulus);
+    if (!drive) return at(spec.stimulus.loc, "stimulus: " + drive.status().message());
+    out.drive = std::move(*drive);
+  }
   for (const traffic::DriveFrame& f : out.drive.frames)
     out.expected.insert(out.expected.end(), f.bytes.begin(), f.bytes.end());
 

@@ -8,6 +8,7 @@
 // Topology, from the transmitting device to the receiving one (netlists/link/README.md):
 //   TX driver -> txp/txn -> board (series R, bypass C, termination) -> tx_lp/tx_ln
 //   -> isolation (cap | cap + chokes | transformer | transformer + chokes) -> tx_cp/tx_cn
+//      (+ kCableBleed to ground per line)
 //   -> cable -> rx_cp/rx_cn -> isolation -> rx_lp/rx_ln -> board -> rxp/rxn -> RX load.
 // X caps (x_cap) across and Y caps (y_cap, to the chassis "0") sit at each end's connector
 // (the cable side of its isolation).
@@ -15,6 +16,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,6 +29,15 @@
 
 namespace isolink::link {
 
+// Bleed resistance (ohm) from each cable line to ground at every end with isolation (cards
+// r<end>bleedp / r<end>bleedn, at the connector nodes <end>_..p / <end>_..n). The isolation caps or
+// transformer leave the cable, and the parts on its side, with no DC path; on a board the
+// isolation barrier's insulation resistance and the cable-side ESD / TVS parts' leakage (tens of
+// nA at a few volts) set its DC level. 10 Mohm per line is that order; with both ends, 5 Mohm per
+// line against the two 2.2 nF isolation caps gives a time constant of 22 ms, over 100 times the
+// longest frame train, so no edge or level the receiver sees moves (tests/link/dc_path_test.cpp).
+inline constexpr double kCableBleed = 10e6;
+
 struct ExpandOptions {
   TxDriverModel driver;               // the transmitting pins
   RxLoadModel load;                   // the receiving pins
@@ -37,6 +48,9 @@ struct ExpandOptions {
   // reaches the chassis through the end's chassis_c; the cable's capacitance to the chassis and
   // the Y caps stay on "0".
   std::string tx_ground = "0", rx_ground = "0";
+  // Drives the link with this instead of the spec's stimulus (analyses that make their own
+  // traffic, e.g. one edge for the worst-case search); .tran then ends with it.
+  std::optional<traffic::Drive> drive;
 };
 
 struct ExpandedLink {

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include "netlists/traffic/stimulus.h"
+
 namespace isolink::link {
 
 using config::Field;
@@ -32,7 +34,10 @@ std::string StimulusSpec::to_script() const {
   std::string s;
   auto add = [&s](const std::string& item) { s += (s.empty() ? "" : "; ") + item; };
   for (const std::string& t : tones) add("tone " + t);
-  for (const std::string& f : frames) add(f);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    if (i < gaps.size()) add(fmt::format("gap {:.12g}", gaps[i]));
+    add(frames[i]);
+  }
   for (const std::string& p : patterns) add("pattern " + p);
   if (!script.empty()) add(script);
   return s;
@@ -63,6 +68,10 @@ Status read_isolation(const YamlDoc& doc, const YAML::Node& node, const std::str
           {"esd", read_quantity(doc, Unit::kFarad, Rule::kNonNegative, &iso->esd)},
       });
   if (!s.ok()) return s;
+  if (node.IsMap() && node["chokes"] && iso->chokes.empty())
+    return doc.error(node["chokes"], fmt::format("key '{}.chokes': one or two chokes, found none "
+                                                 "(leave the key out for the default choke)",
+                                                 path));
   if (iso->chokes.size() > 2 && node["chokes"])
     return doc.error(node["chokes"], fmt::format("key '{}.chokes': one or two chokes, found {}",
                                                  path, iso->chokes.size()));
@@ -71,6 +80,13 @@ Status read_isolation(const YamlDoc& doc, const YAML::Node& node, const std::str
     return doc.error(node["chokes"],
                      fmt::format("key '{}.chokes': type {} has no chokes (use capchoke or "
                                  "transformer_choke)",
+                                 path, iso->type));
+  // Every key that has no effect is an error: the isolation cap exists only in cap and capchoke.
+  const bool has_cap = iso->type == "cap" || iso->type == "capchoke";
+  if (!has_cap && node.IsMap() && node["cap"])
+    return doc.error(node["cap"],
+                     fmt::format("key '{}.cap': only for type cap or capchoke (type is "
+                                 "{})",
                                  path, iso->type));
   const bool has_xfmr = iso->type == "transformer" || iso->type == "transformer_choke";
   if (!has_xfmr && node.IsMap())
@@ -131,15 +147,31 @@ Status read_cable(const YamlDoc& doc, const YAML::Node& node, CableSpec* cable) 
 Status read_stimulus(const YamlDoc& doc, const YAML::Node& node, StimulusSpec* st) {
   st->loc = doc.loc(node);
   std::string direction = "both";
+  std::vector<std::string> gaps;
   Status s = read_map(doc, node, "stimulus",
                       {
                           {"frames", read_text_list(doc, &st->frames)},
+                          {"gaps", read_text_list(doc, &gaps)},
                           {"tones", read_text_list(doc, &st->tones)},
                           {"patterns", read_text_list(doc, &st->patterns)},
                           {"script", read_text(doc, &st->script)},
                           {"direction", read_choice(doc, {"down", "up", "both"}, &direction)},
                       });
   if (!s.ok()) return s;
+  if (!gaps.empty()) {
+    const YAML::Node& at = node["gaps"];
+    if (gaps.size() != st->frames.size())
+      return doc.error(at, fmt::format("key 'stimulus.gaps': {} gaps for {} frames: give one gap "
+                                       "(the idle before it) per frame",
+                                       gaps.size(), st->frames.size()));
+    for (const std::string& g : gaps) {
+      StatusOr<double> t = traffic::parse_time(g);
+      if (!t || !(*t >= 0))
+        return doc.error(at, fmt::format("key 'stimulus.gaps': '{}' {}", g,
+                                         t ? "must be a time >= 0" : t.status().message()));
+      st->gaps.push_back(*t);
+    }
+  }
   if (direction == "down") st->directions = {Direction::kDown};
   if (direction == "up") st->directions = {Direction::kUp};
   return Status::Ok();
@@ -241,7 +273,7 @@ StatusOr<LinkSpec> read_link_spec(const YamlDoc& doc) {
                         const std::string&) { return read_noise(doc, n, &spec.noise); }},
           {"sim",
            [&](const YAML::Node& n, const std::string& p) {
-             return read_map(
+             Status st = read_map(
                  doc, n, p,
                  {
                      {"tstep", read_quantity(doc, Unit::kSecond, Rule::kPositive, &spec.sim.tstep)},
@@ -249,6 +281,14 @@ StatusOr<LinkSpec> read_link_spec(const YamlDoc& doc) {
                      {"method", read_choice(doc, {"trap", "gear"}, &spec.sim.method)},
                      {"reltol", read_quantity(doc, Unit::kNone, Rule::kPositive, &spec.sim.reltol)},
                  });
+             if (!st.ok()) return st;
+             // The solver's own checks come too late to point at the file: check here.
+             if (const std::optional<double> rt = spec.sim.reltol;
+                 rt && !(*rt >= 1e-9 && *rt <= 0.1))
+               return doc.error(n["reltol"], fmt::format("key 'sim.reltol' = {:g}: must be from "
+                                                         "1e-9 to 0.1",
+                                                         *rt));
+             return Status::Ok();
            }},
       });
   if (!s.ok()) return s;

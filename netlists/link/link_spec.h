@@ -8,10 +8,10 @@
 //   name, tx / rx: {device, series_r, bypass_c, termination, isolation: {type, cap, chokes,
 //   part, inductance, leakage, dcr, winding_c, centre_tap_c, cable_side_c, esd}},
 //   cable: {length, material, gauge, temperature, r, l, c, g, segments},
-//   stimulus: {frames, tones, patterns, script, direction}, sim: {tstep, tmax, method, reltol},
-//   noise: {injection, level, position, modulation, f_start, f_stop, points_per_decade,
-//   pin_limit, time_domain, tolerance: {...}} (isolink noise; tx / rx also take x_cap, y_cap,
-//   chassis_c and cable chassis_c).
+//   stimulus: {frames, gaps, tones, patterns, script, direction}, sim: {tstep, tmax, method,
+//   reltol}, noise: {injection, level, position, modulation, f_start, f_stop,
+//   points_per_decade, pin_limit, time_domain, tolerance: {...}} (isolink noise; tx / rx also
+//   take x_cap, y_cap, chassis_c and cable chassis_c).
 // `tx` is the end that transmits in the down direction (the host / bridge side); `rx` the end
 // that receives it. With direction up (or both) the rx end transmits back to the tx end.
 #pragma once
@@ -63,6 +63,7 @@ struct StimulusSpec {
   std::vector<std::string> tones;     // tone items ("wake", "fault couplets=4")
   std::vector<std::string> patterns;  // pattern items ("prbs7 bytes=32")
   std::string script;                 // a stimulus script (traffic/stimulus.h), after the above
+  std::vector<double> gaps;           // s, the idle before each frame (empty: lead / frame gap)
   std::vector<Direction> directions{Direction::kDown, Direction::kUp};
   SourceLoc loc;
   // The stimulus script of all items: tones, then frames, then patterns, then script.

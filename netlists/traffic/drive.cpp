@@ -64,16 +64,23 @@ void DriveBuilder::push(double start, double end, int level) {
 Status DriveBuilder::begin_item() {
   Status s = validate(timing_);
   if (!s.ok()) return s;
-  const double idle = (any_item_ ? timing_.frame_gap : timing_.lead) + pending_idle_;
+  const double automatic = any_item_ ? timing_.frame_gap : timing_.lead;
+  const double idle = (gap_ >= 0 ? gap_ : automatic) + pending_idle_;
   push(t_, t_ + idle, 0);
   pending_idle_ = 0;
+  gap_ = -1;
   any_item_ = true;
   return Status::Ok();
 }
 
-Status DriveBuilder::add_frame(const std::vector<uint8_t>& bytes, std::string label) {
+Status DriveBuilder::add_frame(const std::vector<uint8_t>& bytes, std::string label,
+                               int error_bit) {
   if (bytes.empty()) return Status::Error("frame has no bytes: nothing to send");
-  Status s = validate(enc_);
+  if (error_bit < -1 || error_bit > 1)
+    return Status::Error(fmt::format("error bit {} is invalid: it must be 0 or 1", error_bit));
+  EncodingOptions enc = enc_;
+  if (error_bit >= 0) enc.error_bit = error_bit;
+  Status s = validate(enc);
   if (!s.ok()) return s;
   s = begin_item();
   if (!s.ok()) return s;
@@ -86,10 +93,10 @@ Status DriveBuilder::add_frame(const std::vector<uint8_t>& bytes, std::string la
     if (i) push(t_, t_ + timing_.byte_gap, 0);
     const double t0 = t_;
     f.byte_starts.push_back(t0);
-    const std::vector<int> h = byte_half_bits(bytes[i], enc_);
+    const std::vector<int> h = byte_half_bits(bytes[i], enc);
     for (size_t k = 0; k < h.size(); ++k) {
-      push(t0 + static_cast<double>(k) * enc_.half_bit,
-           t0 + static_cast<double>(k + 1) * enc_.half_bit, h[k]);
+      push(t0 + static_cast<double>(k) * enc.half_bit,
+           t0 + static_cast<double>(k + 1) * enc.half_bit, h[k]);
     }
   }
   f.end = t_;
@@ -127,6 +134,14 @@ Status DriveBuilder::add_idle(double seconds) {
   return Status::Ok();
 }
 
+Status DriveBuilder::set_gap(double seconds) {
+  if (!(seconds >= 0.0) || !std::isfinite(seconds)) {
+    return Status::Error(fmt::format("gap {} s is invalid: it must be a time >= 0", seconds));
+  }
+  gap_ = seconds;
+  return Status::Ok();
+}
+
 Drive DriveBuilder::finish() {
   const double tail = (timing_.tail >= 0.0 && std::isfinite(timing_.tail)) ? timing_.tail : 0.0;
   push(t_, t_ + tail + pending_idle_, 0);
@@ -135,6 +150,7 @@ Drive DriveBuilder::finish() {
   drive_.encoding = enc_;
   t_ = 0;
   pending_idle_ = 0;
+  gap_ = -1;
   any_item_ = false;
   return out;
 }
@@ -162,15 +178,16 @@ void emit_source(std::string& out, const std::string& name, const std::string& n
 
 StatusOr<std::vector<double>> line_pwl(const Drive& d, int line_sign, double edge, double vdd) {
   if (!(edge > 0.0) || !std::isfinite(edge)) {
-    return Status::Error(fmt::format("edge time {} s is invalid: it must be a positive time", edge));
+    return Status::Error(
+        fmt::format("edge time {} s is invalid: it must be a positive time", edge));
   }
   if (d.segments.empty()) return Status::Error("drive is empty: nothing to write as PWL");
   double shortest = d.segments.front().end - d.segments.front().start;
   for (const DriveSegment& g : d.segments) shortest = std::min(shortest, g.end - g.start);
   if (!(edge < shortest)) {
     return Status::Error(fmt::format(
-        "edge time {:g} s is too long: it must be shorter than the shortest segment ({:g} s)",
-        edge, shortest));
+        "edge time {:g} s is too long: it must be shorter than the shortest segment ({:g} s)", edge,
+        shortest));
   }
   std::vector<double> pts;
   pts.reserve(4 * d.segments.size() + 4);

@@ -87,12 +87,16 @@ Status validate(const Timing& t);
 class DriveBuilder {
  public:
   explicit DriveBuilder(EncodingOptions encoding = {}, Timing timing = {});
-  // Sends bytes as one frame (a command or pattern), byte frames byte_gap apart.
-  Status add_frame(const std::vector<uint8_t>& bytes, std::string label = "");
+  // Sends bytes as one frame (a command or pattern), byte frames byte_gap apart. error_bit 0 or 1
+  // overrides the encoding's byte-error bit for these bytes (1: a resent byte); -1 keeps it.
+  Status add_frame(const std::vector<uint8_t>& bytes, std::string label = "", int error_bit = -1);
   // Sends a tone run.
   Status add_tone(Tone tone, const ToneOptions& opt = {});
   // Extra idle time (added to the automatic lead / frame_gap before the next item).
   Status add_idle(double seconds);
+  // The idle time before the next item is `seconds` exactly instead of the automatic lead /
+  // frame_gap (any add_idle still adds to it): traffic with given gaps (a worst case's replay).
+  Status set_gap(double seconds);
   // Adds the tail and returns the drive; the builder is left empty.
   Drive finish();
 
@@ -105,6 +109,7 @@ class DriveBuilder {
   Drive drive_;
   double t_ = 0;  // end of what is built so far
   double pending_idle_ = 0;
+  double gap_ = -1;  // set_gap's value for the next item, -1 = automatic
   bool any_item_ = false;
 };
 
@@ -125,7 +130,8 @@ struct PwlOptions {
 // One line's voltage as flat PWL points t0 v0 t1 v1 ... (line_sign +1: P, -1: N). Each level
 // change ramps linearly over [corner - edge/2, corner + edge/2]; times strictly increase. Errors
 // when edge <= 0 or edge is not shorter than the shortest segment.
-StatusOr<std::vector<double>> line_pwl(const Drive& d, int line_sign, double edge, double vdd = 5.0);
+StatusOr<std::vector<double>> line_pwl(const Drive& d, int line_sign, double edge,
+                                       double vdd = 5.0);
 
 // Two ngspice sources "VTXP txp 0 PWL(t v ...)" and "VTXN txn 0 PWL(...)", each ending in "\n".
 // Each level change ramps linearly over [corner - edge/2, corner + edge/2]; times strictly

@@ -11,6 +11,9 @@
 //   tone NAME [couplets=N] [pulse=T]   or just NAME (wake, sleep-to-active, shutdown, ...)
 //   pattern NAME [bytes=N]             see patterns.h (prbs7, prbs15, all256, alt, ...)
 //   idle T                             extra idle before the next item
+//   gap T                              the idle before the next item is T exactly (instead of
+//                                      the 1 us lead / 12 us frame gap; `idle` still adds)
+//   raw HEX... [nocrc] [err]           err: the bytes carry the byte-error bit (a resent byte)
 // Times take SPICE suffixes with an optional trailing "s": 250n, 250ns, 1u, 1us, 2.5e-7, 20us.
 #pragma once
 
@@ -22,6 +25,9 @@
 #include "base/status.h"
 
 namespace isolink::traffic {
+
+// The longest traffic build_drive accepts, in seconds of simulated time.
+inline constexpr double kMaxDriveSeconds = 1.0;
 
 struct StimulusOptions {
   EncodingOptions encoding;  // byte frame format

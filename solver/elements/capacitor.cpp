@@ -1,5 +1,6 @@
 // C: a linear capacitor between two nodes (open at DC).
 #include <cmath>
+#include <optional>
 
 #include "solver/elements/card_values.h"
 #include "solver/elements/kinds.h"
@@ -10,13 +11,19 @@ namespace {
 
 constexpr ParamSpec kParams[] = {
     {"c", NAN, "F", "capacitance, positive"},
-    {"ic", 0.0, "V", "initial voltage: accepted for ngspice compatibility, ignored (the DC point sets the state)"},
+    {"ic", NAN, "V", "initial voltage, used with .tran ... UIC only (as ngspice)", true},
     {"m", 1.0, "", "parallel multiplier"},
 };
 
 class Capacitor final : public Element {
  public:
-  Capacitor(const Card& card, double c) : Element(card.name, card.loc), c_(c) {}
+  Capacitor(const Card& card, double c, std::optional<double> ic)
+      : Element(card.name, card.loc), c_(c), ic_(ic) {}
+  void uic_charge(const double* x0, double* dq) const override {
+    if (!ic_) return;
+    const double d = c_ * (*ic_ - (x0[nodes_[0]] - x0[nodes_[1]]));
+    dq[nodes_[0]] += d, dq[nodes_[1]] -= d;
+  }
   void declare(MnaPattern& p) override {
     const int a = nodes_[0], b = nodes_[1];
     aa_ = p.slot(a, a), ab_ = p.slot(a, b), ba_ = p.slot(b, a), bb_ = p.slot(b, b);
@@ -27,6 +34,7 @@ class Capacitor final : public Element {
 
  private:
   double c_;
+  std::optional<double> ic_;
   Slot aa_ = 0, ab_ = 0, ba_ = 0, bb_ = 0;
 };
 
@@ -38,14 +46,20 @@ StatusOr<std::unique_ptr<Element>> parse(const Card& card) {
   StatusOr<double> m = card_value(card, kParams, "m", -1);
   if (!m) return m.status();
   if (Status s = require_positive(card, "m", -1, *m, "multiplier"); !s.ok()) return s;
-  return std::unique_ptr<Element>(std::make_unique<Capacitor>(card, *c * *m));
+  std::optional<double> ic;
+  if (card.param("ic")) {
+    StatusOr<double> v = card_value(card, kParams, "ic", -1);
+    if (!v) return v.status();
+    ic = *v;
+  }
+  return std::unique_ptr<Element>(std::make_unique<Capacitor>(card, *c * *m, ic));
 }
 
 }  // namespace
 
 const ElementKind& capacitor_kind() {
-  static const ElementKind kind{'c', "capacitor", "Cname n+ n- value [ic=V] [m=N]", 2, 0, kParams,
-                                parse};
+  static const ElementKind kind{'c',     "capacitor", "Cname n+ n- value [ic=V] [m=N]", 2, 0,
+                                kParams, parse};
   return kind;
 }
 

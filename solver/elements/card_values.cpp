@@ -1,8 +1,8 @@
 #include "solver/elements/card_values.h"
 
-#include <cmath>
-
 #include <fmt/format.h>
+
+#include <cmath>
 
 namespace isolink {
 

@@ -10,12 +10,15 @@ namespace isolink {
 namespace {
 
 constexpr ParamSpec kParams[] = {
-    {"dc", 0.0, "A", "DC value, or PULSE(...) | PWL(...) | SIN(...) as for V"},
+    {"dc", 0.0, "A", "DC value, or PULSE | PWL | SIN | EXP as for V"},
+    {"td", 0.0, "s", "PWL only: delay of the whole PWL"},
+    {"r", -1.0, "s", "PWL only: repeat from this time point, as for V; -1: no repeat"},
 };
 
 class CurrentSource final : public Element {
  public:
-  CurrentSource(const Card& card, SourceFunction f) : Element(card.name, card.loc), f_(std::move(f)) {}
+  CurrentSource(const Card& card, SourceFunction f)
+      : Element(card.name, card.loc), f_(std::move(f)) {}
   void declare(MnaPattern&) override {}
   void stamp(double*, double*) const override {}
   bool has_excitation() const override { return true; }
@@ -23,6 +26,8 @@ class CurrentSource final : public Element {
     const double i = f_.value(t);
     b[nodes_[0]] -= i, b[nodes_[1]] += i;
   }
+  const SourceFunction* source_function() const override { return &f_; }
+  void stamp_unit(double* b) const override { b[nodes_[0]] -= 1.0, b[nodes_[1]] += 1.0; }
   void bind_time(double tstep, double tstop) override { f_.bind_time(tstep, tstop); }
   void breakpoints(double tstop, std::vector<double>& out) const override {
     f_.breakpoints(tstop, out);
@@ -45,9 +50,14 @@ StatusOr<std::unique_ptr<Element>> parse(const Card& card) {
 }  // namespace
 
 const ElementKind& current_source_kind() {
-  static const ElementKind kind{'i', "current source",
-                                "Iname n+ n- [DC] value | PULSE(...) | PWL(...) | SIN(...)", 2, 0,
-                                kParams, parse};
+  static const ElementKind kind{
+      'i',
+      "current source",
+      "Iname n+ n- [DC] value | PULSE(...) | PWL(...) [td=T] [r=T] | SIN(...) | EXP(...)",
+      2,
+      0,
+      kParams,
+      parse};
   return kind;
 }
 

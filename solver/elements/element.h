@@ -3,7 +3,8 @@
 // Lifecycle (driven by Circuit and the engines, never by users of a kind):
 //   1. parse:   ElementKind::parse(card) -> Element, values checked, nodes still names.
 //   2. connect: Circuit maps node names to unknown indices (0 = ground) and hands out branch
-//               unknowns (branch_count()); link() resolves references to other elements (K -> L).
+//               unknowns (branch_count()); link() resolves references to other elements (K -> L),
+//               then check() tests what needs them all linked.
 //   3. declare: declare(pattern) asks for every matrix entry it will touch, once, and keeps the
 //               slot handles. Entries in the ground row or column come back as the write-only
 //               trash slot, so stamps never test for ground.
@@ -25,11 +26,14 @@ namespace isolink {
 
 class Circuit;
 class MnaPattern;
+class SourceFunction;
 
 using Slot = int;  // index into a matrix value array; MnaPattern::kTrash for ground entries
 
 // How an element joins two nodes at DC, for the topology checks before the operating point.
-enum class DcLink { Conductive, VoltageDefining, CurrentSource };
+// Inductive: an inductor, a short at DC; one that would close a loop of voltage sources and
+// inductors is opened instead (its current starts at 0, as ngspice's operating point gives).
+enum class DcLink { Conductive, VoltageDefining, Inductive, CurrentSource };
 struct DcEdge {
   int a, b;
   DcLink link;
@@ -52,6 +56,8 @@ class Element {
   virtual bool branch_is_state() const { return false; }
   // Resolves references to other elements once every element is connected.
   virtual Status link(const Circuit& circuit) { return Status::Ok(); }
+  // Checks that need every element linked (K: the coupled group's inductance matrix).
+  virtual Status check(const Circuit& circuit) const { return Status::Ok(); }
   virtual void declare(MnaPattern& pattern) = 0;
   // Constant values into G and C (value arrays over the declared pattern).
   virtual void stamp(double* g, double* c) const = 0;
@@ -59,12 +65,25 @@ class Element {
   virtual void stamp_rhs(double t, double* b) const {}
   // True when stamp_rhs adds anything (sources): the engines call stamp_rhs on these only.
   virtual bool has_excitation() const { return false; }
+  // Sources: the time dependence (nullptr for elements without one) and the excitation per unit
+  // of it, so that stamp_rhs(t, b) adds source_function()->value(t) * (what stamp_unit(b) adds).
+  // The LTI engine (solver/lti.h) superposes responses to these unit excitations.
+  virtual const SourceFunction* source_function() const { return nullptr; }
+  virtual void stamp_unit(double* b) const {}
+  // False for an element whose stamps change with time or with the solution (a switch, a diode):
+  // the LTI engine refuses a circuit holding one. Every kind in the registry today is LTI.
+  virtual bool linear_time_invariant() const { return true; }
   // Resolves time defaults that depend on the analysis (ngspice: PULSE TR defaults to TSTEP).
   virtual void bind_time(double tstep, double tstop) {}
   // Times in (0, tstop] where the excitation has a corner.
   virtual void breakpoints(double tstop, std::vector<double>& out) const {}
   // DC connectivity for the topology checks.
   virtual void dc_edges(std::vector<DcEdge>& out) const {}
+  // .tran ... UIC: the element's initial condition (ic=). uic_state writes a state unknown of
+  // x0 (inductor current); uic_charge adds, for each node, the charge its ic= puts on the
+  // node beyond C x0 (capacitor: c (ic - (v+ - v-)) at n+, the negative at n-).
+  virtual void uic_state(double* x0) const {}
+  virtual void uic_charge(const double* x0, double* dq) const {}
 
   // Called by Circuit while connecting.
   void set_node_names(std::vector<std::string> names) { node_names_ = std::move(names); }
@@ -82,18 +101,19 @@ class Element {
 // One row of an element kind's parameter table: feeds the parser, --help and the README.
 struct ParamSpec {
   const char* name;       // lower case, as written in key=value or as the positional value
-  double default_value;   // NaN when required
+  double default_value;   // NaN when required (or optional, below)
   const char* unit;       // SI unit symbol, "" when dimensionless
   const char* doc;        // one line
+  bool optional = false;  // default NaN and optional: absent means not given ("none" in docs)
 };
 
 // One element kind: the registry in elements/registry.cpp lists them all explicitly.
 struct ElementKind {
-  char letter;                     // SPICE letter, lower case
-  const char* name;                // "resistor"
-  const char* usage;               // "Rname n+ n- value [key=value...]"
-  int node_count;                  // node tokens after the name
-  int ref_count;                   // element-name tokens after the nodes (K: 2)
+  char letter;        // SPICE letter, lower case
+  const char* name;   // "resistor"
+  const char* usage;  // "Rname n+ n- value [key=value...]"
+  int node_count;     // node tokens after the name
+  int ref_count;      // element-name tokens after the nodes (K: 2)
   std::span<const ParamSpec> params;
   StatusOr<std::unique_ptr<Element>> (*parse)(const Card& card);
 };

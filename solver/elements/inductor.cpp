@@ -12,7 +12,8 @@ namespace {
 
 constexpr ParamSpec kParams[] = {
     {"l", NAN, "H", "inductance, positive"},
-    {"ic", 0.0, "A", "initial current: accepted for ngspice compatibility, ignored (the DC point sets the state)"},
+    {"ic", NAN, "A", "initial current, used with .tran ... UIC only (as ngspice)", true},
+    {"m", 1.0, "", "parallel multiplier: the inductance is l / m"},
 };
 
 StatusOr<std::unique_ptr<Element>> parse(const Card& card) {
@@ -20,7 +21,16 @@ StatusOr<std::unique_ptr<Element>> parse(const Card& card) {
   StatusOr<double> l = card_value(card, kParams, "l", 0);
   if (!l) return l.status();
   if (Status s = require_positive(card, "l", 0, *l, "inductance"); !s.ok()) return s;
-  return std::unique_ptr<Element>(std::make_unique<Inductor>(card, *l));
+  StatusOr<double> m = card_value(card, kParams, "m", -1);
+  if (!m) return m.status();
+  if (Status s = require_positive(card, "m", -1, *m, "multiplier"); !s.ok()) return s;
+  std::optional<double> ic;
+  if (card.param("ic")) {
+    StatusOr<double> v = card_value(card, kParams, "ic", -1);
+    if (!v) return v.status();
+    ic = *v;
+  }
+  return std::unique_ptr<Element>(std::make_unique<Inductor>(card, *l / *m, ic));
 }
 
 }  // namespace
@@ -37,11 +47,16 @@ void Inductor::stamp(double* g, double* c) const {
 }
 
 void Inductor::dc_edges(std::vector<DcEdge>& out) const {
-  out.push_back({nodes_[0], nodes_[1], DcLink::VoltageDefining});
+  out.push_back({nodes_[0], nodes_[1], DcLink::Inductive});
+}
+
+void Inductor::uic_state(double* x0) const {
+  if (ic_) x0[branches_[0]] = *ic_;
 }
 
 const ElementKind& inductor_kind() {
-  static const ElementKind kind{'l', "inductor", "Lname n+ n- value", 2, 0, kParams, parse};
+  static const ElementKind kind{'l',     "inductor", "Lname n+ n- value [ic=A] [m=N]", 2, 0,
+                                kParams, parse};
   return kind;
 }
 

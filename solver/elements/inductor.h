@@ -2,13 +2,16 @@
 // Exposed so that mutual inductance (K) can couple two of them.
 #pragma once
 
+#include <optional>
+
 #include "solver/elements/element.h"
 
 namespace isolink {
 
 class Inductor final : public Element {
  public:
-  Inductor(const Card& card, double l) : Element(card.name, card.loc), l_(l) {}
+  Inductor(const Card& card, double l, std::optional<double> ic = std::nullopt)
+      : Element(card.name, card.loc), l_(l), ic_(ic) {}
   double inductance() const { return l_; }
   int branch() const { return branches_[0]; }
 
@@ -17,9 +20,11 @@ class Inductor final : public Element {
   void declare(MnaPattern& p) override;
   void stamp(double* g, double* c) const override;
   void dc_edges(std::vector<DcEdge>& out) const override;
+  void uic_state(double* x0) const override;
 
  private:
   double l_;
+  std::optional<double> ic_;  // ic=, used with UIC
   Slot a_br_ = 0, b_br_ = 0, br_a_ = 0, br_b_ = 0, br_br_ = 0;
 };
 

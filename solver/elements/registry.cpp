@@ -37,7 +37,8 @@ std::string element_reference_markdown() {
     for (const ParamSpec& p : k.params) {
       out += fmt::format("| {} | {} | {} | {} | {} | {} |\n", first ? k.name : "",
                          first ? cell(fmt::format("`{}`", k.usage)) : "", p.name,
-                         std::isnan(p.default_value) ? "required" : fmt::format("{:g}", p.default_value),
+                         std::isnan(p.default_value) ? (p.optional ? "none" : "required")
+                                                     : fmt::format("{:g}", p.default_value),
                          p.unit, cell(p.doc));
       first = false;
     }

@@ -1,11 +1,11 @@
 #include "solver/elements/source_function.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
-
-#include <fmt/format.h>
 
 namespace isolink {
 
@@ -20,10 +20,15 @@ StatusOr<SourceFunction> SourceFunction::Parse(const Card& card) {
   SourceFunction f;
   bool have_value = false;
   const auto& args = card.args;
+  if (const CardArg* dc = card.param("dc")) {  // dc=1, as DC 1
+    if (dc->kind != CardArg::Kind::Number) return error_at(dc->loc, "expected a number for dc=");
+    f.dc_ = dc->number;
+  }
   for (size_t i = 0; i < args.size(); ++i) {
     const CardArg& a = args[i];
     if (a.kind == CardArg::Kind::Number) {
-      if (have_value) return error_at(a.loc, "unexpected extra value for source '" + card.name + "'");
+      if (have_value)
+        return error_at(a.loc, "unexpected extra value for source '" + card.name + "'");
       f.dc_ = a.number;
       have_value = true;
     } else if (a.kind == CardArg::Kind::Word) {
@@ -54,6 +59,24 @@ StatusOr<SourceFunction> SourceFunction::Parse(const Card& card) {
                                      std::to_string(a.call.size()));
         f.kind_ = Kind::Sin;
         f.p_ = a.call;
+      } else if (a.word == "exp") {
+        if (a.call.size() < 2 || a.call.size() > 6)
+          return error_at(a.loc, "EXP takes 2 to 6 values (V1 V2 TD1 TAU1 TD2 TAU2), got " +
+                                     std::to_string(a.call.size()));
+        f.kind_ = Kind::Exp;
+        f.p_ = a.call;
+        for (size_t k = 2; k < a.call.size(); ++k)
+          if (a.call[k] < 0) return error_at(a.loc, "EXP times must not be negative");
+      } else if (a.word == "trnoise" || a.word == "trrandom" || a.word == "sffm" ||
+                 a.word == "am") {
+        const char* what = a.word == "trnoise"    ? "TRNOISE (transient noise source)"
+                           : a.word == "trrandom" ? "TRRANDOM (random source)"
+                           : a.word == "sffm"     ? "SFFM (frequency-modulated source)"
+                                                  : "AM (amplitude-modulated source)";
+        return error_at(a.loc, std::string(what) +
+                                   " is not supported (isolink's sources are DC, PULSE, PWL, SIN "
+                                   "and EXP; isolink's link specs add crosstalk and noise to "
+                                   "the received eye instead)");
       } else if (a.word == "pwl") {
         if (a.call.size() < 2 || a.call.size() % 2 != 0)
           return error_at(a.loc, "PWL takes time/value pairs, got " +
@@ -70,17 +93,53 @@ StatusOr<SourceFunction> SourceFunction::Parse(const Card& card) {
           f.pwl_v_.push_back(a.call[k + 1]);
         }
       } else {
-        return error_at(a.loc, "unknown source function '" + a.word +
-                                   "' (expected PULSE, PWL or SIN)");
+        return error_at(
+            a.loc, "unknown source function '" + a.word + "' (expected PULSE, PWL, SIN or EXP)");
       }
       have_value = true;
     }
+  }
+  // PWL(...) td=DELAY r=REPEAT_FROM, as ngspice.
+  for (const char* key : {"td", "r"}) {
+    const CardArg* p = card.param(key);
+    if (!p) continue;
+    if (f.kind_ != Kind::Pwl)
+      return error_at(p->loc, std::string(key) + "= applies to a PWL source only");
+    if (p->kind != CardArg::Kind::Number)
+      return error_at(p->loc, std::string("expected a number for ") + key + "=");
+    if (key[0] == 't') {
+      if (p->number < 0)
+        return error_at(p->loc, fmt::format("PWL td={:g} s is negative", p->number));
+      f.pwl_td_ = p->number;
+      continue;
+    }
+    const double r = p->number;
+    if (r == -1.0) continue;  // the table's "no repeat"
+    auto it = std::find(f.pwl_t_.begin(), f.pwl_t_.end(), r);
+    if (r < 0 || it == f.pwl_t_.end() || it + 1 == f.pwl_t_.end())
+      return error_at(p->loc, fmt::format("PWL r={:g} s must be one of the PWL's times other than "
+                                          "the last (the repeat runs from r to the last time)",
+                                          r));
+    f.pwl_repeat_ = static_cast<int>(it - f.pwl_t_.begin());
   }
   f.bind_time(0.0, 0.0);
   return f;
 }
 
 void SourceFunction::bind_time(double tstep, double tstop) {
+  if (kind_ == Kind::Exp) {  // ngspice: TD1 0, TAU1 TSTEP, TD2 TD1 + TSTEP, TAU2 TSTEP
+    const double step = tstep > 0 ? tstep : 1e-12;
+    v1_ = or_default(p_, 0, 0.0);
+    v2_ = or_default(p_, 1, 0.0);
+    td_ = or_default(p_, 2, 0.0);
+    tr_ = or_default(p_, 3, 0.0);
+    if (tr_ <= 0) tr_ = step;
+    pw_ = or_default(p_, 4, 0.0);
+    if (pw_ <= 0) pw_ = td_ + step;
+    tf_ = or_default(p_, 5, 0.0);
+    if (tf_ <= 0) tf_ = step;
+    return;
+  }
   if (kind_ != Kind::Pulse) return;
   v1_ = or_default(p_, 0, 0.0);
   v2_ = or_default(p_, 1, 0.0);
@@ -111,7 +170,18 @@ double SourceFunction::value(double t) const {
       if (tt < tr_ + pw_ + tf_) return v2_ + (v1_ - v2_) * (tt - tr_ - pw_) / tf_;
       return v1_;
     }
+    case Kind::Exp: {  // v1_ v2_ td1 = td_, tau1 = tr_, td2 = pw_, tau2 = tf_
+      if (t <= td_) return v1_;
+      double v = v1_ + (v2_ - v1_) * (1 - std::exp(-(t - td_) / tr_));
+      if (t > pw_) v += (v1_ - v2_) * (1 - std::exp(-(t - pw_) / tf_));
+      return v;
+    }
     case Kind::Pwl: {
+      t -= pwl_td_;
+      if (pwl_repeat_ >= 0 && t > pwl_t_.back()) {
+        const double from = pwl_t_[pwl_repeat_], period = pwl_t_.back() - from;
+        t = from + std::fmod(t - from, period);
+      }
       if (t <= pwl_t_.front()) return pwl_v_.front();
       if (t >= pwl_t_.back()) return pwl_v_.back();
       size_t i = std::upper_bound(pwl_t_.begin(), pwl_t_.end(), t) - pwl_t_.begin();
@@ -145,16 +215,49 @@ void SourceFunction::breakpoints(double tstop, std::vector<double>& out) const {
       }
       return;
     }
-    case Kind::Pwl:
-      for (double t : pwl_t_)
-        if (t > 0 && t <= tstop) out.push_back(t);
+    case Kind::Exp:
+      for (double c : {td_, pw_})
+        if (c > 0 && c <= tstop) out.push_back(c);
       return;
+    case Kind::Pwl: {
+      for (double t : pwl_t_)
+        if (t + pwl_td_ > 0 && t + pwl_td_ <= tstop) out.push_back(t + pwl_td_);
+      if (pwl_repeat_ < 0) return;
+      const double from = pwl_t_[pwl_repeat_], period = pwl_t_.back() - from;
+      for (double base = pwl_t_.back() + pwl_td_; base <= tstop; base += period)
+        for (size_t k = pwl_repeat_ + 1; k < pwl_t_.size(); ++k) {
+          const double t = base + (pwl_t_[k] - from);
+          if (t <= tstop) out.push_back(t);
+        }
+      return;
+    }
     case Kind::Sin: {
       double td = or_default(p_, 3, 0);
       if (td > 0 && td <= tstop) out.push_back(td);
       return;
     }
   }
+}
+
+std::vector<Ramp> SourceFunction::ramps(double tstop) const {
+  std::vector<Ramp> out;
+  if (kind_ == Kind::Dc || !piecewise_linear() || !(tstop > 0)) return out;
+  std::vector<double> corners{0.0};
+  breakpoints(tstop, corners);
+  corners.push_back(tstop);
+  std::sort(corners.begin(), corners.end());
+  const double tiny = tstop * 1e-12;
+  std::vector<double> t;
+  for (double c : corners)
+    if (t.empty() || c - t.back() > tiny) t.push_back(c);
+  double previous = 0.0;  // slope before t[0] = 0: the function is constant before its first corner
+  for (size_t i = 0; i + 1 < t.size(); ++i) {
+    // Exact on each segment: value() is linear between consecutive corners.
+    const double slope = (value(t[i + 1]) - value(t[i])) / (t[i + 1] - t[i]);
+    if (slope != previous) out.push_back({t[i], slope - previous});
+    previous = slope;
+  }
+  return out;
 }
 
 }  // namespace isolink

@@ -10,13 +10,20 @@ namespace isolink {
 namespace {
 
 constexpr ParamSpec kParams[] = {
-    {"dc", 0.0, "V", "DC value, or PULSE(V1 V2 TD TR TF PW PER NP) | PWL(t v ...) | "
-                     "SIN(VO VA F TD THETA PHASE)"},
+    {"dc", 0.0, "V",
+     "DC value (positional, DC VALUE or dc=VALUE); a PULSE(V1 V2 TD TR TF PW PER "
+     "NP), PWL(t v ...), SIN(VO VA F TD THETA PHASE) or EXP(V1 V2 TD1 TAU1 TD2 "
+     "TAU2) function, parentheses optional, sets the transient"},
+    {"td", 0.0, "s", "PWL only: delay of the whole PWL"},
+    {"r", -1.0, "s",
+     "PWL only: repeat the PWL from this time point (one of its times) to its "
+     "last time, for ever; -1: no repeat"},
 };
 
 class VoltageSource final : public Element {
  public:
-  VoltageSource(const Card& card, SourceFunction f) : Element(card.name, card.loc), f_(std::move(f)) {}
+  VoltageSource(const Card& card, SourceFunction f)
+      : Element(card.name, card.loc), f_(std::move(f)) {}
   int branch_count() const override { return 1; }
   void declare(MnaPattern& p) override {
     const int a = nodes_[0], b = nodes_[1], br = branches_[0];
@@ -27,6 +34,8 @@ class VoltageSource final : public Element {
   }
   bool has_excitation() const override { return true; }
   void stamp_rhs(double t, double* b) const override { b[branches_[0]] += f_.value(t); }
+  const SourceFunction* source_function() const override { return &f_; }
+  void stamp_unit(double* b) const override { b[branches_[0]] += 1.0; }
   void bind_time(double tstep, double tstop) override { f_.bind_time(tstep, tstop); }
   void breakpoints(double tstop, std::vector<double>& out) const override {
     f_.breakpoints(tstop, out);
@@ -50,9 +59,14 @@ StatusOr<std::unique_ptr<Element>> parse(const Card& card) {
 }  // namespace
 
 const ElementKind& voltage_source_kind() {
-  static const ElementKind kind{'v', "voltage source",
-                                "Vname n+ n- [DC] value | PULSE(...) | PWL(...) | SIN(...)", 2, 0,
-                                kParams, parse};
+  static const ElementKind kind{
+      'v',
+      "voltage source",
+      "Vname n+ n- [DC] value | PULSE(...) | PWL(...) [td=T] [r=T] | SIN(...) | EXP(...)",
+      2,
+      0,
+      kParams,
+      parse};
   return kind;
 }
 

@@ -2,14 +2,14 @@
 // is scored with the verdict expected for its design; the report bundle is complete; the
 // exported netlist runs in ngspice and agrees with `isolink sim`; bad specs exit 2 and write
 // nothing.
+#include <gtest/gtest.h>
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include "ngspice_runner.h"
 #include "base/waveform.h"
@@ -43,12 +43,17 @@ Result run(const std::string& args, const std::string& tag) {
 // Every example spec and the verdict its design gets (see the comment at the top of each file).
 struct Example {
   const char* file;
-  const char* verdict;       // report.json "verdict"
-  const char* down, *up;     // per-direction verdicts
+  const char* verdict;    // report.json "verdict"
+  const char *down, *up;  // per-direction verdicts
+  // The worst case over all legal traffic (on by default, 60-80 % of a run's time) has its own
+  // tests (tests/analysis/worst_test.cpp); two examples keep it here, the others run --no-worst.
+  bool worst = false;
 };
 
 // The test names already say which example: print only the file in ctest's listing.
-void PrintTo(const Example& e, std::ostream* os) { *os << e.file; }
+void PrintTo(const Example& e, std::ostream* os) {
+  *os << e.file;
+}
 
 class RunExamples : public ::testing::TestWithParam<Example> {};
 
@@ -57,7 +62,9 @@ TEST_P(RunExamples, BundleAndVerdict) {
   const std::string stem = fs::path(ex.file).stem().string();
   const std::string dir = ::testing::TempDir() + "/run_" + stem;
   fs::remove_all(dir);
-  Result r = run("run " + kExamples + "/" + ex.file + " -o " + dir + " -q", stem);
+  Result r = run("run " + kExamples + "/" + ex.file + " -o " + dir + " -q" +
+                     (ex.worst ? "" : " --no-worst"),
+                 stem);
   const bool pass = std::string(ex.verdict) == "pass";
   EXPECT_EQ(r.code, pass ? 0 : 1) << r.err;
   for (const char* f : {"eye.png", "wave.png", "report.json", "report.md", "wave.csv"})
@@ -66,6 +73,7 @@ TEST_P(RunExamples, BundleAndVerdict) {
     EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << e.path();
   nlohmann::json j = nlohmann::json::parse(slurp(dir + "/report.json"));
   EXPECT_EQ(j["verdict"], ex.verdict);
+  EXPECT_EQ(j.contains("worst_case"), ex.worst);
   ASSERT_EQ(j["directions"].size(), 2u);
   EXPECT_EQ(j["directions"][0]["direction"], "down");
   EXPECT_EQ(j["directions"][0]["verdict"], ex.down);
@@ -87,20 +95,20 @@ TEST_P(RunExamples, BundleAndVerdict) {
   std::string header;
   std::getline(csv, header);
   EXPECT_EQ(header,
-            "time,down v(rxp,rxn),down v(rxp),down v(rxn),down v(txp,txn),up v(rxp,rxn),up v(rxp),"
-            "up v(rxn),up v(txp,txn)");
+            "time,\"down v(rxp,rxn)\",down v(rxp),down v(rxn),\"down v(txp,txn)\","
+            "\"up v(rxp,rxn)\",up v(rxp),up v(rxn),\"up v(txp,txn)\"");
 }
 
 INSTANTIATE_TEST_SUITE_P(
     Examples, RunExamples,
-    ::testing::Values(Example{"cap_2m.yaml", "pass", "pass", "pass"},
+    ::testing::Values(Example{"cap_2m.yaml", "pass", "pass", "pass", true},
                       Example{"same_pcb.yaml", "pass", "pass", "pass"},
                       Example{"capchoke_5m.yaml", "pass", "pass", "pass"},
                       Example{"capdualchoke_10m.yaml", "pass", "pass", "pass"},
                       Example{"transformer_15m.yaml", "pass", "pass", "pass"},
                       // The bq79600 bridge's receiver (VSTART 1.8 V, no dips) sees the 12 m
                       // cable's reflection as a dip inside double pulses.
-                      Example{"hybrid_xfmr_cap_12m.yaml", "fail", "pass", "fail"},
+                      Example{"hybrid_xfmr_cap_12m.yaml", "fail", "pass", "fail", true},
                       Example{"bq79606a_same_pcb.yaml", "pass", "pass", "pass"},
                       Example{"bq79606a_cap_2m.yaml", "pass", "pass", "pass"},
                       // 28.6 uH leakage at each end: 50 ns edges and 295 ns pulses.
@@ -144,7 +152,10 @@ TEST(RunCommand, UnknownPartNamesTheKey) {
 }
 
 // The exported netlist runs in ngspice and agrees with `isolink sim` of the same file within
-// 10 mV (ngspice at tight tolerances), and with `isolink run`'s own waveform.
+// 10 mV (ngspice at tight tolerances). Both run the first 12 us only: the preamble and the first
+// byte of the frame, every kind of edge the chokes and the cable shape; ngspice at reltol 1e-6 on
+// the whole 95 us took 255 s of a 308 s suite (10 s of CPU for this window; its error is per
+// edge, not accumulated, so the window loses nothing the comparison checks).
 TEST(ExportSpice, RunsInNgspiceAndAgreesWithIsolink) {
   const std::string work = ::testing::TempDir() + "/export";
   fs::create_directories(work);
@@ -152,10 +163,10 @@ TEST(ExportSpice, RunsInNgspiceAndAgreesWithIsolink) {
   Result e = run("export-spice " + kExamples + "/capchoke_5m.yaml -o " + cir, "export");
   ASSERT_EQ(e.code, 0) << e.err;
   const std::string csv = work + "/iso.csv";
-  Result s = run("sim " + cir + " --probe 'v(rxp,rxn)' -o " + csv, "export_sim");
+  Result s = run("sim " + cir + " --probe 'v(rxp,rxn)' --tstop 12e-6 -o " + csv, "export_sim");
   ASSERT_EQ(s.code, 0) << s.err;
   auto ng = isolink::testing::run_ngspice(cir, {"v(rxp,rxn)"}, work,
-                                          isolink::testing::kNgspiceTight);
+                                          isolink::testing::kNgspiceTight, ".tran 1e-9 12e-6");
   ASSERT_TRUE(ng.ok()) << ng.status().message();
   std::ifstream in(csv);
   isolink::Waveform iso;
@@ -167,6 +178,8 @@ TEST(ExportSpice, RunsInNgspiceAndAgreesWithIsolink) {
   while (in >> t >> comma >> v) iso.time.push_back(t), vs.push_back(v);
   iso.add_column("v(rxp,rxn)", vs);
   ASSERT_GT(iso.samples(), 1000u);
+  ASSERT_NEAR(iso.time.back(), 12e-6, 1e-12);
+  ASSERT_NEAR(ng->time.back(), 12e-6, 1e-12);
   const double dev = isolink::testing::max_abs_difference(iso, 0, *ng, 0);
   std::printf("capchoke_5m exported: isolink sim vs ngspice (tight) max |dv| = %.2f mV\n",
               dev * 1e3);
@@ -175,8 +188,8 @@ TEST(ExportSpice, RunsInNgspiceAndAgreesWithIsolink) {
 
 TEST(ExportSpice, UpDirectionSwapsTheEnds) {
   Result down = run("export-spice " + kExamples + "/hybrid_xfmr_cap_12m.yaml", "export_down");
-  Result up = run("export-spice " + kExamples + "/hybrid_xfmr_cap_12m.yaml --direction up",
-                  "export_up");
+  Result up =
+      run("export-spice " + kExamples + "/hybrid_xfmr_cap_12m.yaml --direction up", "export_up");
   ASSERT_EQ(down.code, 0) << down.err;
   ASSERT_EQ(up.code, 0) << up.err;
   // down: the bq79600 end (transformer) transmits; up: the bq7961x end (cap) transmits, so the

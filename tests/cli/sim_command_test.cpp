@@ -1,11 +1,12 @@
 // `isolink sim` end to end: the CSV contract, exit codes, and nothing written on bad input.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
-
-#include <gtest/gtest.h>
 
 namespace {
 
@@ -19,8 +20,18 @@ struct Result {
   std::string err;
 };
 
+// This test's own folder: ctest -j2 runs the tests of this file as separate processes at once,
+// so nothing may be shared between them (one fixed file made the suite nondeterministic).
+std::string test_dir() {
+  const ::testing::TestInfo* t = ::testing::UnitTest::GetInstance()->current_test_info();
+  const std::string dir = ::testing::TempDir() + "/sim_command_" + t->test_suite_name() + "_" +
+                          t->name() + "_" + std::to_string(::getpid());
+  fs::create_directories(dir);
+  return dir;
+}
+
 Result run(const std::string& args) {
-  const std::string err_file = ::testing::TempDir() + "/sim_stderr.txt";
+  const std::string err_file = test_dir() + "/stderr.txt";
   const std::string cmd = kBinary + " " + args + " >/dev/null 2>" + err_file;
   int status = std::system(cmd.c_str());
   std::ifstream in(err_file);
@@ -30,20 +41,21 @@ Result run(const std::string& args) {
 }
 
 std::string write_temp(const std::string& name, const std::string& text) {
-  const std::string path = ::testing::TempDir() + "/" + name;
+  const std::string path = test_dir() + "/" + name;
   std::ofstream(path) << text;
   return path;
 }
 
 TEST(SimCommand, WritesHeaderAndStrictlyIncreasingTimes) {
-  const std::string out = ::testing::TempDir() + "/wave.csv";
+  const std::string out = test_dir() + "/wave.csv";
   fs::remove(out);
-  Result r = run("sim " + kData + "/floating_cable.cir --probe 'v(rxp,rxn)' --probe 'v(txp)' -o " + out);
+  Result r =
+      run("sim " + kData + "/floating_cable.cir --probe 'v(rxp,rxn)' --probe 'v(txp)' -o " + out);
   ASSERT_EQ(r.code, 0) << r.err;
   std::ifstream in(out);
   std::string line;
   std::getline(in, line);
-  EXPECT_EQ(line, "time,v(rxp,rxn),v(txp)");
+  EXPECT_EQ(line, "time,\"v(rxp,rxn)\",v(txp)");  // RFC 4180: the comma is quoted
   double prev = -1;
   int rows = 0;
   while (std::getline(in, line)) {
@@ -58,7 +70,7 @@ TEST(SimCommand, WritesHeaderAndStrictlyIncreasingTimes) {
 }
 
 TEST(SimCommand, StepResamplesOnAUniformGrid) {
-  const std::string out = ::testing::TempDir() + "/wave_step.csv";
+  const std::string out = test_dir() + "/wave_step.csv";
   Result r = run("sim " + kExamples + "/cap_link_2m.cir -p 'v(rxp,rxn)' --step 10n -q -o " + out);
   ASSERT_EQ(r.code, 0) << r.err;
   std::ifstream in(out);
@@ -75,9 +87,10 @@ TEST(SimCommand, StepResamplesOnAUniformGrid) {
 }
 
 TEST(SimCommand, BadNetlistExitsTwoAndWritesNothing) {
-  const std::string out = ::testing::TempDir() + "/never.csv";
+  const std::string out = test_dir() + "/never.csv";
   fs::remove(out);
-  std::string path = write_temp("bad_r.cir", "bad value\nV1 a 0 1\nR1 a 0 -5\n.tran 1n 10n\n.end\n");
+  std::string path =
+      write_temp("bad_r.cir", "bad value\nV1 a 0 1\nR1 a 0 -5\n.tran 1n 10n\n.end\n");
   Result r = run("sim " + path + " -p 'v(a)' -o " + out);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("bad_r.cir:3:8: error: resistance of r1 must be positive, got -5"),
@@ -99,20 +112,22 @@ TEST(SimCommand, SingularCircuitNamesTheNodes) {
 }
 
 TEST(SimCommand, UnknownProbeAndMissingTranAreErrors) {
-  std::string path = write_temp("rc.cir", "rc\nV1 a 0 PULSE(0 1 0 1n)\nR1 a b 1k\nC1 b 0 1n\n.end\n");
+  std::string path =
+      write_temp("rc.cir", "rc\nV1 a 0 PULSE(0 1 0 1n)\nR1 a b 1k\nC1 b 0 1n\n.end\n");
   Result r = run("sim " + path + " -p 'v(zz)' --tstop 1u");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("no node named 'zz'"), std::string::npos) << r.err;
   r = run("sim " + path + " -p 'v(b)'");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("no .tran card"), std::string::npos) << r.err;
-  EXPECT_EQ(run("sim " + path + " -p 'v(b)' --tstop 1u -o " + ::testing::TempDir() + "/rc.csv").code, 0);
+  EXPECT_EQ(run("sim " + path + " -p 'v(b)' --tstop 1u -o " + test_dir() + "/rc.csv").code, 0);
 }
 
 TEST(SimCommand, UnknownOptionIsWarnedAndIgnored) {
-  std::string path = write_temp("opt.cir", "opt\nV1 a 0 1\nR1 a 0 1k\n.options foo=3 reltol=1e-4\n"
-                                           ".tran 1n 10n\n.end\n");
-  Result r = run("sim " + path + " -p 'v(a)' -o " + ::testing::TempDir() + "/opt.csv");
+  std::string path = write_temp("opt.cir",
+                                "opt\nV1 a 0 1\nR1 a 0 1k\n.options foo=3 reltol=1e-4\n"
+                                ".tran 1n 10n\n.end\n");
+  Result r = run("sim " + path + " -p 'v(a)' -o " + test_dir() + "/opt.csv");
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("opt.cir:4:10: warning: option 'foo' is not used by isolink; ignored"),
             std::string::npos)

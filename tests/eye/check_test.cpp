@@ -100,7 +100,7 @@ TEST(Check, BadSamplesAreErrors) {
   EXPECT_NE(r.status().message().find("vth = -1"), std::string::npos) << r.status().message();
 }
 
-TEST(Check, RecordCutMidFrameIsTruncatedNotFailing) {
+TEST(Check, RecordCutMidFrameIsTruncatedAndInconclusive) {
   Waveform full = synth::ideal_frames({0x15, 0x0B}, FrameFormat{});
   // start the record in the middle of the first frame's first pulse
   Waveform w;
@@ -119,7 +119,10 @@ TEST(Check, RecordCutMidFrameIsTruncatedNotFailing) {
   EXPECT_EQ(r->frames[0].fault, "truncated");
   EXPECT_FALSE(r->frames[0].fails());
   EXPECT_EQ(r->bytes, std::vector<uint8_t>{0x0B});
-  EXPECT_TRUE(r->pass);
+  // the cut pulse cannot be judged: no verdict of pass (issue 14), and no failure either
+  EXPECT_FALSE(r->pass);
+  EXPECT_TRUE(r->inconclusive);
+  EXPECT_EQ(r->failing(), 0u);
 }
 
 // Tone rules: 1 us pulses +/- 8 % (920..1080 ns); nothing is decoded.
@@ -220,6 +223,19 @@ TEST(Check, SummaryTextAndPulsesCsv) {
   for (std::string line; std::getline(in, line);) ++rows;
   EXPECT_EQ(rows, r->pulses.size());
   std::filesystem::remove_all(dir);
+}
+
+// check --json on a capture with millions of pulses used 3.6 GB (issue 15): the JSON lists at
+// most kMaxJsonPulses of them and counts the rest.
+TEST(CheckJson, PulseDetailsAreCapped) {
+  CheckResult r;
+  r.pulses.resize(kMaxJsonPulses + 5);
+  for (size_t i = 0; i < r.pulses.size(); ++i) r.pulses[i].index = i;
+  const nlohmann::ordered_json j = to_json(r);
+  ASSERT_EQ(j["pulses"].size(), kMaxJsonPulses);
+  EXPECT_EQ(j["pulses"].back()["index"], kMaxJsonPulses - 1);
+  EXPECT_EQ(j["pulses_omitted"], 5);
+  EXPECT_EQ(j["summary"]["pulses"], kMaxJsonPulses + 5);  // the summary still counts them all
 }
 
 }  // namespace

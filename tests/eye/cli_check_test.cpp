@@ -1,4 +1,5 @@
 // End to end: the built `isolink check` on CSV files written here; exit codes and JSON names.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -42,7 +43,7 @@ class CliCheck : public ::testing::Test {
   }
   std::string write_frames(const std::string& name, const std::vector<uint8_t>& bytes,
                            double amp = 2.0) {
-    isolink::Waveform w = synth::ideal_frames(bytes, isolink::eye::FrameFormat{});
+    isolink::Waveform w = synth::ideal_frames(bytes, isolink::FrameFormat{});
     for (double& x : w.columns[0]) x *= amp / 2.0;
     const std::string path = (dir_ / name).string();
     EXPECT_TRUE(isolink::write_waveform_csv(w, path).ok());
@@ -109,11 +110,64 @@ TEST_F(CliCheck, BadInputExitsTwoWithFileAndLine) {
   const std::string rules = write_text("r.yaml", "base: bq7961x\nvth: 0\n");
   const std::string good = write_frames("good.csv", {0x15});
   EXPECT_EQ(run("check '" + good + "' --rules '" + rules + "'"), 2);
-  EXPECT_EQ(err_, "isolink check: " + rules + ":2: error: vth = 0: must be > 0\n");
+  EXPECT_EQ(err_, "isolink check: " + rules + ":2:1: error: vth = 0: must be > 0\n vth: 0\n ^\n");
   EXPECT_EQ(run("check '" + (dir_ / "missing.csv").string() + "'"), 2);
   EXPECT_EQ(run("check '" + good + "' --expect 'zz'"), 2);
   EXPECT_EQ(run("check '" + good + "' --diff nope"), 2);
   EXPECT_NE(err_.find("no such column"), std::string::npos) << err_;
+}
+
+TEST_F(CliCheck, TwoFilesPAndNWithWhatWasRead) {
+  // R&S RTB style: one channel per file, units in the names; N in mV
+  isolink::Waveform w = synth::ideal_frames({0x80, 0x15}, isolink::FrameFormat{});
+  std::string p = "in s,C1 in V\n", n = "in s,C2 in mV\n";
+  for (size_t i = 0; i < w.samples(); ++i) {
+    const double v = w.columns[0][i];
+    p += fmt::format("{:.9g},{:.9g}\n", w.time[i], 2.5 + v / 2);
+    n += fmt::format("{:.9g},{:.9g}\n", w.time[i], (2.5 - v / 2) * 1e3);
+  }
+  const std::string a = write_text("C1.csv", p), b = write_text("C2.csv", n);
+  ASSERT_EQ(run("check '" + a + "' '" + b + "' --json --expect '80 15'"), 0) << err_ << out_;
+  nlohmann::json j = nlohmann::json::parse(out_);
+  EXPECT_EQ(j["verdict"], "pass");
+  EXPECT_EQ(j["decoded"]["bytes"], "80 15");
+  const nlohmann::json& in = j["input"];
+  EXPECT_EQ(in["files"].size(), 2u);
+  EXPECT_EQ(in["samples"], w.samples());
+  EXPECT_NEAR(in["interval_s"].get<double>(), 1e-9, 1e-18);
+  EXPECT_NEAR(in["span_s"].get<double>(), w.time.back(), 1e-15);
+  ASSERT_EQ(in["columns"].size(), 3u);
+  EXPECT_EQ(in["columns"][1]["role"], "P");
+  EXPECT_EQ(in["columns"][1]["channel"], "CH1");
+  EXPECT_EQ(in["columns"][2]["role"], "N");
+  EXPECT_EQ(in["columns"][2]["unit"], "mV");
+  EXPECT_DOUBLE_EQ(in["columns"][2]["scale"].get<double>(), 1e-3);
+  EXPECT_EQ(in["alignment"], "the two files share one time base");
+  // the text summary says what was read
+  ASSERT_EQ(run("check '" + a + "' '" + b + "'"), 0) << err_;
+  EXPECT_NE(out_.find("  N     column 2 'C2 in mV' of " + b +
+                      " (default (first channel), unit "
+                      "mV, x0.001 to V)"),
+            std::string::npos)
+      << out_;
+  EXPECT_NE(out_.find(fmt::format("  {} samples, 0 ..", w.samples())), std::string::npos) << out_;
+  // --diff makes no sense with two files
+  EXPECT_EQ(run("check '" + a + "' '" + b + "' --diff 2"), 2);
+  EXPECT_NE(err_.find("with two files"), std::string::npos) << err_;
+}
+
+TEST_F(CliCheck, InconclusiveExitsOneWithReasonAndHint) {
+  // a flat record: nothing to judge
+  std::string text = "time,CH1\n";
+  for (int i = 0; i < 100; ++i) text += fmt::format("{:g},0.001\n", i * 1e-9);
+  const std::string csv = write_text("flat.csv", text);
+  EXPECT_EQ(run("check '" + csv + "'"), 1);
+  EXPECT_NE(out_.find("INCONCLUSIVE (rules bq7961x)"), std::string::npos) << out_;
+  EXPECT_NE(out_.find("  hint: |v| stays under 0.001 V"), std::string::npos) << out_;
+  EXPECT_EQ(run("check '" + csv + "' --json"), 1);
+  nlohmann::json j = nlohmann::json::parse(out_);
+  EXPECT_EQ(j["verdict"], "inconclusive");
+  EXPECT_EQ(j["hints"].size(), 1u);
 }
 
 }  // namespace

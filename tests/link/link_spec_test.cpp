@@ -83,8 +83,10 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         BadSpec{"name: a\ncabel: {length: 3}\n",
                 "bad.yaml:2:1: error: unknown key 'cabel' in the top level"},
-        BadSpec{"cable: {length: -3}\n", "bad.yaml:1:17: error: key 'cable.length' = -3: must be > 0"},
-        BadSpec{"cable: {length: 3km}\n", "key 'cable.length': expected a number in m, found '3km'"},
+        BadSpec{"cable: {length: -3}\n",
+                "bad.yaml:1:17: error: key 'cable.length' = -3: must be > 0"},
+        BadSpec{"cable: {length: 3km}\n",
+                "key 'cable.length': expected a number in m, found '3km'"},
         BadSpec{"rx: {isolation: {type: cap, cap: 2.2nH}}\n",
                 "bad.yaml:1:34: error: key 'rx.isolation.cap': expected a value in F"},
         BadSpec{"tx: {device: bq76952}\n",
@@ -102,6 +104,27 @@ INSTANTIATE_TEST_SUITE_P(
         BadSpec{"- a\n- b\n", "a link spec is a YAML map"},
         BadSpec{"tx: {series_r: [1, 2]}\n", "key 'tx.series_r': expected a value in ohm"},
         BadSpec{"tx: {isolation: {type: cap\n", "bad.yaml:"}));
+
+TEST(LinkSpec, StimulusGapsGiveTheIdleBeforeEachFrame) {
+  auto s = read_link_spec_text(
+      "name: g\nstimulus: {frames: [\"raw 5A nocrc\", \"raw 35 nocrc err\"], "
+      "gaps: [1u, 3.85us], direction: down}\n",
+      "g.yaml");
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  ASSERT_EQ(s->stimulus.gaps.size(), 2u);
+  EXPECT_DOUBLE_EQ(s->stimulus.gaps[1], 3.85e-6);
+  EXPECT_EQ(s->stimulus.to_script(), "gap 1e-06; raw 5A nocrc; gap 3.85e-06; raw 35 nocrc err");
+  auto bad =
+      read_link_spec_text("name: g\nstimulus: {frames: [\"raw 5A\"], gaps: [1u, 2u]}\n", "g.yaml");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("g.yaml:2:"), std::string::npos) << bad.status().message();
+  EXPECT_NE(bad.status().message().find("2 gaps for 1 frames"), std::string::npos);
+  auto neg =
+      read_link_spec_text("name: g\nstimulus: {frames: [\"raw 5A\"], gaps: [-1u]}\n", "g.yaml");
+  ASSERT_FALSE(neg.ok());
+  EXPECT_NE(neg.status().message().find("must be a time >= 0"), std::string::npos)
+      << neg.status().message();
+}
 
 }  // namespace
 }  // namespace isolink::link

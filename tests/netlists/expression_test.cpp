@@ -73,6 +73,55 @@ TEST_F(ExpressionTest, ParamsAndFunctions) {
   EXPECT_DOUBLE_EQ(value("{a}*3"), 6.0);  // braces group like parentheses
 }
 
+// ngspice's comparison, logical and ternary operators: true is 1, false 0.
+TEST_F(ExpressionTest, ComparisonLogicalAndTernary) {
+  params_["a"] = 2;
+  EXPECT_EQ(value("a == 2"), 1.0);
+  EXPECT_EQ(value("a != 2"), 0.0);
+  EXPECT_EQ(value("a < 3") + value("a > 3") + value("a <= 2") + value("a >= 2.5"), 2.0);
+  EXPECT_EQ(value("1 && 0 || 1"), 1.0);  // && binds tighter than ||
+  EXPECT_EQ(value("0 || 0 && 1"), 0.0);
+  EXPECT_EQ(value("!a"), 0.0);
+  EXPECT_EQ(value("!!a"), 1.0);
+  EXPECT_EQ(value("a + 1 > 2 * a - 2"), 1.0);  // arithmetic before comparison: 3 > 2
+  EXPECT_EQ(value("a > 1 ? 10 : 20"), 10.0);
+  EXPECT_EQ(value("a > 5 ? 10 : a > 1 ? 30 : 40"), 30.0);  // right-associative
+  EXPECT_EQ(value("(a == 2 ? 1k : 2k) * 2"), 2000.0);
+  auto e = eval("a ? 1");
+  ASSERT_FALSE(e);
+  EXPECT_NE(e.status().message().find("expected ':'"), std::string::npos);
+}
+
+TEST_F(ExpressionTest, UserFunctions) {
+  params_["g"] = 3;
+  file_ = SourceFile::FromText("e.cir", "R1 a b {x}");
+  UserFunction par{{"a", "b"}, "a*b/(a+b)", [&](std::size_t o) {
+                     return SourceLoc{file_, 1, 1 + static_cast<int>(o)};
+                   }};
+  UserFunction scaled{{"x"}, "par(x, x) * g", par.where};  // calls par, sees parameter g
+  UserFunction rec{{"x"}, "rec(x)", par.where};
+  auto funcs = [&](const std::string& n) -> const UserFunction* {
+    return n == "par" ? &par : n == "scaled" ? &scaled : n == "rec" ? &rec : nullptr;
+  };
+  auto eval_f = [&](const std::string& text) {
+    return evaluate_expression(
+        text,
+        [&](const std::string& n) -> std::optional<double> {
+          auto it = params_.find(n);
+          return it == params_.end() ? std::nullopt : std::optional<double>(it->second);
+        },
+        par.where, funcs);
+  };
+  EXPECT_EQ(*eval_f("par(2k, 2k)"), 1000.0);
+  EXPECT_EQ(*eval_f("scaled(4)"), 6.0);
+  auto bad = eval_f("par(1)");
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.status().message().find("par() takes 2 arguments, got 1"), std::string::npos);
+  auto deep = eval_f("rec(1)");
+  ASSERT_FALSE(deep);
+  EXPECT_NE(deep.status().message().find("nested too deeply"), std::string::npos);
+}
+
 TEST_F(ExpressionTest, Errors) {
   // Columns: the expression starts at column 9 of "R1 a b {...}".
   EXPECT_EQ(error("a*zz").rfind("e.cir:1:11: error: undefined parameter 'zz'", 0), 0u);

@@ -2,67 +2,8 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
-
 namespace isolink::spice {
 namespace {
-
-double num(const char* s) {
-  double v = std::nan("");
-  EXPECT_TRUE(parse_number(s, v)) << s;
-  return v;
-}
-
-TEST(SpiceNumber, SuffixTable) {
-  EXPECT_DOUBLE_EQ(num("2.2nF"), 2.2e-9);
-  EXPECT_DOUBLE_EQ(num("2.2n"), 2.2e-9);
-  EXPECT_DOUBLE_EQ(num("1meg"), 1e6);
-  EXPECT_DOUBLE_EQ(num("1MEG"), 1e6);
-  EXPECT_DOUBLE_EQ(num("10Meg"), 10e6);
-  EXPECT_DOUBLE_EQ(num("1m"), 1e-3);
-  EXPECT_DOUBLE_EQ(num("1M"), 1e-3);  // SPICE: M is milli, not mega
-  EXPECT_DOUBLE_EQ(num("1ms"), 1e-3);
-  EXPECT_DOUBLE_EQ(num("10mil"), 254e-6);
-  EXPECT_DOUBLE_EQ(num("1e-9"), 1e-9);
-  EXPECT_DOUBLE_EQ(num("1E3"), 1000.0);
-  EXPECT_DOUBLE_EQ(num("1e+3"), 1000.0);
-  EXPECT_DOUBLE_EQ(num(".5u"), 0.5e-6);
-  EXPECT_DOUBLE_EQ(num("5."), 5.0);
-  EXPECT_DOUBLE_EQ(num("1kohm"), 1000.0);
-  EXPECT_DOUBLE_EQ(num("1k"), 1000.0);
-  EXPECT_DOUBLE_EQ(num("4.7K"), 4700.0);
-  EXPECT_DOUBLE_EQ(num("3f"), 3e-15);
-  EXPECT_DOUBLE_EQ(num("3p"), 3e-12);
-  EXPECT_DOUBLE_EQ(num("2g"), 2e9);
-  EXPECT_DOUBLE_EQ(num("2t"), 2e12);
-  EXPECT_DOUBLE_EQ(num("2.5V"), 2.5);  // unit letters without a scale are ignored
-  EXPECT_DOUBLE_EQ(num("1e3k"), 1e6);
-  EXPECT_DOUBLE_EQ(num("-47p"), -47e-12);
-  EXPECT_DOUBLE_EQ(num("+3"), 3.0);
-  EXPECT_DOUBLE_EQ(num("100"), 100.0);
-  // Exactly the decimal value, not 2.2 * 1e-9 rounded twice.
-  EXPECT_EQ(num("2.2n"), 2.2e-9);
-  EXPECT_EQ(num("0.1u"), 0.1e-6);
-}
-
-TEST(SpiceNumber, Malformed) {
-  double v = 0;
-  EXPECT_FALSE(parse_number("1.2.3", v));
-  EXPECT_FALSE(parse_number("abc", v));
-  EXPECT_FALSE(parse_number("", v));
-  EXPECT_FALSE(parse_number("-", v));
-  EXPECT_FALSE(parse_number(".", v));
-  EXPECT_FALSE(parse_number("1k5", v));
-  EXPECT_FALSE(parse_number("1_0", v));
-}
-
-TEST(SpiceNumber, ScanStopsAfterUnit) {
-  auto r = scan_number("2.2nF*3");
-  ASSERT_TRUE(r);
-  EXPECT_EQ(r->length, 5u);
-  EXPECT_DOUBLE_EQ(r->value, 2.2e-9);
-  EXPECT_FALSE(scan_number("x1"));
-}
 
 TEST(JoinLines, CommentsAndContinuations) {
   auto file = SourceFile::FromText("t.cir",

@@ -95,5 +95,24 @@ TEST(SpiceWriter, RoundTripFlattenedHierarchyAndLongPwl) {
   EXPECT_EQ(write_spice(*second), written);  // a fixed point
 }
 
+// Issue 13: what the reader resolves (.ic, .global, .temp, .lib, .if) comes back the same.
+TEST(SpiceWriter, RoundTripInitialConditionsAndResolvedDialect) {
+  auto n = read_spice_text(
+      "dialect\n.global vcc\n.temp 50\n.param sel=1\n.subckt s a\nR1 vcc a 1k tc1=1m\n.ends\n"
+      ".if (sel == 1)\nX1 p s\n.else\nX2 p s\n.endif\nV1 vcc 0 dc=2 ac=1\n"
+      "V2 p 0 PWL(0 0 1u 1) td=1u r=0\n.ic v(p)=0.25\n.tran 1n 1u uic\n",
+      "t.cir");
+  ASSERT_TRUE(n) << n.status().message();
+  const std::string text = write_spice(*n);
+  EXPECT_NE(text.find(".ic v(p)=0.25\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("r.x1.r1 vcc p 1000 tc1=0.001 temp=50\n"), std::string::npos) << text;
+  auto back = read_spice_text(text, "back.cir");
+  ASSERT_TRUE(back) << back.status().message() << "\n" << text;
+  expect_same_cards(*n, *back);
+  ASSERT_EQ(back->initial_voltages.size(), 1u);
+  EXPECT_EQ(back->initial_voltages[0].node, "p");
+  EXPECT_EQ(back->initial_voltages[0].value, 0.25);
+}
+
 }  // namespace
 }  // namespace isolink

@@ -1,9 +1,12 @@
 #include "reports/plot.h"
 
 #include <gtest/gtest.h>
+#include <sys/mount.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <vector>
 
@@ -355,12 +358,37 @@ TEST(Png, WritesThroughATempFileAndReadsBack) {
   const std::string path = dir + "/out.png";
   Status s = c.write_png(path);
   ASSERT_TRUE(s.ok()) << s.message();
-  EXPECT_FALSE(std::filesystem::exists(path + ".tmp.png"));
+  for (const auto& e : std::filesystem::directory_iterator(dir))  // no temporary file left
+    EXPECT_EQ(e.path().filename(), "out.png");
   const fixtures::Png p = read_png(path);
   ASSERT_EQ(p.width, 64);
   ASSERT_EQ(p.height, 32);
   EXPECT_TRUE(p.is(10, 10, 0xE00000));
   EXPECT_TRUE(p.is(40, 10, 0xFFFFFF));
+}
+
+// OpenImageIO reports success when the disk fills up under it (issue 15): the PNG is encoded in
+// memory and written with a checked write, so a full disk is an error and leaves no file.
+TEST(Png, FullDiskIsAnErrorAndLeavesNoFile) {
+  const std::string dir = temp_dir("plot_png_full") + "/mnt";
+  std::filesystem::create_directories(dir);
+  if (::mount("tmpfs", dir.c_str(), "tmpfs", 0, "size=8k") != 0)
+    GTEST_SKIP() << "mounting a small tmpfs needs root (CAP_SYS_ADMIN): " << std::strerror(errno);
+  Canvas c = canvas(400, 300);
+  unsigned lcg = 1;  // noise, so the PNG cannot compress below the disk's size
+  for (int y = 0; y < 300; y += 2)
+    for (int x = 0; x < 400; x += 2) {
+      lcg = lcg * 1664525u + 1013904223u;
+      c.fill_rect({x, y, x + 2, y + 2}, (lcg >> 28) & 1 ? kFail : kPass);
+    }
+  Status s = c.write_png(dir + "/eye.png");
+  const bool left = std::filesystem::exists(dir + "/eye.png") || !std::filesystem::is_empty(dir);
+  ::umount(dir.c_str());
+  ASSERT_FALSE(s.ok()) << "an 8 KiB disk took the PNG";
+  EXPECT_NE(s.message().find("eye.png: error: cannot write: No space left on device"),
+            std::string::npos)
+      << s.message();
+  EXPECT_FALSE(left);
 }
 
 TEST(Png, ErrorNamesThePath) {

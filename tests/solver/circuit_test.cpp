@@ -32,9 +32,10 @@ TEST(Circuit, DuplicateNameIsAnError) {
 }
 
 TEST(Circuit, NonPositiveValuesAreErrors) {
-  for (auto [name, v, what] : {std::tuple{"r1", 0.0, "resistance of r1 must be positive, got 0"},
-                               std::tuple{"c1", -1e-9, "capacitance of c1 must be positive, got -1e-09"},
-                               std::tuple{"l1", 0.0, "inductance of l1 must be positive, got 0"}}) {
+  for (auto [name, v, what] :
+       {std::tuple{"r1", 0.0, "resistance of r1 must be positive, got 0"},
+        std::tuple{"c1", -1e-9, "capacitance of c1 must be positive, got -1e-09"},
+        std::tuple{"l1", 0.0, "inductance of l1 must be positive, got 0"}}) {
     Circuit c;
     std::string msg = build(c, {card(name, {"a", "0"}, {num(v)})});
     EXPECT_NE(msg.find(what), std::string::npos) << msg;
@@ -44,19 +45,66 @@ TEST(Circuit, NonPositiveValuesAreErrors) {
 TEST(Circuit, MutualInductanceChecksItsTargetsAndK) {
   {
     Circuit c;
-    std::string msg = build(c, {card("l1", {"a", "0"}, {num(1e-6)}), card("r1", {"a", "0"}, {num(1)}),
-                                card("k1", {}, {num(0.5)}, {"l1", "r1"})});
-    EXPECT_NE(msg.find("k1 couples inductors, but 'r1' is not an inductor"), std::string::npos) << msg;
+    std::string msg =
+        build(c, {card("l1", {"a", "0"}, {num(1e-6)}), card("r1", {"a", "0"}, {num(1)}),
+                  card("k1", {}, {num(0.5)}, {"l1", "r1"})});
+    EXPECT_NE(msg.find("k1 couples inductors, but 'r1' is not an inductor"), std::string::npos)
+        << msg;
   }
-  for (double k : {1.0, -1.2, 0.0}) {
+  for (double k : {-1.2, 1.0001}) {
     Circuit c;
-    std::string msg = build(c, {card("l1", {"a", "0"}, {num(1e-6)}), card("l2", {"b", "0"}, {num(1e-6)}),
-                                card("k1", {}, {num(k)}, {"l1", "l2"})});
-    EXPECT_NE(msg.find("must satisfy 0 < |k| < 1"), std::string::npos) << msg;
+    std::string msg =
+        build(c, {card("l1", {"a", "0"}, {num(1e-6)}), card("l2", {"b", "0"}, {num(1e-6)}),
+                  card("k1", {}, {num(k)}, {"l1", "l2"})});
+    EXPECT_NE(msg.find("must satisfy |k| <= 1"), std::string::npos) << msg;
+  }
+  for (double k : {0.0, 1.0, -1.0}) {  // no coupling; the ideal-transformer idiom
+    Circuit c;
+    EXPECT_EQ(build(c, {card("l1", {"a", "0"}, {num(1e-6)}), card("l2", {"b", "0"}, {num(4e-6)}),
+                        card("k1", {}, {num(k)}, {"l1", "l2"}), card("r1", {"a", "0"}, {num(1)}),
+                        card("r2", {"b", "0"}, {num(1)})}),
+              "")
+        << "k=" << k;
   }
   Circuit c;
-  std::string msg = build(c, {card("l1", {"a", "0"}, {num(1e-6)}), card("k1", {}, {num(0.5)}, {"l1", "l9"})});
+  std::string msg =
+      build(c, {card("l1", {"a", "0"}, {num(1e-6)}), card("k1", {}, {num(0.5)}, {"l1", "l9"})});
   EXPECT_NE(msg.find("'l9' named by k1 not found"), std::string::npos) << msg;
+}
+
+// Three windings with k12 = k23 = 0.9 and k13 = -0.9: v = (1, -1, 1) gives v'Lv = 3 - 5.4 < 0.
+TEST(Circuit, InconsistentCouplingsAreRefusedWhenBuilt) {
+  Circuit c;
+  std::string msg = build(
+      c, {card("l1", {"a", "0"}, {num(1e-6)}), card("l2", {"b", "0"}, {num(1e-6)}),
+          card("l3", {"c", "0"}, {num(1e-6)}), card("k12", {}, {num(0.9)}, {"l1", "l2"}),
+          card("k23", {}, {num(0.9)}, {"l2", "l3"}), card("k13", {}, {num(-0.9)}, {"l1", "l3"})});
+  // Eigenvalues of [[1,.9,-.9],[.9,1,.9],[-.9,.9,1]] uH: 1.9, 1.9, -0.8.
+  EXPECT_NE(msg.find("the couplings k12, k23, k13 make the inductance matrix of l1, l2, l3 not "
+                     "positive semi-definite (smallest eigenvalue -8e-07 H)"),
+            std::string::npos)
+      << msg;
+  Circuit ok;  // the same with k13 = +0.9 is a valid three-winding transformer
+  EXPECT_EQ(
+      build(ok,
+            {card("l1", {"a", "0"}, {num(1e-6)}), card("l2", {"b", "0"}, {num(1e-6)}),
+             card("l3", {"c", "0"}, {num(1e-6)}), card("k12", {}, {num(0.9)}, {"l1", "l2"}),
+             card("k23", {}, {num(0.9)}, {"l2", "l3"}), card("k13", {}, {num(0.9)}, {"l1", "l3"})}),
+      "");
+}
+
+// In MNA an inductor carries a branch current, so a source across it is not a loop in the
+// transient; at DC the inductor is opened (0 A) with a warning, as ngspice's operating point.
+TEST(Circuit, VoltageSourceAcrossAnInductorIsOpenedAtDc) {
+  Circuit c;
+  ASSERT_EQ(build(c, {card("v1", {"a", "0"}, {num(0)}), card("l1", {"a", "0"}, {num(1e-3)}),
+                      card("r1", {"a", "0"}, {num(1)})}),
+            "");
+  ASSERT_EQ(c.dc_open_branches().size(), 1u);
+  EXPECT_EQ(c.unknown_name(c.dc_open_branches()[0]), "current of l1");
+  ASSERT_EQ(c.warnings().size(), 1u);
+  EXPECT_NE(c.warnings()[0].find("start at 0 A (as in ngspice): l1"), std::string::npos)
+      << c.warnings()[0];
 }
 
 TEST(Circuit, VoltageSourceLoopIsSingular) {
@@ -71,8 +119,9 @@ TEST(Circuit, VoltageSourceLoopIsSingular) {
 
 TEST(Circuit, FloatingCurrentSourceIsSingular) {
   Circuit c;
-  std::string msg = build(c, {card("i1", {"a", "b"}, {num(1e-3)}), card("c1", {"a", "0"}, {num(1e-9)}),
-                              card("r1", {"b", "0"}, {num(1)})});
+  std::string msg =
+      build(c, {card("i1", {"a", "b"}, {num(1e-3)}), card("c1", {"a", "0"}, {num(1e-9)}),
+                card("r1", {"b", "0"}, {num(1)})});
   EXPECT_NE(msg.find("current source i1 drives node a, which has no DC path to ground"),
             std::string::npos)
       << msg;
@@ -91,7 +140,9 @@ TEST(Circuit, UnknownParameterIsNamed) {
   Card r = card("r1", {"a", "0"}, {num(1)});
   r.params.push_back({"tc9", num(1)});
   std::string msg = build(c, {r});
-  EXPECT_NE(msg.find("unknown parameter 'tc9' for r1 (known: r)"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("unknown parameter 'tc9' for r1 (known: r, m, tc1, tc2, temp, tnom)"),
+            std::string::npos)
+      << msg;
 }
 
 TEST(Circuit, ProbesNameWhatIsMissing) {
@@ -103,7 +154,8 @@ TEST(Circuit, ProbesNameWhatIsMissing) {
   ASSERT_TRUE(p.ok());
   EXPECT_EQ(p->label, "v(a,b)");
   EXPECT_EQ(parse_probe(c, "v(zz)").status().message(), "probe 'v(zz)': no node named 'zz'");
-  EXPECT_NE(parse_probe(c, "i(r1)").status().message().find("has no branch current"), std::string::npos);
+  EXPECT_NE(parse_probe(c, "i(r1)").status().message().find("has no branch current"),
+            std::string::npos);
   EXPECT_NE(parse_probe(c, "x(a)").status().message().find("expected v(node)"), std::string::npos);
 }
 

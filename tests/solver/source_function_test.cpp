@@ -1,8 +1,8 @@
 #include "solver/elements/source_function.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "test_cards.h"
 
@@ -20,7 +20,7 @@ TEST(SourceFunction, PulseShapeAndCorners) {
   SourceFunction f = parse({call("pulse", {0, 5, 10e-9, 2e-9, 4e-9, 20e-9, 50e-9})});
   f.bind_time(1e-9, 100e-9);
   EXPECT_DOUBLE_EQ(f.value(5e-9), 0.0);
-  EXPECT_NEAR(f.value(11e-9), 2.5, 1e-12);   // half way up the 2 ns rise
+  EXPECT_NEAR(f.value(11e-9), 2.5, 1e-12);  // half way up the 2 ns rise
   EXPECT_DOUBLE_EQ(f.value(20e-9), 5.0);
   EXPECT_NEAR(f.value(34e-9), 2.5, 1e-12);  // half way down: 10+2+20 = 32, +2 of 4 ns
   EXPECT_NEAR(f.value(61e-9), 2.5, 1e-9);   // second period
@@ -38,6 +38,46 @@ TEST(SourceFunction, PulseDefaultsFollowNgspice) {
   EXPECT_DOUBLE_EQ(f.value(0.5e-6), 2.0);
 }
 
+// EXP(V1 V2 TD1 TAU1 TD2 TAU2), ngspice's formula, and its TSTEP defaults.
+TEST(SourceFunction, ExpRisesAndFallsExponentially) {
+  SourceFunction f = parse({call("exp", {0, 2, 1e-6, 1e-6, 3e-6, 0.5e-6})});
+  f.bind_time(1e-9, 10e-6);
+  EXPECT_DOUBLE_EQ(f.value(0.5e-6), 0.0);
+  EXPECT_NEAR(f.value(2e-6), 2 * (1 - std::exp(-1.0)), 1e-12);
+  EXPECT_NEAR(f.value(4e-6), 2 * (1 - std::exp(-3.0)) - 2 * (1 - std::exp(-2.0)), 1e-12);
+  std::vector<double> bp;
+  f.breakpoints(10e-6, bp);
+  ASSERT_EQ(bp.size(), 2u);
+  EXPECT_EQ(bp[0], 1e-6);
+  EXPECT_EQ(bp[1], 3e-6);
+  SourceFunction d = parse({call("exp", {1, 0})});  // TD1 0, TAU1 = TD2 = TAU2 = TSTEP
+  d.bind_time(1e-6, 10e-6);
+  EXPECT_NEAR(d.value(0.5e-6), std::exp(-0.5), 1e-12);
+  EXPECT_NEAR(d.value(2e-6), std::exp(-2.0) + (1 - std::exp(-1.0)), 1e-12);
+}
+
+// PWL td= delays the whole list; r= repeats from that time point to the last, for ever.
+TEST(SourceFunction, PwlDelayAndRepeat) {
+  auto c = card("v1", {"a", "0"}, {call("pwl", {0, 0, 1e-6, 1, 2e-6, 0})});
+  c.params.emplace_back("td", num(0.5e-6));
+  c.params.emplace_back("r", num(0));
+  auto f = SourceFunction::Parse(c);
+  ASSERT_TRUE(f) << f.status().message();
+  EXPECT_DOUBLE_EQ(f->value(0.25e-6), 0.0);  // before td: the first value
+  EXPECT_NEAR(f->value(1e-6), 0.5, 1e-12);
+  EXPECT_NEAR(f->value(3e-6), 0.5, 1e-12);  // 2.5 us into the list: 0.5 us into the repeat
+  EXPECT_NEAR(f->value(4e-6), 0.5, 1e-12);  // 3.5 us: 1.5 us into the 2 us period
+  std::vector<double> bp;
+  f->breakpoints(5e-6, bp);
+  const std::vector<double> want{0.5e-6, 1.5e-6, 2.5e-6, 3.5e-6, 4.5e-6};
+  ASSERT_EQ(bp.size(), want.size());
+  for (size_t i = 0; i < bp.size(); ++i) EXPECT_NEAR(bp[i], want[i], 1e-18);
+  c.params.back().second = num(1.5e-6);  // not one of the times
+  auto bad = SourceFunction::Parse(c);
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.status().message().find("must be one of the PWL's times"), std::string::npos);
+}
+
 TEST(SourceFunction, PwlInterpolatesAndHoldsEnds) {
   SourceFunction f = parse({call("pwl", {1e-9, 1, 3e-9, 5})});
   EXPECT_DOUBLE_EQ(f.value(0), 1.0);
@@ -49,13 +89,15 @@ TEST(SourceFunction, SinWithDelayDampingAndPhase) {
   SourceFunction f = parse({call("sin", {1, 2, 1e6, 1e-6, 1e5, 90})});
   EXPECT_DOUBLE_EQ(f.value(0), 3.0);  // before TD: VO + VA sin(phase)
   const double t = 1.3e-6, tt = 0.3e-6;
-  EXPECT_NEAR(f.value(t), 1 + 2 * std::exp(-tt * 1e5) * std::sin(2 * M_PI * 1e6 * tt + M_PI / 2), 1e-12);
+  EXPECT_NEAR(f.value(t), 1 + 2 * std::exp(-tt * 1e5) * std::sin(2 * M_PI * 1e6 * tt + M_PI / 2),
+              1e-12);
 }
 
 TEST(SourceFunction, DcForms) {
   EXPECT_DOUBLE_EQ(parse({num(2.5)}).value(1.0), 2.5);
   EXPECT_DOUBLE_EQ(parse({word("dc"), num(-1)}).value(1.0), -1.0);
-  EXPECT_DOUBLE_EQ(parse({word("dc"), num(0), word("ac"), num(1), call("pwl", {0, 0, 1, 4})}).value(0.5), 2.0);
+  EXPECT_DOUBLE_EQ(
+      parse({word("dc"), num(0), word("ac"), num(1), call("pwl", {0, 0, 1, 4})}).value(0.5), 2.0);
 }
 
 TEST(SourceFunction, BadFormsAreErrors) {
@@ -64,7 +106,7 @@ TEST(SourceFunction, BadFormsAreErrors) {
   };
   EXPECT_NE(bad({call("pwl", {0, 1, 1e-9})}).find("PWL takes time/value pairs"), std::string::npos);
   EXPECT_NE(bad({call("pulse", {0})}).find("PULSE takes 2 to 8 values"), std::string::npos);
-  EXPECT_NE(bad({call("exp", {0, 1})}).find("unknown source function 'exp'"), std::string::npos);
+  EXPECT_NE(bad({call("foo", {0, 1})}).find("unknown source function 'foo'"), std::string::npos);
   EXPECT_NE(bad({word("dc")}).find("expected a number after DC"), std::string::npos);
 }
 

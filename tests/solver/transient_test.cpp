@@ -1,10 +1,10 @@
 // Transient engine against closed-form answers.
 #include "solver/transient.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
-
-#include <gtest/gtest.h>
 
 #include "test_cards.h"
 
@@ -17,7 +17,8 @@ struct SimResult {
   TransientStats stats;
 };
 
-SimResult simulate(const std::vector<Card>& cards, TransientOptions opt, std::vector<std::string> probes) {
+SimResult simulate(const std::vector<Card>& cards, TransientOptions opt,
+                   std::vector<std::string> probes) {
   Circuit c;
   EXPECT_EQ(build(c, cards), "");
   std::vector<Probe> ps;
@@ -44,9 +45,10 @@ class Methods : public ::testing::TestWithParam<IntegrationMethod> {};
 TEST_P(Methods, RcChargeFollowsExponential) {
   const double r = 1e3, cap = 1e-9, tau = r * cap, tr = 1e-9;
   TransientOptions opt{.tstep = 10e-9, .tstop = 5e-6, .method = GetParam(), .reltol = 1e-4};
-  SimResult run = simulate({card("v1", {"in", "0"}, {call("pulse", {0, 1, 0, tr, tr, 1, 2})}),
-                      card("r1", {"in", "out"}, {num(r)}), card("c1", {"out", "0"}, {num(cap)})},
-                     opt, {"v(out)"});
+  SimResult run =
+      simulate({card("v1", {"in", "0"}, {call("pulse", {0, 1, 0, tr, tr, 1, 2})}),
+                card("r1", {"in", "out"}, {num(r)}), card("c1", {"out", "0"}, {num(cap)})},
+               opt, {"v(out)"});
   ASSERT_GT(run.w.samples(), 50u);
   double worst = 0;
   for (size_t i = 0; i < run.w.samples(); ++i)
@@ -58,9 +60,10 @@ TEST_P(Methods, RcChargeFollowsExponential) {
 TEST_P(Methods, RlCurrentRisesWithTimeConstantLOverR) {
   const double r = 50, l = 10e-6, tau = l / r, tr = 1e-9;
   TransientOptions opt{.tstep = 10e-9, .tstop = 1e-6, .method = GetParam(), .reltol = 1e-4};
-  SimResult run = simulate({card("v1", {"in", "0"}, {call("pulse", {0, 1, 0, tr, tr, 1, 2})}),
-                      card("r1", {"in", "mid"}, {num(r)}), card("l1", {"mid", "0"}, {num(l)})},
-                     opt, {"i(l1)"});
+  SimResult run =
+      simulate({card("v1", {"in", "0"}, {call("pulse", {0, 1, 0, tr, tr, 1, 2})}),
+                card("r1", {"in", "mid"}, {num(r)}), card("l1", {"mid", "0"}, {num(l)})},
+               opt, {"i(l1)"});
   double worst = 0;
   for (size_t i = 0; i < run.w.samples(); ++i)
     worst = std::max(worst, std::fabs(run.w.columns[0][i] * r - lag_ramp(run.w.time[i], tau, tr)));
@@ -82,33 +85,41 @@ void check_rlc(IntegrationMethod m, double r) {
   const double l = 1e-6, c = 1e-9, tr = 1e-12;
   TransientOptions opt{.tstep = 1e-9, .tstop = 1e-6, .method = m, .reltol = 1e-5};
   SimResult run = simulate({card("v1", {"in", "0"}, {call("pulse", {0, 1, 0, tr, tr, 1, 2})}),
-                      card("r1", {"in", "a"}, {num(r)}), card("l1", {"a", "b"}, {num(l)}),
-                      card("c1", {"b", "0"}, {num(c)})},
-                     opt, {"v(b)"});
+                            card("r1", {"in", "a"}, {num(r)}), card("l1", {"a", "b"}, {num(l)}),
+                            card("c1", {"b", "0"}, {num(c)})},
+                           opt, {"v(b)"});
   double worst = 0;
   for (size_t i = 0; i < run.w.samples(); ++i)
-    worst = std::max(worst, std::fabs(run.w.columns[0][i] - rlc_step(run.w.time[i] - tr / 2, r, l, c)));
+    worst =
+        std::max(worst, std::fabs(run.w.columns[0][i] - rlc_step(run.w.time[i] - tr / 2, r, l, c)));
   EXPECT_LT(worst, 2e-3) << "R=" << r;
 }
 
-TEST_P(Methods, UnderdampedRlcRings) { check_rlc(GetParam(), 10.0); }   // zeta = 0.16
-TEST_P(Methods, OverdampedRlcCreeps) { check_rlc(GetParam(), 200.0); }  // zeta = 3.16
+TEST_P(Methods, UnderdampedRlcRings) {
+  check_rlc(GetParam(), 10.0);
+}  // zeta = 0.16
+TEST_P(Methods, OverdampedRlcCreeps) {
+  check_rlc(GetParam(), 200.0);
+}  // zeta = 3.16
 
 INSTANTIATE_TEST_SUITE_P(TrapAndGear, Methods,
-                         ::testing::Values(IntegrationMethod::Trapezoidal, IntegrationMethod::Gear2));
+                         ::testing::Values(IntegrationMethod::Trapezoidal,
+                                           IntegrationMethod::Gear2));
 
 TEST(Transient, CoupledInductorsInduceMTimesDiDt) {
   // 1 mA, 1 MHz through L1; open secondary (1 Mohm): v2 = M di1/dt.
   const double l = 100e-6, k = 0.9, m = k * l, f = 1e6, w = 2 * M_PI * f;
   TransientOptions opt{.tstep = 2e-9, .tstop = 3e-6, .reltol = 1e-5};
-  SimResult run = simulate({card("i1", {"0", "p"}, {call("sin", {0, 1e-3, f})}),
-                      card("l1", {"p", "0"}, {num(l)}), card("l2", {"s", "0"}, {num(l)}),
-                      card("k1", {}, {num(k)}, {"l1", "l2"}), card("r2", {"s", "0"}, {num(1e6)})},
-                     opt, {"v(s)", "v(p)"});
+  SimResult run =
+      simulate({card("i1", {"0", "p"}, {call("sin", {0, 1e-3, f})}),
+                card("l1", {"p", "0"}, {num(l)}), card("l2", {"s", "0"}, {num(l)}),
+                card("k1", {}, {num(k)}, {"l1", "l2"}), card("r2", {"s", "0"}, {num(1e6)})},
+               opt, {"v(s)", "v(p)"});
   double worst = 0;
   for (size_t i = 0; i < run.w.samples(); ++i) {
     const double t = run.w.time[i];
-    if (t < 1e-6) continue;  // the 1 Mohm / L2 start-up transient (tau = 0.1 ns) and DC offset die out
+    if (t < 1e-6)
+      continue;  // the 1 Mohm / L2 start-up transient (tau = 0.1 ns) and DC offset die out
     worst = std::max(worst, std::fabs(run.w.columns[0][i] - m * 1e-3 * w * std::cos(w * t)));
   }
   EXPECT_LT(worst, 0.565 * 5e-3);  // 0.5 % of the 0.565 V amplitude
@@ -118,11 +129,12 @@ TEST(Transient, TransformerVoltageRatioIsKTimesTurnsRatio) {
   // Open secondary (10 Mohm), L2 = 4 L1 (n = 2), k = 0.95: v2 / v1 = M / L1 = k n = 1.9.
   const double l1 = 100e-6, k = 0.95, f = 1e6;
   TransientOptions opt{.tstep = 2e-9, .tstop = 2e-6, .reltol = 1e-5};
-  SimResult run = simulate({card("v1", {"in", "0"}, {call("sin", {0, 1, f})}),
-                            card("r1", {"in", "p"}, {num(1)}),  // v(p): the primary's own voltage
-                            card("l1", {"p", "0"}, {num(l1)}), card("l2", {"s", "0"}, {num(4 * l1)}),
-                            card("k1", {}, {num(k)}, {"l1", "l2"}), card("r2", {"s", "0"}, {num(1e7)})},
-                           opt, {"v(s)", "v(p)"});
+  SimResult run =
+      simulate({card("v1", {"in", "0"}, {call("sin", {0, 1, f})}),
+                card("r1", {"in", "p"}, {num(1)}),  // v(p): the primary's own voltage
+                card("l1", {"p", "0"}, {num(l1)}), card("l2", {"s", "0"}, {num(4 * l1)}),
+                card("k1", {}, {num(k)}, {"l1", "l2"}), card("r2", {"s", "0"}, {num(1e7)})},
+               opt, {"v(s)", "v(p)"});
   double worst = 0;
   for (size_t i = 0; i < run.w.samples(); ++i)
     if (run.w.time[i] > 0.5e-6)
@@ -135,10 +147,11 @@ TEST(Transient, ShortedSecondaryLeavesTheLeakageInductance) {
   const double l1 = 260e-6, k = 0.99, f = 1e6, w = 2 * M_PI * f, amp = 1e-3;
   const double leak = l1 * (1 - k * k);  // 5.17 uH
   TransientOptions opt{.tstep = 1e-9, .tstop = 2e-6, .reltol = 1e-5};
-  SimResult run = simulate({card("i1", {"0", "p"}, {call("sin", {0, amp, f})}),
-                            card("l1", {"p", "0"}, {num(l1)}), card("l2", {"s", "0"}, {num(l1)}),
-                            card("k1", {}, {num(k)}, {"l1", "l2"}), card("r2", {"s", "0"}, {num(1e-3)})},
-                           opt, {"v(p)"});
+  SimResult run =
+      simulate({card("i1", {"0", "p"}, {call("sin", {0, amp, f})}),
+                card("l1", {"p", "0"}, {num(l1)}), card("l2", {"s", "0"}, {num(l1)}),
+                card("k1", {}, {num(k)}, {"l1", "l2"}), card("r2", {"s", "0"}, {num(1e-3)})},
+               opt, {"v(p)"});
   double worst = 0;
   for (size_t i = 0; i < run.w.samples(); ++i) {
     const double t = run.w.time[i];
@@ -169,7 +182,8 @@ TEST(Transient, LosslessLcLadderDelaysByNSqrtLC) {
   const auto& v = run.w.columns[0];
   for (size_t i = 1; i < v.size() && crossing == 0; ++i)
     if (v[i - 1] < 0.5 && v[i] >= 0.5)
-      crossing = run.w.time[i - 1] + (0.5 - v[i - 1]) / (v[i] - v[i - 1]) * (run.w.time[i] - run.w.time[i - 1]);
+      crossing = run.w.time[i - 1] +
+                 (0.5 - v[i - 1]) / (v[i] - v[i - 1]) * (run.w.time[i] - run.w.time[i - 1]);
   const double delay = crossing - td - tr / 2;
   EXPECT_NEAR(delay, sections * std::sqrt(l * c), 0.02 * sections * std::sqrt(l * c));
   EXPECT_NEAR(v.back(), 1.0, 0.01);  // matched: half the 2 V source
@@ -210,9 +224,10 @@ TEST(Transient, RingingCurrentDoesNotHoldTheStepDownAtItsZeroCrossings) {
 TEST(Transient, RepeatedStepSizesReuseFactorizations) {
   // A square wave: the same step sizes recur every period.
   TransientOptions opt{.tstep = 5e-9, .tstop = 20e-6};
-  SimResult run = simulate({card("v1", {"in", "0"}, {call("pulse", {0, 5, 0, 10e-9, 10e-9, 240e-9, 500e-9})}),
-                      card("r1", {"in", "out"}, {num(49)}), card("c1", {"out", "0"}, {num(220e-12)})},
-                     opt, {"v(out)"});
+  SimResult run =
+      simulate({card("v1", {"in", "0"}, {call("pulse", {0, 5, 0, 10e-9, 10e-9, 240e-9, 500e-9})}),
+                card("r1", {"in", "out"}, {num(49)}), card("c1", {"out", "0"}, {num(220e-12)})},
+               opt, {"v(out)"});
   EXPECT_GT(run.stats.accepted, 400);
   EXPECT_LT(run.stats.factorizations, run.stats.accepted / 4);
   EXPECT_GT(run.stats.reuses, run.stats.accepted / 2);
@@ -220,9 +235,10 @@ TEST(Transient, RepeatedStepSizesReuseFactorizations) {
 
 TEST(Transient, OneRowPerAcceptedStepWithIncreasingTimes) {
   TransientOptions opt{.tstep = 1e-9, .tstop = 200e-9, .tstart = 50e-9};
-  SimResult run = simulate({card("v1", {"in", "0"}, {call("pwl", {0, 0, 10e-9, 1, 100e-9, 1, 110e-9, 0})}),
-                      card("r1", {"in", "out"}, {num(100)}), card("c1", {"out", "0"}, {num(1e-10)})},
-                     opt, {"v(out)", "v(in,out)"});
+  SimResult run =
+      simulate({card("v1", {"in", "0"}, {call("pwl", {0, 0, 10e-9, 1, 100e-9, 1, 110e-9, 0})}),
+                card("r1", {"in", "out"}, {num(100)}), card("c1", {"out", "0"}, {num(1e-10)})},
+               opt, {"v(out)", "v(in,out)"});
   ASSERT_GT(run.w.samples(), 10u);
   EXPECT_GE(run.w.time.front(), 50e-9 - 1e-18);
   for (size_t i = 1; i < run.w.samples(); ++i) EXPECT_GT(run.w.time[i], run.w.time[i - 1]);
@@ -234,18 +250,110 @@ TEST(Transient, OneRowPerAcceptedStepWithIncreasingTimes) {
 
 TEST(Transient, RowCountIsAcceptedStepsPlusTheDcPoint) {
   TransientOptions opt{.tstep = 1e-9, .tstop = 200e-9};
-  SimResult run = simulate({card("v1", {"in", "0"}, {call("pwl", {0, 0, 10e-9, 1})}),
-                      card("r1", {"in", "out"}, {num(100)}), card("c1", {"out", "0"}, {num(1e-10)})},
-                     opt, {"v(out)"});
+  SimResult run =
+      simulate({card("v1", {"in", "0"}, {call("pwl", {0, 0, 10e-9, 1})}),
+                card("r1", {"in", "out"}, {num(100)}), card("c1", {"out", "0"}, {num(1e-10)})},
+               opt, {"v(out)"});
   EXPECT_EQ(static_cast<long>(run.w.samples()), run.stats.accepted + 1);
   EXPECT_EQ(run.w.time.front(), 0.0);
 }
 
+// .ic without UIC: the node is held while the DC point is solved, then released.
+// V1 = 1 V, R1 = R3 = 1k, C = 1n at out: v(out) = 0.5 + (2 - 0.5) exp(-t / 0.5 us).
+TEST(Transient, InitialConditionHoldsTheNodeOnlyForTheOperatingPoint) {
+  Circuit c;
+  ASSERT_EQ(build(c, {card("v1", {"in", "0"}, {num(1)}), card("r1", {"in", "out"}, {num(1e3)}),
+                      card("r3", {"out", "0"}, {num(1e3)}), card("c1", {"out", "0"}, {num(1e-9)})}),
+            "");
+  TransientOptions opt{.tstep = 10e-9, .tstop = 3e-6};
+  opt.node_ic = {{c.find_node("out"), 2.0}};
+  auto probe = parse_probe(c, "v(out)");
+  auto w = run_transient(c, opt, {*probe});
+  ASSERT_TRUE(w) << w.status().message();
+  EXPECT_EQ(w->columns[0][0], 2.0);
+  double worst = 0;
+  for (size_t i = 0; i < w->samples(); ++i)
+    worst =
+        std::max(worst, std::fabs(w->columns[0][i] - (0.5 + 1.5 * std::exp(-w->time[i] / 0.5e-6))));
+  EXPECT_LT(worst, 1.5e-3);  // 0.1 % of the 1.5 V swing
+}
+
+// UIC: C1 = 1n with ic=1 V discharges through 1k; L1 = 1 mH with ic=1 mA decays through 1k.
+TEST(Transient, UicStartsFromTheElementsInitialConditions) {
+  auto cap = card("c1", {"a", "0"}, {num(1e-9)});
+  cap.params.emplace_back("ic", num(1.0));
+  auto ind = card("l1", {"b", "0"}, {num(1e-3)});
+  ind.params.emplace_back("ic", num(1e-3));
+  TransientOptions opt{.tstep = 10e-9, .tstop = 4e-6, .uic = true};
+  SimResult run =
+      simulate({cap, card("r1", {"a", "0"}, {num(1e3)}), ind, card("r2", {"b", "0"}, {num(1e3)})},
+               opt, {"v(a)", "i(l1)"});
+  ASSERT_GT(run.w.samples(), 20u);
+  double worst_v = 0, worst_i = 0;
+  for (size_t i = 1; i < run.w.samples(); ++i) {
+    const double e = std::exp(-run.w.time[i] / 1e-6);
+    worst_v = std::max(worst_v, std::fabs(run.w.columns[0][i] - e));
+    worst_i = std::max(worst_i, std::fabs(run.w.columns[1][i] - 1e-3 * e));
+  }
+  EXPECT_LT(worst_v, 1e-3);
+  EXPECT_LT(worst_i, 1e-6);
+}
+
+// A 10 ns RC charged from 0 V with UIC under a 1 us step limit: the first steps after t = 0
+// (a tenth of tmax, then doubling) were never error-checked and ended 9 % off; the first step
+// is now checked with the second step's point.
+TEST(Transient, FirstStepsAfterABreakpointAreErrorControlled) {
+  for (IntegrationMethod m : {IntegrationMethod::Trapezoidal, IntegrationMethod::Gear2}) {
+    TransientOptions opt{.tstep = 1e-6, .tstop = 20e-6, .method = m, .uic = true};
+    SimResult run =
+        simulate({card("v1", {"in", "0"}, {num(1)}), card("r1", {"in", "out"}, {num(10)}),
+                  card("c1", {"out", "0"}, {num(1e-9)})},
+                 opt, {"v(out)"});
+    double worst = 0;
+    for (size_t i = 1; i < run.w.samples(); ++i)
+      worst =
+          std::max(worst, std::fabs(run.w.columns[0][i] - (1 - std::exp(-run.w.time[i] / 10e-9))));
+    EXPECT_LT(worst, 2e-3) << (m == IntegrationMethod::Gear2 ? "gear" : "trap");
+    EXPECT_GT(run.stats.rejected, 0);
+  }
+}
+
+// A voltage source across an inductor: i(l1) = integral of v / L, from 0 A.
+TEST(Transient, VoltageSourceAcrossAnInductorIntegrates) {
+  TransientOptions opt{.tstep = 10e-9, .tstop = 10e-6};
+  SimResult run =
+      simulate({card("v1", {"a", "0"}, {call("pwl", {0, 0, 1e-9, 1})}),
+                card("l1", {"a", "0"}, {num(1e-3)}), card("r1", {"a", "0"}, {num(1e3)})},
+               opt, {"i(l1)"});
+  ASSERT_GT(run.w.samples(), 10u);
+  EXPECT_EQ(run.w.columns[0][0], 0.0);
+  EXPECT_NEAR(run.w.columns[0].back(), (10e-6 - 0.5e-9) / 1e-3, 1e-8);
+}
+
+// Non-finite values never reach an output: the run stops, naming the time and the unknown.
+TEST(Transient, NonFiniteSolutionStopsTheRun) {
+  Circuit c;
+  ASSERT_EQ(build(c, {card("v1", {"a", "0"}, {num(1e300)}), card("r1", {"a", "0"}, {num(1e-300)})}),
+            "");
+  TransientOptions opt{.tstep = 1e-9, .tstop = 1e-6};
+  auto w = run_transient(c, opt, {*parse_probe(c, "v(a)")});
+  ASSERT_FALSE(w);
+  const std::string& m = w.status().message();
+  EXPECT_NE(m.find("non-finite value ("), std::string::npos) << m;
+  EXPECT_NE(m.find(") in the solution at t=0 s (the DC operating point): "), std::string::npos)
+      << m;
+  EXPECT_TRUE(m.find("node a;") != std::string::npos ||
+              m.find("current of v1;") != std::string::npos)
+      << m;
+  EXPECT_NE(m.find("; likely cause: "), std::string::npos) << m;
+}
+
 TEST(Transient, TmaxBoundsTheStep) {
   TransientOptions opt{.tstep = 1e-9, .tstop = 1e-6, .tmax = 7e-9};
-  SimResult run = simulate({card("v1", {"in", "0"}, {num(1)}), card("r1", {"in", "out"}, {num(1e3)}),
-                      card("c1", {"out", "0"}, {num(1e-9)})},
-                     opt, {"v(out)"});
+  SimResult run =
+      simulate({card("v1", {"in", "0"}, {num(1)}), card("r1", {"in", "out"}, {num(1e3)}),
+                card("c1", {"out", "0"}, {num(1e-9)})},
+               opt, {"v(out)"});
   for (size_t i = 1; i < run.w.samples(); ++i)
     EXPECT_LE(run.w.time[i] - run.w.time[i - 1], 7e-9 * (1 + 1e-9));
   EXPECT_NEAR(run.w.columns[0].back(), 1.0, 1e-9);  // DC point: already charged
@@ -253,9 +361,9 @@ TEST(Transient, TmaxBoundsTheStep) {
 
 TEST(Transient, DcOperatingPointOfADivider) {
   Circuit c;
-  ASSERT_EQ(build(c, {card("v1", {"in", "0"}, {word("dc"), num(5)}), card("r1", {"in", "mid"}, {num(3e3)}),
-                      card("r2", {"mid", "0"}, {num(2e3)}), card("l1", {"mid", "x"}, {num(1e-6)}),
-                      card("r3", {"x", "0"}, {num(1e9)})}),
+  ASSERT_EQ(build(c, {card("v1", {"in", "0"}, {word("dc"), num(5)}),
+                      card("r1", {"in", "mid"}, {num(3e3)}), card("r2", {"mid", "0"}, {num(2e3)}),
+                      card("l1", {"mid", "x"}, {num(1e-6)}), card("r3", {"x", "0"}, {num(1e9)})}),
             "");
   auto x = dc_operating_point(c);
   ASSERT_TRUE(x.ok()) << x.status().message();
@@ -266,10 +374,11 @@ TEST(Transient, DcOperatingPointOfADivider) {
 
 TEST(Transient, FloatingNodeBetweenSeriesCapsIsTiedAndWarned) {
   Circuit c;
-  ASSERT_EQ(build(c, {card("v1", {"in", "0"}, {call("pulse", {0, 5, 0, 1e-9, 1e-9, 100e-9, 200e-9})}),
-                      card("c1", {"in", "mid"}, {num(2.2e-9)}), card("c2", {"mid", "out"}, {num(2.2e-9)}),
-                      card("r1", {"out", "0"}, {num(1e3)})}),
-            "");
+  ASSERT_EQ(
+      build(c, {card("v1", {"in", "0"}, {call("pulse", {0, 5, 0, 1e-9, 1e-9, 100e-9, 200e-9})}),
+                card("c1", {"in", "mid"}, {num(2.2e-9)}), card("c2", {"mid", "out"}, {num(2.2e-9)}),
+                card("r1", {"out", "0"}, {num(1e3)})}),
+      "");
   ASSERT_EQ(c.floating_nodes().size(), 1u);
   ASSERT_EQ(c.warnings().size(), 1u);
   EXPECT_NE(c.warnings()[0].find("mid"), std::string::npos);

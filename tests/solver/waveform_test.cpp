@@ -1,10 +1,10 @@
 #include "base/waveform.h"
 
+#include <gtest/gtest.h>
+
 #include <cstdio>
 #include <fstream>
 #include <sstream>
-
-#include <gtest/gtest.h>
 
 namespace isolink {
 namespace {
@@ -29,7 +29,7 @@ TEST(Waveform, CsvHasHeaderAndRows) {
   std::ifstream in(path);
   std::stringstream ss;
   ss << in.rdbuf();
-  EXPECT_EQ(ss.str(), "time,v(a,b)\n0,1.5\n1e-09,-2\n");
+  EXPECT_EQ(ss.str(), "time,\"v(a,b)\"\n0,1.5\n1e-09,-2\n");  // RFC 4180 quoting
   EXPECT_FALSE(write_waveform_csv(w, "/nonexistent-dir/x.csv").ok());
 }
 

@@ -192,7 +192,8 @@ TEST(SweepSim, ResumeSkipsThePointsAlreadyDone) {
   // --keep-waves: the point that ran has its waveforms.
   EXPECT_FALSE(fs::exists(dir + "/out/waves/point_00000.csv"));
   ASSERT_TRUE(fs::exists(dir + "/out/waves/point_00001.csv"));
-  EXPECT_EQ(slurp(dir + "/out/waves/point_00001.csv").substr(0, 24), "time,down v(rxp,rxn),dow");
+  EXPECT_EQ(slurp(dir + "/out/waves/point_00001.csv").substr(0, 26),
+            "time,\"down v(rxp,rxn)\",dow");
 }
 
 TEST(SweepSim, MonteCarloWritesTheHistogramAndYield) {

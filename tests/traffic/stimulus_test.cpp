@@ -31,6 +31,22 @@ TEST(ParseTime, SpiceSuffixes) {
   EXPECT_NE(parse_time("10nsec").status().message().find("trailing text"), std::string::npos);
 }
 
+// Times come from the one scanner (base/si_number.h): its whole suffix set, exact decimals, and
+// the traffic rule on top (the unit may only be "s").
+TEST(ParseTime, SharedScannerRules) {
+  EXPECT_EQ(*parse_time("1mil"), 25.4e-6);
+  EXPECT_EQ(*parse_time("2t"), 2e12);
+  EXPECT_EQ(*parse_time("1u5"), 1.5e-6);  // RKM
+  EXPECT_EQ(*parse_time(" 20US "), 20e-6);
+  EXPECT_EQ(*parse_time("1megs"), 1e6);
+  EXPECT_EQ(*parse_time("-1n"), -1e-9);  // the sign is read; callers check the range
+  EXPECT_FALSE(parse_time("1e").ok());
+  EXPECT_FALSE(parse_time("1nF").ok());
+  EXPECT_NE(parse_time("10 us").status().message().find("unknown unit suffix ' us'"),
+            std::string::npos);
+  EXPECT_NE(parse_time("1e400").status().message().find("not a finite time"), std::string::npos);
+}
+
 TEST(Stimulus, ScriptBuildsItemsInOrder) {
   StatusOr<Drive> d = build_drive(
       "wake couplets=2; stack-read reg=0x0215 n=12 # comment\n"
@@ -87,6 +103,27 @@ TEST(Stimulus, ErrorsNameTheItem) {
   d = build_drive(" ; # only a comment");
   ASSERT_FALSE(d.ok());
   EXPECT_NE(d.status().message().find("stimulus is empty"), std::string::npos);
+}
+
+TEST(Stimulus, GapSetsTheIdleBeforeTheNextItemExactly) {
+  // gap replaces the 1 us lead and the 12 us frame gap; idle still adds to it.
+  StatusOr<Drive> d = build_drive(
+      "gap 2u; raw 5A nocrc; gap 3.85u; raw 35 nocrc err; "
+      "idle 1u; gap 4u; raw 00 nocrc");
+  ASSERT_TRUE(d.ok()) << d.status().message();
+  ASSERT_EQ(d->frames.size(), 3u);
+  const double frame = 6.5e-6;
+  EXPECT_NEAR(d->frames[0].start, 2e-6, 1e-15);
+  EXPECT_NEAR(d->frames[1].start, 2e-6 + frame + 3.85e-6, 1e-15);
+  EXPECT_NEAR(d->frames[2].start, d->frames[1].end + 5e-6, 1e-15);
+  // err: the second byte carries the error bit: its last bit is (+, -), so the half bit before
+  // the postamble is -, touching it (one 500 ns negative pulse at the end).
+  EXPECT_EQ(d->level_at(d->frames[1].end - 0.6e-6), +1);
+  EXPECT_EQ(d->level_at(d->frames[1].end - 0.4e-6), -1);
+  EXPECT_EQ(d->level_at(d->frames[0].end - 0.4e-6), +1);  // 0x5A with error bit 0: (-, +)
+  EXPECT_FALSE(build_drive("gap -1u; raw 00 nocrc").ok());
+  EXPECT_NE(build_drive("gap; raw 00").status().message().find("gap: expected one time"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -1,0 +1,250 @@
+#include "analysis/pack.h"
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+
+#include "analysis/sweep_run.h"
+#include "base/hex.h"
+#include "netlists/link/cable.h"
+#include "netlists/link/expand.h"
+#include "netlists/spice_writer.h"
+#include "netlists/traffic/command.h"
+
+namespace isolink::analysis {
+
+namespace {
+
+std::vector<int> range(int a, int b, int step) {  // a, a + step, ... through b
+  std::vector<int> out;
+  for (int k = a; step > 0 ? k <= b : k >= b; k += step) out.push_back(k);
+  return out;
+}
+
+// The dedupe key of an expanded direction: its circuit and traffic as SPICE text (the title names
+// the spec and is left out), the receiver's rules and the bytes it must decode.
+std::string circuit_key(const link::ExpandedLink& x) {
+  Netlist n = x.netlist;
+  n.title.clear();
+  std::string key = write_spice(n);
+  key += "\n* rules " + x.rules + "\n* expect " + to_hex(x.expected) + "\n";
+  return key;
+}
+
+// Whether a hop's traffic asks for responses (reads), so that it carries both directions.
+bool has_reads(const link::LinkSpec& spec) {
+  for (const std::string& f : spec.stimulus.frames) {
+    StatusOr<traffic::Command> c = traffic::parse_command(f);
+    if (c && traffic::is_read(c->kind)) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+std::vector<BreakCase> ring_breaks(int n, bool ring) {
+  std::vector<BreakCase> out;
+  const int last = ring ? n + 1 : n;
+  for (int b = 0; b <= last; ++b) {
+    BreakCase c;
+    c.broken = b;
+    const int top_normal = b == 0 || b == n + 1 ? n : b - 1;  // devices 1..top_normal
+    c.normal_side = range(1, top_normal, 1);
+    for (int h = 1; h <= top_normal; ++h) c.carried.push_back({h, false});
+    if (b >= 1 && b <= n) {
+      if (ring) {
+        c.reverse_side = range(n, b, -1);
+        c.carried.push_back({n + 1, false});
+        for (int h = n; h >= b + 1; --h) c.carried.push_back({h, true});
+      } else {
+        c.unreached = range(b, n, 1);
+      }
+    }
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+StatusOr<PackTiming> pack_timing(const PackSpec& pack) {
+  PackTiming t;
+  const TimingSpec& ts = pack.timing;
+  const int n = pack.chain_hops();
+  for (const HopSpec& h : pack.hops) {
+    StatusOr<link::CableModel> m = link::cable_model(h.spec.cable);
+    if (!m) return m.status().with_context(fmt::format("hop {}", h.index));
+    t.cable_delay.push_back(h.spec.cable.length / m->velocity());
+  }
+  if (pack.hops.empty()) return t;
+  // Cable delay from the bridge to device k (k = 0..n), either way round the ring.
+  std::vector<double> up(n + 1, 0.0), down(n + 2, 0.0);
+  for (int k = 1; k <= n; ++k) up[k] = up[k - 1] + t.cable_delay[k - 1];
+  const bool ring = pack.ring && static_cast<int>(t.cable_delay.size()) > n;
+  if (ring) {
+    down[n] = t.cable_delay[n];  // the return hop
+    for (int k = n - 1; k >= 1; --k) down[k] = down[k + 1] + t.cable_delay[k];
+  }
+  for (bool reversed : {false, true}) {
+    if (reversed && !ring) break;
+    // Device k has the whole command after the bridge's byte delay, the re-clock of every stack
+    // device before it and the cables on the way.
+    auto cable = [&](int k) { return reversed ? down[k] : up[k]; };
+    auto before = [&](int k) { return reversed ? n - k : k - 1; };
+    for (const std::string& text : pack.hops.front().spec.stimulus.frames) {
+      CommandTiming c;
+      c.command = text;
+      c.reversed = reversed;
+      for (int k = 1; k <= n; ++k)
+        c.arrival.push_back(ts.bridge_delay + ts.device_delay * before(k) + cable(k));
+      StatusOr<traffic::Command> cmd = traffic::parse_command(text);
+      if (cmd && traffic::is_read(cmd->kind)) {
+        c.read = true;
+        if (cmd->kind == traffic::CommandKind::kSingleRead) {
+          if (cmd->device >= 1 && cmd->device <= n)
+            c.responders = {cmd->device};
+          else
+            c.note =
+                fmt::format("device {} is not in the stack (1..{}): no response", cmd->device, n);
+        } else {
+          c.responders = range(1, n, 1);
+        }
+        // Each response (read_bytes + 6 bytes: header, device, register, data, CRC) leaves its
+        // device response_delay after the command is complete; its first byte reaches the bridge
+        // one chain byte later plus the re-clock and cables on the way down. The UART back to
+        // the host (uart_byte per byte) is slower than the chain, so the bridge sends each
+        // response as one UART burst from its first byte on, one response after another.
+        const int bytes = cmd->read_bytes + 6;
+        std::vector<double> first;
+        for (int k : c.responders)
+          first.push_back(c.arrival[k - 1] + ts.response_delay + ts.chain_byte +
+                          ts.device_delay * before(k) + cable(k));
+        std::sort(first.begin(), first.end());
+        double end = 0;
+        for (double a : first) end = std::max(end, a) + bytes * ts.uart_byte;
+        if (!first.empty()) c.response_done = end;
+        c.late = ts.timeout && (first.empty() || end > *ts.timeout);
+      }
+      t.commands.push_back(std::move(c));
+    }
+  }
+  return t;
+}
+
+StatusOr<PackResult> run_pack(const PackSpec& pack, const link::PartLibrary& parts,
+                              const PackOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  PackResult out;
+  // Expand every hop in every direction it carries; keep one run per distinct circuit.
+  std::vector<std::vector<link::ExpandedLink>> own(pack.hops.size());  // per hop and direction
+  struct Distinct {
+    link::ExpandedLink link;
+    StatusOr<DirectionRun> run = Status::Error("not run");
+  };
+  std::vector<Distinct> distinct;
+  std::map<std::string, int> by_key;
+  for (const HopSpec& h : pack.hops) {
+    HopResult hr;
+    hr.index = h.index;
+    std::vector<link::Direction> dirs = h.spec.stimulus.directions;
+    if (pack.ring) dirs = {link::Direction::kDown, link::Direction::kUp};
+    for (link::Direction d : dirs) {
+      StatusOr<link::ExpandedLink> ex = link::expand_link(h.spec, parts, d, opt.run.expand);
+      if (!ex) return ex.status().with_context(fmt::format("hop {}", h.index));
+      ++out.expansions;
+      // A symmetric hop's up direction is the same circuit as its down (node names follow the
+      // roles), so it dedupes too.
+      const std::string key = circuit_key(*ex);
+      auto [it, added] = by_key.emplace(key, static_cast<int>(distinct.size()));
+      if (added) distinct.push_back({*ex, Status::Error("not run")});
+      hr.runs.push_back(it->second);
+      own[out.hops.size()].push_back(std::move(*ex));
+    }
+    out.hops.push_back(std::move(hr));
+  }
+  out.simulations = static_cast<int>(distinct.size());
+
+  const DirectionRunner runner =
+      opt.runner ? opt.runner : DirectionRunner([](link::ExpandedLink x, const RunOptions& o) {
+        return run_direction(std::move(x), o);
+      });
+  tbb::task_arena arena(opt.jobs > 0 ? opt.jobs : tbb::task_arena::automatic);
+  arena.execute([&] {
+    tbb::parallel_for(size_t{0}, distinct.size(),
+                      [&](size_t i) { distinct[i].run = runner(distinct[i].link, opt.run); });
+  });
+  for (const Distinct& d : distinct)
+    if (!d.run) return d.run.status();
+
+  // Per hop: its directions, verdict and worst margin.
+  out.pass = true;
+  double weakest_rel = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < out.hops.size(); ++i) {
+    HopResult& hr = out.hops[i];
+    hr.run.pass = true;
+    for (size_t k = 0; k < hr.runs.size(); ++k) {
+      const int r = hr.runs[k];
+      hr.run.directions.push_back(*distinct[r].run);
+      hr.run.directions.back().link = own[i][k];  // this hop's direction, names and BOM
+      hr.run.pass = hr.run.pass && distinct[r].run->pass;
+      hr.run.seconds += distinct[r].run->sim.seconds;
+    }
+    hr.pass = hr.run.pass;
+    out.pass = out.pass && hr.pass;
+    hr.same_as = hr.index;
+    for (size_t j = 0; j < i; ++j)
+      if (out.hops[j].runs == hr.runs) {
+        hr.same_as = out.hops[j].index;
+        break;
+      }
+    for (const DirectionRun& d : hr.run.directions) {
+      LinkRun one;
+      one.pass = d.pass;
+      one.directions.push_back(d);
+      const sweep::PointResult s = sweep::score_run(one);
+      if (std::isnan(hr.worst_rel) || s.worst_rel < hr.worst_rel) {
+        hr.worst_rel = s.worst_rel;
+        hr.worst_metric = s.worst_metric;
+        hr.worst_direction = link::direction_name(d.link.direction);
+      }
+    }
+    // A failing hop is weaker than any passing one.
+    const double rank = (hr.pass ? 0.0 : -1e9) + (std::isnan(hr.worst_rel) ? -1.0 : hr.worst_rel);
+    if (rank < weakest_rel) weakest_rel = rank, out.weakest = hr.index;
+  }
+
+  // Ring breaks: every hop still carrying traffic must pass in the directions it now carries.
+  for (const BreakCase& c : ring_breaks(pack.chain_hops(), pack.ring)) {
+    BreakResult b;
+    b.c = c;
+    b.pass = true;
+    for (const BreakCase::Use& u : c.carried) {
+      const HopSpec& h = pack.hops[u.hop - 1];
+      const HopResult& hr = out.hops[u.hop - 1];
+      const link::Direction command = u.reversed ? link::Direction::kUp : link::Direction::kDown;
+      const link::Direction reply = u.reversed ? link::Direction::kDown : link::Direction::kUp;
+      for (const DirectionRun& d : hr.run.directions) {
+        const bool needed =
+            d.link.direction == command || (d.link.direction == reply && has_reads(h.spec));
+        if (needed && !d.pass) {
+          b.pass = false;
+          b.failing.push_back(fmt::format("hop {} {} ({})", u.hop,
+                                          u.reversed ? "reversed" : "normal",
+                                          link::direction_name(d.link.direction)));
+        }
+      }
+    }
+    out.breaks.push_back(std::move(b));
+  }
+
+  StatusOr<PackTiming> timing = pack_timing(pack);
+  if (!timing) return timing.status();
+  out.timing = std::move(*timing);
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+}  // namespace isolink::analysis

@@ -1,0 +1,825 @@
+#include "analysis/worst.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include "netlists/traffic/command.h"
+#include "netlists/traffic/encoding.h"
+#include "solver/circuit.h"
+#include "solver/probe.h"
+#include "solver/transient.h"
+
+namespace isolink::analysis {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr int kMetrics = 5;
+const std::array<const char*, kMetrics> kNames{"vstart", "vend", "width_min", "width_max", "edge"};
+constexpr double kLead = 1e-6;  // idle before the replayed traffic (the drive's default lead)
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+long to_samples(double t, double dt) {
+  return std::lround(t / dt);
+}
+
+// A byte pattern: byte | error_bit << 8.
+ByteFrame pattern_frame(int pattern) {
+  return {static_cast<uint8_t>(pattern & 0xFF), (pattern >> 8) & 1};
+}
+
+// The level changes of one byte frame starting at sample `start`: (sample, dL).
+void frame_edges(const ByteFrame& f, const traffic::EncodingOptions& enc, long start, long half,
+                 std::vector<std::pair<long, int>>& out) {
+  traffic::EncodingOptions e = enc;
+  e.error_bit = f.error_bit;
+  const std::vector<int> h = traffic::byte_half_bits(f.byte, e);
+  int prev = 0;
+  for (size_t k = 0; k <= h.size(); ++k) {
+    const int level = k < h.size() ? h[k] : 0;
+    if (level != prev) out.push_back({start + static_cast<long>(k) * half, level - prev});
+    prev = level;
+  }
+}
+
+// v[i] += sum dL E(origin + i - n_edge) for i in [0, v.size()): the record of E where it
+// overlaps, its last value after it (a running sum, so long records cost what E's length does).
+void add_edges(const EdgeResponse& e, const std::vector<std::pair<long, int>>& edges, long origin,
+               std::vector<double>& v) {
+  const long n = static_cast<long>(v.size());
+  std::vector<double> step(static_cast<size_t>(n) + 1, 0.0);
+  for (const auto& [at, dl] : edges) {
+    const long zero = at - origin - e.pre;  // window sample of e[0]; E is 0 before it
+    const long first = std::max(0L, zero);
+    const long body_end = std::min(n, zero + static_cast<long>(e.e.size()));
+    for (long i = first; i < body_end; ++i)
+      v[static_cast<size_t>(i)] += dl * e.e[static_cast<size_t>(i - zero)];
+    step[static_cast<size_t>(std::min(n, std::max(first, body_end)))] += e.e.back() * dl;
+  }
+  double level = 0;
+  for (long i = 0; i < n; ++i) {
+    level += step[static_cast<size_t>(i)];
+    v[static_cast<size_t>(i)] += level;
+  }
+}
+
+// Per-metric "key": lower is worse. vstart, vend: the value; width_min: width - window min;
+// width_max: window max - width; edge: limit - edge.
+struct PulseScore {
+  double key = kInf;
+  double value = 0, limit = 0, margin = 0;
+  size_t pulse = 0;
+  double a = 0;  // in the scored window (s)
+  int sign = 0;
+  std::string role;
+  bool valid() const { return key < kInf; }
+};
+
+struct Score {
+  std::array<PulseScore, kMetrics> m;
+  bool pass = true;
+  std::string reason;  // first failure reason of the check
+};
+
+const eye::WidthWindow* nearest_window(const eye::Rules& r, int k) {
+  const eye::WidthWindow* best = nullptr;
+  for (const eye::WidthWindow& w : r.width)
+    if (!best || std::abs(w.k - k) < std::abs(best->k - k)) best = &w;
+  return best;
+}
+
+// Scores the pulses of a checked window (all of them belong to the target frame).
+Score score_check(const eye::CheckResult& c, const eye::Rules& rules) {
+  Score s;
+  s.pass = c.pass;
+  if (!c.pass) s.reason = c.reasons.empty() ? "fails its rules" : c.reasons.front();
+  auto offer = [&](int m, double key, double value, double limit, const eye::PulseMetrics& p) {
+    if (!std::isfinite(key) || key >= s.m[m].key) return;
+    s.m[m] = {key, value, limit, 0, p.index, p.a, p.sign, p.role};
+  };
+  for (const eye::PulseMetrics& p : c.pulses) {
+    if (p.truncated) continue;
+    if (p.vstart.measured()) {
+      const double lim = p.vstart.judged() ? p.vstart.limit : rules.vstart_min;
+      offer(0, p.vstart.value, p.vstart.value, lim, p);
+    }
+    if (p.vend.measured()) offer(1, p.vend.value, p.vend.value, rules.vend_min, p);
+    if (!p.idle && p.width.measured()) {
+      if (const eye::WidthWindow* w = nearest_window(rules, std::max(p.k, 1))) {
+        offer(2, p.width.value - w->min, p.width.value, w->min, p);
+        offer(3, w->max - p.width.value, p.width.value, w->max, p);
+      }
+    }
+    if (p.edge.measured()) offer(4, rules.edge_max - p.edge.value, p.edge.value, rules.edge_max, p);
+  }
+  for (int m = 0; m < kMetrics; ++m) {
+    PulseScore& ps = s.m[m];
+    if (!ps.valid()) continue;
+    ps.margin = (m == 0 || m == 1 || m == 2) ? ps.value - ps.limit : ps.limit - ps.value;
+  }
+  return s;
+}
+
+// The search over one direction.
+class Search {
+ public:
+  Search(const EdgeResponse& e, const eye::Rules& rules, const WorstOptions& opt)
+      : e_(e), rules_(rules), opt_(opt), enc_(opt.expand.stimulus.encoding) {
+    half_ = to_samples(enc_.half_bit, e.dt);
+    frame_ = half_ * traffic::byte_half_bit_count(enc_);
+    pre_ = to_samples(300e-9, e.dt);
+    post_ = to_samples(1.5e-6, e.dt);
+    len_ = pre_ + frame_ + post_;
+    t_.resize(static_cast<size_t>(len_));
+    for (long i = 0; i < len_; ++i) t_[static_cast<size_t>(i)] = static_cast<double>(i) * e.dt;
+  }
+
+  long half() const { return half_; }
+  long frame() const { return frame_; }
+  long pre() const { return pre_; }
+  long len() const { return len_; }
+
+  // The target frame's own waveform (history idle) on the window; target starts at sample pre_.
+  std::vector<double> target_wave(int pattern) const {
+    std::vector<double> v(static_cast<size_t>(len_), e_.v_idle);
+    std::vector<std::pair<long, int>> edges;
+    frame_edges(pattern_frame(pattern), enc_, pre_, half_, edges);
+    add_edges(e_, edges, 0, v);
+    return v;
+  }
+  // Adds the previous byte ending `gap` samples before the target's start.
+  void add_previous(std::vector<double>& v, int pattern, long gap) const {
+    std::vector<std::pair<long, int>> edges;
+    frame_edges(pattern_frame(pattern), enc_, pre_ - gap - frame_, half_, edges);
+    add_edges(e_, edges, 0, v);
+  }
+
+  StatusOr<eye::CheckResult> check(const std::vector<double>& v, int target) const {
+    eye::CheckOptions co;
+    co.expect = std::vector<uint8_t>{pattern_frame(target).byte};
+    return eye::check_samples(t_, v, rules_, co);
+  }
+
+  StatusOr<Score> score(const std::vector<double>& v, int target) {
+    StatusOr<eye::CheckResult> c = check(v, target);
+    if (!c) return c.status();
+    ++scored_;
+    return score_check(*c, rules_);
+  }
+
+  long scored_ = 0;
+
+ private:
+  const EdgeResponse& e_;
+  const eye::Rules& rules_;
+  const WorstOptions& opt_;
+  traffic::EncodingOptions enc_;
+  long half_ = 0, frame_ = 0, pre_ = 0, post_ = 0, len_ = 0;
+  std::vector<double> t_;
+};
+
+// Slope dv/dt at time a of sampled v (window times i * dt).
+double slope_at(const std::vector<double>& v, double dt, double a) {
+  const long i =
+      std::clamp(static_cast<long>(std::floor(a / dt)), 1L, static_cast<long>(v.size()) - 3);
+  return (v[static_cast<size_t>(i + 1)] - v[static_cast<size_t>(i)]) / dt;
+}
+
+// First-order model of one candidate target waveform: for each pulse and metric the key with
+// idle history plus coefficients on u (the previous byte's contribution) at a few samples.
+struct Term {
+  long sample;  // where u is read (window sample)
+  double coef;  // d key / d u there
+};
+struct Linear {
+  int metric;
+  double key0;
+  std::vector<Term> terms;
+};
+
+std::vector<Linear> linearize(const eye::CheckResult& c, const std::vector<double>& v,
+                              const eye::Rules& r, double dt) {
+  std::vector<Linear> out;
+  const std::vector<eye::PulseMetrics>& ps = c.pulses;
+  auto sample = [&](double t) { return std::lround(t / dt); };
+  // Crossing shift per unit u at a crossing t: -1 / v'(t).
+  auto shift = [&](double t) {
+    const double s = slope_at(v, dt, t);
+    return std::abs(s) > 1e-3 / dt * 1e-6 ? -1.0 / s : 0.0;
+  };
+  for (size_t j = 0; j < ps.size(); ++j) {
+    const eye::PulseMetrics& p = ps[j];
+    if (p.truncated) continue;
+    const double sg = p.sign;
+    if (p.vstart.measured()) {
+      // The time of the maximum of s v over [a, (a + b) / 2].
+      long best = sample(p.a);
+      for (long i = sample(p.a); i <= sample(0.5 * (p.a + p.b)) && i < static_cast<long>(v.size());
+           ++i)
+        if (sg * v[static_cast<size_t>(i)] > sg * v[static_cast<size_t>(best)]) best = i;
+      out.push_back({0, p.vstart.value, {{best, sg}}});
+    }
+    if (p.vend.measured()) out.push_back({1, p.vend.value, {{sample(p.b - r.vend_offset), sg}}});
+    if (!p.idle && p.width.measured() && j + 1 < ps.size()) {
+      const eye::PulseMetrics& n = ps[j + 1];
+      if (const eye::WidthWindow* w = nearest_window(r, std::max(p.k, 1))) {
+        // width = a_next - a.
+        const std::vector<Term> d{{sample(n.a), shift(n.a)}, {sample(p.a), -shift(p.a)}};
+        out.push_back({2, p.width.value - w->min, d});
+        out.push_back(
+            {3, w->max - p.width.value, {{d[0].sample, -d[0].coef}, {d[1].sample, -d[1].coef}}});
+      }
+    }
+    if (p.edge.measured() && j > 0) {
+      const eye::PulseMetrics& q = ps[j - 1];
+      // edge = a - b_prev; key = limit - edge.
+      out.push_back(
+          {4, r.edge_max - p.edge.value, {{sample(p.a), -shift(p.a)}, {sample(q.b), shift(q.b)}}});
+    }
+  }
+  return out;
+}
+
+std::string traffic_text(const Traffic& t) {
+  std::string s;
+  for (size_t i = 0; i < t.frames.size(); ++i) {
+    if (i) s += ", ";
+    s += fmt::format("{:02X}{} after {:.3g} us", t.frames[i].byte,
+                     t.frames[i].error_bit ? " (error bit)" : "", t.gaps[i] * 1e6);
+  }
+  return s;
+}
+
+}  // namespace
+
+Status WorstOptions::validate() const {
+  const std::pair<const char*, double> positive[] = {{"dt", dt},
+                                                     {"gap_min", gap_min},
+                                                     {"gap_step", gap_step},
+                                                     {"tail_tol", tail_tol},
+                                                     {"reltol", reltol},
+                                                     {"settle_tol", settle_tol},
+                                                     {"max_span", max_span},
+                                                     {"max_memory", max_memory}};
+  for (const auto& [name, v] : positive)
+    if (!(v > 0) || !std::isfinite(v))
+      return Status::Error(
+          fmt::format("worst-case option {} = {:g}: must be a positive number", name, v));
+  const double half = expand.stimulus.encoding.half_bit;
+  for (const auto& [name, v] : {std::pair{"half bit", half}, std::pair{"gap_min", gap_min},
+                                std::pair{"gap_step", gap_step}}) {
+    const double n = v / dt;
+    if (std::abs(n - std::round(n)) > 1e-6 * n)
+      return Status::Error(fmt::format(
+          "worst-case option {} = {:g} s: must be a whole number of dt = {:g} s", name, v, dt));
+  }
+  if (max_candidates < 1 || verify < 1)
+    return Status::Error(fmt::format(
+        "worst-case options max_candidates = {} and verify = {}: both must be at least 1",
+        max_candidates, verify));
+  for (const std::vector<int>* list : {&targets, &previous})
+    for (int p : *list)
+      if (p < 0 || p > 511)
+        return Status::Error(
+            fmt::format("worst-case pattern {}: must be 0-511 (byte | error bit << 8)", p));
+  return Status::Ok();
+}
+
+double Traffic::frame_start(size_t i, double byte_duration) const {
+  double t = 0;
+  for (size_t k = 0; k <= i && k < gaps.size(); ++k) t += gaps[k] + (k < i ? byte_duration : 0);
+  return t;
+}
+
+const WorstMetric* DirectionWorst::metric(const std::string& name) const {
+  for (const WorstMetric& m : metrics)
+    if (m.name == name) return &m;
+  return nullptr;
+}
+
+StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::PartLibrary& parts,
+                                     link::Direction d, const WorstOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  EdgeResponse out;
+  out.dt = opt.dt;
+  out.pre = to_samples(50e-9, opt.dt);
+  const double lead = kLead;
+  for (double span = 40e-6;; span *= 2) {
+    traffic::Drive drive;
+    drive.encoding = opt.expand.stimulus.encoding;
+    drive.segments = {{0.0, lead, 0}, {lead, lead + span, +1}};
+    link::ExpandOptions ex = opt.expand;
+    ex.drive = drive;
+    StatusOr<link::ExpandedLink> link = link::expand_link(spec, parts, d, ex);
+    if (!link) return link.status();
+    Circuit circuit;
+    for (const Card& card : link->netlist.cards)
+      if (Status s = circuit.add(card); !s.ok()) return s;
+    if (Status s = circuit.finalize(); !s.ok()) return s;
+    StatusOr<Probe> probe = parse_probe(circuit, "v(rxp,rxn)");
+    if (!probe) return probe.status();
+    TransientOptions to;
+    to.tstep = opt.dt;
+    to.tstop = lead + span;
+    to.tmax = opt.dt;
+    to.reltol = opt.reltol;
+    if (Status s = to.validate(); !s.ok()) return s;
+    StatusOr<Waveform> w = run_transient(circuit, to, {*probe});
+    if (!w) return w.status().with_context(link->description + ", edge response");
+    out.v_idle = w->value_at(0, lead - 2 * out.pre * opt.dt);
+    const long n = out.pre + to_samples(span, opt.dt);
+    out.e.assign(static_cast<size_t>(n), 0.0);
+    for (long i = 0; i < n; ++i)
+      out.e[static_cast<size_t>(i)] =
+          w->value_at(0, lead + static_cast<double>(i - out.pre) * opt.dt) - out.v_idle;
+    out.span = span;
+    out.settle = 0;
+    out.drift = 0;
+    const long half = to_samples(opt.expand.stimulus.encoding.half_bit, opt.dt);
+    for (long i = n - n / 10; i < n; ++i) {
+      out.settle = std::max(out.settle, std::abs(out.e[static_cast<size_t>(i)] - out.e.back()));
+      out.drift = std::max(out.drift, std::abs(out.e[static_cast<size_t>(i)] -
+                                               out.e[static_cast<size_t>(i - half)]));
+    }
+    for (double x : out.e)
+      if (!std::isfinite(x))
+        return Status::Error(link->description + ": the edge response is not finite");
+    if (out.drift <= opt.settle_tol) break;
+    if (span * 2 > opt.max_span)
+      return Status::Error(fmt::format(
+          "{}: the edge response has not settled {:g} us after the edge (a half bit's response is "
+          "still {:.1f} uV, more than {:.1f} uV): the link's memory is too long for the "
+          "worst-case search",
+          link->description, span * 1e6, out.drift * 1e6, opt.settle_tol * 1e6));
+  }
+  out.engine = fmt::format("transient, reltol {:g}, tmax = the {:g} ns grid it is sampled on",
+                           opt.reltol, opt.dt * 1e9);
+  out.seconds = seconds_since(start);
+  return out;
+}
+
+namespace {
+
+// P*(n) = max |p| over samples >= n (p(n) = E(n) - E(n - half), 0 past the record).
+std::vector<double> pulse_envelope(const EdgeResponse& e, long half) {
+  const long n = static_cast<long>(e.e.size()) - e.pre + half;
+  std::vector<double> env(static_cast<size_t>(std::max(n, 1L)) + 1, 0.0);
+  for (long i = n - 1; i >= 0; --i)
+    env[static_cast<size_t>(i)] =
+        std::max(env[static_cast<size_t>(i + 1)], std::abs(e.at(i) - e.at(i - half)));
+  return env;
+}
+
+double bound_from(const std::vector<double>& env, long n0, long half) {
+  double b = 0;
+  for (long n = std::max(n0, 0L); n < static_cast<long>(env.size()); n += half)
+    b += env[static_cast<size_t>(n)];
+  return b;
+}
+
+}  // namespace
+
+double tail_bound(const EdgeResponse& e, double half_bit, double tau) {
+  const long half = to_samples(half_bit, e.dt);
+  return bound_from(pulse_envelope(e, half), to_samples(tau, e.dt), half);
+}
+
+Waveform synthesize(const EdgeResponse& e, const Traffic& traffic,
+                    const traffic::EncodingOptions& enc, double t0, double t1) {
+  const long half = to_samples(enc.half_bit, e.dt);
+  const long frame = half * traffic::byte_half_bit_count(enc);
+  std::vector<std::pair<long, int>> edges;
+  long start = 0;
+  for (size_t i = 0; i < traffic.frames.size(); ++i) {
+    start += to_samples(i < traffic.gaps.size() ? traffic.gaps[i] : 0.0, e.dt);
+    frame_edges(traffic.frames[i], enc, start, half, edges);
+    start += frame;
+  }
+  const long origin = to_samples(t0, e.dt);
+  const long n = std::max(2L, to_samples(t1, e.dt) - origin + 1);
+  std::vector<double> v(static_cast<size_t>(n), e.v_idle);
+  add_edges(e, edges, origin, v);
+  Waveform w;
+  w.time.resize(static_cast<size_t>(n));
+  for (long i = 0; i < n; ++i)
+    w.time[static_cast<size_t>(i)] = static_cast<double>(origin + i) * e.dt;
+  w.add_column("v(rxp,rxn)", std::move(v));
+  return w;
+}
+
+StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::Rules& rules,
+                                              const WorstOptions& opt) {
+  if (Status s = opt.validate(); !s.ok()) return s;
+  const auto start = std::chrono::steady_clock::now();
+  DirectionWorst dw;
+  dw.rules = rules;
+  Search search(e, rules, opt);
+  const long half = search.half(), frame = search.frame(), pre = search.pre();
+  const double dt = e.dt;
+  const double byte_duration = static_cast<double>(frame) * dt;
+
+  // Memory and bounds (method items 2 and 3).
+  const std::vector<double> env = pulse_envelope(e, half);
+  long memory = 0;
+  const long max_memory = to_samples(opt.max_memory, dt);
+  while (memory < static_cast<long>(env.size()) && memory < max_memory &&
+         bound_from(env, memory, half) > opt.tail_tol)
+    memory += half;
+  dw.memory = static_cast<double>(memory) * dt;
+  dw.gap_min = opt.gap_min;
+  const long gap_min = to_samples(opt.gap_min, dt), gap_step = to_samples(opt.gap_step, dt);
+  // The previous byte's last half bit ends >= gap_min before the target, seen from the window's
+  // first sample (pre before the target); anything older is >= 2 gap_min + frame back.
+  dw.previous_bound = bound_from(env, gap_min - pre, half);
+  dw.older_bound = bound_from(env, 2 * gap_min + frame - pre, half);
+  // The previous byte matters up to the gap where it falls inside the tail tolerance.
+  long gap_max = gap_min;
+  while (gap_max < memory + pre && bound_from(env, gap_max - pre, half) > opt.tail_tol)
+    gap_max += gap_step;
+
+  dw.gap_max = static_cast<double>(gap_max) * dt;
+  std::vector<int> targets = opt.targets, previous = opt.previous;
+  if (targets.empty())
+    for (int p = 0; p < 512; ++p) targets.push_back(p);
+  if (previous.empty())
+    for (int p = 0; p < 512; ++p) previous.push_back(p);
+  std::vector<long> gaps;
+  for (long g = gap_min; g <= gap_max; g += gap_step) gaps.push_back(g);
+  const bool history = dw.previous_bound > opt.tail_tol;
+
+  struct Best {
+    PulseScore s;
+    int target = -1, prev = -1;
+    long gap = 0;
+  };
+  std::array<Best, kMetrics> best;
+  auto consider = [&](const Score& sc, int target, int prev, long gap) {
+    for (int m = 0; m < kMetrics; ++m)
+      if (sc.m[m].valid() && sc.m[m].key < best[m].s.key) best[m] = {sc.m[m], target, prev, gap};
+    if (!sc.pass) {
+      Traffic t;
+      if (prev >= 0) t.frames.push_back(pattern_frame(prev)), t.gaps.push_back(kLead);
+      t.frames.push_back(pattern_frame(target));
+      t.gaps.push_back(prev >= 0 ? static_cast<double>(gap) * dt : kLead);
+      const std::string why = sc.reason.substr(0, sc.reason.find(':'));
+      for (const std::string& r : dw.reasons)
+        if (r.rfind(why, 0) == 0) return;
+      dw.reasons.push_back(fmt::format("{} (traffic {})", sc.reason, traffic_text(t)));
+    }
+  };
+
+  // Stage 1: every target pattern after idle.
+  std::vector<Score> idle_scores(targets.size());
+  for (size_t i = 0; i < targets.size(); ++i) {
+    StatusOr<Score> sc = search.score(search.target_wave(targets[i]), targets[i]);
+    if (!sc) return sc.status();
+    idle_scores[i] = *sc;
+    consider(*sc, targets[i], -1, 0);
+  }
+
+  // Slowest threshold-crossing slope of the idle-history winners: a voltage change dv moves a
+  // crossing by about dv / slope (the time slack and the time bounds).
+  double slope_min = kInf;
+  for (size_t m = 0; m < kMetrics; ++m) {
+    if (best[m].target < 0) continue;
+    const std::vector<double> v = search.target_wave(best[m].target);
+    StatusOr<eye::CheckResult> c = search.check(v, best[m].target);
+    if (!c) return c.status();
+    for (const eye::PulseMetrics& p : c->pulses) {
+      if (p.truncated) continue;
+      slope_min =
+          std::min({slope_min, std::abs(slope_at(v, dt, p.a)), std::abs(slope_at(v, dt, p.b))});
+    }
+  }
+  if (!std::isfinite(slope_min) || slope_min <= 0) slope_min = 0;
+
+  if (history && opt.exhaustive) {
+    for (int t : targets) {
+      const std::vector<double> base = search.target_wave(t);
+      for (int q : previous)
+        for (long g : gaps) {
+          std::vector<double> v = base;
+          search.add_previous(v, q, g);
+          StatusOr<Score> sc = search.score(v, t);
+          if (!sc) return sc.status();
+          consider(*sc, t, q, g);
+        }
+    }
+  } else if (history) {
+    // The previous byte alone, from its start, for every pattern: u at window sample i for gap g
+    // is prev_wave[q][i - pre + g + frame].
+    const long reach = frame + gap_max + search.len();
+    std::vector<std::vector<float>> prev_wave(previous.size());
+    for (size_t k = 0; k < previous.size(); ++k) {
+      std::vector<double> v(static_cast<size_t>(reach), 0.0);
+      std::vector<std::pair<long, int>> edges;
+      frame_edges(pattern_frame(previous[k]), opt.expand.stimulus.encoding, 0, half, edges);
+      add_edges(e, edges, 0, v);
+      prev_wave[k].assign(v.begin(), v.end());
+    }
+    const double slack_v = 2 * dw.previous_bound;
+    const double slack_t = slope_min > 0 ? slack_v / slope_min : 0;
+    // Candidates per metric: the target patterns within the slack of the best after idle.
+    std::vector<std::vector<size_t>> cands(kMetrics);
+    for (int m = 0; m < kMetrics; ++m) {
+      const double slack = m < 2 ? slack_v : slack_t;
+      std::vector<std::pair<double, size_t>> order;
+      for (size_t i = 0; i < targets.size(); ++i)
+        if (idle_scores[i].m[m].valid()) order.push_back({idle_scores[i].m[m].key, i});
+      std::sort(order.begin(), order.end());
+      for (const auto& [key, i] : order) {
+        if (static_cast<int>(cands[m].size()) >= opt.max_candidates) break;
+        if (!cands[m].empty() && key > order.front().first + slack) break;
+        cands[m].push_back(i);
+      }
+    }
+    std::vector<size_t> all;
+    for (const auto& c : cands) all.insert(all.end(), c.begin(), c.end());
+    std::sort(all.begin(), all.end());
+    all.erase(std::unique(all.begin(), all.end()), all.end());
+    for (size_t ci : all) {
+      const int t = targets[ci];
+      const std::vector<double> base = search.target_wave(t);
+      StatusOr<eye::CheckResult> c = search.check(base, t);
+      if (!c) return c.status();
+      const std::vector<Linear> lin = linearize(*c, base, rules, dt);
+      std::array<bool, kMetrics> wanted{};
+      for (int m = 0; m < kMetrics; ++m)
+        wanted[m] = std::find(cands[m].begin(), cands[m].end(), ci) != cands[m].end();
+      // Rank every history by its predicted key per metric; keep the `verify` lowest.
+      std::array<std::vector<std::tuple<double, size_t, long>>, kMetrics> top;
+      for (size_t k = 0; k < previous.size(); ++k) {
+        const std::vector<float>& w = prev_wave[k];
+        for (long g : gaps) {
+          ++dw.ranked;
+          std::array<double, kMetrics> key;
+          key.fill(kInf);
+          const long off = -pre + g + frame;
+          for (const Linear& l : lin) {
+            if (!wanted[l.metric]) continue;
+            double y = l.key0;
+            for (const Term& term : l.terms) {
+              const long i = term.sample + off;
+              if (i >= 0 && i < reach) y += term.coef * w[static_cast<size_t>(i)];
+            }
+            key[l.metric] = std::min(key[l.metric], y);
+          }
+          for (int m = 0; m < kMetrics; ++m) {
+            if (!wanted[m]) continue;
+            auto& tm = top[m];
+            if (static_cast<int>(tm.size()) < opt.verify || key[m] < std::get<0>(tm.back())) {
+              if (static_cast<int>(tm.size()) >= opt.verify) tm.pop_back();
+              tm.insert(std::upper_bound(tm.begin(), tm.end(), std::tuple{key[m], k, g}),
+                        {key[m], k, g});
+            }
+          }
+        }
+      }
+      std::vector<std::pair<size_t, long>> exact;
+      for (const auto& tm : top)
+        for (const auto& [key, k, g] : tm) exact.push_back({k, g});
+      std::sort(exact.begin(), exact.end());
+      exact.erase(std::unique(exact.begin(), exact.end()), exact.end());
+      for (const auto& [k, g] : exact) {
+        std::vector<double> v = base;
+        search.add_previous(v, previous[k], g);
+        StatusOr<Score> sc = search.score(v, t);
+        if (!sc) return sc.status();
+        consider(*sc, t, previous[k], g);
+      }
+    }
+  }
+
+  // Results.
+  dw.pass = dw.reasons.empty();
+  for (int m = 0; m < kMetrics; ++m) {
+    const Best& b = best[m];
+    if (b.target < 0) continue;
+    WorstMetric wm;
+    wm.name = kNames[m];
+    wm.value = b.s.value;
+    wm.limit = b.s.limit;
+    wm.margin = b.s.margin;
+    wm.pulse_sign = b.s.sign;
+    wm.role = b.s.role;
+    if (b.prev >= 0) {
+      wm.traffic.frames = {pattern_frame(b.prev), pattern_frame(b.target)};
+      wm.traffic.gaps = {kLead, static_cast<double>(b.gap) * dt};
+    } else {
+      wm.traffic.frames = {pattern_frame(b.target)};
+      wm.traffic.gaps = {kLead};
+    }
+    const double target_start = wm.traffic.frame_start(wm.traffic.frames.size() - 1, byte_duration);
+    wm.pulse_time = target_start - static_cast<double>(pre) * dt + b.s.a;
+    wm.record = target_start + byte_duration + 5e-6;
+    // Older traffic moves v by at most older_bound, each of a width's or an edge's two crossings
+    // by about that over its slope.
+    wm.bound = m < 2 ? dw.older_bound : (slope_min > 0 ? 2 * dw.older_bound / slope_min : 0.0);
+    if (wm.margin < 0) {
+      dw.pass = false;
+      dw.reasons.push_back(fmt::format("{} {:.4g} breaks its limit {:.4g} (traffic {})", wm.name,
+                                       wm.value, wm.limit, traffic_text(wm.traffic)));
+    }
+    dw.metrics.push_back(std::move(wm));
+  }
+  dw.scored = search.scored_;
+  dw.seconds = seconds_since(start);
+  return dw;
+}
+
+StatusOr<WorstResult> worst_case(const link::LinkSpec& spec, const link::PartLibrary& parts,
+                                 const WorstOptions& opt) {
+  if (Status s = opt.validate(); !s.ok()) return s;
+  const auto start = std::chrono::steady_clock::now();
+  WorstResult out;
+  for (link::Direction d : spec.stimulus.directions) {
+    StatusOr<link::ExpandedLink> ex = link::expand_link(spec, parts, d, opt.expand);
+    if (!ex) return ex.status();
+    StatusOr<eye::Rules> rules = eye::load_rules(ex->rules);
+    if (!rules) return rules.status();
+    StatusOr<EdgeResponse> e = edge_response(spec, parts, d, opt);
+    if (!e) return e.status();
+    StatusOr<DirectionWorst> dw = worst_case_direction(*e, *rules, opt);
+    if (!dw) return dw.status().with_context(ex->description + ", worst case");
+    dw->direction = d;
+    dw->description = ex->description;
+    dw->receiver = ex->receiver;
+    dw->edge = std::move(*e);
+    out.pass = out.pass && dw->pass;
+    out.directions.push_back(std::move(*dw));
+  }
+  out.seconds = seconds_since(start);
+  return out;
+}
+
+link::StimulusSpec reproduce_spec(const WorstMetric& m, link::Direction d) {
+  link::StimulusSpec st;
+  for (size_t i = 0; i < m.traffic.frames.size(); ++i) {
+    const ByteFrame& f = m.traffic.frames[i];
+    st.frames.push_back(fmt::format("raw {:02X} nocrc{}", f.byte, f.error_bit ? " err" : ""));
+    st.gaps.push_back(m.traffic.gaps[i]);
+  }
+  st.directions = {d};
+  return st;
+}
+
+namespace {
+
+std::string time_text(double s) {
+  return fmt::format("{:.6g}u", s * 1e6);
+}
+
+std::string unit_of(const std::string& metric) {
+  return metric == "vstart" || metric == "vend" ? "V" : "s";
+}
+
+std::string value_text(const std::string& metric, double v) {
+  return unit_of(metric) == "V" ? fmt::format("{:.3f} V", v) : fmt::format("{:.1f} ns", v * 1e9);
+}
+
+std::string label_of(const std::string& metric) {
+  if (metric == "vstart") return "lowest VSTART";
+  if (metric == "vend") return "lowest VEND";
+  if (metric == "width_min") return "narrowest pulse";
+  if (metric == "width_max") return "widest pulse";
+  return "slowest edge";
+}
+
+std::string frames_text(const Traffic& t) {
+  std::string s;
+  for (size_t i = 0; i < t.frames.size(); ++i)
+    s +=
+        fmt::format("{}{:02X}{}", i ? " " : "", t.frames[i].byte, t.frames[i].error_bit ? "*" : "");
+  return s;
+}
+
+}  // namespace
+
+std::string reproduce_stimulus(const WorstMetric& m, link::Direction d) {
+  const link::StimulusSpec st = reproduce_spec(m, d);
+  std::string frames, gaps;
+  for (size_t i = 0; i < st.frames.size(); ++i) {
+    frames += fmt::format("{}\"{}\"", i ? ", " : "", st.frames[i]);
+    gaps += fmt::format("{}{}", i ? ", " : "", time_text(st.gaps[i]));
+  }
+  return fmt::format("stimulus: {{frames: [{}], gaps: [{}], direction: {}}}", frames, gaps,
+                     link::direction_name(d));
+}
+
+nlohmann::ordered_json worst_json(const WorstResult& r) {
+  using nlohmann::ordered_json;
+  ordered_json j;
+  j["verdict"] = r.pass ? "pass" : "fail";
+  j["seconds"] = r.seconds;
+  j["directions"] = ordered_json::array();
+  for (const DirectionWorst& d : r.directions) {
+    ordered_json dj;
+    dj["direction"] = link::direction_name(d.direction);
+    dj["description"] = d.description;
+    dj["receiver"] = d.receiver;
+    dj["rules"] = d.rules.name;
+    dj["verdict"] = d.pass ? "pass" : "fail";
+    dj["reasons"] = d.reasons;
+    dj["memory_us"] = d.memory * 1e6;
+    dj["gap_range_us"] = {d.gap_min * 1e6, "idle"};
+    dj["gap_grid_us"] = {{"from", d.gap_min * 1e6}, {"to", d.gap_max * 1e6}};
+    dj["previous_byte_bound_mV"] = d.previous_bound * 1e3;
+    dj["older_traffic_bound_mV"] = d.older_bound * 1e3;
+    dj["scored"] = d.scored;
+    dj["ranked"] = d.ranked;
+    dj["seconds"] = d.seconds;
+    dj["edge_response"] = {
+        {"engine", d.edge.engine},          {"span_us", d.edge.span * 1e6},
+        {"settle_mV", d.edge.settle * 1e3}, {"half_bit_residue_uV", d.edge.drift * 1e6},
+        {"v_idle", d.edge.v_idle},          {"seconds", d.edge.seconds}};
+    ordered_json w = ordered_json::object();
+    for (const WorstMetric& m : d.metrics) {
+      ordered_json mj;
+      mj["value"] = m.value;
+      mj["limit"] = m.limit;
+      mj["margin"] = m.margin;
+      mj["unit"] = unit_of(m.name);
+      mj["bound"] = m.bound;
+      ordered_json frames = ordered_json::array(), errs = ordered_json::array(),
+                   gaps = ordered_json::array();
+      for (size_t i = 0; i < m.traffic.frames.size(); ++i) {
+        frames.push_back(fmt::format("{:02X}", m.traffic.frames[i].byte));
+        errs.push_back(m.traffic.frames[i].error_bit);
+        gaps.push_back(m.traffic.gaps[i] * 1e6);
+      }
+      mj["frames"] = frames;
+      mj["error_bits"] = errs;
+      mj["gaps_us"] = gaps;
+      mj["pulse"] = {{"time_us", m.pulse_time * 1e6},
+                     {"sign", m.pulse_sign > 0 ? "+" : "-"},
+                     {"role", m.role}};
+      const link::StimulusSpec st = reproduce_spec(m, d.direction);
+      mj["reproduce"] = {{"frames", st.frames},
+                         {"gaps_us", gaps},
+                         {"direction", link::direction_name(d.direction)},
+                         {"stimulus", reproduce_stimulus(m, d.direction)}};
+      w[m.name] = mj;
+    }
+    dj["worst"] = w;
+    j["directions"].push_back(dj);
+  }
+  return j;
+}
+
+std::string worst_markdown(const WorstResult& r) {
+  std::string md;
+  md += fmt::format("Worst case over all legal traffic: **{}**\n\n", r.pass ? "PASS" : "FAIL");
+  for (const DirectionWorst& d : r.directions) {
+    md += fmt::format("### {} ({})\n\n", d.description, d.pass ? "pass" : "FAIL");
+    md +=
+        "| metric | worst | limit | margin | traffic (byte frames, * = error bit; gap before each) "
+        "| pulse |\n";
+    md += "|---|---|---|---|---|---|\n";
+    for (const WorstMetric& m : d.metrics) {
+      std::string gaps;
+      for (size_t i = 0; i < m.traffic.gaps.size(); ++i)
+        gaps += fmt::format("{}{:.3g}", i ? ", " : "", m.traffic.gaps[i] * 1e6);
+      md += fmt::format("| {} | {} | {} | {}{} | {} (gaps {} us) | {} {} at {:.3f} us |\n",
+                        label_of(m.name), value_text(m.name, m.value), value_text(m.name, m.limit),
+                        m.margin >= 0 ? "+" : "", value_text(m.name, m.margin),
+                        frames_text(m.traffic), gaps, m.pulse_sign > 0 ? "+" : "-", m.role,
+                        m.pulse_time * 1e6);
+    }
+    md += fmt::format(
+        "\nMemory {:.2f} us; gaps searched from {:.2f} us (the shortest the devices produce) to "
+        "idle; the previous byte moves v by at most {:.1f} mV, older traffic by at most {:.2f} mV "
+        "(bound); {} waveforms scored, {} histories ranked, {:.1f} s. Edge response: {}.\n\n",
+        d.memory * 1e6, d.gap_min * 1e6, d.previous_bound * 1e3, d.older_bound * 1e3, d.scored,
+        d.ranked, d.seconds + d.edge.seconds, d.edge.engine);
+    for (const std::string& why : d.reasons) md += "- " + why + "\n";
+    if (!d.reasons.empty()) md += "\n";
+    md += "Replay any row in `isolink run` with its stimulus block:\n\n```yaml\n";
+    for (const WorstMetric& m : d.metrics)
+      md += fmt::format("# {}\n{}\n", label_of(m.name), reproduce_stimulus(m, d.direction));
+    md += "```\n\n";
+  }
+  return md;
+}
+
+std::string worst_summary_text(const WorstResult& r) {
+  std::string s;
+  for (const DirectionWorst& d : r.directions) {
+    s += fmt::format("worst case {}: {}", d.description, d.pass ? "pass" : "FAIL");
+    for (const WorstMetric& m : d.metrics)
+      s += fmt::format("  {} {} ({}{})", m.name, value_text(m.name, m.value),
+                       m.margin >= 0 ? "+" : "", value_text(m.name, m.margin));
+    s += "\n";
+  }
+  return s;
+}
+
+}  // namespace isolink::analysis

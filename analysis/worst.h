@@ -1,0 +1,175 @@
+// The worst case over all legal daisy-chain traffic (`isolink worst`, the "Worst case over all
+// traffic" section of `isolink run`): per direction, the lowest VSTART, the lowest VEND, the
+// narrowest and widest pulse and the slowest edge any legal traffic can produce at the receiver,
+// the traffic that produces each, and a stimulus block that replays it.
+//
+//   StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
+//   StatusOr<WorstResult> w = worst_case(spec, *parts, {});
+//   for (const DirectionWorst& d : w->directions) d.metric("vstart")->value ...
+//   std::puts(worst_json(*w).dump(2).c_str());
+//   return w->pass ? 0 : 1;
+//
+// Method (the README "Worst case over all traffic" has the argument in full):
+// 1. Every link is linear and time-invariant, and the driver moves both lines by the same linear
+//    10 ns ramp scaled by the level change (P = 2.5 (1 + L), N = 2.5 (1 - L)), so the receiver's
+//    v(t) for any traffic is exactly v_idle + sum_i dL_i E(t - t_i): E is the response to one
+//    0 -> +1 level change (edge_response; today from a tight transient run until it settles).
+// 2. Memory: p(t) = E(t) - E(t - T) is one half bit's response. Half bits older than tau move v
+//    by at most B(tau) = sum_k max |p| over [tau + kT, tau + (k + 1) T) (|level| <= 1, at most one
+//    half bit per T). The memory M is the smallest tau with B(tau) <= tail_tol (at most
+//    max_memory; B(M) is reported either way). The edge response is run until a half bit's
+//    response E(t) - E(t - T) stays below settle_tol over the last 10 % of the run; past the run E
+//    is taken as constant (a slow residual drift cancels in DC-balanced frames to first order).
+// 3. Traffic inside the memory of one byte frame (the "target": any byte, error bit 0 or 1, 512
+//    patterns) is the previous byte frame (512 patterns or none) at a gap g >= gap_min (3.8 us,
+//    the shortest the devices produce) on a gap_step grid up to M; anything older is at least
+//    2 gap_min + 6.5 us before the target and is covered by the bound B (reported).
+// 4. Search: every target pattern is scored with the eye checker (eye/check.h, the same metric
+//    definitions as `isolink check`) after idle; the target patterns within a slack of the best
+//    for each metric (the slack is what the previous byte can change it by: 2 x its bound, in
+//    volts or, divided by the slowest crossing slope, in seconds) are then combined with every
+//    previous byte and gap, ranked by the first-order change each makes to every pulse's metric,
+//    and the best-ranked ones are scored exactly. With `exhaustive`, every combination is scored
+//    (brute force; the tests check the search against it).
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "base/status.h"
+#include "base/waveform.h"
+#include "eye/check.h"
+#include "eye/rules.h"
+#include "netlists/link/expand.h"
+#include "netlists/link/link_spec.h"
+#include "netlists/link/parts.h"
+
+namespace isolink::analysis {
+
+// The receiver's response to one driver edge, on a uniform grid.
+struct EdgeResponse {
+  double dt = 1e-9;       // sample spacing (s)
+  long pre = 0;           // e[pre] is at the corner (the middle of the driver's ramp)
+  std::vector<double> e;  // v(rxp,rxn) after a 0 -> +1 level change, minus v_idle (V)
+  double v_idle = 0;      // v(rxp,rxn) with the line idle (V)
+  double span = 0;        // simulated time after the corner (s)
+  double settle = 0;      // max |e - e.back()| over the last 10 % of the span (V)
+  double drift = 0;       // max |E(t) - E(t - T)| over the last 10 %: a half bit's residue (V)
+  std::string engine;     // what produced it ("transient reltol 1e-06")
+  double seconds = 0;     // wall time
+  // e at n samples after the corner: 0 before the record, e.back() after it.
+  double at(long n) const {
+    const long i = n + pre;
+    if (i < 0) return 0.0;
+    if (i >= static_cast<long>(e.size())) return e.back();
+    return e[static_cast<size_t>(i)];
+  }
+};
+
+struct WorstOptions {
+  double dt = 1e-9;           // synthesis grid (s); edges and gaps fall on it
+  double gap_min = 3.8e-6;    // shortest idle between byte frames (traffic::Timing byte_gap)
+  double gap_step = 50e-9;    // gap grid of the previous byte (s)
+  double tail_tol = 0.5e-3;   // V: the memory ends where the tail bound falls below this
+  double reltol = 1e-6;       // transient tolerance of the edge response
+  double settle_tol = 20e-6;  // V: settled when a half bit's response stays below this
+  double max_memory = 20e-6;  // s: longest memory searched; B there is reported as the bound
+  double max_span = 400e-6;   // s: longest edge-response run before giving up
+  int max_candidates = 24;    // target patterns carried into the history search per metric
+  int verify = 6;             // best-ranked histories scored exactly per candidate and metric
+  bool exhaustive = false;    // score every target x history combination (brute force)
+  // Restrict the patterns searched (tests; empty = all 512). A pattern is byte | error_bit << 8.
+  std::vector<int> targets;
+  std::vector<int> previous;
+  link::ExpandOptions expand;  // driver, load, encoding (its half bit is the T above)
+
+  Status validate() const;  // names the field, its value and the rule
+};
+
+// A byte frame as sent.
+struct ByteFrame {
+  uint8_t byte = 0;
+  int error_bit = 0;
+};
+
+// Byte frames with the idle before each (gaps[0]: idle before the first; nothing earlier).
+struct Traffic {
+  std::vector<ByteFrame> frames;
+  std::vector<double> gaps;  // s, one per frame
+  // Start of frame i's preamble (s), the first frame starting at gaps[0].
+  double frame_start(size_t i, double byte_duration) const;
+};
+
+// One metric's worst value.
+struct WorstMetric {
+  std::string name;       // vstart | vend | width_min | width_max | edge
+  double value = 0;       // V or s
+  double limit = 0;       // V or s
+  double margin = 0;      // distance to the limit, positive = inside
+  double bound = 0;       // how much worse older traffic could make it (V or s), >= 0
+  Traffic traffic;        // the traffic that produces it (the last frame holds the pulse)
+  double pulse_time = 0;  // the worst pulse's start crossing a, from the record's start (s)
+  int pulse_sign = 0;     // +1 / -1
+  std::string role;       // its place in the frame ("bit 3", "postamble", ...)
+  double record = 0;      // length of the replayed record (s)
+};
+
+struct DirectionWorst {
+  link::Direction direction = link::Direction::kDown;
+  std::string description;  // "down: bq79600 -> bq7961x"
+  std::string receiver;     // device
+  eye::Rules rules;         // the receiver's data rules
+  EdgeResponse edge;
+  double memory = 0;          // s
+  double gap_min = 0;         // s, shortest gap searched (the range runs to idle)
+  double gap_max = 0;         // s, longest gap on the grid; longer ones count as idle
+  double older_bound = 0;     // V: traffic older than the previous byte moves v by at most this
+  double previous_bound = 0;  // V: the previous byte moves v by at most this
+  long scored = 0;            // waveforms scored with the eye checker
+  long ranked = 0;            // histories ranked by first-order change
+  double seconds = 0;
+  std::vector<WorstMetric> metrics;  // vstart, vend, width_min, width_max, edge
+  bool pass = true;                  // every scored waveform passes and every margin >= 0
+  std::vector<std::string> reasons;  // why not (the first failing traffic per reason)
+  const WorstMetric* metric(const std::string& name) const;
+};
+
+struct WorstResult {
+  std::vector<DirectionWorst> directions;
+  bool pass = true;
+  double seconds = 0;
+};
+
+// The edge response of one direction of the link (the one adapter to the engine).
+StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::PartLibrary& parts,
+                                     link::Direction d, const WorstOptions& opt);
+
+// B(tau): the most that half bits older than tau (s) can move v (V). See the method above.
+double tail_bound(const EdgeResponse& e, double half_bit, double tau);
+
+// v(rxp,rxn) of traffic by superposition, on [t0, t1] every e.dt (times from the record start).
+Waveform synthesize(const EdgeResponse& e, const Traffic& traffic,
+                    const traffic::EncodingOptions& enc, double t0, double t1);
+
+// The worst case of every direction in spec.stimulus.directions.
+StatusOr<WorstResult> worst_case(const link::LinkSpec& spec, const link::PartLibrary& parts,
+                                 const WorstOptions& opt = {});
+// One direction, from its edge response (tests build their own).
+StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::Rules& rules,
+                                              const WorstOptions& opt);
+
+// The stimulus block that replays a metric's traffic in `isolink run` (YAML flow map).
+std::string reproduce_stimulus(const WorstMetric& m, link::Direction d);
+// The traffic as a StimulusSpec (frames "raw HH nocrc [err]", gaps, the direction).
+link::StimulusSpec reproduce_spec(const WorstMetric& m, link::Direction d);
+
+// JSON (the shape of issue 12: verdict, directions[].worst.{vstart, vend, width_min, width_max,
+// edge}), Markdown section body, terminal lines.
+nlohmann::ordered_json worst_json(const WorstResult& r);
+std::string worst_markdown(const WorstResult& r);
+std::string worst_summary_text(const WorstResult& r);
+
+}  // namespace isolink::analysis

@@ -1,0 +1,68 @@
+// OpenImageIO behind the C table of image_plugin.h: text measuring and rendering, PNG writing.
+// Built as a MODULE (libisolink_images.so) and loaded by plot.cpp on first use; the only file
+// in the project that includes OpenImageIO outside the tests.
+#include "reports/image_plugin.h"
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cstring>
+#include <memory>
+#include <vector>
+#include <string>
+
+namespace {
+
+int text_size(const char* text, int size, const char* font, int box[4]) {
+  const OIIO::ROI r = OIIO::ImageBufAlgo::text_size(text, size, font);
+  if (!r.defined()) return 0;
+  box[0] = r.xbegin;
+  box[1] = r.xend;
+  box[2] = r.ybegin;
+  box[3] = r.yend;
+  return 1;
+}
+
+int render_text(float* mask, int w, int h, int x, int y, const char* text, int size,
+                const char* font) {
+  OIIO::ImageBuf buf(OIIO::ImageSpec(w, h, 1, OIIO::TypeDesc::FLOAT), mask);  // wraps mask
+  const float one = 1.0f;
+  return OIIO::ImageBufAlgo::render_text(buf, x, y, text, size, font, OIIO::cspan<float>(&one, 1))
+             ? 1
+             : 0;
+}
+
+int encode_png(int w, int h, const unsigned char* rgb,
+               void (*sink)(void* ctx, const unsigned char* data, size_t n), void* ctx, char* err,
+               size_t errlen) {
+  OIIO::ImageBuf img(OIIO::ImageSpec(w, h, 3, OIIO::TypeDesc::UINT8));
+  img.set_pixels(OIIO::ROI(0, w, 0, h, 0, 1, 0, 3), OIIO::TypeDesc::UINT8, rgb);
+  std::vector<unsigned char> bytes;
+  OIIO::Filesystem::IOVecOutput proxy(bytes);
+  std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create("image.png", &proxy);
+  if (out && out->open("image.png", img.spec()) && img.write(out.get()) && out->close()) {
+    out.reset();
+    sink(ctx, bytes.data(), bytes.size());
+    return 0;
+  }
+  std::string msg = out ? out->geterror() : std::string();
+  if (msg.empty()) msg = img.geterror();
+  if (msg.empty()) msg = OIIO::geterror();
+  if (errlen > 0) {
+    const size_t n = std::min(msg.size(), errlen - 1);
+    std::memcpy(err, msg.data(), n);
+    err[n] = '\0';
+  }
+  return 1;
+}
+
+const IsolinkImageApi kApi{kImagePluginVersion, &text_size, &render_text, &encode_png};
+
+}  // namespace
+
+extern "C" __attribute__((visibility("default"))) const IsolinkImageApi* isolink_image_api() {
+  return &kApi;
+}

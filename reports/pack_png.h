@@ -1,0 +1,42 @@
+// pack.png: a pack's daisy chain as a diagram. The bridge and the stack devices as boxes in rows
+// (a snake: left to right, then right to left), each hop a thick line coloured by its worst
+// relative margin, labelled with its number, cable length, isolation and margin; the ring's return
+// hop drawn around the chain back to the bridge; the weakest hop marked.
+//
+//   PackDiagram d{.title = "pack-16", .verdict = "PASS", .devices = 16, .ring = true};
+//   d.hops.push_back({.index = 1, .pass = true, .margin = 0.31, .length = 0.3, .isolation =
+//   "cap"}); Status s = draw_pack_png(d, "out/pack.png");
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "base/status.h"
+#include "reports/plot.h"
+
+namespace isolink::reports {
+
+struct PackDiagram {
+  std::string title;
+  std::string verdict;  // "PASS" | "FAIL"
+  int devices = 0;      // stack devices; node 0 is the bridge
+  bool ring = false;
+  int weakest = 0;  // hop index, 0: none
+  struct Hop {
+    int index = 0;  // hop k joins node k - 1 and node k; the return hop is devices + 1
+    bool ring_return = false;
+    bool pass = true;
+    double margin = 0;      // worst relative margin (NaN: none judged)
+    double length = 0;      // m
+    std::string isolation;  // "cap", "xfmr", "cap/xfmr"
+  };
+  std::vector<Hop> hops;
+};
+
+// The colour of a hop: red when it fails, else from orange (margin 0) through yellow to green
+// (relative margin >= 15 %; the width rule alone caps it near 12 %).
+Color margin_color(bool pass, double margin);
+
+Status draw_pack_png(const PackDiagram& d, const std::string& path);
+
+}  // namespace isolink::reports

@@ -1,0 +1,586 @@
+#include "solver/lti.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "solver/mna_system.h"
+
+namespace isolink {
+
+Status LtiOptions::validate() const {
+  auto bad = [](const char* field, double v, const char* rule) {
+    return Status::Error(fmt::format("LTI option {} = {:g}: {}", field, v, rule));
+  };
+  if (!(horizon > 0) || !std::isfinite(horizon)) return bad("horizon", horizon, "must be positive");
+  if (!(step_reltol > 0 && step_reltol < 1))
+    return bad("step_reltol", step_reltol, "must be in (0, 1)");
+  if (!(step_abstol > 0)) return bad("step_abstol", step_abstol, "must be positive");
+  if (!(settle_tol > 0)) return bad("settle_tol", settle_tol, "must be positive");
+  if (!(first_step >= 0)) return bad("first_step", first_step, "must not be negative");
+  if (!(max_step >= 0)) return bad("max_step", max_step, "must not be negative");
+  if (max_steps <= 0) return bad("max_steps", static_cast<double>(max_steps), "must be positive");
+  return Status::Ok();
+}
+
+SourceInput pwl_input(const std::vector<double>& t, const std::vector<double>& v) {
+  SourceInput in;
+  if (t.empty()) return in;
+  in.initial = v[0];
+  double previous = 0.0;
+  for (size_t i = 0; i + 1 < t.size(); ++i) {
+    const double slope = (v[i + 1] - v[i]) / (t[i + 1] - t[i]);
+    if (slope != previous) in.ramps.push_back({t[i], slope - previous});
+    previous = slope;
+  }
+  if (previous != 0.0) in.ramps.push_back({t.back(), -previous});
+  return in;
+}
+
+Status check_lti(const Circuit& circuit) {
+  for (const auto& e : circuit.elements()) {
+    if (!e->linear_time_invariant())
+      return error_at(e->loc(), "element '" + e->name() +
+                                    "' is not linear and time-invariant: the LTI engine cannot "
+                                    "simulate it (use --engine transient)");
+    const SourceFunction* f = e->source_function();
+    if (f && !f->piecewise_linear())
+      return error_at(e->loc(), "source '" + e->name() +
+                                    "' is not a continuous piecewise-linear function (SIN, EXP, "
+                                    "or a PWL whose r= repeat jumps): the LTI engine takes DC, "
+                                    "PULSE and PWL sources (use --engine transient)");
+  }
+  if (!circuit.dc_open_branches().empty())
+    return Status::Error(
+        "an inductor closes a loop of voltage sources and inductors and is opened for the DC "
+        "point: the LTI engine needs a DC operating point of the circuit as it is (use --engine "
+        "transient)");
+  return Status::Ok();
+}
+
+namespace {
+
+// The last accepted points of the march, oldest first: times and the full state of each source.
+struct MarchHistory {
+  std::array<double, 3> times{};
+  std::array<std::vector<std::vector<double>>, 3> states;  // [slot][source][unknown]
+  int first = 0, count = 0;
+  double t(int i) const { return times[(first + i) % 3]; }
+  const std::vector<double>& x(int i, size_t k) const { return states[(first + i) % 3][k]; }
+  void push(double t1, const std::vector<std::vector<double>>& x1) {
+    if (count == 3) first = (first + 1) % 3, --count;
+    const int slot = (first + count) % 3;
+    times[slot] = t1;
+    states[slot] = x1;
+    ++count;
+  }
+};
+
+}  // namespace
+
+StatusOr<LtiResponses> LtiResponses::compute(const Circuit& circuit,
+                                             const std::vector<Probe>& probes,
+                                             const LtiOptions& opt) {
+  if (Status s = opt.validate(); !s.ok()) return s;
+  if (Status s = check_lti(circuit); !s.ok()) return s;
+  LtiResponses r;
+  for (const Probe& p : probes) {
+    r.labels_.push_back(p.label);
+    r.is_current_.push_back(p.label.rfind("i(", 0) == 0);
+  }
+
+  MnaSystem sys;
+  if (Status s = sys.build(circuit); !s.ok()) return s;
+  const int n = sys.n;
+  std::vector<std::vector<double>> unit;  // per source: its unit excitation (n + 1)
+  for (const auto& e : circuit.elements()) {
+    const SourceFunction* f = e->source_function();
+    if (!f || f->kind() == SourceFunction::Kind::Dc) continue;
+    r.sources_.push_back({e->name(), f, f->value(0.0)});
+    unit.emplace_back(n + 1, 0.0);
+    e->stamp_unit(unit.back().data());
+    unit.back()[0] = 0.0;
+  }
+  const size_t nk = r.sources_.size(), np = probes.size();
+
+  // DC: the operating point of the netlist's sources at t = 0, and each source's DC gain.
+  {
+    KluSolver dc_klu;
+    if (Status s = sys.factor_dc(circuit, dc_klu); !s.ok())
+      return s.with_context("DC operating point");
+    std::vector<double> x(n + 1);
+    sys.rhs(0.0, x);
+    if (Status s = dc_klu.solve(x.data() + 1); !s.ok()) return s;
+    x[0] = 0.0;
+    for (const Probe& p : probes) r.y_dc_.push_back(p.value(x.data()));
+    for (size_t k = 0; k < nk; ++k) {
+      x = unit[k];
+      if (Status s = dc_klu.solve(x.data() + 1); !s.ok()) return s;
+      x[0] = 0.0;
+      r.gain_.emplace_back();
+      for (const Probe& p : probes) r.gain_[k].push_back(p.value(x.data()));
+    }
+    r.stats_.factorizations = 1;
+  }
+
+  r.tau_.push_back(0.0);
+  r.r_.assign(nk, std::vector<std::vector<double>>(np, std::vector<double>{0.0}));
+  r.s_.assign(nk, std::vector<std::vector<double>>(np, std::vector<double>{0.0}));
+  if (nk == 0) return r;
+
+  // Watched states and their absolute tolerances, as the transient's error control.
+  std::vector<int> watched;
+  for (int u = 1; u <= n; ++u) {
+    const bool has_c = sys.c[sys.pattern.slot(u, u)] != 0.0;
+    if ((circuit.unknown_is_node(u) && has_c) || circuit.unknown_is_state(u)) watched.push_back(u);
+  }
+  // peak |S| per source and watched state, and 1 / tolerance (recomputed when a peak grows).
+  std::vector<std::vector<double>> peak(nk, std::vector<double>(watched.size(), 0.0));
+  std::vector<std::vector<double>> inv_tol(
+      nk, std::vector<double>(watched.size(), 1.0 / opt.step_abstol));
+
+  const double horizon = opt.horizon;
+  const double hmax = opt.max_step > 0 ? std::min(opt.max_step, horizon) : horizon / 64;
+  const double h0 = opt.first_step > 0 ? opt.first_step : std::min(1e-12, horizon * 1e-9);
+  const double hmin = std::max(1e-18, horizon * 1e-14);
+  auto ladder = [&](double h) {  // largest hmax / 2^k not above h
+    if (h >= hmax) return hmax;
+    const int e = static_cast<int>(std::ceil(std::log2(hmax / h) - 1e-9));
+    return std::ldexp(hmax, -e);
+  };
+
+  std::vector<std::vector<double>> x(nk, std::vector<double>(n + 1, 0.0)), xdot = x, xnew = x,
+                                                                           hist_part = x;
+  MarchHistory hist;
+  for (auto& s : hist.states) s = x;
+  hist.push(0.0, x);
+  double tau = 0.0, h = ladder(h0);
+  int worst_unknown = 0;
+  // Largest |chord slope| of each probe's response so far: no settling before it has arrived.
+  std::vector<std::vector<double>> probe_peak(nk, std::vector<double>(np, 0.0));
+  size_t next_check = 16;  // settle checks at geometrically spaced march points and times
+  double next_check_tau = 0.0;
+
+  while (tau < horizon * (1 - 1e-12)) {
+    if (r.stats_.steps + r.stats_.rejected >= opt.max_steps)
+      return Status::Error(fmt::format("LTI march gave up at {:g} s after {} steps (max_steps)",
+                                       tau, opt.max_steps));
+    double step = std::min(h, horizon - tau);
+    const bool euler = hist.count < 2;
+    const double a0 = euler ? 1.0 / step : 2.0 / step;
+    if (Status s = sys.select_or_factor(circuit, a0); !s.ok())
+      return s.with_context(fmt::format("LTI march at {:g} s", tau + step));
+    const double t1 = tau + step;
+    for (size_t k = 0; k < nk; ++k) {
+      auto& hp = hist_part[k];
+      for (int u = 1; u <= n; ++u) hp[u] = euler ? -x[k][u] / step : -a0 * x[k][u] - xdot[k][u];
+      auto& b = xnew[k];
+      for (int u = 0; u <= n; ++u) b[u] = unit[k][u] * t1;  // unit ramp: u(t) = t
+      sys.sub_c_times(hp.data(), b.data());
+      if (Status s = sys.solve(b); !s.ok()) return s;
+    }
+
+    // Truncation error per unit time against step_reltol * peak|S| + step_abstol.
+    double ratio = 0.0;
+    if (hist.count == 3) {
+      const double t0 = hist.t(2), tm1 = hist.t(1), tm2 = hist.t(0);
+      const double ia = 1.0 / (t1 - t0), ib = 1.0 / (t0 - tm1), ic = 1.0 / (tm1 - tm2);
+      const double ie = 1.0 / (t1 - tm1), iff = 1.0 / (t0 - tm2), ig = 1.0 / (t1 - tm2);
+      const double h2 = step * step * 0.5 * ig;  // h^3 * (1/12) * 6 / h
+      const double w1 = h2 * ie * ia, w2 = -h2 * ib * (ie + iff), w3 = h2 * iff * ic;
+      for (size_t k = 0; k < nk; ++k) {
+        const auto &x0 = hist.x(2, k), &xm1 = hist.x(1, k), &xm2 = hist.x(0, k);
+        const auto& xn = xnew[k];
+        for (size_t w = 0; w < watched.size(); ++w) {
+          const int u = watched[w];
+          const double e = inv_tol[k][w] * std::fabs(w1 * (xn[u] - x0[u]) + w2 * (x0[u] - xm1[u]) +
+                                                     w3 * (xm1[u] - xm2[u]));
+          if (e > ratio) ratio = e, worst_unknown = u;
+        }
+      }
+    }
+    if (ratio > 1.0) {
+      ++r.stats_.rejected;
+      h = step * std::max(0.25, 0.9 * std::sqrt(1.0 / ratio));
+      if (h < hmin)
+        return Status::Error(fmt::format(
+            "LTI march: step too small at {:g} s (h={:g} s): the truncation error of {} does not "
+            "converge",
+            tau, h, circuit.unknown_name(worst_unknown)));
+      h = ladder(h);
+      continue;
+    }
+
+    ++r.stats_.steps;
+    tau = t1;
+    for (size_t k = 0; k < nk; ++k) {
+      for (int u = 1; u <= n; ++u) xdot[k][u] = a0 * xnew[k][u] + hist_part[k][u];
+      std::swap(x[k], xnew[k]);
+      for (size_t w = 0; w < watched.size(); ++w) {
+        const double a = std::fabs(xdot[k][watched[w]]);
+        if (a > peak[k][w])
+          peak[k][w] = a, inv_tol[k][w] = 1.0 / (opt.step_reltol * a + opt.step_abstol);
+      }
+    }
+    hist.push(tau, x);
+    r.tau_.push_back(tau);
+    for (size_t k = 0; k < nk; ++k)
+      for (size_t p = 0; p < np; ++p) {
+        auto &R = r.r_[k][p], &S = r.s_[k][p];
+        R.push_back(probes[p].value(x[k].data()));
+        S.push_back(probes[p].value(xdot[k].data()));
+        const double chord = (R.back() - R[R.size() - 2]) / step;
+        probe_peak[k][p] = std::max(probe_peak[k][p], std::fabs(chord));
+      }
+    // Error per unit time scales as h^2: grow by sqrt, at most 2x.
+    const double grow = ratio > 0 ? std::min(2.0, 0.9 * std::sqrt(1.0 / ratio)) : 2.0;
+    h = ladder(std::max(step * std::max(grow, 0.5), hmin));
+
+    // Settling (see lti.h), checked whenever the step count or the time has grown by 10 %.
+    const size_t i = r.tau_.size() - 1;
+    if (i >= next_check || (i >= 16 && tau >= next_check_tau)) {
+      next_check = static_cast<size_t>(static_cast<double>(i) * 1.1) + 1;
+      next_check_tau = tau * 1.1;
+      bool settled = true;
+      const size_t from = static_cast<size_t>(
+          std::lower_bound(r.tau_.begin(), r.tau_.end(), 0.5 * tau) - r.tau_.begin());
+      // On chord slopes (R_j - R_j-1) / h_j, the mean of S over each step: the trapezoidal rule's
+      // derivative S carries a +-delta alternation that never damps, its chords do not.
+      auto chord = [&](const std::vector<double>& R, size_t j) {
+        return (R[j] - R[j - 1]) / (r.tau_[j] - r.tau_[j - 1]);
+      };
+      for (size_t k = 0; k < nk && settled; ++k)
+        for (size_t p = 0; p < np && settled; ++p) {
+          const auto& R = r.r_[k][p];
+          const double last = chord(R, i);
+          const double slope = (last - chord(R, i - 1)) / (0.5 * (r.tau_[i] - r.tau_[i - 2]));
+          if (probe_peak[k][p] < 100 * opt.settle_tol ||
+              std::fabs(slope) * (horizon - tau) > opt.settle_tol ||
+              std::fabs(last - r.gain_[k][p]) > opt.settle_tol) {
+            settled = false;
+            break;
+          }
+          for (size_t j = std::max<size_t>(from, 1); j < i; ++j)
+            if (std::fabs(chord(R, j) - last) > opt.settle_tol) {
+              settled = false;
+              break;
+            }
+        }
+      if (settled) {
+        r.stats_.settled = true;
+        break;
+      }
+    }
+  }
+  r.stats_.settled_at = tau;
+  // S at the march points from R alone: the slope at tau_i of the parabola through the points
+  // i-1, i, i+1 (second order on any spacing; one-sided at the ends). Not the trapezoidal
+  // derivative xdot: its error from the first (Euler) step alternates in sign and never damps,
+  // and the Hermite interpolant would carry it into the output.
+  const size_t m = r.tau_.size();
+  for (size_t k = 0; k < nk; ++k)
+    for (size_t p = 0; p < np; ++p) {
+      const auto& R = r.r_[k][p];
+      auto& S = r.s_[k][p];
+      auto chord = [&](size_t j) { return (R[j] - R[j - 1]) / (r.tau_[j] - r.tau_[j - 1]); };
+      for (size_t i = 1; i + 1 < m; ++i) {
+        const double hp = r.tau_[i] - r.tau_[i - 1], hn = r.tau_[i + 1] - r.tau_[i];
+        S[i] = (hn * chord(i) + hp * chord(i + 1)) / (hp + hn);
+      }
+      if (m >= 3) {
+        const double h1 = r.tau_[1], h2 = r.tau_[2] - r.tau_[1];
+        S[0] = chord(1) - h1 * (chord(2) - chord(1)) / (h1 + h2);
+        const double hl = r.tau_[m - 1] - r.tau_[m - 2], hq = r.tau_[m - 2] - r.tau_[m - 3];
+        S[m - 1] = chord(m - 1) + hl * (chord(m - 1) - chord(m - 2)) / (hl + hq);
+      }
+    }
+  // Beyond the march R continues with the last chord slope (see the settle check).
+  const size_t e = r.tau_.size() - 1;
+  r.end_slope_.assign(nk, std::vector<double>(np, 0.0));
+  for (size_t k = 0; k < nk; ++k)
+    for (size_t p = 0; p < np; ++p)
+      r.end_slope_[k][p] = (r.r_[k][p][e] - r.r_[k][p][e - 1]) / (r.tau_[e] - r.tau_[e - 1]);
+  r.stats_.factorizations += sys.klu.factorizations();
+  return r;
+}
+
+int LtiResponses::find_source(const std::string& name) const {
+  for (size_t k = 0; k < sources_.size(); ++k)
+    if (sources_[k].name == name) return static_cast<int>(k);
+  return -1;
+}
+
+std::vector<SourceInput> LtiResponses::netlist_inputs(double tstop) const {
+  std::vector<SourceInput> in;
+  for (const Source& s : sources_) in.push_back({s.initial, s.function->ramps(tstop)});
+  return in;
+}
+
+double LtiResponses::hermite(size_t k, size_t p, size_t i, double tau) const {
+  const double h = tau_[i + 1] - tau_[i];
+  const double u = (tau - tau_[i]) / h, u2 = u * u, u3 = u2 * u;
+  const double h00 = 2 * u3 - 3 * u2 + 1, h10 = u3 - 2 * u2 + u, h01 = -2 * u3 + 3 * u2,
+               h11 = u3 - u2;
+  const auto &R = r_[k][p], &S = s_[k][p];
+  return h00 * R[i] + h10 * h * S[i] + h01 * R[i + 1] + h11 * h * S[i + 1];
+}
+
+double LtiResponses::ramp_response(size_t k, size_t p, double tau) const {
+  if (tau <= 0) return 0.0;
+  const double end = tau_.back();
+  if (tau >= end) return r_[k][p].back() + end_slope_[k][p] * (tau - end);
+  size_t i = std::upper_bound(tau_.begin(), tau_.end(), tau) - tau_.begin() - 1;
+  return hermite(k, p, i, tau);
+}
+
+double LtiResponses::step_response(size_t k, size_t p, double tau) const {
+  if (tau <= 0) return 0.0;
+  const double end = tau_.back();
+  if (tau >= end) return end_slope_[k][p];
+  size_t i = std::upper_bound(tau_.begin(), tau_.end(), tau) - tau_.begin() - 1;
+  // Derivative of the Hermite interpolant.
+  const double h = tau_[i + 1] - tau_[i];
+  const double u = (tau - tau_[i]) / h, u2 = u * u;
+  const auto &R = r_[k][p], &S = s_[k][p];
+  return ((6 * u2 - 6 * u) * R[i] + (6 * u - 6 * u2) * R[i + 1]) / h + (3 * u2 - 4 * u + 1) * S[i] +
+         (3 * u2 - 2 * u) * S[i + 1];
+}
+
+double LtiResponses::value(size_t p, double t, const std::vector<SourceInput>& inputs) const {
+  double y = y_dc_[p];
+  for (size_t k = 0; k < sources_.size() && k < inputs.size(); ++k) {
+    y += (inputs[k].initial - sources_[k].initial) * gain_[k][p];
+    for (const Ramp& ramp : inputs[k].ramps) {
+      if (ramp.t >= t) break;
+      y += ramp.slope * ramp_response(k, p, t - ramp.t);
+    }
+  }
+  return y;
+}
+
+void LtiResponses::superpose(const std::vector<SourceInput>& inputs, double t0, double dt,
+                             long count, std::vector<std::vector<double>>& out) const {
+  const size_t np = labels_.size();
+  const double end = tau_.back();
+  const size_t last = tau_.size() - 1;
+  // Beyond the march's end each ramp adds slope * (R_end + S_end (t - t_j - end)): an affine
+  // function of t, added through difference arrays a (constant) and b (times t).
+  std::vector<std::vector<double>> da(np, std::vector<double>(count + 1, 0.0)), db = da;
+  std::vector<double> basis(4);
+  for (size_t k = 0; k < sources_.size() && k < inputs.size(); ++k) {
+    for (const Ramp& ramp : inputs[k].ramps) {
+      // First row strictly after the corner.
+      long i = static_cast<long>(std::floor((ramp.t - t0) / dt)) + 1;
+      if (i < 0) i = 0;
+      while (i > 0 && t0 + static_cast<double>(i - 1) * dt > ramp.t) --i;
+      while (i < count && t0 + static_cast<double>(i) * dt <= ramp.t) ++i;
+      size_t m = 0;  // march interval
+      for (; i < count; ++i) {
+        const double tau = t0 + static_cast<double>(i) * dt - ramp.t;
+        if (tau >= end) break;
+        while (m + 1 < last && tau_[m + 1] <= tau) ++m;
+        const double h = tau_[m + 1] - tau_[m];
+        const double u = (tau - tau_[m]) / h, u2 = u * u, u3 = u2 * u;
+        const double h00 = 2 * u3 - 3 * u2 + 1, h10 = (u3 - 2 * u2 + u) * h, h01 = -2 * u3 + 3 * u2,
+                     h11 = (u3 - u2) * h;
+        for (size_t p = 0; p < np; ++p) {
+          const auto &R = r_[k][p], &S = s_[k][p];
+          out[p][i] += ramp.slope * (h00 * R[m] + h10 * S[m] + h01 * R[m + 1] + h11 * S[m + 1]);
+        }
+      }
+      if (i < count)
+        for (size_t p = 0; p < np; ++p) {
+          const double rend = r_[k][p][last], send = end_slope_[k][p];
+          // slope * (rend + send * (t - ramp.t - end)), t = t0 + i dt
+          da[p][i] += ramp.slope * (rend - send * (ramp.t + end - t0));
+          db[p][i] += ramp.slope * send;
+        }
+    }
+  }
+  for (size_t p = 0; p < np; ++p) {
+    double a = 0.0, b = 0.0;
+    for (long i = 0; i < count; ++i) {
+      a += da[p][i], b += db[p][i];
+      out[p][i] += a + b * static_cast<double>(i) * dt;
+    }
+  }
+}
+
+Waveform LtiResponses::waveform(const std::vector<SourceInput>& inputs, const GridOptions& grid,
+                                GridInfo* info) const {
+  const size_t np = labels_.size();
+  GridInfo local;
+  GridInfo& gi = info ? *info : local;
+  gi = GridInfo{};
+  for (const SourceInput& in : inputs) gi.corners += static_cast<long>(in.ramps.size());
+  std::vector<double> base(np);
+  for (size_t p = 0; p < np; ++p) {
+    base[p] = y_dc_[p];
+    for (size_t k = 0; k < sources_.size() && k < inputs.size(); ++k)
+      base[p] += (inputs[k].initial - sources_[k].initial) * gain_[k][p];
+  }
+  const double span = grid.tstop - grid.tstart;
+  // Source corners strictly inside the span: rows of their own, so that a probe on a driven node
+  // is exact between rows too (not with a given step: the caller asked for that grid).
+  std::vector<double> corners;
+  for (const SourceInput& in : inputs)
+    for (const Ramp& ramp : in.ramps)
+      if (grid.step <= 0 && ramp.t > grid.tstart && ramp.t < grid.tstop) corners.push_back(ramp.t);
+  std::sort(corners.begin(), corners.end());
+  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+  // Any probe at any time in O(ramps inside the march window): the ramps older than the march's
+  // end respond affinely, summed from prefix sums of slope and slope * time.
+  const double end = tau_.back();
+  std::vector<std::vector<double>> sum_s(inputs.size()), sum_st(inputs.size());
+  for (size_t k = 0; k < inputs.size(); ++k) {
+    sum_s[k].assign(inputs[k].ramps.size() + 1, 0.0);
+    sum_st[k].assign(inputs[k].ramps.size() + 1, 0.0);
+    for (size_t j = 0; j < inputs[k].ramps.size(); ++j) {
+      sum_s[k][j + 1] = sum_s[k][j] + inputs[k].ramps[j].slope;
+      sum_st[k][j + 1] = sum_st[k][j] + inputs[k].ramps[j].slope * inputs[k].ramps[j].t;
+    }
+  }
+  auto value_at = [&](size_t p, double t) {
+    double y = base[p];
+    for (size_t k = 0; k < sources_.size() && k < inputs.size(); ++k) {
+      const auto& ramps = inputs[k].ramps;
+      auto before = [&](double x) {  // ramps with t_j < x
+        return static_cast<size_t>(
+            std::lower_bound(ramps.begin(), ramps.end(), x,
+                             [](const Ramp& r, double v) { return r.t < v; }) -
+            ramps.begin());
+      };
+      const size_t hi = before(t), lo = std::min(hi, before(t - end));
+      const double rend = r_[k][p].back(), send = end_slope_[k][p];
+      y += (rend - send * end) * sum_s[k][lo] + send * (t * sum_s[k][lo] - sum_st[k][lo]);
+      for (size_t j = lo; j < hi; ++j) y += ramps[j].slope * ramp_response(k, p, t - ramps[j].t);
+    }
+    return y;
+  };
+  auto rows_at = [&](double t0, double dt, long count) {
+    std::vector<std::vector<double>> v(np, std::vector<double>(count, 0.0));
+    for (size_t p = 0; p < np; ++p) std::fill(v[p].begin(), v[p].end(), base[p]);
+    superpose(inputs, t0, dt, count, v);
+    return v;
+  };
+
+  // The superposition's cost at a step: each ramp is evaluated on the rows inside its march window
+  // (beyond it the response is affine and costs nothing per row).
+  double reach = 0.0;
+  for (const SourceInput& in : inputs)
+    for (const Ramp& ramp : in.ramps)
+      if (ramp.t < grid.tstop) reach += std::min(grid.tstop - std::max(ramp.t, grid.tstart), end);
+  auto over_budget = [&](double step) {
+    const double evaluations = static_cast<double>(np) * reach / step;
+    gi.evaluations += evaluations;
+    if (grid.max_evaluations > 0 && evaluations > grid.max_evaluations) gi.over_budget = true;
+    return gi.over_budget;
+  };
+
+  double dt = grid.step;
+  std::vector<std::vector<double>> rows;
+  long count = 0;
+  if (dt > 0) {
+    count = static_cast<long>(std::floor(span / dt * (1 + 1e-12))) + 1;
+    if (over_budget(dt)) return Waveform{};
+    rows = rows_at(grid.tstart, dt, count);
+  } else {
+    dt = span;
+    while (dt > 20e-9) dt *= 0.5;
+    count = static_cast<long>(std::llround(span / dt)) + 1;
+    if (over_budget(dt)) return Waveform{};
+    rows = rows_at(grid.tstart, dt, count);
+    while (true) {
+      if (over_budget(dt)) return Waveform{};
+      auto mids = rows_at(grid.tstart + 0.5 * dt, dt, count - 1);
+      double worst = 0.0;
+      // Cells holding a source corner are skipped: the corner becomes a row of its own below.
+      std::vector<char> has_corner(count, 0);
+      for (double c : corners) {
+        const long i = static_cast<long>(std::floor((c - grid.tstart) / dt));
+        if (i >= 0 && i < count) has_corner[i] = 1;
+      }
+      for (size_t p = 0; p < np; ++p) {
+        if (!grid.grid_probes.empty() && (p >= grid.grid_probes.size() || !grid.grid_probes[p]))
+          continue;
+        const double scale = is_current_[p] ? 1e3 : 1.0;  // 1 mV -> 1 uA
+        for (long i = 0; i + 1 < count; ++i)
+          if (!has_corner[i])
+            worst = std::max(worst,
+                             scale * std::fabs(mids[p][i] - 0.5 * (rows[p][i] + rows[p][i + 1])));
+        // A cell holding corners is tested piece by piece between them (the corners are rows of
+        // their own): a fast response just after a corner is as visible as anywhere else.
+        for (size_t c = 0; c < corners.size();) {
+          const long i = static_cast<long>(std::floor((corners[c] - grid.tstart) / dt));
+          if (i < 0 || i + 1 >= count) {
+            ++c;
+            continue;
+          }
+          double a = grid.tstart + static_cast<double>(i) * dt, ya = rows[p][i];
+          for (; c < corners.size() && corners[c] < a + dt; ++c) {
+            const double yc = value_at(p, corners[c]);
+            const double ym = value_at(p, 0.5 * (a + corners[c]));
+            worst = std::max(worst, scale * std::fabs(ym - 0.5 * (ya + yc)));
+            a = corners[c], ya = yc;
+          }
+          const double b = grid.tstart + static_cast<double>(i + 1) * dt;
+          const double ym = value_at(p, 0.5 * (a + b));
+          worst = std::max(worst, scale * std::fabs(ym - 0.5 * (ya + rows[p][i + 1])));
+        }
+      }
+      if (worst <= 0.5 * grid.interp_tol) break;
+      // Budgeted: a smooth response's interpolation error falls as dt^2, so the step that meets
+      // the tolerance is about dt sqrt(tol / worst); when even that level would be over budget,
+      // stop now instead of computing the levels on the way (a kink needs finer still).
+      if (grid.max_evaluations > 0) {
+        const double final_dt = dt * std::sqrt(0.5 * grid.interp_tol / worst);
+        const double predicted = static_cast<double>(np) * reach / final_dt;
+        if (predicted > grid.max_evaluations) {
+          gi.evaluations += predicted;
+          gi.over_budget = true;
+          return Waveform{};
+        }
+      }
+      if (2 * count - 1 > grid.max_rows) {
+        gi.warning = fmt::format(
+            "LTI output grid stopped at {} rows (step {:g} s): linear interpolation between rows "
+            "may be off by up to {:.3g} mV, over the {:g} mV target",
+            count, dt, 2e3 * worst, 1e3 * grid.interp_tol);
+        break;
+      }
+      // Interleave: the midpoints are the finer grid's odd rows.
+      for (size_t p = 0; p < np; ++p) {
+        std::vector<double> fine(2 * count - 1);
+        for (long i = 0; i < count; ++i) fine[2 * i] = rows[p][i];
+        for (long i = 0; i + 1 < count; ++i) fine[2 * i + 1] = mids[p][i];
+        rows[p].swap(fine);
+      }
+      count = 2 * count - 1;
+      dt *= 0.5;
+    }
+  }
+  Waveform w;
+  std::vector<std::vector<double>> cols(np);
+  const double tiny = dt * 1e-6;
+  size_t c = 0;
+  for (long i = 0; i < count; ++i) {
+    const double t = grid.tstart + static_cast<double>(i) * dt;
+    for (; c < corners.size() && corners[c] < t; ++c) {
+      if (corners[c] <= t - tiny && (w.time.empty() || corners[c] >= w.time.back() + tiny)) {
+        w.time.push_back(corners[c]);
+        for (size_t p = 0; p < np; ++p) cols[p].push_back(value_at(p, corners[c]));
+      }
+    }
+    if (!w.time.empty() && t <= w.time.back()) continue;
+    w.time.push_back(t);
+    for (size_t p = 0; p < np; ++p) cols[p].push_back(rows[p][i]);
+  }
+  for (size_t p = 0; p < np; ++p) w.add_column(labels_[p], std::move(cols[p]));
+  gi.rows = static_cast<long>(w.time.size());
+  gi.step = dt;
+  return w;
+}
+
+}  // namespace isolink

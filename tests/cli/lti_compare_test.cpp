@@ -1,0 +1,153 @@
+// The LTI engine (what `isolink sim` and `isolink run` use by default) against ngspice at tight
+// tolerances (reltol 1e-6) and against the transient engine, on the example netlists, the example
+// link specs (exported as `isolink export-spice` does) and 20 m and 40 m transformer links.
+// Windows are short (a few us) so that the tight ngspice runs stay a few seconds:
+// the LTI engine's error does not accumulate over a run (each corner adds its own response).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "analysis/simulate.h"
+#include "netlists/link/expand.h"
+#include "netlists/link/link_spec.h"
+#include "netlists/link/parts.h"
+#include "netlists/spice_writer.h"
+#include "ngspice_runner.h"
+
+namespace isolink {
+namespace {
+
+const std::string kExamples = ISOLINK_EXAMPLES_DIR;
+
+// Runs `netlist` (written at `path`) through the LTI engine, the default transient and tight
+// ngspice to `tstop` (0: the netlist's); returns the max deviations (V) of v(rxp,rxn).
+struct Deviation {
+  double lti = 0, transient = 0;
+};
+Deviation compare(const Netlist& netlist, const std::string& path, double tstop) {
+  const std::vector<std::string> probes = {"v(rxp,rxn)"};
+  analysis::SimulationRequest req{.probes = probes};
+  std::string tran;
+  if (tstop > 0) {
+    req.tstop = tstop;
+    char card[64];
+    std::snprintf(card, sizeof card, ".tran %.9g %.9g", netlist.tran->tstep, tstop);
+    tran = card;
+  }
+  req.engine = analysis::Engine::Lti;
+  auto lti = analysis::simulate_netlist(netlist, req);
+  EXPECT_TRUE(lti.ok()) << lti.status().message();
+  req.engine = analysis::Engine::Transient;
+  auto transient = analysis::simulate_netlist(netlist, req);
+  EXPECT_TRUE(transient.ok()) << transient.status().message();
+  const std::string work = ::testing::TempDir() + "/lti_compare";
+  // trtol 1: at reltol 1e-6 ngspice's default trtol 7 leaves 2.4 mV of its own error on the 15 m
+  // transformer link (against reltol 1e-7, tmax 0.1 ns; README "LTI engine").
+  auto ng = testing::run_ngspice(path, probes, work,
+                                 std::string(testing::kNgspiceTight) + " trtol=1", tran);
+  EXPECT_TRUE(ng.ok()) << ng.status().message();
+  if (!lti.ok() || !transient.ok() || !ng.ok()) return {1, 1};
+  EXPECT_GT(ng->samples(), 1000u);
+  EXPECT_EQ(lti->engine, analysis::Engine::Lti);
+  EXPECT_NEAR(lti->wave.time.back(), ng->time.back(), 1e-12);
+  Deviation d{testing::max_abs_difference(lti->wave, 0, *ng, 0),
+              testing::max_abs_difference(transient->wave, 0, *ng, 0)};
+  std::printf(
+      "%s: max |dev| from ngspice tight: LTI %.3f mV (%ld march steps, %ld rows), "
+      "transient %.3f mV\n",
+      path.c_str(), d.lti * 1e3, lti->lti.steps, lti->grid.rows, d.transient * 1e3);
+  ::testing::Test::RecordProperty("lti_mV", std::to_string(d.lti * 1e3));
+  return d;
+}
+
+void compare_example(const std::string& name, double tstop) {
+  const std::string path = kExamples + "/" + name + ".cir";
+  auto netlist = read_spice_file(path);
+  ASSERT_TRUE(netlist.ok()) << netlist.status().message();
+  Deviation d = compare(*netlist, path, tstop);
+  EXPECT_LE(d.lti, 2e-3) << name;
+  EXPECT_LE(d.transient, 10e-3) << name;  // the transient's documented accuracy
+}
+
+TEST(LtiVsNgspice, CapLink2m) {
+  compare_example("cap_link_2m", 0);
+}
+TEST(LtiVsNgspice, CmcLink5m) {
+  compare_example("cmc_link_5m", 5e-6);
+}
+TEST(LtiVsNgspice, HybridXfmrCap3m) {
+  compare_example("hybrid_xfmr_cap_3m", 0);
+}
+TEST(LtiVsNgspice, XfmrLink15mFirst5us) {
+  compare_example("xfmr_link_15m", 5e-6);
+}
+
+// A link spec expanded (down direction) and exported as export-spice does.
+void compare_spec(const std::string& yaml_text, const std::string& name, double tstop) {
+  auto spec = link::read_link_spec_text(yaml_text, name + ".yaml");
+  ASSERT_TRUE(spec.ok()) << spec.status().message();
+  auto parts = link::PartLibrary::load({});
+  ASSERT_TRUE(parts.ok()) << parts.status().message();
+  auto ex = link::expand_link(*spec, *parts, link::Direction::kDown);
+  ASSERT_TRUE(ex.ok()) << ex.status().message();
+  const std::string dir = ::testing::TempDir() + "/lti_compare";
+  std::filesystem::create_directories(dir);
+  const std::string path = dir + "/" + name + ".cir";
+  std::ofstream(path) << write_spice(ex->netlist);
+  Deviation d = compare(ex->netlist, path, tstop);
+  EXPECT_LE(d.lti, 2e-3) << name;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+TEST(LtiVsNgspice, TransformerLink20m) {
+  compare_spec(
+      "name: xfmr-20m\n"
+      "tx: {device: bq7961x, isolation: {type: transformer, part: HMU1228NL}}\n"
+      "rx: {device: bq7961x, isolation: {type: transformer, part: HMU1228NL}}\n"
+      "cable: {length: 20, material: pp, gauge: 24}\n"
+      "stimulus: {frames: [\"single-read dev=1 reg=0x0100 n=1\"]}\n",
+      "xfmr_20m", 4e-6);
+}
+TEST(LtiVsNgspice, TransformerLink40m) {
+  compare_spec(
+      "name: xfmr-40m\n"
+      "tx: {device: bq7961x, isolation: {type: transformer, part: HMU1228NL}}\n"
+      "rx: {device: bq7961x, isolation: {type: transformer, part: HMU1228NL}}\n"
+      "cable: {length: 40, material: pp, gauge: 24}\n"
+      "stimulus: {frames: [\"single-read dev=1 reg=0x0100 n=1\"]}\n",
+      "xfmr_40m", 4e-6);
+}
+TEST(LtiVsNgspice, HybridLinkExampleSpec) {
+  compare_spec(slurp(kExamples + "/hybrid_xfmr_cap_12m.yaml"), "hybrid_xfmr_cap_12m", 4e-6);
+}
+TEST(LtiVsNgspice, CapChokeExampleSpec) {
+  compare_spec(slurp(kExamples + "/capchoke_5m.yaml"), "capchoke_5m", 4e-6);
+}
+
+// Auto picks LTI for every link; a SIN source sends auto to the transient and makes lti an error.
+TEST(LtiEngineChoice, AutoFallsBackOnSinAndLtiRefusesNamingTheSource) {
+  const std::string path = ::testing::TempDir() + "/sin_rc.cir";
+  std::ofstream(path) << "sin rc\nVS in 0 SIN(0 1 1meg)\nR1 in out 1k\nC1 out 0 1n\n.tran 1n 2u\n"
+                         ".end\n";
+  auto netlist = read_spice_file(path);
+  ASSERT_TRUE(netlist.ok()) << netlist.status().message();
+  analysis::SimulationRequest req{.probes = {"v(out)"}};
+  auto r = analysis::simulate_netlist(*netlist, req);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_EQ(r->engine, analysis::Engine::Transient);
+  EXPECT_NE(r->engine_note.find("'vs'"), std::string::npos) << r->engine_note;
+  req.engine = analysis::Engine::Lti;
+  auto forced = analysis::simulate_netlist(*netlist, req);
+  ASSERT_FALSE(forced.ok());
+  EXPECT_NE(forced.status().message().find("sin_rc.cir:2:1: error: source 'vs'"), std::string::npos)
+      << forced.status().message();
+}
+
+}  // namespace
+}  // namespace isolink

@@ -1,0 +1,44 @@
+// libFuzzer targets for every reader (issue 15): one source, built once per reader with
+// ISOLINK_FUZZ_READER set (tests/fuzz/CMakeLists.txt). Each feeds the bytes to the reader as a
+// file's text; any crash, sanitizer report, leak, timeout or memory blow-up is a finding. The
+// readers answer bad input with a Status, so the return value is ignored.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#if ISOLINK_FUZZ_READER == 1
+#include "netlists/spice_reader.h"
+#elif ISOLINK_FUZZ_READER == 2
+#include "netlists/link/link_spec.h"
+#elif ISOLINK_FUZZ_READER == 3
+#include "analysis/sweep_spec.h"
+#elif ISOLINK_FUZZ_READER == 4
+#include "netlists/link/parts.h"
+#elif ISOLINK_FUZZ_READER == 5
+#include "eye/rules.h"
+#elif ISOLINK_FUZZ_READER == 6
+#include "eye/waveform_csv.h"
+#elif ISOLINK_FUZZ_READER == 7
+#include "netlists/traffic/stimulus.h"
+#endif
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+#if ISOLINK_FUZZ_READER == 1
+  (void)isolink::read_spice_text(text, "fuzz.cir");
+#elif ISOLINK_FUZZ_READER == 2
+  (void)isolink::link::read_link_spec_text(text, "fuzz.yaml");
+#elif ISOLINK_FUZZ_READER == 3
+  (void)isolink::analysis::sweep::read_sweep_text(text, "fuzz.yaml");
+#elif ISOLINK_FUZZ_READER == 4
+  (void)isolink::link::read_parts_text(text, "fuzz.yaml");
+#elif ISOLINK_FUZZ_READER == 5
+  (void)isolink::eye::parse_rules(text, "fuzz.yaml");
+#elif ISOLINK_FUZZ_READER == 6
+  (void)isolink::eye::parse_differential_csv(text, "fuzz.csv");
+#elif ISOLINK_FUZZ_READER == 7
+  (void)isolink::traffic::build_drive(text);
+#endif
+  return 0;
+}

@@ -1,0 +1,323 @@
+// LTI engine against closed-form answers and against the transient engine at tight tolerance.
+#include "solver/lti.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "solver/transient.h"
+#include "test_cards.h"
+
+namespace isolink {
+namespace {
+using namespace isolink::testing;
+
+struct Built {
+  Circuit circuit;
+  std::vector<Probe> probes;
+};
+
+std::unique_ptr<Built> make(const std::vector<Card>& cards,
+                            const std::vector<std::string>& probes) {
+  auto b = std::make_unique<Built>();
+  EXPECT_EQ(build(b->circuit, cards), "");
+  for (const auto& p : probes) {
+    auto probe = parse_probe(b->circuit, p);
+    EXPECT_TRUE(probe.ok()) << probe.status().message();
+    if (probe) b->probes.push_back(*probe);
+  }
+  return b;
+}
+
+LtiResponses responses(const Built& b, double horizon) {
+  LtiOptions opt;
+  opt.horizon = horizon;
+  auto r = LtiResponses::compute(b.circuit, b.probes, opt);
+  EXPECT_TRUE(r.ok()) << r.status().message();
+  return std::move(*r);
+}
+
+// First-order lag (time constant tau): unit-ramp response and unit-step response.
+double lag_ramp(double t, double tau) {
+  return t <= 0 ? 0 : t - tau * (1 - std::exp(-t / tau));
+}
+double lag_step(double t, double tau) {
+  return t <= 0 ? 0 : 1 - std::exp(-t / tau);
+}
+
+TEST(Lti, RcRampAndStepResponsesMatchClosedForm) {
+  const double r = 1e3, cap = 1e-9, tau = r * cap;
+  auto b = make({card("v1", {"in", "0"}, {call("pwl", {0, 0, 1e-9, 1})}),
+                 card("r1", {"in", "out"}, {num(r)}), card("c1", {"out", "0"}, {num(cap)})},
+                {"v(out)"});
+  LtiResponses lti = responses(*b, 20e-6);
+  ASSERT_EQ(lti.source_count(), 1u);
+  EXPECT_EQ(lti.source_name(0), "v1");
+  double worst_step = 0, worst_ramp = 0;
+  for (double t = 1e-9; t < 20e-6; t *= 1.07) {
+    worst_step = std::max(worst_step, std::fabs(lti.step_response(0, 0, t) - lag_step(t, tau)));
+    // The ramp response in units of tau: its error per unit time is what the output sees.
+    worst_ramp =
+        std::max(worst_ramp, std::fabs(lti.ramp_response(0, 0, t) - lag_ramp(t, tau)) / tau);
+  }
+  // step_reltol 1e-5 bounds the error added per unit time; on one time constant it stays near it.
+  EXPECT_LT(worst_step, 3e-5);
+  EXPECT_LT(worst_ramp, 3e-5);
+  EXPECT_NEAR(lti.dc_gain(0, 0), 1.0, 1e-9);
+  EXPECT_EQ(lti.ramp_response(0, 0, 0.0), 0.0);
+  EXPECT_EQ(lti.ramp_response(0, 0, -1e-9), 0.0);
+}
+
+TEST(Lti, RcSettlesEarlyAndExtendsTheRampResponseAsALine) {
+  const double tau = 1e-6;
+  auto b = make({card("v1", {"in", "0"}, {call("pwl", {0, 0, 1e-9, 1})}),
+                 card("r1", {"in", "out"}, {num(1e3)}), card("c1", {"out", "0"}, {num(1e-9)})},
+                {"v(out)"});
+  LtiResponses lti = responses(*b, 1e-3);
+  EXPECT_TRUE(lti.stats().settled);
+  // settle_tol 1e-6: exp(-t/tau) < 1e-6 needs t > 13.8 tau.
+  EXPECT_GT(lti.stats().settled_at, 13.8 * tau);
+  EXPECT_LT(lti.stats().settled_at, 100 * tau);
+  // Beyond the march: R(T) + S(T) (t - T), off the exact ramp response by < settle_tol * tau.
+  EXPECT_NEAR(lti.ramp_response(0, 0, 500e-6), lag_ramp(500e-6, tau), 2e-6 * tau);
+  EXPECT_NEAR(lti.step_response(0, 0, 500e-6), 1.0, 2e-6);
+}
+
+TEST(Lti, PulseTrainThroughRcIsTheSumOfRampsAtExactCorners) {
+  // PULSE(0 5 TD=13.3n TR=7n TF=11n PW=93n PER=250n NP=3): corners off any grid.
+  const double tau = 47e-9;
+  auto b = make(
+      {card("v1", {"in", "0"}, {call("pulse", {0, 5, 13.3e-9, 7e-9, 11e-9, 93e-9, 250e-9, 3})}),
+       card("r1", {"in", "out"}, {num(47)}), card("c1", {"out", "0"}, {num(1e-9)})},
+      {"v(out)", "v(in)"});
+  for (auto& e : b->circuit.elements()) e->bind_time(1e-9, 1e-6);
+  LtiResponses lti = responses(*b, 1e-6);
+  const auto inputs = lti.netlist_inputs(1e-6);
+  ASSERT_EQ(inputs.size(), 1u);
+  EXPECT_EQ(inputs[0].ramps.size(), 12u);  // 4 corners per pulse
+  auto exact = [&](double t) {
+    double y = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double t0 = 13.3e-9 + k * 250e-9;
+      y += 5 / 7e-9 * (lag_ramp(t - t0, tau) - lag_ramp(t - t0 - 7e-9, tau));
+      y -= 5 / 11e-9 * (lag_ramp(t - t0 - 100e-9, tau) - lag_ramp(t - t0 - 111e-9, tau));
+    }
+    return y;
+  };
+  double worst = 0;
+  for (double t = 0; t < 1e-6; t += 0.737e-9)
+    worst = std::max(worst, std::fabs(lti.value(0, t, inputs) - exact(t)));
+  EXPECT_LT(worst, 50e-6);  // V, on a 5 V pulse
+  // The source itself comes back exactly (a probe on the driven node).
+  EXPECT_NEAR(lti.value(1, 13.3e-9 + 3.5e-9, inputs), 2.5, 1e-9);
+  EXPECT_NEAR(lti.value(1, 13.3e-9 + 50e-9, inputs), 5.0, 1e-9);
+}
+
+// Series RLC, underdamped: v(c) for a unit step, the closed form.
+TEST(Lti, UnderdampedRlcStepResponseMatchesClosedForm) {
+  const double r = 10, l = 1e-6, cap = 1e-9;
+  const double alpha = r / (2 * l), w0 = 1 / std::sqrt(l * cap),
+               wd = std::sqrt(w0 * w0 - alpha * alpha);
+  auto b = make(
+      {card("v1", {"in", "0"}, {call("pwl", {0, 0, 1e-9, 1})}), card("r1", {"in", "a"}, {num(r)}),
+       card("l1", {"a", "c"}, {num(l)}), card("c1", {"c", "0"}, {num(cap)})},
+      {"v(c)", "i(l1)"});
+  LtiResponses lti = responses(*b, 5e-6);
+  double worst = 0;
+  for (double t = 1e-9; t < 5e-6; t += 3.1e-9) {
+    const double exact =
+        1 - std::exp(-alpha * t) * (std::cos(wd * t) + alpha / wd * std::sin(wd * t));
+    worst = std::max(worst, std::fabs(lti.step_response(0, 0, t) - exact));
+  }
+  EXPECT_LT(worst, 1e-4);  // V per V of step: 1e-5 per unit time accumulated over 16 periods, Q 3.2
+}
+
+// The output grid: linear interpolation between rows within 1 mV of the exact value anywhere, and
+// the whole waveform within 0.5 mV of the transient engine at reltol 1e-7.
+TEST(Lti, GridRuleAndTransientCrossCheckOnRlcBurst) {
+  std::vector<Card> cards{card("v1", {"in", "0"},
+                               {call("pwl", {0, 0, 100e-9, 0, 110e-9, 5, 350e-9, 5, 360e-9, -5,
+                                             600e-9, -5, 610e-9, 0})}),
+                          card("r1", {"in", "a"}, {num(20)}), card("l1", {"a", "c"}, {num(1e-6)}),
+                          card("c1", {"c", "0"}, {num(1e-9)}), card("r2", {"c", "0"}, {num(200)})};
+  auto b = make(cards, {"v(c)", "i(l1)"});
+  LtiResponses lti = responses(*b, 3e-6);
+  const auto inputs = lti.netlist_inputs(3e-6);
+  LtiResponses::GridInfo info;
+  // The rule on v(c) only (a current probe's 1 uA would make this grid much finer).
+  Waveform w = lti.waveform(inputs, {.tstop = 3e-6, .grid_probes = {true, false}}, &info);
+  EXPECT_EQ(info.warning, "");
+  EXPECT_EQ(info.corners, 6);
+  EXPECT_GT(w.samples(), 100u);
+  EXPECT_NEAR(w.time.back(), 3e-6, 1e-15);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> when(0, 3e-6);
+  double worst = 0;
+  for (int i = 0; i < 5000; ++i) {
+    const double t = when(rng);
+    worst = std::max(worst, std::fabs(w.value_at(0, t) - lti.value(0, t, inputs)));
+  }
+  EXPECT_LT(worst, 1e-3);
+  EXPECT_GT(worst, 1e-5);  // the grid is not absurdly fine
+
+  TransientOptions topt{.tstep = 1e-9, .tstop = 3e-6, .reltol = 1e-7};
+  topt.tmax = 1e-9;
+  auto tr = run_transient(b->circuit, topt, b->probes);
+  ASSERT_TRUE(tr.ok()) << tr.status().message();
+  double dev = 0, dev_i = 0;
+  for (size_t i = 0; i < tr->samples(); ++i) {
+    dev = std::max(dev, std::fabs(tr->columns[0][i] - lti.value(0, tr->time[i], inputs)));
+    dev_i = std::max(dev_i, std::fabs(tr->columns[1][i] - lti.value(1, tr->time[i], inputs)));
+  }
+  EXPECT_LT(dev, 0.5e-3);
+  EXPECT_LT(dev_i, 5e-6);
+}
+
+TEST(Lti, DcSourcesAndNewInitialValuesShiftByTheDcGain) {
+  // Divider: out = (v1 + v2) / 2 at DC, C across the bottom.
+  auto b = make({card("v1", {"a", "0"}, {call("pwl", {0, 1, 1e-6, 3})}),
+                 card("v2", {"b", "0"}, {word("dc"), num(2)}), card("r1", {"a", "out"}, {num(1e3)}),
+                 card("r2", {"b", "out"}, {num(1e3)}), card("c1", {"out", "0"}, {num(1e-12)})},
+                {"v(out)"});
+  LtiResponses lti = responses(*b, 10e-6);
+  ASSERT_EQ(lti.source_count(), 1u);  // the DC source is in the operating point
+  const auto in = lti.netlist_inputs(10e-6);
+  EXPECT_NEAR(lti.value(0, 0.0, in), 1.5, 1e-9);
+  EXPECT_NEAR(lti.value(0, 9e-6, in), 2.5, 1e-6);
+  EXPECT_NEAR(lti.dc_gain(0, 0), 0.5, 1e-9);
+  SourceInput other = pwl_input({0, 1e-6}, {-1, -1});  // constant -1 V
+  EXPECT_TRUE(other.ramps.empty());
+  EXPECT_NEAR(lti.value(0, 5e-6, {other}), 0.5, 1e-9);
+}
+
+TEST(Lti, PwlInputGivesTheSourceFunctionsRamps) {
+  SourceInput in = pwl_input({1e-9, 2e-9, 5e-9, 6e-9}, {0, 1, 1, 0});
+  ASSERT_EQ(in.ramps.size(), 4u);
+  EXPECT_DOUBLE_EQ(in.ramps[0].t, 1e-9);
+  EXPECT_NEAR(in.ramps[0].slope, 1e9, 1e-3);
+  EXPECT_NEAR(in.ramps[1].slope, -1e9, 1e-3);
+  EXPECT_NEAR(in.ramps[2].slope, -1e9, 1e-3);
+  EXPECT_NEAR(in.ramps[3].slope, 1e9, 1e-3);
+  auto f = SourceFunction::Parse(
+      card("v1", {"a", "0"}, {call("pwl", {1e-9, 0, 2e-9, 1, 5e-9, 1, 6e-9, 0})}));
+  ASSERT_TRUE(f.ok());
+  auto ramps = f->ramps(10e-9);
+  ASSERT_EQ(ramps.size(), 4u);
+  for (size_t i = 0; i < 4; ++i) {
+    EXPECT_NEAR(ramps[i].t, in.ramps[i].t, 1e-20);
+    EXPECT_NEAR(ramps[i].slope, in.ramps[i].slope, 1e-3);
+  }
+}
+
+TEST(Lti, RefusesASinSourceNamingIt) {
+  auto b = make(
+      {card("vsin", {"in", "0"}, {call("sin", {0, 1, 1e6})}), card("r1", {"in", "0"}, {num(1e3)})},
+      {"v(in)"});
+  Status s = check_lti(b->circuit);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("'vsin'"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("not a continuous piecewise-linear"), std::string::npos)
+      << s.message();
+  LtiOptions opt;
+  opt.horizon = 1e-6;
+  EXPECT_FALSE(LtiResponses::compute(b->circuit, b->probes, opt).ok());
+}
+
+TEST(Lti, RefusesExpAndAJumpingPwlRepeatButTakesAContinuousOne) {
+  auto refused = [](std::vector<CardArg> args, const char* name) {
+    auto b = make({card(name, {"in", "0"}, std::move(args)), card("r1", {"in", "0"}, {num(1e3)})},
+                  {"v(in)"});
+    Status s = check_lti(b->circuit);
+    return !s.ok() && s.message().find(std::string("'") + name + "'") != std::string::npos;
+  };
+  EXPECT_TRUE(refused({call("exp", {0, 1, 0, 1e-9, 5e-9, 1e-9})}, "vexp"));
+  // r=0: repeats from t=0 (value 0) after t=1u (value 1): a jump of 1 V every microsecond.
+  Card jump = card("vjump", {"in", "0"}, {call("pwl", {0, 0, 1e-6, 1})});
+  CardArg r0 = num(0.0);
+  jump.params.emplace_back("r", r0);
+  auto bj = make({jump, card("r1", {"in", "0"}, {num(1e3)})}, {"v(in)"});
+  EXPECT_FALSE(check_lti(bj->circuit).ok());
+  // A triangle that ends where it starts repeats without a jump: a sum of ramps.
+  Card tri = card("vtri", {"in", "0"}, {call("pwl", {0, 0, 1e-6, 1, 2e-6, 0})});
+  tri.params.emplace_back("r", r0);
+  auto bt = make({tri, card("r1", {"in", "0"}, {num(1e3)})}, {"v(in)"});
+  EXPECT_TRUE(check_lti(bt->circuit).ok()) << check_lti(bt->circuit).message();
+}
+
+TEST(Lti, RefusesAnInductorOpenedForTheDcPoint) {
+  auto b = make({card("v1", {"in", "0"}, {call("pwl", {0, 0, 1e-9, 1})}),
+                 card("l1", {"in", "0"}, {num(1e-6)})},
+                {"i(l1)"});
+  Status s = check_lti(b->circuit);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("opened for the DC"), std::string::npos) << s.message();
+}
+
+// The superposition's predicted cost is probes x sum over ramps of the rows inside the march
+// window; over max_evaluations the rule stops with an empty waveform (auto then runs the
+// transient).
+TEST(Lti, GridPredictsItsEvaluationsAndStopsOverBudget) {
+  auto b = make({card("v1", {"in", "0"}, {call("pwl", {0, 0, 10e-9, 1, 1e-6, 1})}),
+                 card("r1", {"in", "out"}, {num(1e3)}), card("c1", {"out", "0"}, {num(1e-9)})},
+                {"v(out)", "v(in)"});
+  LtiResponses lti = responses(*b, 2e-6);
+  const double end = lti.stats().settled_at;
+  ASSERT_GT(end, 0.0);
+  LtiResponses::GridOptions grid;
+  grid.tstop = 2e-6;
+  grid.step = 1e-8;
+  LtiResponses::GridInfo info;
+  // Ramps at 0, 10 ns (end of the rise) and 1 us (a slope change of 0: none).
+  const auto inputs = lti.netlist_inputs(2e-6);
+  ASSERT_EQ(inputs.size(), 1u);
+  ASSERT_EQ(inputs[0].ramps.size(), 2u);
+  const double expected =
+      2.0 * (std::min(2e-6, end) + std::min(2e-6 - 10e-9, end)) / 1e-8;  // 2 probes
+  Waveform w = lti.waveform(inputs, grid, &info);
+  EXPECT_FALSE(info.over_budget);
+  EXPECT_NEAR(info.evaluations, expected, 1e-6 * expected);
+  EXPECT_EQ(w.samples(), 201u);
+  grid.max_evaluations = 0.5 * expected;
+  w = lti.waveform(inputs, grid, &info);
+  EXPECT_TRUE(info.over_budget);
+  EXPECT_EQ(w.samples(), 0u);
+}
+
+// The output grid rule holds its 1 uA promise in the cell just after a corner too: an RL lag
+// of tau = 0.5 ns, driven by a 10 ns ramp whose end is inside the first 20 ns cell, read by
+// linear interpolation between the rows against the closed-form ramp response.
+TEST(Lti, GridRuleMeetsItsToleranceRightAfterACorner) {
+  const double r = 2e3, l = 1e-6, tau = l / r, a = 1.0 / 10e-9;  // input slope V/s
+  auto b = make({card("v1", {"in", "0"}, {call("pwl", {0, 0, 10e-9, 1, 1e-6, 1})}),
+                 card("r1", {"in", "x"}, {num(r)}), card("l1", {"x", "0"}, {num(l)})},
+                {"i(l1)"});
+  LtiResponses lti = responses(*b, 1e-6);
+  LtiResponses::GridOptions grid;
+  grid.tstop = 1e-6;
+  Waveform w = lti.waveform(lti.netlist_inputs(1e-6), grid);
+  auto exact = [&](double t) {  // i = (a / r) * (lag_ramp(t) - lag_ramp(t - 10 ns))
+    return a / r * (lag_ramp(t, tau) - lag_ramp(t - 10e-9, tau));
+  };
+  double worst = 0;
+  for (size_t i = 0; i + 1 < w.time.size(); ++i)
+    for (double f : {0.25, 0.5, 0.75}) {
+      const double t = w.time[i] + f * (w.time[i + 1] - w.time[i]);
+      const double lin = w.columns[0][i] + f * (w.columns[0][i + 1] - w.columns[0][i]);
+      worst = std::max(worst, std::fabs(lin - exact(t)));
+    }
+  EXPECT_LT(worst, 1.2e-6) << "rows: " << w.time.size();  // 1 uA target, 20 % for the march
+}
+
+TEST(Lti, OptionsAreValidatedByName) {
+  LtiOptions opt;
+  Status s = opt.validate();
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("horizon = 0"), std::string::npos) << s.message();
+  opt.horizon = 1e-6;
+  opt.step_reltol = 2;
+  EXPECT_NE(opt.validate().message().find("step_reltol = 2"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace isolink
