@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "analysis/noise.h"
-#include "base/atomic_file.h"
+#include "base/file_io.h"
 #include "cli/commands.h"
 #include "netlists/link/cards.h"
 #include "netlists/link/link_spec.h"
