@@ -398,6 +398,25 @@ FieldReader read_int(const YamlDoc& doc, int lo, int hi, int* out) {
   };
 }
 
+FieldReader read_percent(const YamlDoc& doc, double max_percent, double* out) {
+  return [&doc, max_percent, out](const YAML::Node& n, const std::string& key) -> Status {
+    std::string s = n.IsScalar() ? n.Scalar() : "";
+    while (!s.empty() && s.back() == ' ') s.pop_back();
+    const bool has_sign = !s.empty() && s.back() == '%';
+    if (has_sign) s.pop_back();
+    while (!s.empty() && s.back() == ' ') s.pop_back();
+    double v = 0;
+    if (!has_sign || !parse_quantity(s, Unit::kNone, &v))
+      return doc.error(n, fmt::format("key '{}': expected a percentage, e.g. 10%, found '{}'", key,
+                                      node_text(n)));
+    if (!(v >= 0 && v <= max_percent))
+      return doc.error(
+          n, fmt::format("key '{}' = {}: must be in 0..{:g} %", key, n.Scalar(), max_percent));
+    *out = v / 100.0;
+    return Status::Ok();
+  };
+}
+
 FieldReader read_text_list(const YamlDoc& doc, std::vector<std::string>* out) {
   return [&doc, out](const YAML::Node& n, const std::string& key) -> Status {
     out->clear();

@@ -96,6 +96,8 @@ FieldReader read_text(const YamlDoc& doc, std::string* out);
 FieldReader read_choice(const YamlDoc& doc, std::vector<std::string> options, std::string* out);
 FieldReader read_bool(const YamlDoc& doc, bool* out);
 FieldReader read_int(const YamlDoc& doc, int lo, int hi, int* out);
+// A percentage "10%" (or "10 %"), stored as the fraction 0.1; must lie in [0, max_percent].
+FieldReader read_percent(const YamlDoc& doc, double max_percent, double* out);
 // A list of text items, or one text item.
 FieldReader read_text_list(const YamlDoc& doc, std::vector<std::string>* out);
 

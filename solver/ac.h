@@ -22,8 +22,8 @@
 namespace isolink {
 
 struct AcSolution {
-  double frequency = 0;                     // Hz
-  std::vector<std::complex<double>> x;      // per unknown; x[0] is ground (0)
+  double frequency = 0;                 // Hz
+  std::vector<std::complex<double>> x;  // per unknown; x[0] is ground (0)
   std::complex<double> voltage(const Probe& p) const { return x[p.a] - x[p.b]; }
 };
 
@@ -37,6 +37,26 @@ class AcAnalysis {
 
   // Drives the named V or I source (lower case) with amplitude 1 at frequency f (Hz, >= 0).
   StatusOr<AcSolution> solve(const std::string& source, double frequency);
+
+  // Several right-hand sides on one factorization (noise analysis: sources driven together,
+  // adjoint sensitivities). Vectors are indexed by unknown, [0] being ground (ignored in b, 0 in
+  // the result).
+  using Vector = std::vector<std::complex<double>>;
+  // Factors G + j 2 pi f C at f (Hz, >= 0); the solves below reuse it until the next factor().
+  Status factor(double frequency);
+  double factored_frequency() const;
+  // x with A x = b.
+  Vector solve_factored(const Vector& b) const;
+  // z with A^T z = c: for an output c.x, a change dA of the matrix moves it by -z^T dA x.
+  Vector solve_transposed(const Vector& c) const;
+  // Adds amplitude times the named V or I source's unit excitation into b (size unknowns + 1).
+  Status add_excitation(const std::string& source, std::complex<double> amplitude, Vector& b) const;
+  // The stamps: A = G + j w C, values in the pattern's CSC order (col_start, row_index, both
+  // over unknowns - 1, i.e. without ground).
+  const std::vector<double>& g_values() const;
+  const std::vector<double>& c_values() const;
+  const std::vector<int>& col_start() const;
+  const std::vector<int>& row_index() const;
 
  private:
   AcAnalysis();

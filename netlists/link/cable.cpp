@@ -1,11 +1,11 @@
 #include "netlists/link/cable.h"
 
+#include <fmt/format.h>
+
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-
-#include <Eigen/Dense>
-#include <fmt/format.h>
 
 #include "netlists/link/cards.h"
 
@@ -22,7 +22,7 @@ constexpr double kAlphaCu = 0.00393;        // 1/K, copper resistance temperatur
 constexpr double kFillDiff = 0.70;          // differential fill factor: er_eff = 1 + q (er - 1)
 constexpr int kSkinSections = 7;            // R || L sections per conductor
 constexpr int kDielectricBranches = 7;      // series R-C branches across the pair
-constexpr int kMaxLossStride = 4;          // segments per loss section, at most
+constexpr int kMaxLossStride = 4;           // segments per loss section, at most
 constexpr double kNeighbourCoupling = 0.1;  // kappa between adjacent segments' inductors
 
 // Insulation wall (mm) for even gauges 18..30, interpolated for odd ones (assumed, typical
@@ -260,6 +260,8 @@ Status CableSpec::validate() const {
   if (l && !(*l > 0 && std::isfinite(*l))) return field_error("l", *l, "must be > 0 (H/m)");
   if (c && !(*c > 0 && std::isfinite(*c))) return field_error("c", *c, "must be > 0 (F/m)");
   if (g && !(*g >= 0 && std::isfinite(*g))) return field_error("g", *g, "must be >= 0 (S/m)");
+  if (chassis_c && !(*chassis_c > 0 && std::isfinite(*chassis_c)))
+    return field_error("chassis_c", *chassis_c, "must be > 0 (F/m per conductor)");
   if (segments < 0 || segments > 1000)
     return field_error("segments", segments, "must be 0 (automatic) or 1..1000");
   return Status::Ok();
@@ -383,6 +385,15 @@ StatusOr<CableModel> cable_model(const CableSpec& spec) {
   m.er_eff_cm = x / (x - (1 - 1 / m.er) * std::log(1 + m.wall / a));
   m.c_g = m.er_eff_cm / (kC0 * kC0 * m.l_cm) / 2;
   double c_diff = m.er_eff / (kC0 * kC0 * m.l_diff);
+  if (spec.chassis_c) {
+    const double c_d = spec.c ? *spec.c : c_diff;
+    if (!(*spec.chassis_c < 2 * c_d))
+      return field_error("chassis_c", *spec.chassis_c,
+                         fmt::format("must be below 2 c = {:.4g} F/m (the differential "
+                                     "capacitance holds half of it)",
+                                     2 * c_d));
+    m.c_g = *spec.chassis_c;
+  }
   if (spec.c) {
     if (!(*spec.c > m.c_g / 2))
       return field_error("c", *spec.c,
@@ -424,7 +435,9 @@ StatusOr<CableModel> cable_model(const CableSpec& spec) {
   return m;
 }
 
-int loss_stride(int segments) { return std::clamp(segments / 8, 1, kMaxLossStride); }
+int loss_stride(int segments) {
+  return std::clamp(segments / 8, 1, kMaxLossStride);
+}
 int loss_stride(const CableSpec& spec, int segments) {
   return spec.loss_stride > 0 ? spec.loss_stride : loss_stride(segments);
 }

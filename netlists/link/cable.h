@@ -55,9 +55,12 @@ struct CableSpec {
   //   g: differential conductance (S/m) at 1 MHz: sets the effective loss tangent
   //      g / (2 pi 1 MHz c); G then grows with frequency (constant loss tangent). 0 = no loss.
   std::optional<double> r, l, c, g;
-  int segments = 0;             // 0: chosen from the edge time (cable_segments)
-  int loss_stride = 0;          // segments per loss section; 0: automatic (loss_stride()); else 1..1000
-  bool skin_effect = true;      // false: DC resistance only, no internal inductance
+  //   chassis_c: each conductor's capacitance to the chassis (F/m), replacing the geometry's c_g
+  //      (the pair 20 mm over the chassis: 6.7 pF/m for 24 AWG PP); c stays as given or preset.
+  std::optional<double> chassis_c;
+  int segments = 0;         // 0: chosen from the edge time (cable_segments)
+  int loss_stride = 0;      // segments per loss section; 0: automatic (loss_stride()); else 1..1000
+  bool skin_effect = true;  // false: DC resistance only, no internal inductance
   bool dielectric_loss = true;  // false: loss-free dielectric, capacitances constant
 
   // Names the field, its value and the rule: "cable.length = -1: must be > 0".

@@ -146,6 +146,33 @@ StatusOr<std::pair<std::string, std::string>> add_end(std::vector<Card>& cards, 
   return std::pair{p, n};
 }
 
+// Moves the cards from index `from` on off the chassis onto the board ground `ground`.
+void reground(std::vector<Card>& cards, size_t from, const std::string& ground) {
+  if (ground == "0") return;
+  for (size_t i = from; i < cards.size(); ++i)
+    for (std::string& node : cards[i].nodes)
+      if (node == "0" || node == "gnd") node = ground;
+}
+
+// X and Y caps at the connector (p, n) of an end, and the board's capacitance to the chassis
+// when its ground is kept apart.
+void add_connector_caps(std::vector<Card>& cards, const EndSpec& end, const std::string& side,
+                        const std::string& p, const std::string& n, const std::string& ground,
+                        std::string* bom) {
+  if (end.x_cap > 0) {
+    *bom += "; X cap " + format_si(end.x_cap, "F");
+    cards.push_back(make_card('c', "c" + side + "x", {p, n}, {number_arg(end.x_cap)}));
+  }
+  if (end.y_cap > 0) {
+    *bom += "; Y caps " + format_si(end.y_cap, "F") + " per line";
+    cards.push_back(make_card('c', "c" + side + "yp", {p, "0"}, {number_arg(end.y_cap)}));
+    cards.push_back(make_card('c', "c" + side + "yn", {n, "0"}, {number_arg(end.y_cap)}));
+  }
+  if (ground != "0")
+    cards.push_back(
+        make_card('c', "c" + side + "chassis", {ground, "0"}, {number_arg(end.chassis_c)}));
+}
+
 NetlistOption option(const std::string& key, double v) {
   return NetlistOption{key, number_arg(v), {}};
 }
@@ -178,16 +205,25 @@ StatusOr<ExpandedLink> expand_link(const LinkSpec& spec, const PartLibrary& part
   std::vector<Card>& cards = out.netlist.cards;
   if (Status s = add_tx_driver(cards, "tx", "txp", "txn", out.drive, opt.driver); !s.ok())
     return s.with_context("tx driver");
-  auto a = add_end(cards, from, "tx", from_key, parts, down ? &out.tx_bom : &out.rx_bom);
+  std::string* from_bom = down ? &out.tx_bom : &out.rx_bom;
+  std::string* to_bom = down ? &out.rx_bom : &out.tx_bom;
+  auto a = add_end(cards, from, "tx", from_key, parts, from_bom);
   if (!a) return a.status();
-  auto b = add_end(cards, to, "rx", to_key, parts, down ? &out.rx_bom : &out.tx_bom);
+  reground(cards, 0, opt.tx_ground);
+  add_connector_caps(cards, from, "tx", a->first, a->second, opt.tx_ground, from_bom);
+  size_t to_start = cards.size();
+  auto b = add_end(cards, to, "rx", to_key, parts, to_bom);
   if (!b) return b.status();
+  reground(cards, to_start, opt.rx_ground);
+  add_connector_caps(cards, to, "rx", b->first, b->second, opt.rx_ground, to_bom);
   if (Status s = add_cable(cards, "cab", a->first, a->second, b->first, b->second, spec.cable,
                            opt.driver.edge, &out.cable_segments);
       !s.ok())
     return at(spec.cable_loc, "cable: " + s.message());
+  const size_t load_start = cards.size();
   if (Status s = add_rx_load(cards, "rx", "rxp", "rxn", opt.load); !s.ok())
     return s.with_context("rx load");
+  reground(cards, load_start, opt.rx_ground);
 
   out.netlist.title = fmt::format("isolink link spec '{}', {}", spec.name, out.description);
   TranSpec tran;

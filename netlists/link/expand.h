@@ -10,6 +10,8 @@
 //   -> isolation (cap | cap + chokes | transformer | transformer + chokes) -> tx_cp/tx_cn
 //      (+ kCableBleed to ground per line)
 //   -> cable -> rx_cp/rx_cn -> isolation -> rx_lp/rx_ln -> board -> rxp/rxn -> RX load.
+// X caps (x_cap) across and Y caps (y_cap, to the chassis "0") sit at each end's connector
+// (the cable side of its isolation).
 // Node names follow the role in this direction: txp/txn always drive, rxp/rxn always receive.
 #pragma once
 
@@ -40,6 +42,12 @@ struct ExpandOptions {
   TxDriverModel driver;               // the transmitting pins
   RxLoadModel load;                   // the receiving pins
   traffic::StimulusOptions stimulus;  // encoding and timing of the traffic
+  // Ground nodes of the transmitting and the receiving board. "0" (the default) is the chassis:
+  // both boards' grounds joined to it, as `isolink run` simulates. Other names keep the boards
+  // apart (isolink noise): everything the board references goes to its ground node, which
+  // reaches the chassis through the end's chassis_c; the cable's capacitance to the chassis and
+  // the Y caps stay on "0".
+  std::string tx_ground = "0", rx_ground = "0";
   // Drives the link with this instead of the spec's stimulus (analyses that make their own
   // traffic, e.g. one edge for the worst-case search); .tran then ends with it.
   std::optional<traffic::Drive> drive;

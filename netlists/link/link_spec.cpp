@@ -111,6 +111,9 @@ Status read_end(const YamlDoc& doc, const YAML::Node& node, const std::string& p
            [&](const YAML::Node& n, const std::string& p) {
              return read_isolation(doc, n, p, &end->isolation);
            }},
+          {"x_cap", read_quantity(doc, Unit::kFarad, Rule::kNonNegative, &end->x_cap)},
+          {"y_cap", read_quantity(doc, Unit::kFarad, Rule::kNonNegative, &end->y_cap)},
+          {"chassis_c", read_quantity(doc, Unit::kFarad, Rule::kPositive, &end->chassis_c)},
       });
 }
 
@@ -128,6 +131,7 @@ Status read_cable(const YamlDoc& doc, const YAML::Node& node, CableSpec* cable) 
           {"c", read_quantity(doc, Unit::kFarad, Rule::kPositive, &cable->c)},
           {"g", read_quantity(doc, Unit::kSiemens, Rule::kNonNegative, &cable->g)},
           {"segments", read_int(doc, 1, 1000, &cable->segments)},
+          {"chassis_c", read_quantity(doc, Unit::kFarad, Rule::kPositive, &cable->chassis_c)},
           {"skin_effect", read_bool(doc, &cable->skin_effect)},
           {"dielectric_loss", read_bool(doc, &cable->dielectric_loss)},
       });
@@ -173,6 +177,68 @@ Status read_stimulus(const YamlDoc& doc, const YAML::Node& node, StimulusSpec* s
   return Status::Ok();
 }
 
+Status read_noise(const YamlDoc& doc, const YAML::Node& node, NoiseSpec* ns) {
+  ns->loc = doc.loc(node);
+  std::optional<double> level;
+  NoiseTolerances& t = ns->tolerance;
+  Status s = read_map(
+      doc, node, "noise",
+      {
+          {"injection", read_choice(doc, {"bci", "ground_shift", "dm"}, &ns->injection)},
+          {"level",
+           [&](const YAML::Node& n, const std::string& p) -> Status {
+             // The unit follows the injection, which may come later in the map: read it after.
+             if (!n.IsScalar()) return doc.error(n, fmt::format("key '{}': expected a value", p));
+             level = 0;
+             return Status::Ok();
+           }},
+          {"position", read_quantity(doc, Unit::kNone, Rule::kNonNegative, &ns->position)},
+          {"modulation", read_choice(doc, {"cw", "am"}, &ns->modulation)},
+          {"f_start", read_quantity(doc, Unit::kHertz, Rule::kPositive, &ns->f_start)},
+          {"f_stop", read_quantity(doc, Unit::kHertz, Rule::kPositive, &ns->f_stop)},
+          {"points_per_decade", read_int(doc, 1, 200, &ns->points_per_decade)},
+          {"pin_limit", read_quantity(doc, Unit::kVolt, Rule::kPositive, &ns->pin_limit)},
+          {"calibration_r", read_quantity(doc, Unit::kOhm, Rule::kPositive, &ns->calibration_r)},
+          {"clamp_r", read_quantity(doc, Unit::kOhm, Rule::kNonNegative, &ns->clamp_r)},
+          {"time_domain", read_bool(doc, &ns->time_domain)},
+          {"tolerance",
+           [&](const YAML::Node& n, const std::string& p) {
+             using config::read_percent;
+             return read_map(doc, n, p,
+                             {
+                                 {"isolation_cap", read_percent(doc, 50, &t.isolation_cap)},
+                                 {"series_r", read_percent(doc, 50, &t.series_r)},
+                                 {"bypass_c", read_percent(doc, 50, &t.bypass_c)},
+                                 {"y_cap", read_percent(doc, 50, &t.y_cap)},
+                                 {"esd", read_percent(doc, 50, &t.esd)},
+                                 {"winding_c", read_percent(doc, 50, &t.winding_c)},
+                                 {"choke_imbalance", read_percent(doc, 50, &t.choke_imbalance)},
+                                 {"cable_chassis_c", read_percent(doc, 50, &t.cable_chassis_c)},
+                                 {"rx_pin", read_percent(doc, 50, &t.rx_pin)},
+                             });
+           }},
+      });
+  if (!s.ok()) return s;
+  if (level) {
+    const YAML::Node n = node["level"];
+    const Unit unit = ns->injection == "ground_shift" ? Unit::kVolt : Unit::kAmpere;
+    if (Status r = read_quantity(doc, unit, Rule::kPositive, &ns->level)(n, "noise.level"); !r.ok())
+      return r;
+  } else if (ns->injection == "ground_shift") {
+    ns->level = 1.0;  // V RMS
+  }
+  if (ns->position > 1)
+    return doc.error(node["position"],
+                     fmt::format("key 'noise.position' = {:g}: must be in 0..1 (a fraction of the "
+                                 "cable length from the tx end)",
+                                 ns->position));
+  if (!(ns->f_stop > ns->f_start))
+    return doc.error(node["f_stop"] ? node["f_stop"] : node,
+                     fmt::format("key 'noise.f_stop' = {:g} Hz: must be above f_start = {:g} Hz",
+                                 ns->f_stop, ns->f_start));
+  return Status::Ok();
+}
+
 }  // namespace
 
 StatusOr<LinkSpec> read_link_spec(const YamlDoc& doc) {
@@ -203,6 +269,8 @@ StatusOr<LinkSpec> read_link_spec(const YamlDoc& doc) {
              spec.stimulus.frames.clear();
              return read_stimulus(doc, n, &spec.stimulus);
            }},
+          {"noise", [&](const YAML::Node& n,
+                        const std::string&) { return read_noise(doc, n, &spec.noise); }},
           {"sim",
            [&](const YAML::Node& n, const std::string& p) {
              Status st = read_map(

@@ -9,7 +9,9 @@
 //   part, inductance, leakage, dcr, winding_c, centre_tap_c, cable_side_c, esd}},
 //   cable: {length, material, gauge, temperature, r, l, c, g, segments},
 //   stimulus: {frames, gaps, tones, patterns, script, direction}, sim: {tstep, tmax, method,
-//   reltol}.
+//   reltol}, noise: {injection, level, position, modulation, f_start, f_stop,
+//   points_per_decade, pin_limit, time_domain, tolerance: {...}} (isolink noise; tx / rx also
+//   take x_cap, y_cap, chassis_c and cable chassis_c).
 // `tx` is the end that transmits in the down direction (the host / bridge side); `rx` the end
 // that receives it. With direction up (or both) the rx end transmits back to the tx end.
 #pragma once
@@ -46,6 +48,10 @@ struct EndSpec {
   std::optional<double> bypass_c;     // F per line
   std::optional<double> termination;  // ohm, differential
   IsolationSpec isolation;
+  double x_cap = 0;         // F across the lines at the connector (X capacitor), 0: none
+  double y_cap = 0;         // F per line to the chassis at the connector (Y caps), 0: none
+  double chassis_c = 1e-9;  // F, the board's ground (and its module) to the chassis;
+                            // used when the grounds are kept apart (isolink noise)
   SourceLoc loc;
 };
 
@@ -71,6 +77,41 @@ struct SimSpec {
   std::optional<double> reltol;
 };
 
+// Part tolerances the noise analysis takes its worst case over (fractions, +/-): each P and N
+// part moves on its own (isolink noise; analysis/README.md has the sources of the defaults).
+struct NoiseTolerances {
+  double isolation_cap = 0.10;    // isolation caps (Knowles 1206J2K00222KXR: K = 10 %)
+  double series_r = 0.01;         // series resistors (1 % thick film)
+  double bypass_c = 0.10;         // board bypass caps (C0G/X7R, 10 %)
+  double y_cap = 0.10;            // Y caps and cable-side caps (CBYPASS2)
+  double esd = 0.20;              // ESD parts' capacitance
+  double winding_c = 0.20;        // choke winding and transformer inter-winding capacitance halves
+  double choke_imbalance = 0.01;  // each choke winding's inductance (winding imbalance)
+  double cable_chassis_c = 0.02;  // each conductor's capacitance to the chassis (twist, routing)
+  double rx_pin = 0.05;           // receiver input R and C per pin
+};
+
+// The `noise:` block: what is injected, how hard, over which band (isolink noise).
+struct NoiseSpec {
+  std::string injection = "bci";  // bci | ground_shift | dm
+  double level = 0.1;             // A (bci, dm: RMS of the CW carrier) or V (ground_shift: RMS)
+  double position = 0.5;          // bci, dm: place on the cable, fraction of its length from tx
+  std::string modulation = "am";  // cw | am (ISO 11452-4 AM: 80 % at 1 kHz, peak 1.8 x carrier)
+  double f_start = 100e3;         // Hz
+  double f_stop = 400e6;          // Hz
+  int points_per_decade = 10;     // log-spaced
+  double calibration_r = 100;     // ohm: bci / dm induce level x this in series (ISO 11452-4
+                                  // calibration jig: 50 ohm line, 50 ohm at each end)
+  double clamp_r = 50;            // ohm: the clamp's source impedance in the loop (the
+                                  // generator's 50 ohm through the 1:1 probe)
+  double pin_limit = 20;          // V, receiver pins' common-mode limit (domain.md 2)
+  bool time_domain = true;        // confirm the worst frequency with a transient + the checker
+  NoiseTolerances tolerance;
+  SourceLoc loc;
+  // "A" or "V".
+  const char* level_unit() const { return injection == "ground_shift" ? "V" : "A"; }
+};
+
 struct LinkSpec {
   std::string name = "link";
   std::string source;  // the file it was read from
@@ -79,6 +120,7 @@ struct LinkSpec {
   SourceLoc cable_loc;
   StimulusSpec stimulus;
   SimSpec sim;
+  NoiseSpec noise;
 };
 
 // Reads a spec; errors name the file, line, column and key.

@@ -1,0 +1,641 @@
+#include "analysis/noise.h"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <numbers>
+
+#include "netlists/link/cards.h"
+#include "netlists/spice_writer.h"
+#include "solver/ac.h"
+#include "solver/circuit.h"
+
+namespace isolink::analysis {
+
+namespace {
+
+using Complex = std::complex<double>;
+constexpr double kPi = std::numbers::pi;
+// Conversion below this (V per unit of injection) counts as none: keeps immunity finite.
+constexpr double kFloor = 1e-30;
+
+struct SlotDelta {
+  int row = 0, col = 0;  // unknown indices (ground = 0)
+  double dg = 0, dc = 0;
+};
+
+bool starts_with(const std::string& s, const std::string& p) {
+  return s.rfind(p, 0) == 0;
+}
+
+}  // namespace
+
+std::vector<ToleranceGroup> tolerance_groups(const std::vector<Card>& cards,
+                                             const link::NoiseTolerances& t) {
+  using TolGroup = ToleranceGroup;
+  std::vector<TolGroup> groups;
+  TolGroup cable_p{"cable chassis C, P", "cable_chassis_c", {}, t.cable_chassis_c};
+  TolGroup cable_n{"cable chassis C, N", "cable_chassis_c", {}, t.cable_chassis_c};
+  for (size_t i = 0; i < cards.size(); ++i) {
+    const Card& c = cards[i];
+    const std::string& n = c.name;
+    if (c.args.empty() || c.args[0].kind != CardArg::Kind::Number) continue;
+    if (starts_with(n, "ccab_gp")) {
+      cable_p.cards.push_back(i);
+      continue;
+    }
+    if (starts_with(n, "ccab_gn")) {
+      cable_n.cards.push_back(i);
+      continue;
+    }
+    const char* kind = nullptr;
+    double tol = 0;
+    for (const std::string side : {"tx", "rx"}) {
+      auto is = [&](const std::string& stem) { return n == stem + "p" || n == stem + "n"; };
+      if (is("c" + side + "iso")) kind = "isolation_cap", tol = t.isolation_cap;
+      if (is("r" + side + "bser") || is("r" + side + "bpin")) kind = "series_r", tol = t.series_r;
+      if (is("c" + side + "bbyp")) kind = "bypass_c", tol = t.bypass_c;
+      if (is("c" + side + "y") || is("c" + side + "cab")) kind = "y_cap", tol = t.y_cap;
+      if (is("c" + side + "esd")) kind = "esd", tol = t.esd;
+      if (is("t" + side + ".ci")) kind = "winding_c", tol = t.winding_c;
+      if (starts_with(n, "l" + side) && n.find('.') != std::string::npos) {
+        const std::string leaf = n.substr(n.find('.') + 1);
+        if (leaf == "lp" || leaf == "ln") kind = "choke_imbalance", tol = t.choke_imbalance;
+        if (leaf == "cwp" || leaf == "cwn") kind = "winding_c", tol = t.winding_c;
+      }
+    }
+    if (n == "rrxinp" || n == "rrxinn" || n == "crxinp" || n == "crxinn")
+      kind = "rx_pin", tol = t.rx_pin;
+    if (kind != nullptr && tol > 0) groups.push_back(TolGroup{n, kind, {i}, tol});
+  }
+  for (TolGroup* g : {&cable_p, &cable_n})
+    if (!g->cards.empty() && g->tol > 0) groups.push_back(*g);
+  return groups;
+}
+
+namespace {
+
+StatusOr<Circuit*> build_circuit(const std::vector<Card>& cards, Circuit& c) {
+  if (Status s = link::add_cards(c, cards); !s.ok()) return s;
+  if (Status s = c.finalize(); !s.ok()) return s;
+  return &c;
+}
+
+// max |h0 + sum s_i d_i| over d_i in [-1, 1]: the box's worst corner of a linear complex
+// function, max over theta of Re(e^-j theta h0) + sum |Re(e^-j theta s_i)|: a 0.5 degree scan,
+// then a golden-section search around its best (the function is smooth between the corners'
+// switching angles; the scan alone is under 4e-5 short).
+double worst_abs(Complex h0, const std::vector<Complex>& s) {
+  auto value = [&](double theta) {
+    const Complex u = std::polar(1.0, -theta);
+    double v = (h0 * u).real();
+    for (const Complex& si : s) v += std::abs((si * u).real());
+    return v;
+  };
+  double best = std::abs(h0), best_theta = 0;
+  const double step = kPi / 360.0;
+  for (int k = 0; k < 720; ++k)
+    if (const double v = value(step * k); v > best) best = v, best_theta = step * k;
+  const double g = (std::sqrt(5.0) - 1) / 2;
+  double a = best_theta - step, b = best_theta + step;
+  double c = b - g * (b - a), d = a + g * (b - a), fc = value(c), fd = value(d);
+  for (int i = 0; i < 60; ++i) {
+    if (fc > fd) {
+      b = d, d = c, fd = fc, c = b - g * (b - a), fc = value(c);
+    } else {
+      a = c, c = d, fc = fd, d = a + g * (b - a), fd = value(d);
+    }
+  }
+  return std::max({best, fc, fd});
+}
+
+double db(double ratio) {
+  return 20 * std::log10(std::max(ratio, 1e-20));
+}
+
+// Per pulse: the largest sine amplitude a with vend - a >= vend_min and
+// vstart - a >= vstart_required(vend - a) (bisection; the rule is a step in vend).
+double amplitude_budget(const eye::PulseMetrics& p, const eye::Rules& r) {
+  if (!p.vstart.measured() || !p.vend.measured()) return std::numeric_limits<double>::infinity();
+  auto ok = [&](double a) {
+    return p.vend.value - a >= r.vend_min &&
+           p.vstart.value - a >= r.vstart_required(p.vend.value - a);
+  };
+  if (!ok(0)) return 0;
+  double lo = 0, hi = std::max(p.vstart.value, p.vend.value) + 1;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = (lo + hi) / 2;
+    (ok(mid) ? lo : hi) = mid;
+  }
+  return lo;
+}
+
+}  // namespace
+
+NoiseBudget noise_budget(const eye::CheckResult& check, const eye::Rules& rules,
+                         double pin_signal) {
+  NoiseBudget b;
+  const double inf = std::numeric_limits<double>::infinity();
+  double slowest = 0;
+  for (const eye::PulseMetrics& p : check.pulses)
+    if (p.edge.measured()) slowest = std::max(slowest, p.edge.value);
+  if (!(slowest > 0)) slowest = rules.edge_max;  // no edge measured: the rule's limit
+  b.slope = 2 * rules.vth / slowest;
+  b.amplitude = b.width = b.edge = inf;
+  for (const eye::PulseMetrics& p : check.pulses) {
+    if (p.truncated) continue;
+    b.amplitude = std::min(b.amplitude, amplitude_budget(p, rules));
+    if (p.width.judged()) b.width = std::min(b.width, std::max(0.0, p.width.margin) * b.slope / 2);
+    if (p.edge.judged()) b.edge = std::min(b.edge, std::max(0.0, p.edge.margin) * b.slope / 2);
+  }
+  b.idle = rules.vth;
+  b.dm_amplitude = b.idle;
+  b.limited_by = "idle";
+  for (auto [v, name] : {std::pair{b.amplitude, "vstart/vend"}, std::pair{b.width, "width"},
+                         std::pair{b.edge, "edge"}})
+    if (v < b.dm_amplitude) b.dm_amplitude = v, b.limited_by = name;
+  // A link that fails on its own has no budget.
+  if (!check.pass) b.dm_amplitude = 0, b.limited_by = "the link fails without noise";
+  for (double* v : {&b.amplitude, &b.width, &b.edge})
+    if (std::isinf(*v)) *v = b.idle;
+  b.pin_signal = pin_signal;
+  return b;
+}
+
+double noise_peak_factor(const link::NoiseSpec& n) {
+  return std::sqrt(2.0) * (n.modulation == "am" ? 1.8 : 1.0);
+}
+
+std::vector<double> noise_frequencies(const link::NoiseSpec& n) {
+  const double decades = std::log10(n.f_stop / n.f_start);
+  const int steps = std::max(1, static_cast<int>(std::ceil(decades * n.points_per_decade - 1e-9)));
+  std::vector<double> f;
+  for (int i = 0; i <= steps; ++i) f.push_back(n.f_start * std::pow(10.0, decades * i / steps));
+  f.back() = n.f_stop;
+  return f;
+}
+
+StatusOr<NoiseCircuit> build_noise_circuit(const link::LinkSpec& spec,
+                                           const link::PartLibrary& parts, link::Direction d,
+                                           const NoiseOptions& opt) {
+  NoiseCircuit out;
+  link::ExpandOptions eo = opt.expand;
+  eo.tx_ground = out.tx_ground;
+  eo.rx_ground = out.rx_ground;
+  StatusOr<link::ExpandedLink> ex = link::expand_link(spec, parts, d, eo);
+  if (!ex) return ex.status();
+  out.link = std::move(*ex);
+  out.link.netlist.tran.reset();
+  out.link.netlist.title = fmt::format("isolink noise '{}', {}, {} injection", spec.name,
+                                       out.link.description, spec.noise.injection);
+  std::vector<Card>& cards = out.link.netlist.cards;
+  const link::NoiseSpec& ns = spec.noise;
+  if (ns.injection == "ground_shift") {
+    cards.push_back(
+        link::make_card('v', "vnoise", {out.rx_ground, out.tx_ground}, {link::number_arg(0)}));
+    out.sources = {{"vnoise", 1.0}};
+    return out;
+  }
+  // bci / dm: at the cable node nearest the position (from the spec's tx end).
+  const int n = out.link.cable_segments;
+  if (n < 2)
+    return Status::Error(fmt::format(
+        "noise: {} injection needs a cable node inside the cable; the cable has {} segment "
+        "(set cable.segments >= 2)",
+        ns.injection, n));
+  const double x = d == link::Direction::kDown ? ns.position : 1 - ns.position;
+  const int k = std::clamp(static_cast<int>(std::lround(x * n)), 1, n - 1);
+  // The clamp induces the same series voltage in both wires: a source in each conductor between
+  // segment k and segment k + 1 (whose first series element is re-attached to the source).
+  // V per A of calibrated current: the jig's loop (calibration_r) plus the clamp's own impedance.
+  const double v = ns.calibration_r + ns.clamp_r;
+  for (char side : {'p', 'n'}) {
+    const std::string node = fmt::format("cab_{}{}", side, k);
+    const std::string inner = fmt::format("noise_{}", side);
+    bool moved = false;
+    for (const char* letter : {"r", "l"}) {
+      const std::string first = fmt::format("{}cab_{}{}", letter, side, k + 1);
+      for (Card& c : cards)
+        if (!moved && c.name == first && !c.nodes.empty() && c.nodes[0] == node)
+          c.nodes[0] = inner, moved = true;
+    }
+    if (!moved)
+      return Status::Error(
+          fmt::format("noise: no series element of cable segment {} at {}", k + 1, node));
+    // The clamp's source impedance (common mode: both wires' resistors in parallel).
+    const std::string name = fmt::format("vnoise{}", side), mid = inner + "_r";
+    cards.push_back(link::make_card('v', name, {inner, mid}, {link::number_arg(0)}));
+    cards.push_back(link::make_card('r', fmt::format("rnoise{}", side), {mid, node},
+                                    {link::number_arg(2 * ns.clamp_r)}));
+    out.sources.push_back({name, side == 'n' && ns.injection == "dm" ? -v / 2
+                                 : ns.injection == "dm"              ? v / 2
+                                                                     : v});
+  }
+  return out;
+}
+
+std::string noise_spice(const NoiseCircuit& c, const link::NoiseSpec& n) {
+  std::string text = write_spice(c.link.netlist);
+  std::string out;
+  size_t pos = 0;
+  while (pos < text.size()) {
+    size_t end = text.find('\n', pos);
+    if (end == std::string::npos) end = text.size();
+    std::string line = text.substr(pos, end - pos);
+    pos = end + 1;
+    if (line == ".end") continue;
+    for (const auto& [name, amp] : c.sources)
+      if (starts_with(line, name + " ")) line += fmt::format(" ac {:.12g}", amp);
+    out += line + "\n";
+  }
+  out += fmt::format(".options rshunt=1e12\n.ac dec {} {:.12g} {:.12g}\n.end\n",
+                     n.points_per_decade, n.f_start, n.f_stop);
+  return out;
+}
+
+StatusOr<std::vector<ConversionPoint>> conversion_sweep(const std::vector<Card>& cards,
+                                                        const ConversionRequest& req,
+                                                        int* factorizations, int* unknowns) {
+  Circuit circuit;
+  if (StatusOr<Circuit*> c = build_circuit(cards, circuit); !c) return c.status();
+  if (unknowns) *unknowns = circuit.unknown_count();
+  StatusOr<AcAnalysis> ac = AcAnalysis::create(circuit);
+  if (!ac) return ac.status();
+
+  // Each group moved by +tol: the matrix entries that change.
+  std::vector<std::vector<SlotDelta>> deltas;
+  const std::vector<int>& cs = ac->col_start();
+  const std::vector<int>& ri = ac->row_index();
+  for (const ToleranceGroup& g : req.groups) {
+    std::vector<Card> moved = cards;
+    for (size_t i : g.cards) {
+      if (i >= moved.size() || moved[i].args.empty() ||
+          moved[i].args[0].kind != CardArg::Kind::Number)
+        return Status::Error(
+            fmt::format("noise: tolerance group '{}' names a card without a value", g.name));
+      moved[i].args[0].number *= 1 + g.tol;
+    }
+    Circuit pc;
+    if (StatusOr<Circuit*> c = build_circuit(moved, pc); !c) return c.status();
+    StatusOr<AcAnalysis> pa = AcAnalysis::create(pc);
+    if (!pa) return pa.status();
+    std::vector<SlotDelta> d;
+    for (int col = 0; col + 1 < static_cast<int>(cs.size()); ++col)
+      for (int k = cs[col]; k < cs[col + 1]; ++k) {
+        const double dg = pa->g_values()[k] - ac->g_values()[k];
+        const double dc = pa->c_values()[k] - ac->c_values()[k];
+        if (dg != 0 || dc != 0) d.push_back(SlotDelta{ri[k] + 1, col + 1, dg, dc});
+      }
+    deltas.push_back(std::move(d));
+  }
+
+  const int p = circuit.find_node(req.p), n = circuit.find_node(req.n);
+  const int ref = circuit.find_node(req.ref);
+  if (p < 0 || n < 0 || ref < 0)
+    return Status::Error(fmt::format("noise: the circuit has no node '{}'", p < 0   ? req.p
+                                                                            : n < 0 ? req.n
+                                                                                    : req.ref));
+  const size_t size = circuit.unknown_count() + 1;
+  AcAnalysis::Vector b(size, 0.0), cp(size, 0.0), cn(size, 0.0);
+  for (const auto& [name, amp] : req.sources)
+    if (Status s = ac->add_excitation(name, amp, b); !s.ok()) return s;
+  cp[p] += 1, cp[ref] -= 1;
+  cn[n] += 1, cn[ref] -= 1;
+  cp[0] = cn[0] = 0;
+
+  std::vector<ConversionPoint> out;
+  for (double f : req.frequencies) {
+    if (Status s = ac->factor(f); !s.ok()) return s;
+    if (factorizations) ++*factorizations;
+    const AcAnalysis::Vector x = ac->solve_factored(b);
+    const AcAnalysis::Vector zp = ac->solve_transposed(cp);
+    const AcAnalysis::Vector zn = ac->solve_transposed(cn);
+    const double w = 2 * kPi * f;
+    std::vector<Complex> sp, sn, sdm, scm;
+    for (const std::vector<SlotDelta>& d : deltas) {
+      Complex ap = 0, an = 0;
+      for (const SlotDelta& e : d) {
+        const Complex ax = Complex(e.dg, w * e.dc) * x[e.col];
+        ap -= zp[e.row] * ax;
+        an -= zn[e.row] * ax;
+      }
+      sp.push_back(ap), sn.push_back(an);
+      sdm.push_back(ap - an), scm.push_back((ap + an) / 2.0);
+    }
+    ConversionPoint pt;
+    pt.freq_hz = f;
+    pt.vp = x[p] - x[ref];
+    pt.vn = x[n] - x[ref];
+    pt.dm_worst = worst_abs(pt.vp - pt.vn, sdm);
+    pt.cm_worst = worst_abs((pt.vp + pt.vn) / 2.0, scm);
+    pt.pin_worst = std::max(worst_abs(pt.vp, sp), worst_abs(pt.vn, sn));
+    out.push_back(pt);
+  }
+  return out;
+}
+
+namespace {
+
+StatusOr<NoiseDirection> analyze_direction(const link::LinkSpec& spec,
+                                           const link::PartLibrary& parts,
+                                           const NoiseDirectionInput& in, const NoiseOptions& opt,
+                                           const NoiseBudget& budget, double peak_factor,
+                                           int* factorizations) {
+  NoiseDirection nd;
+  nd.direction = in.direction;
+  nd.budget = budget;
+  StatusOr<NoiseCircuit> nc = build_noise_circuit(spec, parts, in.direction, opt);
+  if (!nc) return nc.status();
+  nd.description = nc->link.description;
+  const std::vector<Card>& cards = nc->link.netlist.cards;
+  ConversionRequest req;
+  req.sources = nc->sources;
+  req.ref = nc->rx_ground;
+  req.groups = tolerance_groups(cards, spec.noise.tolerance);
+  for (const ToleranceGroup& g : req.groups)
+    nd.tolerances.push_back(fmt::format("{} +/-{:g} %", g.name, g.tol * 100));
+  const link::NoiseSpec& ns = spec.noise;
+  req.frequencies = noise_frequencies(ns);
+  StatusOr<std::vector<ConversionPoint>> conv =
+      conversion_sweep(cards, req, factorizations, &nd.unknowns);
+  if (!conv) return conv.status().with_context(nd.description);
+
+  const double pin_room = std::max(0.0, ns.pin_limit - budget.pin_signal);
+  nd.immunity_min = std::numeric_limits<double>::infinity();
+  for (const ConversionPoint& c : *conv) {
+    NoisePoint pt;
+    pt.freq_hz = c.freq_hz;
+    pt.dm = c.vp - c.vn;
+    pt.cm = (c.vp + c.vn) / 2.0;
+    pt.dm_worst = std::max(kFloor, c.dm_worst);
+    pt.cm_worst = c.cm_worst;
+    pt.pin_worst = std::max(kFloor, c.pin_worst);
+    const double cm_ref = std::max(std::abs(pt.cm), kFloor);
+    pt.cm_to_dm_db = std::max(-400.0, db(pt.dm_worst / cm_ref));
+    pt.cm_to_dm_nominal_db = std::max(-400.0, db(std::abs(pt.dm) / cm_ref));
+    pt.dm_v = pt.dm_worst * ns.level * peak_factor;
+    pt.pin_cm_v = pt.cm_worst * ns.level * peak_factor;
+    const double imm_dm = budget.dm_amplitude / (pt.dm_worst * peak_factor);
+    const double imm_pin = pin_room / (pt.pin_worst * peak_factor);
+    pt.immunity = std::min(imm_dm, imm_pin);
+    pt.limited_by = imm_dm <= imm_pin ? "dm" : "pins";
+    if (pt.immunity < nd.immunity_min)
+      nd.immunity_min = pt.immunity, nd.immunity_min_freq = c.freq_hz;
+    nd.points.push_back(pt);
+  }
+  nd.pass = ns.level <= nd.immunity_min;
+  return nd;
+}
+
+// Superposes the worst frequency's differential noise (at the level's peak, worst corner) on the
+// link's received waveform at `phases` phases and runs the checker on each.
+TimeDomainCheck confirm_in_time(const link::LinkSpec& spec, const NoiseDirectionInput& in,
+                                const NoiseDirection& nd) {
+  TimeDomainCheck td;
+  if (!spec.noise.time_domain) {
+    td.skipped = "noise.time_domain is false";
+    return td;
+  }
+  if (!spec.stimulus.tones.empty()) {
+    td.skipped = "the stimulus has tones (the check covers data frames only)";
+    return td;
+  }
+  if (in.wave == nullptr || in.rules == nullptr || in.wave->samples() < 2) {
+    td.skipped = "no waveform";
+    return td;
+  }
+  const NoisePoint* worst = nullptr;
+  for (const NoisePoint& p : nd.points)
+    if (p.freq_hz == nd.immunity_min_freq) worst = &p;
+  if (worst == nullptr) {
+    td.skipped = "no frequency";
+    return td;
+  }
+  td.freq_hz = worst->freq_hz;
+  td.dm_amplitude = worst->dm_v;
+  td.predicted_pass = nd.pass;
+  // At least 20 samples per period, never coarser than the simulation's output step.
+  const Waveform& w = *in.wave;
+  const double span = w.time.back() - w.time.front();
+  const double step0 = span / static_cast<double>(w.samples() - 1);
+  const double dt = std::min(step0, 1 / (20 * td.freq_hz));
+  const size_t count = static_cast<size_t>(span / dt) + 1;
+  std::vector<double> t(count), v0(count), v(count);
+  for (size_t i = 0; i < count; ++i) {
+    t[i] = w.time.front() + dt * static_cast<double>(i);
+    v0[i] = w.value_at(0, t[i]);
+  }
+  eye::CheckOptions co;
+  if (!in.expected.empty()) co.expect = in.expected;
+  td.phases = 8;
+  for (int k = 0; k < td.phases; ++k) {
+    const double phi = 2 * kPi * k / td.phases;
+    for (size_t i = 0; i < count; ++i)
+      v[i] = v0[i] + td.dm_amplitude * std::sin(2 * kPi * td.freq_hz * t[i] + phi);
+    StatusOr<eye::CheckResult> r = eye::check_samples(t, v, *in.rules, co);
+    if (!r) {
+      td.failures.push_back(fmt::format("phase {} deg: {}", 45 * k, r.status().message()));
+      continue;
+    }
+    if (r->pass)
+      ++td.phases_pass;
+    else if (!r->reasons.empty())
+      td.failures.push_back(fmt::format("phase {} deg: {}", 45 * k, r->reasons.front()));
+    if (r->expect_match && !r->bytes.empty()) ++td.phases_decoded;
+  }
+  td.done = true;
+  return td;
+}
+
+double max_abs_column(const Waveform& w, size_t k) {
+  double m = 0;
+  if (k < w.columns.size())
+    for (double v : w.columns[k]) m = std::max(m, std::abs(v));
+  return m;
+}
+
+}  // namespace
+
+StatusOr<NoiseResult> analyze_noise(const link::LinkSpec& spec, const link::PartLibrary& parts,
+                                    std::span<const NoiseDirectionInput> inputs,
+                                    const NoiseOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  NoiseResult r;
+  r.spec = spec.noise;
+  r.peak_factor = noise_peak_factor(spec.noise);
+  r.pass = true;
+  for (const NoiseDirectionInput& in : inputs) {
+    if (in.check == nullptr || in.rules == nullptr)
+      return Status::Error("noise: a direction without its link check");
+    const double pin_signal =
+        in.wave ? std::max(max_abs_column(*in.wave, 1), max_abs_column(*in.wave, 2)) : 0.0;
+    const NoiseBudget budget = noise_budget(*in.check, *in.rules, pin_signal);
+    StatusOr<NoiseDirection> d =
+        analyze_direction(spec, parts, in, opt, budget, r.peak_factor, &r.factorizations);
+    if (!d) return d.status();
+    d->time_domain = confirm_in_time(spec, in, *d);
+    r.pass = r.pass && d->pass;
+    r.directions.push_back(std::move(*d));
+  }
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+StatusOr<NoiseRun> run_noise(const link::LinkSpec& spec, const link::PartLibrary& parts) {
+  NoiseRun out;
+  StatusOr<LinkRun> run = run_link(spec, parts);
+  if (!run) return run.status();
+  out.run = std::move(*run);
+  std::vector<NoiseDirectionInput> inputs;
+  for (const DirectionRun& d : out.run.directions) {
+    const bool data = d.data.has_value();
+    if (!data && !d.tones.has_value()) return Status::Error("noise: a direction without traffic");
+    inputs.push_back({d.link.direction, data ? &*d.data : &*d.tones,
+                      data ? &d.rules : &d.tone_rules, &d.sim.wave, d.link.expected});
+  }
+  StatusOr<NoiseResult> noise = analyze_noise(spec, parts, inputs);
+  if (!noise) return noise.status();
+  out.noise = std::move(*noise);
+  return out;
+}
+
+double noise_immunity_min_db(const NoiseResult& r) {
+  double worst = std::numeric_limits<double>::infinity();
+  for (const NoiseDirection& d : r.directions) worst = std::min(worst, d.immunity_min);
+  if (r.directions.empty()) return 0;
+  return db(worst / r.spec.level);
+}
+
+nlohmann::ordered_json noise_json(const NoiseResult& r) {
+  using nlohmann::ordered_json;
+  const link::NoiseSpec& n = r.spec;
+  ordered_json j;
+  j["verdict"] = r.pass ? "pass" : "fail";
+  j["injection"] = n.injection;
+  j["level"] = n.level;
+  j["level_unit"] = n.level_unit();
+  j["level_is"] = "RMS of the unmodulated carrier";
+  j["modulation"] = n.modulation;
+  j["peak_factor"] = r.peak_factor;
+  if (n.injection != "ground_shift") j["position"] = n.position;
+  j["pin_limit_v"] = n.pin_limit;
+  j["immunity_min_db"] = noise_immunity_min_db(r);
+  j["worst_case"] = "worst corner of the linearised tolerance box (adjoint sensitivities)";
+  ordered_json dirs = ordered_json::array();
+  for (const NoiseDirection& d : r.directions) {
+    ordered_json dj;
+    dj["direction"] = link::direction_name(d.direction);
+    dj["description"] = d.description;
+    ordered_json pts = ordered_json::array();
+    for (const NoisePoint& p : d.points) {
+      ordered_json pj;
+      pj["freq_hz"] = p.freq_hz;
+      pj["cm_to_dm_db"] = p.cm_to_dm_db;
+      pj["cm_to_dm_nominal_db"] = p.cm_to_dm_nominal_db;
+      pj["dm_per_unit"] = std::abs(p.dm);
+      pj["dm_per_unit_worst"] = p.dm_worst;
+      pj["cm_per_unit"] = std::abs(p.cm);
+      pj["pin_cm_v"] = p.pin_cm_v;
+      pj["dm_v"] = p.dm_v;
+      pj["immunity"] = p.immunity;
+      pj["limited_by"] = p.limited_by;
+      pts.push_back(pj);
+    }
+    dj["points"] = pts;
+    dj["immunity_min"] = {{"value", d.immunity_min}, {"freq_hz", d.immunity_min_freq}};
+    dj["verdict"] = d.pass ? "pass" : "fail";
+    const NoiseBudget& b = d.budget;
+    dj["budget"] = {{"dm_amplitude_v", b.dm_amplitude},
+                    {"limited_by", b.limited_by},
+                    {"vstart_vend_v", b.amplitude},
+                    {"width_v", b.width},
+                    {"edge_v", b.edge},
+                    {"idle_v", b.idle},
+                    {"slope_v_per_ns", b.slope * 1e-9},
+                    {"pin_signal_v", b.pin_signal}};
+    const TimeDomainCheck& t = d.time_domain;
+    ordered_json tj;
+    tj["done"] = t.done;
+    if (!t.done) {
+      tj["skipped"] = t.skipped;
+    } else {
+      tj["freq_hz"] = t.freq_hz;
+      tj["dm_amplitude_v"] = t.dm_amplitude;
+      tj["phases"] = t.phases;
+      tj["phases_pass"] = t.phases_pass;
+      tj["phases_decoded"] = t.phases_decoded;
+      tj["predicted_pass"] = t.predicted_pass;
+      tj["failures"] = t.failures;
+    }
+    dj["time_domain"] = tj;
+    dj["tolerances"] = d.tolerances;
+    dj["unknowns"] = d.unknowns;
+    dirs.push_back(dj);
+  }
+  j["directions"] = dirs;
+  j["factorizations"] = r.factorizations;
+  j["seconds"] = r.seconds;
+  return j;
+}
+
+std::string noise_markdown(const NoiseResult& r) {
+  const link::NoiseSpec& n = r.spec;
+  const char* unit = n.level_unit();
+  auto level = [&](double v) { return link::format_si(v, unit); };
+  std::string md = fmt::format("## Noise immunity: {}\n\n", r.pass ? "PASS" : "FAIL");
+  std::string what =
+      n.injection == "bci" ? fmt::format(
+                                 "BCI: common-mode current into both wires at {:g} of the "
+                                 "cable from the tx end (ISO 11452-4)",
+                                 n.position)
+      : n.injection == "dm" ? fmt::format("differential current at {:g} of the cable", n.position)
+                            : std::string("ground shift between the two boards' grounds");
+  md +=
+      fmt::format("- Injection: {}, test level {} RMS, {} (peak {:.3g} x the level), {} to {}.\n",
+                  what, level(n.level), n.modulation == "am" ? "AM 80 % at 1 kHz" : "CW",
+                  r.peak_factor, link::format_si(n.f_start, "Hz"), link::format_si(n.f_stop, "Hz"));
+  md +=
+      "- Worst case: each P and N part at its own tolerance limit, the worst corner of the "
+      "linearised response at every frequency (`noise.tolerance`).\n";
+  md += fmt::format(
+      "- Immunity: the highest level at which the differential noise at the "
+      "receiver, at its worst phase, still meets every receiver rule and the pins "
+      "stay inside +/-{:g} V. See `noise.png`.\n\n",
+      n.pin_limit);
+  md +=
+      "| direction | noise budget (DM) | limited by | immunity min | at | verdict | time domain "
+      "|\n|---|---|---|---|---|---|---|\n";
+  for (const NoiseDirection& d : r.directions) {
+    const TimeDomainCheck& t = d.time_domain;
+    std::string td = t.done ? fmt::format("{:.3g} V DM at {}: {}/{} phases pass, {}/{} decode",
+                                          t.dm_amplitude, link::format_si(t.freq_hz, "Hz"),
+                                          t.phases_pass, t.phases, t.phases_decoded, t.phases)
+                            : "skipped: " + t.skipped;
+    md += fmt::format("| {} | {:.3g} V | {} | {} | {} | {} | {} |\n", d.description,
+                      d.budget.dm_amplitude, d.budget.limited_by, level(d.immunity_min),
+                      link::format_si(d.immunity_min_freq, "Hz"), d.pass ? "pass" : "FAIL", td);
+  }
+  md += "\n";
+  for (const NoiseDirection& d : r.directions) {
+    md += fmt::format(
+        "### {}\n\n| f | CM->DM worst (dB) | nominal (dB) | DM at level (V) | pin CM "
+        "at level (V) | immunity | limited by |\n|---|---|---|---|---|---|---|\n",
+        d.description);
+    const size_t stride = std::max<size_t>(1, d.points.size() / 16);
+    for (size_t i = 0; i < d.points.size(); i += stride) {
+      const NoisePoint& p = d.points[i];
+      md += fmt::format("| {} | {:.1f} | {:.1f} | {:.3g} | {:.3g} | {} | {} |\n",
+                        link::format_si(p.freq_hz, "Hz"), p.cm_to_dm_db, p.cm_to_dm_nominal_db,
+                        p.dm_v, p.pin_cm_v, level(p.immunity), p.limited_by);
+    }
+    md += fmt::format("\nToleranced parts: {}.\n\n", fmt::join(d.tolerances, ", "));
+  }
+  return md;
+}
+
+}  // namespace isolink::analysis

@@ -1,0 +1,213 @@
+#include "reports/noise_png.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "netlists/link/cards.h"
+#include "reports/plot.h"
+
+namespace isolink::reports {
+
+namespace {
+
+constexpr int kW = 1800, kH = 1650, kFont = 20;
+constexpr Color kDirColor[2] = {kSeriesP, kSeriesN};
+constexpr Color kLimit = kFail;
+
+// Decade ticks over [lo, hi] (log10 values), labelled by fmt_label(10^k).
+template <typename F>
+AxisTicks decade_ticks(double lo, double hi, const std::string& unit, F fmt_label) {
+  AxisTicks t;
+  t.unit = UnitScale{1, unit};
+  t.step = 1;
+  for (int k = static_cast<int>(std::ceil(lo - 1e-9)); k <= static_cast<int>(std::floor(hi + 1e-9));
+       ++k)
+    t.ticks.push_back({static_cast<double>(k), fmt_label(std::pow(10.0, k))});
+  return t;
+}
+
+std::string si_label(double v) {
+  std::string s = link::format_si(v, "");
+  while (!s.empty() && s.back() == ' ') s.pop_back();
+  return s;
+}
+
+struct Panel {
+  PlotArea area;
+  AxisTicks xt, yt;
+};
+
+Panel make_panel(Rect r, double flo, double fhi, double ylo, double yhi, bool ylog,
+                 const std::string& yunit) {
+  Panel p;
+  p.area = PlotArea::make(r, flo, fhi, ylo, yhi);
+  p.xt = decade_ticks(flo, fhi, "Hz", si_label);
+  if (ylog)
+    p.yt = decade_ticks(ylo, yhi, yunit, si_label);
+  else
+    p.yt = make_ticks(p.area.y, UnitScale{1, yunit}, 7);
+  return p;
+}
+
+// The y range of the values (log10 when log), padded, at least `min_span` wide.
+std::pair<double, double> range_of(const std::vector<double>& v, bool log, double min_span) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (double x : v) {
+    const double y = log ? std::log10(std::max(x, 1e-30)) : x;
+    if (!std::isfinite(y)) continue;
+    lo = std::min(lo, y), hi = std::max(hi, y);
+  }
+  if (!std::isfinite(lo)) lo = 0, hi = 1;
+  if (log) lo = std::floor(lo), hi = std::ceil(hi);
+  if (hi - lo < min_span) {
+    const double mid = (lo + hi) / 2;
+    lo = mid - min_span / 2, hi = mid + min_span / 2;
+  }
+  if (!log) {
+    const double pad = (hi - lo) * 0.06;
+    lo -= pad, hi += pad;
+  }
+  return {lo, hi};
+}
+
+void line_series(Canvas& c, const PlotArea& a, const std::vector<double>& x,
+                 const std::vector<double>& y, const LineStyle& s) {
+  std::vector<double> px, py;
+  for (size_t i = 0; i < x.size(); ++i) {
+    px.push_back(a.px(x[i]));
+    py.push_back(a.py(std::clamp(y[i], a.y.lo, a.y.hi)));
+  }
+  c.polyline(px, py, s, a.rect);
+}
+
+}  // namespace
+
+Status write_noise_png(const analysis::NoiseResult& r, const std::string& title,
+                       const std::string& path) {
+  StatusOr<Canvas> cv = Canvas::create(kW, kH);
+  if (!cv) return cv.status();
+  Canvas& c = *cv;
+  const link::NoiseSpec& n = r.spec;
+  const char* unit = n.level_unit();
+  const double flo = std::log10(n.f_start), fhi = std::log10(n.f_stop);
+
+  // Title and verdict.
+  const std::string what = n.injection == "bci"  ? "BCI (CM current into both wires)"
+                           : n.injection == "dm" ? "DM current"
+                                                 : "ground shift (CM voltage between grounds)";
+  draw_runs(c, 40, 24,
+            {{fmt::format("{}: noise immunity, {} ", title, what), kInk, FontFace::kBold},
+             {r.pass ? "PASS" : "FAIL", r.pass ? kPass : kFail, FontFace::kBold}},
+            30);
+  c.text(40, 90,
+         fmt::format("test level {} RMS {} (peak x{:.2f}), worst corner of the part tolerances; "
+                     "solid: worst case, dashed: nominal",
+                     link::format_si(n.level, unit), n.modulation == "am" ? "AM 80 % 1 kHz" : "CW",
+                     r.peak_factor),
+         kFont, kMuted, FontFace::kSans, HAlign::kLeft, VAlign::kTop);
+
+  const int x0 = 150, x1 = 1400;
+  const Rect r1{x0, 150, x1, 580}, r2{x0, 660, x1, 1060}, r3{x0, 1140, x1, 1560};
+  std::vector<LegendEntry> legend;
+
+  // Panel 1: conversion.
+  std::vector<double> all;
+  for (const auto& d : r.directions)
+    for (const auto& p : d.points)
+      all.push_back(p.cm_to_dm_db), all.push_back(p.cm_to_dm_nominal_db);
+  auto [c_lo, c_hi] = range_of(all, false, 20);
+  c_lo = std::max(c_lo, c_hi - 200);
+  Panel p1 = make_panel(r1, flo, fhi, c_lo, c_hi, false, "dB");
+  draw_grid(c, p1.area, p1.xt, p1.yt);
+  // Panel 2: pin common mode at the level (log).
+  all.clear();
+  for (const auto& d : r.directions)
+    for (const auto& p : d.points) all.push_back(p.pin_cm_v);
+  all.push_back(n.pin_limit);
+  auto [v_lo, v_hi] = range_of(all, true, 2);
+  v_lo = std::max(v_lo, v_hi - 8);
+  Panel p2 = make_panel(r2, flo, fhi, v_lo, v_hi, true, "V");
+  draw_grid(c, p2.area, p2.xt, p2.yt);
+  // Panel 3: immunity (log), test level.
+  all.clear();
+  for (const auto& d : r.directions)
+    for (const auto& p : d.points) all.push_back(p.immunity);
+  all.push_back(n.level);
+  auto [i_lo, i_hi] = range_of(all, true, 2);
+  i_lo = std::max(i_lo, std::log10(n.level) - 5);
+  i_hi = std::min(i_hi, std::log10(n.level) + 5);
+  Panel p3 = make_panel(r3, flo, fhi, i_lo, i_hi, true, unit);
+  draw_grid(c, p3.area, p3.xt, p3.yt);
+
+  for (size_t k = 0; k < r.directions.size(); ++k) {
+    const analysis::NoiseDirection& d = r.directions[k];
+    const Color col = kDirColor[k % 2];
+    std::vector<double> f, worst, nom, pin, imm;
+    for (const auto& p : d.points) {
+      f.push_back(std::log10(p.freq_hz));
+      worst.push_back(p.cm_to_dm_db);
+      nom.push_back(p.cm_to_dm_nominal_db);
+      pin.push_back(std::log10(std::max(p.pin_cm_v, 1e-30)));
+      imm.push_back(std::log10(std::max(p.immunity, 1e-30)));
+    }
+    // Failing frequencies: shaded in panel 3.
+    for (size_t i = 0; i < d.points.size(); ++i)
+      if (d.points[i].immunity < n.level) {
+        const double a = i > 0 ? (f[i - 1] + f[i]) / 2 : f[i];
+        const double b = i + 1 < f.size() ? (f[i] + f[i + 1]) / 2 : f[i];
+        c.fill_rect(p3.area.data_rect(a, b, i_lo, std::log10(n.level)), kFail.with_alpha(0.12f));
+      }
+    line_series(c, p1.area, f, worst, {.color = col, .width = 3});
+    line_series(c, p1.area, f, nom, {.color = col, .width = 2, .dash = 10, .gap = 7});
+    line_series(c, p2.area, f, pin, {.color = col, .width = 3});
+    line_series(c, p3.area, f, imm, {.color = col, .width = 3});
+    // The weakest point.
+    const double xm = p3.area.px(std::log10(d.immunity_min_freq));
+    const double ym =
+        p3.area.py(std::clamp(std::log10(std::max(d.immunity_min, 1e-30)), i_lo, i_hi));
+    c.stroke_rect(Rect{static_cast<int>(xm) - 7, static_cast<int>(ym) - 7, static_cast<int>(xm) + 8,
+                       static_cast<int>(ym) + 8},
+                  d.pass ? col : kFail, 3);
+    draw_label(c, xm + 12, ym + 10,
+               fmt::format("{} min {} at {}", link::direction_name(d.direction),
+                           link::format_si(d.immunity_min, unit),
+                           link::format_si(d.immunity_min_freq, "Hz")),
+               kFont - 2, d.pass ? kInk : kFail, HAlign::kLeft, VAlign::kTop);
+    legend.push_back({d.description, {.color = col, .width = 3}});
+  }
+  // Limits.
+  for (double s : {1.0}) {
+    const double y = std::log10(n.pin_limit) * s;
+    if (y >= v_lo && y <= v_hi)
+      c.hline(p2.area.py(y), p2.area.rect.x0, p2.area.rect.x1,
+              {.color = kLimit, .width = 3, .dash = 14, .gap = 8});
+  }
+  c.hline(p3.area.py(std::log10(n.level)), p3.area.rect.x0, p3.area.rect.x1,
+          {.color = kLimit, .width = 3, .dash = 14, .gap = 8});
+  draw_label(c, p2.area.rect.x1 - 8,
+             p2.area.py(std::clamp(std::log10(n.pin_limit), v_lo, v_hi)) - 4,
+             fmt::format("pin limit +/-{:g} V", n.pin_limit), kFont - 2, kLimit, HAlign::kRight,
+             VAlign::kBottom);
+  draw_label(c, p3.area.rect.x1 - 8, p3.area.py(std::log10(n.level)) - 4,
+             fmt::format("test level {}", link::format_si(n.level, unit)), kFont - 2, kLimit,
+             HAlign::kRight, VAlign::kBottom);
+
+  draw_axes(c, p1.area, p1.xt, p1.yt, "frequency", "CM -> DM at the receiver pins", kFont);
+  draw_axes(c, p2.area, p2.xt, p2.yt, "frequency", "pin common mode at the test level", kFont);
+  draw_axes(c, p3.area, p3.xt, p3.yt, "frequency",
+            fmt::format("immunity (highest {} level)",
+                        n.injection == "ground_shift" ? "voltage" : "current"),
+            kFont);
+  legend.push_back({"worst corner", {.color = kInk, .width = 3}});
+  legend.push_back({"nominal parts", {.color = kInk, .width = 2, .dash = 10, .gap = 7}});
+  legend.push_back({"limit / test level", {.color = kLimit, .width = 3, .dash = 14, .gap = 8}});
+  legend.push_back({"level fails here", {.color = kFail.with_alpha(0.25f)}, true});
+  draw_legend(c, x1 + 30, r1.y0, legend, kFont - 2);
+  return c.write_png(path);
+}
+
+}  // namespace isolink::reports

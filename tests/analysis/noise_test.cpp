@@ -1,0 +1,277 @@
+// Noise immunity (analysis/noise.h): conversion against a hand-worked RC case and ngspice, the
+// balanced link, the receiver budget, TI's ranking of the isolation types on the BCI setup.
+#include "analysis/noise.h"
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+
+#include "eye/rules.h"
+#include "netlists/link/cards.h"
+#include "ngspice_runner.h"
+
+namespace isolink::analysis {
+namespace {
+
+using Complex = std::complex<double>;
+constexpr double kPi = std::numbers::pi;
+
+const link::PartLibrary& parts() {
+  static const link::PartLibrary lib = *link::PartLibrary::load({});
+  return lib;
+}
+
+link::LinkSpec spec_of(const std::string& yaml) {
+  StatusOr<link::LinkSpec> s = link::read_link_spec_text(yaml, "test.yaml");
+  EXPECT_TRUE(s.ok()) << s.status().message();
+  return s.ok() ? *s : link::LinkSpec{};
+}
+
+// A common-mode source driving two R-C lines to ground: p and n.
+std::vector<Card> rc_cards(double r, double c) {
+  using link::make_card;
+  using link::number_arg;
+  return {make_card('v', "vcm", {"s", "0"}, {number_arg(0)}),
+          make_card('r', "rp", {"s", "p"}, {number_arg(r)}),
+          make_card('r', "rn", {"s", "n"}, {number_arg(r)}),
+          make_card('c', "cp", {"p", "0"}, {number_arg(c)}),
+          make_card('c', "cn", {"n", "0"}, {number_arg(c)})};
+}
+
+// By hand: H(x) = 1 / (1 + j x), x = w R C. With C_p = C (1 + t) and C_n = C (1 - t) (the worst
+// corner: the two lines move apart) the differential response is H(x (1 + t)) - H(x (1 - t)),
+// to first order 2 t x / (1 + x^2): largest (t) at x = 1, falling as 2 t x at low and 2 t / x at
+// high frequency, and growing in proportion to t.
+TEST(NoiseConversion, RcImbalanceGrowsAsTheHandCalculationSays) {
+  const double r = 1e3, c = 1e-9, f0 = 1 / (2 * kPi * r * c);
+  for (double t : {0.01, 0.02, 0.05}) {
+    ConversionRequest req;
+    req.sources = {{"vcm", 1.0}};
+    req.p = "p", req.n = "n";
+    req.groups = {{"cp", "test", {3}, t}, {"cn", "test", {4}, t}};
+    req.frequencies = {f0 / 10, f0, 10 * f0};
+    StatusOr<std::vector<ConversionPoint>> pts = conversion_sweep(rc_cards(r, c), req);
+    ASSERT_TRUE(pts.ok()) << pts.status().message();
+    for (const ConversionPoint& p : *pts) {
+      const double x = 2 * kPi * p.freq_hz * r * c;
+      auto h = [](double y) { return 1.0 / Complex(1, y); };
+      const double exact = std::abs(h(x * (1 + t)) - h(x * (1 - t)));
+      const double first_order = 2 * t * x / (1 + x * x);
+      EXPECT_NEAR(std::abs(p.vp - h(x)), 0, 1e-12);
+      EXPECT_NEAR(std::abs(p.vp - p.vn), 0, 1e-12) << "balanced nominal";
+      // The linearised worst case: first order exactly, the true corner within t^2.
+      EXPECT_NEAR(p.dm_worst, first_order, 1e-9 * first_order) << "t " << t << " x " << x;
+      EXPECT_NEAR(p.dm_worst, exact, 1.5 * t * t * exact) << "t " << t << " x " << x;
+    }
+  }
+}
+
+TEST(NoiseConversion, BalancedRcConvertsNothing) {
+  ConversionRequest req;
+  req.sources = {{"vcm", 1.0}};
+  req.p = "p", req.n = "n";
+  req.frequencies = {1e4, 1e5, 1e6, 1e7, 1e8};
+  StatusOr<std::vector<ConversionPoint>> pts = conversion_sweep(rc_cards(1e3, 1e-9), req);
+  ASSERT_TRUE(pts.ok()) << pts.status().message();
+  for (const ConversionPoint& p : *pts) {
+    EXPECT_EQ(p.dm_worst, std::abs(p.vp - p.vn));
+    EXPECT_LT(std::abs(p.vp - p.vn), 1e-15);
+  }
+}
+
+const char* kLink17 = R"(
+name: bci-1p7m
+tx: {device: bq7961x, isolation: {ISO}}
+rx: {device: bq7961x, isolation: {ISO}}
+cable: {length: 1.7}
+noise: {injection: INJ, level: 100m, position: 0.5, time_domain: false}
+)";
+
+std::string link17(const std::string& iso, const std::string& injection = "bci") {
+  std::string s = kLink17;
+  for (int i = 0; i < 2; ++i) s.replace(s.find("ISO"), 3, iso);
+  s.replace(s.find("INJ"), 3, injection);
+  return s;
+}
+
+const char* kCap = "type: cap, cap: 2.2n";
+const char* kCapChoke = "type: capchoke, cap: 2.2n, chokes: [ACT45B-510-2P-TL003]";
+const char* kXfmr = "type: transformer, part: HMU1228NL";
+
+// Every P and N part equal, the cable perfectly twisted: no common mode becomes differential,
+// whatever the injection, down to the solver's rounding.
+TEST(NoiseLink, PerfectlyBalancedLinkConvertsNothing) {
+  for (const char* iso : {kCap, kCapChoke, kXfmr})
+    for (const char* inj : {"bci", "ground_shift"}) {
+      link::LinkSpec spec = spec_of(link17(iso, inj));
+      StatusOr<NoiseCircuit> nc = build_noise_circuit(spec, parts(), link::Direction::kDown);
+      ASSERT_TRUE(nc.ok()) << nc.status().message();
+      ConversionRequest req;
+      req.sources = nc->sources;
+      req.ref = nc->rx_ground;
+      req.frequencies = noise_frequencies(spec.noise);
+      StatusOr<std::vector<ConversionPoint>> pts = conversion_sweep(nc->link.netlist.cards, req);
+      ASSERT_TRUE(pts.ok()) << pts.status().message();
+      // Relative to the largest pin voltage of the sweep (the solution's scale: where the pins'
+      // common mode is itself tiny, rounding is relative to the larger voltages elsewhere).
+      double scale = 0, worst = 0;
+      for (const ConversionPoint& p : *pts)
+        scale = std::max({scale, std::abs(p.vp), std::abs(p.vn)});
+      ASSERT_GT(scale, 0);
+      for (const ConversionPoint& p : *pts) worst = std::max(worst, std::abs(p.vp - p.vn) / scale);
+      // -140 dB: the solver's floor on these circuits (measured 2e-8 at most, the transformer;
+      // 1e-12 S floating ties against kilohm parts); 1 % of imbalance gives about -40 dB.
+      EXPECT_LT(worst, 1e-7) << iso << ", " << inj;
+    }
+}
+
+// The noise circuit exported for ngspice (noise_spice) with one isolation cap 10 % high, so the
+// nominal link converts: ngspice's AC analysis gives the same differential and pin voltages
+// within 1 dB at every frequency of its sweep.
+TEST(NoiseLink, ConversionAgreesWithNgspiceAc) {
+  const std::string dir = ::testing::TempDir() + "/noise_ngspice";
+  std::filesystem::create_directories(dir);
+  struct Case {
+    const char* iso;
+    const char* injection;
+    const char* moved;  // the card made 10 % larger
+  };
+  for (const Case& k : {Case{kCap, "bci", "crxisop"}, Case{kCapChoke, "bci", "lrx1.lp"},
+                        Case{kXfmr, "ground_shift", "trx.cip"}}) {
+    link::LinkSpec spec = spec_of(link17(k.iso, k.injection));
+    StatusOr<NoiseCircuit> nc = build_noise_circuit(spec, parts(), link::Direction::kDown);
+    ASSERT_TRUE(nc.ok()) << nc.status().message();
+    bool moved = false;
+    for (Card& c : nc->link.netlist.cards)
+      if (c.name == k.moved) c.args[0].number *= 1.1, moved = true;
+    ASSERT_TRUE(moved) << k.moved;
+    const std::string deck = dir + "/" + std::string(k.moved) + ".cir";
+    std::ofstream(deck) << noise_spice(*nc, spec.noise);
+    StatusOr<Waveform> ng =
+        testing::run_ngspice(deck, {"mag(v(rxp)-v(rxn))", "mag(v(rxp)-v(grx))"}, dir);
+    ASSERT_TRUE(ng.ok()) << ng.status().message();
+    ASSERT_GT(ng->samples(), 30u);
+    ConversionRequest req;
+    req.sources = nc->sources;
+    req.ref = nc->rx_ground;
+    req.frequencies = ng->time;
+    StatusOr<std::vector<ConversionPoint>> pts = conversion_sweep(nc->link.netlist.cards, req);
+    ASSERT_TRUE(pts.ok()) << pts.status().message();
+    double worst_dm = 0, worst_pin = 0;
+    for (size_t i = 0; i < pts->size(); ++i) {
+      const ConversionPoint& p = (*pts)[i];
+      const double dm = std::abs(p.vp - p.vn), pin = std::abs(p.vp);
+      worst_dm = std::max(worst_dm, std::abs(20 * std::log10(dm / ng->columns[0][i])));
+      worst_pin = std::max(worst_pin, std::abs(20 * std::log10(pin / ng->columns[1][i])));
+    }
+    EXPECT_LT(worst_dm, 1.0) << k.iso;
+    EXPECT_LT(worst_pin, 1.0) << k.iso;
+    std::printf("%s (%s, %s +10 %%): |dB| worst DM %.4f, pin %.4f over %zu points\n", k.iso,
+                k.injection, k.moved, worst_dm, worst_pin, pts->size());
+  }
+}
+
+eye::PulseMetrics pulse(double vstart, double vend, double width_margin, double edge,
+                        double edge_margin) {
+  eye::PulseMetrics p;
+  p.vstart.value = vstart;
+  p.vend.value = vend;
+  p.width.value = 250e-9, p.width.margin = width_margin;
+  p.edge.value = edge, p.edge.margin = edge_margin;
+  return p;
+}
+
+// Hand-checked budgets on the BQ7961x rules (VEND >= 1.2; VSTART >= 1.6, or 1.7 once VEND <= 1.3).
+TEST(NoiseBudget, FollowsTheReceiverRules) {
+  StatusOr<eye::Rules> rules = eye::load_rules("bq7961x");
+  ASSERT_TRUE(rules.ok());
+  eye::CheckResult r;
+  r.pass = true;
+  // VSTART 2.0 / VEND 1.8: 0.4 V takes VSTART to 1.6 while VEND (1.4) stays above the knee.
+  // Edges 20 ns: slope 2.4 V / 20 ns; a 20 ns width margin takes 20 ns x slope / 2 = 1.2 V.
+  r.pulses = {pulse(2.0, 1.8, 20e-9, 20e-9, 40e-9)};
+  NoiseBudget b = noise_budget(r, *rules, 4.0);
+  EXPECT_NEAR(b.amplitude, 0.4, 1e-9);
+  EXPECT_NEAR(b.width, 1.2, 1e-9);
+  EXPECT_NEAR(b.edge, 2.4, 1e-9);
+  EXPECT_NEAR(b.dm_amplitude, 0.4, 1e-9);
+  EXPECT_EQ(b.limited_by, "vstart/vend");
+  // VSTART 2.5 / VEND 1.35: past 0.05 V VEND is under the knee and VSTART needs 1.7 (room to
+  // 0.8 V), but VEND reaches 1.2 V at 0.15 V.
+  r.pulses = {pulse(2.5, 1.35, 20e-9, 20e-9, 40e-9)};
+  EXPECT_NEAR(noise_budget(r, *rules, 4.0).amplitude, 0.15, 1e-9);
+  // VSTART 1.75 / VEND 1.32: under the knee after 0.02 V, where VSTART (1.73) is above 1.7 until
+  // 0.05 V.
+  r.pulses = {pulse(1.75, 1.32, 20e-9, 20e-9, 40e-9)};
+  EXPECT_NEAR(noise_budget(r, *rules, 4.0).amplitude, 0.05, 1e-9);
+  // A width margin of 2 ns with 20 ns edges: 2 ns x 0.12 V/ns / 2 = 0.12 V.
+  r.pulses = {pulse(3, 3, 2e-9, 20e-9, 40e-9)};
+  b = noise_budget(r, *rules, 4.0);
+  EXPECT_NEAR(b.dm_amplitude, 0.12, 1e-9);
+  EXPECT_EQ(b.limited_by, "width");
+  // A failing link has no budget.
+  r.pass = false;
+  EXPECT_EQ(noise_budget(r, *rules, 4.0).dm_amplitude, 0);
+}
+
+StatusOr<NoiseResult> analyze(const link::LinkSpec& spec) {
+  StatusOr<NoiseRun> r = run_noise(spec, parts());
+  if (!r) return r.status();
+  return r->noise;
+}
+
+// TI's BCI setup (domain.md 6: ISO 11452-4, 1.7 m, 1 Mbps): the three isolation types with TI's
+// parts. Capacitor-only has the lowest immunity over most of the band; capacitor + choke and
+// transformer are far better.
+// DISABLED: the model does not reproduce TI's ranking yet (issue 16 left open on this point).
+// Measured (100 mA AM, worst corner, down): cap-only is lowest at 10 of 38 points; cap + choke is
+// 5-20x better above 3 MHz but equal below 1 MHz (the loop is capacitive there: the choke's
+// 51 uH is not yet the larger impedance) and worst at its CM resonance near 0.9 MHz (17 mA against
+// cap-only's 21 mA at 8.9 MHz); the transformer is 10-50x better below 1 MHz and above 40 MHz but
+// 2x worse at 8-20 MHz, where the cable's CM resonance drives current through the 100 pF
+// cable-side caps (CBYPASS2, 10 %). Candidates: where CBYPASS2 returns (board ground here), the
+// assumed board-to-chassis 1 nF, the chokes' single-resonance model, no cable radiation loss.
+TEST(NoiseRanking, DISABLED_TiBciSetupCapacitorOnlyIsWeakest) {
+  std::vector<NoiseResult> r;
+  for (const char* iso : {kCap, kCapChoke, kXfmr}) {
+    link::LinkSpec spec = spec_of(link17(iso));
+    spec.stimulus.directions = {link::Direction::kDown};
+    StatusOr<NoiseResult> n = analyze(spec);
+    ASSERT_TRUE(n.ok()) << n.status().message();
+    r.push_back(*n);
+  }
+  const auto& cap = r[0].directions[0].points;
+  const auto& choke = r[1].directions[0].points;
+  const auto& xfmr = r[2].directions[0].points;
+  ASSERT_EQ(cap.size(), choke.size());
+  size_t lowest = 0;
+  std::vector<double> gain_choke, gain_xfmr;
+  for (size_t i = 0; i < cap.size(); ++i) {
+    if (cap[i].immunity < choke[i].immunity && cap[i].immunity < xfmr[i].immunity) ++lowest;
+    gain_choke.push_back(20 * std::log10(choke[i].immunity / cap[i].immunity));
+    gain_xfmr.push_back(20 * std::log10(xfmr[i].immunity / cap[i].immunity));
+  }
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+  std::printf(
+      "cap lowest at %zu of %zu points; median gain over cap: choke %.1f dB, "
+      "transformer %.1f dB; immunity min: cap %.3g A, choke %.3g A, xfmr %.3g A\n",
+      lowest, cap.size(), median(gain_choke), median(gain_xfmr), r[0].directions[0].immunity_min,
+      r[1].directions[0].immunity_min, r[2].directions[0].immunity_min);
+  EXPECT_GT(static_cast<double>(lowest), 0.6 * static_cast<double>(cap.size()));
+  EXPECT_GT(median(gain_choke), 10.0);
+  EXPECT_GT(median(gain_xfmr), 10.0);
+  EXPECT_LT(r[0].directions[0].immunity_min, r[1].directions[0].immunity_min);
+  EXPECT_LT(r[0].directions[0].immunity_min, r[2].directions[0].immunity_min);
+}
+
+}  // namespace
+}  // namespace isolink::analysis

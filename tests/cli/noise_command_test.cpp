@@ -1,0 +1,111 @@
+// `isolink noise` end to end: it runs on every example spec (exit 0 or 1 as its verdict says),
+// prints the JSON shape of issue 16, writes report.md / report.json with the noise section and
+// noise.png; bad noise keys exit 2 with file:line:col and write nothing.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kBinary = ISOLINK_BINARY;
+const std::string kExamples = ISOLINK_EXAMPLES_DIR;
+
+struct Result {
+  int code;
+  std::string out, err;
+};
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+Result run(const std::string& args, const std::string& tag) {
+  const std::string out_file = ::testing::TempDir() + "/noise_" + tag + "_stdout.txt";
+  const std::string err_file = ::testing::TempDir() + "/noise_" + tag + "_stderr.txt";
+  const std::string cmd = kBinary + " " + args + " >" + out_file + " 2>" + err_file;
+  int status = std::system(cmd.c_str());
+  return {WEXITSTATUS(status), slurp(out_file), slurp(err_file)};
+}
+
+class NoiseExamples : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(NoiseExamples, RunsAndReportsTheIssueShape) {
+  const std::string stem = fs::path(GetParam()).stem().string();
+  const std::string dir = ::testing::TempDir() + "/noise_" + stem;
+  fs::remove_all(dir);
+  Result r = run("noise " + kExamples + "/" + GetParam() + " --json -o " + dir, stem);
+  ASSERT_TRUE(r.code == 0 || r.code == 1) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["verdict"], r.code == 0 ? "pass" : "fail");
+  EXPECT_EQ(j["injection"], "bci");
+  EXPECT_DOUBLE_EQ(j["level"].get<double>(), 0.1);
+  EXPECT_EQ(j["level_unit"], "A");
+  ASSERT_FALSE(j["directions"].empty());
+  bool any_fail = false;
+  for (const auto& d : j["directions"]) {
+    EXPECT_TRUE(d["direction"] == "down" || d["direction"] == "up");
+    ASSERT_EQ(d["points"].size(), 38u);  // 100 kHz-400 MHz, 10 per decade, both ends
+    double lowest = 1e300, at = 0;
+    for (const auto& p : d["points"]) {
+      for (const char* k : {"freq_hz", "cm_to_dm_db", "pin_cm_v", "immunity"})
+        ASSERT_TRUE(p[k].is_number()) << k;
+      if (p["immunity"].get<double>() < lowest) lowest = p["immunity"], at = p["freq_hz"];
+    }
+    EXPECT_DOUBLE_EQ(d["immunity_min"]["value"].get<double>(), lowest);
+    EXPECT_DOUBLE_EQ(d["immunity_min"]["freq_hz"].get<double>(), at);
+    any_fail = any_fail || lowest < 0.1;
+  }
+  EXPECT_EQ(any_fail, r.code == 1);
+  nlohmann::json report = nlohmann::json::parse(slurp(dir + "/report.json"));
+  EXPECT_EQ(report["noise"]["verdict"], j["verdict"]);
+  EXPECT_NE(slurp(dir + "/report.md").find("## Noise immunity"), std::string::npos);
+  EXPECT_GT(fs::file_size(dir + "/noise.png"), 10000u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Examples, NoiseExamples,
+                         ::testing::Values("cap_2m.yaml", "same_pcb.yaml", "capchoke_5m.yaml",
+                                           "capdualchoke_10m.yaml", "transformer_15m.yaml",
+                                           "hybrid_xfmr_cap_12m.yaml", "bq79606a_cap_2m.yaml",
+                                           "bq79606a_same_pcb.yaml", "bq79606a_xfmr_10m.yaml"),
+                         [](const ::testing::TestParamInfo<std::string>& i) {
+                           std::string s = fs::path(i.param).stem().string();
+                           for (char& c : s)
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           return s;
+                         });
+
+TEST(NoiseCommand, BadNoiseKeysExit2AndWriteNothing) {
+  const std::string dir = ::testing::TempDir() + "/noise_bad";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  struct Case {
+    const char* yaml;
+    const char* message;
+  };
+  for (const Case& c : {
+           Case{"noise: {level: 5V}", "bad.yaml:1:16: error: key 'noise.level'"},
+           Case{"noise: {injection: ground_shift, level: 5mA}", "key 'noise.level'"},
+           Case{"noise: {position: 1.5}", "key 'noise.position' = 1.5: must be in 0..1"},
+           Case{"noise: {f_start: 1meg, f_stop: 100k}", "must be above f_start"},
+           Case{"noise: {tolerance: {isolation_cap: 10}}", "expected a percentage"},
+           Case{"noise: {clamp: 3}", "unknown key"},
+           Case{"rx: {y_cap: 4.7nH}", "key 'rx.y_cap'"},
+       }) {
+    std::ofstream(dir + "/bad.yaml") << c.yaml << "\n";
+    Result r = run("noise " + dir + "/bad.yaml -o " + dir + "/out", "bad");
+    EXPECT_EQ(r.code, 2) << c.yaml;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.yaml << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(dir + "/out")) << c.yaml;
+  }
+}
+
+}  // namespace
