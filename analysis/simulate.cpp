@@ -110,7 +110,10 @@ StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequ
       lo.horizon = opt.tstop;
       // auto: a march longer than kAutoLtiMaxSteps costs more than the transient of any example
       // link (the longest takes 190k steps), so auto stops there and runs the transient.
-      if (req.engine == Engine::Auto) lo.max_steps = std::min(lo.max_steps, kAutoLtiMaxSteps);
+      if (req.engine == Engine::Auto) {
+        lo.max_steps = std::min(lo.max_steps, kAutoLtiMaxSteps);
+        lo.settle_by = 0.25 * opt.tstop;
+      }
       StatusOr<LtiResponses> responses = LtiResponses::compute(circuit, probes, lo);
       // auto: a response march that cannot meet its error control falls back to the transient
       // engine (the cross-check) and says why; a forced `lti` reports the failure.

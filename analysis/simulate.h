@@ -18,8 +18,8 @@
 namespace isolink::analysis {
 
 // auto: the LTI engine when the circuit allows it (check_lti: every element LTI, every source DC,
-// PULSE or PWL, no .tran uic) and its output costs no more than about the transient would
-// (kAutoLtiBudget), else the transient; lti: the LTI engine or an error naming the element;
+// PULSE or PWL, no .tran uic) and it is the cheaper engine (responses settled within a quarter
+// of the run, kAutoLtiMaxSteps, kAutoLtiBudget), else the transient; lti: the LTI engine or an error naming the element;
 // transient: always the transient.
 enum class Engine { Auto, Lti, Transient };
 const char* engine_name(Engine e);

@@ -22,6 +22,7 @@ Status LtiOptions::validate() const {
   if (!(first_step >= 0)) return bad("first_step", first_step, "must not be negative");
   if (!(max_step >= 0)) return bad("max_step", max_step, "must not be negative");
   if (max_steps <= 0) return bad("max_steps", static_cast<double>(max_steps), "must be positive");
+  if (!(settle_by >= 0)) return bad("settle_by", settle_by, "must not be negative");
   return Status::Ok();
 }
 
@@ -167,6 +168,11 @@ StatusOr<LtiResponses> LtiResponses::compute(const Circuit& circuit,
     if (r.stats_.steps + r.stats_.rejected >= opt.max_steps)
       return Status::Error(fmt::format("LTI march gave up at {:g} s after {} steps (max_steps)",
                                        tau, opt.max_steps));
+    if (opt.settle_by > 0 && tau > opt.settle_by)
+      return Status::Error(fmt::format(
+          "the responses have not settled by {:g} s (settle_by, a quarter of the run): marching "
+          "them over the run would cost more than the transient",
+          opt.settle_by));
     double step = std::min(h, horizon - tau);
     const bool euler = hist.count < 2;
     const double a0 = euler ? 1.0 / step : 2.0 / step;

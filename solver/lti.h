@@ -60,6 +60,10 @@ struct LtiOptions {
   double first_step = 0.0;     // s; 0 = min(1e-12, horizon * 1e-9)
   double max_step = 0.0;       // s; 0 = horizon / 64
   long max_steps = 5'000'000;  // accepted + rejected march steps before giving up
+  // s; 0 = no limit. The march gives up (an error) when the responses have not settled by then:
+  // `auto` sets a quarter of the run, since a march over the whole run costs more than the
+  // transient (one solve per source and step against one per step).
+  double settle_by = 0.0;
 
   // Errors name the field, its value and the rule it breaks.
   Status validate() const;

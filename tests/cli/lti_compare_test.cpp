@@ -5,6 +5,7 @@
 // the LTI engine's error does not accumulate over a run (each corner adds its own response).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -147,6 +148,38 @@ TEST(LtiEngineChoice, AutoFallsBackOnSinAndLtiRefusesNamingTheSource) {
   ASSERT_FALSE(forced.ok());
   EXPECT_NE(forced.status().message().find("sin_rc.cir:2:1: error: source 'vs'"), std::string::npos)
       << forced.status().message();
+}
+
+// auto takes the LTI engine when the responses settle early in the run, and the transient when
+// they do not settle within a quarter of it (the march would then cost more than the transient).
+// RC step responses, tau = 0.5 us (the march calls it settled at about 14 us of a 100 us run) and
+// tau = 100 us (still moving at 25 us); each against v = 1 - exp(-t / tau).
+TEST(LtiEngineChoice, AutoTakesTheLtiEngineOnlyWhenTheResponsesSettleEarly) {
+  for (double tau : {0.5e-6, 100e-6}) {
+    const std::string path = ::testing::TempDir() + "/rc_settle.cir";
+    std::ofstream(path) << "rc\nV1 in 0 PWL(0 0 1n 1)\nR1 in out 1k\nC1 out 0 " << tau / 1e3
+                        << "\n.tran 100n 100u\n.end\n";
+    auto netlist = read_spice_file(path);
+    ASSERT_TRUE(netlist.ok()) << netlist.status().message();
+    analysis::SimulationRequest req{.probes = {"v(out)"}};
+    auto r = analysis::simulate_netlist(*netlist, req);
+    ASSERT_TRUE(r.ok()) << r.status().message();
+    const bool settles = tau < 10e-6;
+    EXPECT_EQ(r->engine, settles ? analysis::Engine::Lti : analysis::Engine::Transient) << tau;
+    if (!settles) {
+      EXPECT_NE(r->engine_note.find("not settled by 2.5e-05 s"), std::string::npos)
+          << r->engine_note;
+    }
+    double worst = 0;
+    for (size_t i = 0; i < r->wave.samples(); ++i) {
+      const double t = r->wave.time[i];
+      if (t < 1e-9) continue;
+      // The 1 ns ramp shifts the response by half a nanosecond.
+      worst =
+          std::max(worst, std::fabs(r->wave.columns[0][i] - (1 - std::exp(-(t - 0.5e-9) / tau))));
+    }
+    EXPECT_LT(worst, settles ? 1.5e-3 : 10e-3) << tau;
+  }
 }
 
 }  // namespace
