@@ -16,6 +16,8 @@
 #include <stdlib.h>
 
 #include <algorithm>
+#include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -44,6 +46,7 @@ namespace isolink::python {
 namespace {
 
 PyObject* g_error = nullptr;  // isolink.Error
+struct ErrorTag {};           // names isolink.Error's type; no C++ exception is translated to it
 
 [[noreturn]] void raise(const Status& s) {
   PyErr_SetString(g_error, s.message().c_str());
@@ -189,9 +192,11 @@ py::dict load_spec(const std::string& path) {
 py::object cell(const std::string& name, const std::string& text) {
   if (text.empty()) return py::none();
   if (text == "true" || text == "false") return py::bool_(text == "true");
-  char* end = nullptr;
-  const double x = std::strtod(text.c_str(), &end);
-  if (end == text.c_str() + text.size()) {
+  double x = 0;
+  const char* end = text.data() + text.size();
+  // Decimal numbers only (no hex); "nan" or "inf" would be a variant's name.
+  if (auto [p, ec] = std::from_chars(text.data(), end, x);
+      ec == std::errc() && p == end && std::isfinite(x)) {
     if (name == "point" || name == "sample") return py::int_(static_cast<int64_t>(x));
     return py::float_(x);
   }
@@ -261,7 +266,7 @@ PYBIND11_MODULE(isolink, m) {
       "isolink: signal integrity of BMS daisy-chain links (run, check, load_spec, sweep). "
       "Results are the JSON the isolink CLI writes, as dicts; errors raise isolink.Error with "
       "the CLI's file:line:col message.";
-  static py::exception<std::runtime_error> error(m, "Error", PyExc_ValueError);
+  static py::exception<ErrorTag> error(m, "Error", PyExc_ValueError);
   g_error = error.ptr();
   m.def("run", &run, py::arg("spec"), py::kw_only(), py::arg("direction") = py::none(),
         py::arg("engine") = "auto", py::arg("parts") = std::vector<std::string>{},
