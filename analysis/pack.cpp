@@ -10,6 +10,7 @@
 #include <map>
 
 #include "analysis/sweep_run.h"
+#include "base/hex.h"
 #include "netlists/link/cable.h"
 #include "netlists/link/expand.h"
 #include "netlists/spice_writer.h"
@@ -31,7 +32,7 @@ std::string circuit_key(const link::ExpandedLink& x) {
   Netlist n = x.netlist;
   n.title.clear();
   std::string key = write_spice(n);
-  key += "\n* rules " + x.rules + "\n* expect " + traffic::hex_bytes(x.expected) + "\n";
+  key += "\n* rules " + x.rules + "\n* expect " + to_hex(x.expected) + "\n";
   return key;
 }
 

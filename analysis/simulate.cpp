@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 
 #include "solver/circuit.h"
@@ -107,6 +108,9 @@ StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequ
       for (const auto& e : circuit.elements()) e->bind_time(opt.tstep, opt.tstop);
       LtiOptions lo;
       lo.horizon = opt.tstop;
+      // auto: a march longer than kAutoLtiMaxSteps costs more than the transient of any example
+      // link (the longest takes 190k steps), so auto stops there and runs the transient.
+      if (req.engine == Engine::Auto) lo.max_steps = std::min(lo.max_steps, kAutoLtiMaxSteps);
       StatusOr<LtiResponses> responses = LtiResponses::compute(circuit, probes, lo);
       // auto: a response march that cannot meet its error control falls back to the transient
       // engine (the cross-check) and says why; a forced `lti` reports the failure.
@@ -117,7 +121,20 @@ StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequ
         grid.tstop = opt.tstop;
         grid.step = req.grid_step;
         grid.grid_probes = req.grid_probes;
+        // auto: the LTI output only when it costs about what the transient would (a transient
+        // step costs about an unknown's worth of work per unknown, as does a probe evaluation).
+        if (req.engine == Engine::Auto)
+          grid.max_evaluations =
+              kAutoLtiBudget * static_cast<double>(responses->stats().steps) * result.unknowns;
         result.wave = responses->waveform(responses->netlist_inputs(opt.tstop), grid, &result.grid);
+      }
+      if (responses && result.grid.over_budget) {
+        lti_ok = Status::Error(fmt::format(
+            "the LTI output grid would take {:.3g} probe evaluations, more than the transient "
+            "costs here ({} march steps x {} unknowns x {:g})",
+            result.grid.evaluations, responses->stats().steps, result.unknowns, kAutoLtiBudget));
+        result.grid = {};
+      } else if (responses) {
         if (!result.grid.warning.empty())
           result.warnings.push_back("warning: " + result.grid.warning);
         result.lti = responses->stats();
@@ -125,8 +142,9 @@ StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequ
         result.seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         return result;
+      } else {
+        lti_ok = Status::Error("the LTI response march failed: " + responses.status().message());
       }
-      lti_ok = Status::Error("the LTI response march failed: " + responses.status().message());
     }
     result.engine_note = lti_ok.message();
   }

@@ -18,12 +18,22 @@
 namespace isolink::analysis {
 
 // auto: the LTI engine when the circuit allows it (check_lti: every element LTI, every source DC,
-// PULSE or PWL, no .tran uic), else the transient; lti: the LTI engine or an error naming the
-// element; transient: always the transient.
+// PULSE or PWL, no .tran uic) and its output costs no more than about the transient would
+// (kAutoLtiBudget), else the transient; lti: the LTI engine or an error naming the element;
+// transient: always the transient.
 enum class Engine { Auto, Lti, Transient };
 const char* engine_name(Engine e);
 // "auto", "lti", "transient" -> Engine; an error names the value and the choices.
 StatusOr<Engine> parse_engine(const std::string& text);
+
+// auto runs the LTI output only while each grid level's probe evaluations stay under this many
+// times (march steps x unknowns). Measured 2026-11-30: a probe evaluation costs about 10 ns and a
+// transient step about 8 ns per unknown, and the transient takes 1-4 times the march's steps; 4
+// keeps the exact engine wherever the two cost about the same (xfmr_link_15m: 1.2 s LTI, 1.1 s
+// transient) and leaves it where it is far slower (cap_2m with its traffic: 9.8 s against 0.7 s,
+// its responses never settling within the run).
+inline constexpr double kAutoLtiBudget = 4.0;
+inline constexpr long kAutoLtiMaxSteps = 400'000;
 
 // The most output rows a --step grid may ask for.
 inline constexpr size_t kMaxGridRows = 10'000'000;

@@ -9,7 +9,7 @@
 #include <random>
 
 #include "base/file_io.h"
-#include "netlists/lexer.h"
+#include "base/si_number.h"
 
 namespace isolink::analysis::sweep {
 
@@ -171,7 +171,7 @@ bool parse_number_for(const std::string& path, const std::string& text, double* 
   const Unit u = key_unit(path);
   if (u != Unit::kNone) return config::parse_quantity(text, u, out);
   double v = 0;
-  if (!spice::parse_number(text, v)) return false;
+  if (!parse_si_number(text, v)) return false;
   *out = v;
   return true;
 }

@@ -9,13 +9,13 @@
 #include <vector>
 
 #include "eye/check.h"
-#include "eye/decode.h"
 #include "eye/rules.h"
 #include "eye/waveform_csv.h"
+#include "protocol/frame.h"
 
 namespace {
 
-using isolink::eye::FrameFormat;
+using isolink::FrameFormat;
 
 struct Wave {
   std::vector<double> t, v;
@@ -31,7 +31,7 @@ Wave make_wave(size_t n, double dt) {
   const size_t idle_halves = static_cast<size_t>(gap / T);
   size_t byte = 0;
   while (static_cast<double>(hb.size()) * T < static_cast<double>(n) * dt) {
-    for (int s : isolink::eye::frame_half_bits(static_cast<uint8_t>(byte++), FrameFormat{}))
+    for (int s : isolink::frame_half_bits(static_cast<uint8_t>(byte++), FrameFormat{}))
       hb.push_back(s);
     hb.insert(hb.end(), idle_halves, 0);
   }

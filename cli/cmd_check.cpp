@@ -6,11 +6,12 @@
 #include <optional>
 #include <string>
 
+#include "base/hex.h"
 #include "cli/commands.h"
 #include "eye/check.h"
-#include "eye/decode.h"
 #include "eye/rules.h"
 #include "eye/waveform_csv.h"
+#include "protocol/frame.h"
 
 namespace isolink::cli {
 namespace {
@@ -39,10 +40,10 @@ int run_check(const CheckArgs& a) {
   eye::CheckOptions opt;
   if (a.sof) opt.sof = *a.sof;
   if (a.sof_value) opt.sof_value = *a.sof_value;
-  if (a.msb_first) opt.bit_order = eye::BitOrder::kMsbFirst;
-  if (a.lsb_first) opt.bit_order = eye::BitOrder::kLsbFirst;
+  if (a.msb_first) opt.bit_order = BitOrder::kMsbFirst;
+  if (a.lsb_first) opt.bit_order = BitOrder::kLsbFirst;
   if (!a.expect.empty()) {
-    StatusOr<std::vector<uint8_t>> e = eye::parse_hex_bytes(a.expect);
+    StatusOr<std::vector<uint8_t>> e = parse_hex_bytes(a.expect);
     if (!e) return fail_input("--expect: error: " + e.status().message());
     opt.expect = *e;
   }

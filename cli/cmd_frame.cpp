@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "base/hex.h"
 #include "cli/commands.h"
 #include "netlists/traffic/command.h"
 #include "netlists/traffic/drive.h"
@@ -82,7 +83,7 @@ std::string sign_char(int s) {
 void print_text(const tr::Drive& d) {
   for (const tr::DriveFrame& f : d.frames) {
     if (f.kind == tr::FrameKind::kData) {
-      std::printf("%s\n", tr::hex_bytes(f.bytes).c_str());
+      std::printf("%s\n", to_hex(f.bytes).c_str());
     } else {
       const int p = tr::tone_polarity(f.tone);
       std::printf("tone %s: %d couplets (%s%s), %g us pulses\n", f.label.c_str(), f.couplets,
@@ -122,7 +123,7 @@ void print_json(const tr::Drive& d) {
     jf["end"] = f.end;
     if (f.kind == tr::FrameKind::kData) {
       jf["bytes"] = f.bytes;
-      jf["hex"] = tr::hex_bytes(f.bytes);
+      jf["hex"] = to_hex(f.bytes);
       jf["byte_starts"] = f.byte_starts;
       nlohmann::json fb = nlohmann::json::array();
       for (uint8_t b : f.bytes) {
@@ -143,7 +144,7 @@ void print_json(const tr::Drive& d) {
     pulses.push_back({{"start", p.start}, {"width", p.width}, {"sign", p.sign}});
   }
   j["bytes"] = bytes;
-  j["hex"] = tr::hex_bytes(bytes.get<std::vector<uint8_t>>());
+  j["hex"] = to_hex(bytes.get<std::vector<uint8_t>>());
   j["bits"] = bits;
   j["pulses"] = pulses;
   j["frames"] = frames;
@@ -151,7 +152,7 @@ void print_json(const tr::Drive& d) {
   j["encoding"] = {{"half_bit", d.encoding.half_bit},
                    {"sof", d.encoding.sof},
                    {"sof_value", d.encoding.sof_value},
-                   {"bit_order", d.encoding.bit_order == tr::BitOrder::kLsbFirst ? "lsb" : "msb"},
+                   {"bit_order", d.encoding.bit_order == BitOrder::kLsbFirst ? "lsb" : "msb"},
                    {"error_bit", d.encoding.error_bit}};
   std::printf("%s\n", j.dump(2).c_str());
 }
@@ -160,7 +161,7 @@ int run_frame(const FrameArgs& a) {
   tr::StimulusOptions opt;
   opt.encoding.sof = !a.no_sof;
   opt.encoding.sof_value = a.sof;
-  opt.encoding.bit_order = a.msb_first ? tr::BitOrder::kMsbFirst : tr::BitOrder::kLsbFirst;
+  opt.encoding.bit_order = a.msb_first ? BitOrder::kMsbFirst : BitOrder::kLsbFirst;
   opt.encoding.error_bit = a.error_bit;
   opt.tone.couplets = a.couplets;
   tr::PwlOptions pwl;
@@ -194,7 +195,7 @@ int run_frame(const FrameArgs& a) {
       return 2;
     }
     for (const tr::DriveFrame& f : d->frames) {
-      std::printf("* %s\n", f.kind == tr::FrameKind::kData ? tr::hex_bytes(f.bytes).c_str()
+      std::printf("* %s\n", f.kind == tr::FrameKind::kData ? to_hex(f.bytes).c_str()
                                                            : ("tone " + f.label).c_str());
     }
     std::fputs(text->c_str(), stdout);

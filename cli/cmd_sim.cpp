@@ -8,8 +8,8 @@
 #include <optional>
 
 #include "analysis/simulate.h"
+#include "base/si_number.h"
 #include "cli/commands.h"
-#include "netlists/lexer.h"
 
 namespace isolink::cli {
 using namespace isolink::analysis;  // simulate_netlist
@@ -33,7 +33,7 @@ struct SimArgs {
 std::optional<double> si_option(const char* flag, const std::string& text, bool* bad) {
   if (text.empty()) return std::nullopt;
   double v = 0;
-  if (!spice::parse_number(text, v) || !(v > 0)) {
+  if (!parse_si_number(text, v) || !(v > 0)) {
     std::cerr << "isolink sim: error: " << flag << " expects a positive time such as 10n, got '"
               << text << "'\n";
     *bad = true;

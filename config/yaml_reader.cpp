@@ -2,11 +2,15 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <optional>
+#include <string_view>
 
 #include "base/file_io.h"
+#include "base/si_number.h"
 #include "base/utf8.h"
 
 namespace isolink::config {
@@ -101,45 +105,38 @@ bool parse_quantity(std::string_view text, Unit unit, double* out) {
   while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.pop_back();
   size_t start = 0;
   while (start < s.size() && std::isspace(static_cast<unsigned char>(s[start]))) ++start;
-  s.erase(0, start);
-  if (s.empty()) return false;
-  double v = 0;
-  const char* b = s.data();
-  const char* e = s.data() + s.size();
-  auto [ptr, ec] = std::from_chars(b, e, v);
-  if (ec != std::errc() || !std::isfinite(v)) return false;
-  std::string rest(ptr, e);
-  while (!rest.empty() && rest[0] == ' ') rest.erase(0, 1);
+  std::string_view body = std::string_view(s).substr(start);
+  if (body.empty()) return false;
+  const bool neg = body[0] == '-';
+  if (body[0] == '+' || body[0] == '-') body.remove_prefix(1);
   const std::vector<std::string> words = unit_words(unit);
-  auto is_unit = [&](const std::string& r) {
+  auto is_unit = [&](std::string_view r) {
     if (r.empty()) return true;
     for (const std::string& w : words)
       if (r == w) return true;
     return false;
   };
-  if (unit == Unit::kMetre || unit == Unit::kCelsius || unit == Unit::kNone) {
-    // No scale suffixes: "12m" is 12 metres, not 12 milli.
-    if (!is_unit(rest)) return false;
-    *out = v;
-    return true;
-  }
-  double scale = 1.0;
-  static const std::pair<const char*, double> kSuffixes[] = {
-      {"meg", 1e6}, {"mil", 25.4e-6}, {"f", 1e-15}, {"p", 1e-12}, {"n", 1e-9},
-      {"u", 1e-6},  {"m", 1e-3},      {"k", 1e3},   {"g", 1e9},   {"t", 1e12}};
+  // The one SPICE number scanner (base/si_number.h), first stopped before any letter: the unit
+  // symbol is tried first, so "2.2f" for a capacitance is 2.2 F, not 2.2 femto.
+  std::optional<SiNumber> n = scan_si_number(body, {.scale = false, .unit_letters = false});
+  if (!n) return false;
+  std::string_view rest = body.substr(n->length);
+  const bool spaced = !rest.empty() && rest[0] == ' ';
+  while (!rest.empty() && rest[0] == ' ') rest.remove_prefix(1);
   if (!is_unit(rest)) {
-    bool found = false;
-    for (const auto& [sfx, mult] : kSuffixes) {
-      const std::string_view sv(sfx);
-      if (rest.compare(0, sv.size(), sv) == 0 && is_unit(rest.substr(sv.size()))) {
-        scale = mult;
-        found = true;
-        break;
-      }
-    }
-    if (!found) return false;
+    // Lengths and temperatures take no scale suffix: "12m" is 12 metres, not 12 milli.
+    if (unit == Unit::kMetre || unit == Unit::kCelsius || unit == Unit::kNone) return false;
+    // A scale suffix, then the unit: "2.2nF", "2.2 nF", "10meg", "4k7". Across a blank only
+    // letters may follow ("2.2 nF"; not "4 k7" or "1 e5").
+    if (spaced && !std::all_of(rest.begin(), rest.end(), [](char c) {
+          return std::isalpha(static_cast<unsigned char>(c)) != 0;
+        }))
+      return false;
+    const std::string joined = std::string(body.substr(0, n->length)).append(rest);
+    n = scan_si_number(joined, {.scale = true, .unit_letters = false});
+    if (!n || !is_unit(std::string_view(joined).substr(n->length))) return false;
   }
-  *out = v * scale;
+  *out = neg ? -n->value : n->value;
   return std::isfinite(*out);
 }
 

@@ -10,6 +10,7 @@
 
 #include "base/csv.h"
 #include "base/file_io.h"
+#include "base/hex.h"
 
 namespace isolink::eye {
 namespace {

@@ -19,12 +19,12 @@
 #include <string>
 #include <vector>
 
-#include "eye/decode.h"
+#include "base/status.h"
+#include "base/waveform.h"
 #include "eye/metrics.h"
 #include "eye/pulses.h"
 #include "eye/rules.h"
-#include "base/status.h"
-#include "base/waveform.h"
+#include "protocol/frame.h"
 
 namespace isolink::eye {
 

@@ -4,14 +4,13 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
-#include <charconv>
-#include <cmath>
 #include <filesystem>
-#include <functional>
+#include <limits>
 #include <map>
 #include <optional>
 
 #include "base/file_io.h"
+#include "config/yaml_reader.h"
 
 namespace isolink::eye {
 namespace detail {
@@ -95,177 +94,92 @@ std::optional<Issue> find_issue(const Rules& r) {
   return std::nullopt;
 }
 
-bool parse_spice_number(std::string_view s, double* out) {
-  while (!s.empty() && s.front() == ' ') s.remove_prefix(1);
-  while (!s.empty() && s.back() == ' ') s.remove_suffix(1);
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  double v = 0;
-  auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (ec != std::errc() || ptr == s.data()) return false;
-  std::string rest(ptr, s.data() + s.size());
-  std::transform(rest.begin(), rest.end(), rest.begin(), [](char c) {
-    return static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  });
-  double scale = 1;
-  if (rest.rfind("meg", 0) == 0) {
-    scale = 1e6;
-    rest.erase(0, 3);
-  } else if (!rest.empty()) {
-    static const std::map<char, double> kSuffix = {{'f', 1e-15}, {'p', 1e-12}, {'n', 1e-9},
-                                                   {'u', 1e-6},  {'m', 1e-3},  {'k', 1e3},
-                                                   {'g', 1e9},   {'t', 1e12}};
-    auto it = kSuffix.find(rest[0]);
-    if (it != kSuffix.end() && rest != "s" && rest != "v") {
-      scale = it->second;
-      rest.erase(0, 1);
-    }
-  }
-  if (!rest.empty() && rest != "s" && rest != "v") return false;
-  *out = v * scale;
-  return std::isfinite(*out);
-}
-
-// Reads one YAML document into Rules, key by key, remembering each field's line.
+// Reads one YAML document into Rules, key by key, through config's reader (config/yaml_reader.h:
+// file:line:col diagnostics, SPICE numbers with units, duplicate keys refused). What it adds:
+// every key is required unless the file names a base, and the limits are checked last.
 class Parser {
  public:
   explicit Parser(std::string source) : source_(std::move(source)) {}
 
-  Status error(const YAML::Mark& m, const std::string& msg) const {
-    if (m.line < 0) return Status::Error(fmt::format("{}: error: {}", source_, msg));
-    return Status::Error(fmt::format("{}:{}: error: {}", source_, m.line + 1, msg));
-  }
-  Status error_at_field(const std::string& field, const std::string& msg) const {
-    auto it = lines_.find(field);
-    if (it == lines_.end()) {
-      // fall back to the section, then to the whole file
-      std::string f = field;
-      while (it == lines_.end()) {
-        size_t dot = f.find_last_of(".[");
-        if (dot == std::string::npos) break;
-        f.erase(dot);
-        it = lines_.find(f);
-      }
-    }
-    if (it == lines_.end()) return Status::Error(fmt::format("{}: error: {}", source_, msg));
-    return Status::Error(fmt::format("{}:{}: error: {}", source_, it->second, msg));
-  }
+  using Handler = config::FieldReader;
+  using Field = config::Field;
 
-  using Handler = std::function<Status(const YAML::Node&, const std::string&)>;
-  struct Field {
-    std::string key;
-    Handler handle;
-  };
-
-  // Walks map node: unknown keys are errors; missing keys are errors unless a base was given.
+  // Walks a map: unknown keys are errors; missing keys are errors unless a base was given.
   Status section(const YAML::Node& node, const std::string& path,
                  const std::vector<Field>& fields) {
     const std::string where = path.empty() ? "the top level" : "'" + path + "'";
-    if (!node.IsMap()) return error(node.Mark(), fmt::format("{} must be a map of keys", where));
-    std::vector<bool> seen(fields.size(), false);
-    for (auto it = node.begin(); it != node.end(); ++it) {
-      const std::string key = it->first.Scalar();
-      const std::string full = path.empty() ? key : path + "." + key;
-      auto f =
-          std::find_if(fields.begin(), fields.end(), [&](const Field& x) { return x.key == key; });
-      if (f == fields.end()) {
-        std::string known;
-        for (const Field& x : fields) known += (known.empty() ? "" : ", ") + x.key;
-        return error(it->first.Mark(),
-                     fmt::format("unknown key '{}' in {} (known keys: {})", full, where, known));
-      }
-      seen[f - fields.begin()] = true;
-      lines_[full] = it->first.Mark().line + 1;
-      if (Status s = f->handle(it->second, full); !s.ok()) return s;
-    }
+    if (!node.IsMap())
+      return doc_->error(node, fmt::format("{} must be a map of keys, found a {}", where,
+                                           config::node_kind(node)));
+    for (auto it = node.begin(); it != node.end(); ++it)
+      nodes_[path.empty() ? it->first.Scalar() : path + "." + it->first.Scalar()] = it->first;
+    if (Status s = config::read_map(*doc_, node, path, fields); !s.ok()) return s;
     if (!has_base_)
-      for (size_t i = 0; i < fields.size(); ++i)
-        if (!seen[i] && fields[i].key != "base" && fields[i].key != "description" &&
-            !(path.empty() && fields[i].key == "decode"))
-          return error(node.Mark(),
-                       fmt::format("missing key '{}{}' in {}", path.empty() ? "" : path + ".",
-                                   fields[i].key, where));
+      for (const Field& f : fields)
+        if (!node[f.key] && f.key != "base" && f.key != "description" &&
+            !(path.empty() && f.key == "decode"))
+          return doc_->error(node, fmt::format("missing key '{}{}' in {}",
+                                               path.empty() ? "" : path + ".", f.key, where));
     return Status::Ok();
   }
+  // An error at the line of field (a dotted path), else of its section, else of the file.
+  Status error_at_field(const std::string& field, const std::string& msg) const {
+    std::string f = field;
+    auto it = nodes_.find(f);
+    while (it == nodes_.end()) {
+      const size_t dot = f.find_last_of(".[");
+      if (dot == std::string::npos) break;
+      f.erase(dot);
+      it = nodes_.find(f);
+    }
+    if (it == nodes_.end()) return Status::Error(fmt::format("{}: error: {}", source_, msg));
+    return doc_->error(it->second, msg);
+  }
 
-  Handler number(double* dst) {
-    return [this, dst](const YAML::Node& n, const std::string& key) -> Status {
-      if (!n.IsScalar() || !parse_spice_number(n.Scalar(), dst))
-        return error(n.Mark(), fmt::format("key '{}': expected a number (SPICE suffixes allowed, "
-                                           "e.g. 60n), found '{}'",
-                                           key, n.IsScalar() ? n.Scalar() : "a " + kind(n)));
-      return Status::Ok();
-    };
+  // Times in seconds, levels in volts: SPICE suffixes and the unit symbol ("60n", "60ns").
+  Handler seconds(double* dst) {
+    return config::read_quantity(*doc_, config::Unit::kSecond, config::Rule::kAny, dst);
   }
-  Handler text(std::string* dst) {
-    return [this, dst](const YAML::Node& n, const std::string& key) -> Status {
-      if (!n.IsScalar())
-        return error(n.Mark(), fmt::format("key '{}': expected text, found a {}", key, kind(n)));
-      *dst = n.Scalar();
-      return Status::Ok();
-    };
+  Handler volts(double* dst) {
+    return config::read_quantity(*doc_, config::Unit::kVolt, config::Rule::kAny, dst);
   }
-  Handler boolean(bool* dst) {
-    return [this, dst](const YAML::Node& n, const std::string& key) -> Status {
-      bool b = false;
-      if (!n.IsScalar() || !YAML::convert<bool>::decode(n, b))
-        return error(n.Mark(), fmt::format("key '{}': expected true or false, found '{}'", key,
-                                           n.IsScalar() ? n.Scalar() : "a " + kind(n)));
-      *dst = b;
-      return Status::Ok();
-    };
-  }
+  Handler text(std::string* dst) { return config::read_text(*doc_, dst); }
+  Handler boolean(bool* dst) { return config::read_bool(*doc_, dst); }
+  // Any whole number; the ranges are limits that find_issue checks with the rule's wording.
   Handler integer(int* dst) {
-    return [this, dst](const YAML::Node& n, const std::string& key) -> Status {
-      const std::string s = n.IsScalar() ? n.Scalar() : "";
-      int v = 0;
-      auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-      if (s.empty() || ec != std::errc() || ptr != s.data() + s.size())
-        return error(n.Mark(), fmt::format("key '{}': expected an integer, found '{}'", key,
-                                           n.IsScalar() ? s : "a " + kind(n)));
-      *dst = v;
-      return Status::Ok();
-    };
+    return config::read_int(*doc_, std::numeric_limits<int>::min(), std::numeric_limits<int>::max(),
+                            dst);
   }
   template <class E>
   Handler choice(E* dst, std::vector<std::pair<std::string, E>> options) {
     return [this, dst, options](const YAML::Node& n, const std::string& key) -> Status {
-      std::string names;
-      for (const auto& [name, value] : options) {
-        if (n.IsScalar() && n.Scalar() == name) {
-          *dst = value;
-          return Status::Ok();
-        }
-        names += (names.empty() ? "" : " | ") + name;
-      }
-      return error(n.Mark(), fmt::format("key '{}': expected {}, found '{}'", key, names,
-                                         n.IsScalar() ? n.Scalar() : "a " + kind(n)));
+      std::vector<std::string> names;
+      for (const auto& [name, value] : options) names.push_back(name);
+      std::string picked;
+      if (Status s = config::read_choice(*doc_, names, &picked)(n, key); !s.ok()) return s;
+      for (const auto& [name, value] : options)
+        if (name == picked) *dst = value;
+      return Status::Ok();
     };
-  }
-
-  static std::string kind(const YAML::Node& n) {
-    if (n.IsMap()) return "map";
-    if (n.IsSequence()) return "list";
-    if (n.IsNull()) return "nothing";
-    return "scalar";
   }
 
   StatusOr<Rules> parse(std::string_view yaml_text);
 
  private:
   std::string source_;
-  std::map<std::string, int> lines_;
+  const config::YamlDoc* doc_ = nullptr;
+  std::map<std::string, YAML::Node> nodes_;  // dotted key path -> its key node, for errors
   bool has_base_ = false;
 };
 
 StatusOr<Rules> Parser::parse(std::string_view yaml_text) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(yaml_text));
-  } catch (const YAML::Exception& e) {
-    return error(e.mark, "YAML syntax: " + e.msg);
-  }
+  StatusOr<config::YamlDoc> loaded = config::YamlDoc::from_text(std::string(yaml_text), source_);
+  if (!loaded) return loaded.status();
+  const config::YamlDoc& doc = *loaded;
+  doc_ = &doc;
+  const YAML::Node& root = doc.root();
   if (!root.IsMap())
-    return error(root.Mark(), "a rule file is a YAML map of keys (name, vth, timing, ...)");
+    return doc.error(root, "a rule file is a YAML map of keys (name, vth, timing, ...)");
 
   Rules r;
   if (const YAML::Node base = root["base"]) {
@@ -274,8 +188,8 @@ StatusOr<Rules> Parser::parse(std::string_view yaml_text) {
     if (base_text.empty()) {
       std::string names;
       for (const auto& n : builtin_rule_names()) names += (names.empty() ? "" : ", ") + n;
-      return error(base.Mark(), fmt::format("key 'base': '{}' is not a shipped rule set ({})",
-                                            base_name, names));
+      return doc.error(
+          base, fmt::format("key 'base': '{}' is not a shipped rule set ({})", base_name, names));
     }
     StatusOr<Rules> b = Parser("eye/rules/" + base_name + ".yaml").parse(base_text);
     if (!b) return b.status();
@@ -287,21 +201,22 @@ StatusOr<Rules> Parser::parse(std::string_view yaml_text) {
 
   std::string kind_name = r.tone ? "tone" : "data";
   bool decode_seen = false;
-  YAML::Mark decode_mark;
+  YAML::Node decode_node;
   auto width_handler = [this, &r](const YAML::Node& n, const std::string& key) -> Status {
     if (!n.IsSequence())
-      return error(n.Mark(),
-                   fmt::format("key '{}': expected a list of {{class, min, max}}, found a {}", key,
-                               kind(n)));
+      return doc_->error(n, fmt::format("key '{}': expected a list of {{class, min, max}}, "
+                                        "found a {}",
+                                        key, config::node_kind(n)));
     r.width.clear();
     const bool had_base = has_base_;
     has_base_ = false;  // every window names all three keys
     for (size_t i = 0; i < n.size(); ++i) {
       WidthWindow w;
       const std::string path = fmt::format("{}[{}]", key, i);
-      lines_[path] = n[i].Mark().line + 1;
-      Status s = section(
-          n[i], path, {{"class", integer(&w.k)}, {"min", number(&w.min)}, {"max", number(&w.max)}});
+      nodes_[path] = n[i];
+      Status s =
+          section(n[i], path,
+                  {{"class", integer(&w.k)}, {"min", seconds(&w.min)}, {"max", seconds(&w.max)}});
       if (!s.ok()) {
         has_base_ = had_base;
         return s;
@@ -313,12 +228,12 @@ StatusOr<Rules> Parser::parse(std::string_view yaml_text) {
   };
   auto timing = [this, &r](const YAML::Node& n, const std::string& key) {
     return section(n, key,
-                   {{"pulse_time", number(&r.pulse_time)},
-                    {"merge_gap", number(&r.merge_gap)},
-                    {"min_pulse", number(&r.min_pulse)},
-                    {"transition_gap", number(&r.transition_gap)},
-                    {"edge_max", number(&r.edge_max)},
-                    {"vend_offset", number(&r.vend_offset)}});
+                   {{"pulse_time", seconds(&r.pulse_time)},
+                    {"merge_gap", seconds(&r.merge_gap)},
+                    {"min_pulse", seconds(&r.min_pulse)},
+                    {"transition_gap", seconds(&r.transition_gap)},
+                    {"edge_max", seconds(&r.edge_max)},
+                    {"vend_offset", seconds(&r.vend_offset)}});
   };
   auto amplitude = [&, this](const YAML::Node& n, const std::string& key) -> Status {
     // the rule decides which keys exist, so read it first
@@ -332,21 +247,21 @@ StatusOr<Rules> Parser::parse(std::string_view yaml_text) {
       }
     std::vector<Field> fields = {
         {"rule", [](const YAML::Node&, const std::string&) { return Status::Ok(); }},
-        {"vend_min", number(&r.vend_min)},
-        {"vstart_min", number(&r.vstart_min)},
-        {"droop_max", number(&r.droop_max)}};
+        {"vend_min", volts(&r.vend_min)},
+        {"vstart_min", volts(&r.vstart_min)},
+        {"droop_max", volts(&r.droop_max)}};
     if (r.amplitude == AmplitudeRule::kBq7961x) {
-      fields.push_back({"vend_knee", number(&r.vend_knee)});
-      fields.push_back({"vstart_min_low_vend", number(&r.vstart_min_low_vend)});
+      fields.push_back({"vend_knee", volts(&r.vend_knee)});
+      fields.push_back({"vstart_min_low_vend", volts(&r.vstart_min_low_vend)});
     }
     return section(n, key, fields);
   };
   auto idle = [this, &r](const YAML::Node& n, const std::string& key) {
-    return section(n, key, {{"level", number(&r.idle_level)}, {"tblank", number(&r.tblank)}});
+    return section(n, key, {{"level", volts(&r.idle_level)}, {"tblank", seconds(&r.tblank)}});
   };
   auto decode = [&, this](const YAML::Node& n, const std::string& key) -> Status {
     decode_seen = true;
-    decode_mark = n.Mark();
+    decode_node = n;
     return section(n, key,
                    {{"sof", boolean(&r.frame.sof)},
                     {"sof_value", integer(&r.frame.sof_value)},
@@ -362,7 +277,7 @@ StatusOr<Rules> Parser::parse(std::string_view yaml_text) {
                {"description", text(&r.description)},
                {"kind", choice(&kind_name, {std::pair{std::string("data"), std::string("data")},
                                             {std::string("tone"), std::string("tone")}})},
-               {"vth", number(&r.vth)},
+               {"vth", volts(&r.vth)},
                {"timing", timing},
                {"width", width_handler},
                {"amplitude", amplitude},
@@ -371,10 +286,10 @@ StatusOr<Rules> Parser::parse(std::string_view yaml_text) {
   if (!s.ok()) return s;
   r.tone = kind_name == "tone";
   if (r.tone && decode_seen)
-    return error(decode_mark,
-                 "key 'decode': only data rules decode bytes (this one is kind: tone)");
+    return doc.error(decode_node,
+                     "key 'decode': only data rules decode bytes (this one is kind: tone)");
   if (!r.tone && !decode_seen && !base_given)
-    return error(root.Mark(), "missing key 'decode' at the top level (needed for kind: data)");
+    return doc.error(root, "missing key 'decode' at the top level (needed for kind: data)");
   if (std::optional<Issue> issue = find_issue(r))
     return error_at_field(issue->field, issue->message);
   return r;

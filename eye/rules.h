@@ -14,8 +14,8 @@
 #include <string_view>
 #include <vector>
 
-#include "eye/decode.h"
 #include "base/status.h"
+#include "protocol/frame.h"
 
 namespace isolink::eye {
 

@@ -5,6 +5,7 @@
 #include <numbers>
 #include <vector>
 
+#include "base/si_number.h"
 #include "netlists/lexer.h"
 
 namespace isolink::spice {
@@ -267,7 +268,7 @@ class Parser {
       ++pos_;
       return true;
     }
-    if (auto num = scan_number(s_.substr(pos_))) {
+    if (auto num = scan_si_number(s_.substr(pos_))) {
       pos_ += num->length;
       if (pos_ < s_.size() &&
           (s_[pos_] == '.' || std::isdigit(static_cast<unsigned char>(s_[pos_])) ||

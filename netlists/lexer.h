@@ -1,11 +1,10 @@
 // SPICE lexing: physical lines -> logical lines (comments stripped, '+' continuations joined)
-// -> tokens, and SPICE numbers with SI suffixes.
+// -> tokens. (SPICE numbers with SI suffixes: base/si_number.h.)
 //
 //   auto file = SourceFile::FromText("a.cir", text);
 //   std::vector<LogicalLine> lines = join_lines(file, /*first_line=*/2);  // skip the title
 //   StatusOr<std::vector<Token>> toks = tokenize(lines[0]);
 //   SourceLoc where = lines[0].loc((*toks)[1].offset);
-//   double v; bool ok = parse_number("2.2nF", v);  // v == 2.2e-9
 #pragma once
 
 #include <cstddef>
@@ -63,20 +62,7 @@ struct Token {
 // Tokens of one logical line. Errors (with location): unbalanced ( ) { } or an unterminated '.
 StatusOr<std::vector<Token>> tokenize(const LogicalLine& line);
 
-// Scans a SPICE number at the start of s (no sign): digits, optional fraction and exponent, then
-// an optional scale suffix (f p n u m k g t meg mil, any case) and ignored unit letters
-// ("2.2nF", "1kohm", "10Meg"), or RKM notation where the letter is the decimal point ("4k7" =
-// 4700, "2r2" = 2.2, "1u5" = 1.5e-6). Returns the value and the number of characters used, or
-// nullopt when s does not start with a digit or '.' followed by a digit, or when an 'e' after the
-// mantissa has no exponent digits ("1e" is refused, not read as 1 with a unit letter).
-struct ScannedNumber {
-  double value;
-  std::size_t length;
-};
-std::optional<ScannedNumber> scan_number(std::string_view s);
-
-// True when all of s (with an optional leading sign) is one SPICE number.
-bool parse_number(std::string_view s, double& out);
+// SPICE numbers with SI suffixes ("2.2nF", "4k7") are read by base/si_number.h.
 
 // ASCII lower case.
 std::string lower(std::string_view s);

@@ -13,6 +13,7 @@
 #include <unordered_set>
 
 #include "base/file_io.h"
+#include "base/si_number.h"
 #include "netlists/expression.h"
 #include "netlists/lexer.h"
 #include "solver/elements/element.h"
@@ -414,7 +415,7 @@ class Reader {
     if (t.kind != TokenKind::Word)
       return error_at(line.ll.loc(t.offset), "expected a number, got '" + describe(t) + "'");
     double v = 0;
-    if (spice::parse_number(t.text, v)) return v;
+    if (parse_si_number(t.text, v)) return v;
     std::string_view body = t.text;
     if (!body.empty() && (body[0] == '+' || body[0] == '-')) body.remove_prefix(1);
     if (body.empty() || std::isdigit(static_cast<unsigned char>(body[0])) || body[0] == '.')

@@ -466,18 +466,34 @@ Waveform LtiResponses::waveform(const std::vector<SourceInput>& inputs, const Gr
     return v;
   };
 
+  // The superposition's cost at a step: each ramp is evaluated on the rows inside its march window
+  // (beyond it the response is affine and costs nothing per row).
+  double reach = 0.0;
+  for (const SourceInput& in : inputs)
+    for (const Ramp& ramp : in.ramps)
+      if (ramp.t < grid.tstop) reach += std::min(grid.tstop - std::max(ramp.t, grid.tstart), end);
+  auto over_budget = [&](double step) {
+    const double evaluations = static_cast<double>(np) * reach / step;
+    gi.evaluations += evaluations;
+    if (grid.max_evaluations > 0 && evaluations > grid.max_evaluations) gi.over_budget = true;
+    return gi.over_budget;
+  };
+
   double dt = grid.step;
   std::vector<std::vector<double>> rows;
   long count = 0;
   if (dt > 0) {
     count = static_cast<long>(std::floor(span / dt * (1 + 1e-12))) + 1;
+    if (over_budget(dt)) return Waveform{};
     rows = rows_at(grid.tstart, dt, count);
   } else {
     dt = span;
     while (dt > 20e-9) dt *= 0.5;
     count = static_cast<long>(std::llround(span / dt)) + 1;
+    if (over_budget(dt)) return Waveform{};
     rows = rows_at(grid.tstart, dt, count);
     while (true) {
+      if (over_budget(dt)) return Waveform{};
       auto mids = rows_at(grid.tstart + 0.5 * dt, dt, count - 1);
       double worst = 0.0;
       // Cells holding a source corner are skipped: the corner becomes a row of its own below.
@@ -515,6 +531,18 @@ Waveform LtiResponses::waveform(const std::vector<SourceInput>& inputs, const Gr
         }
       }
       if (worst <= 0.5 * grid.interp_tol) break;
+      // Budgeted: a smooth response's interpolation error falls as dt^2, so the step that meets
+      // the tolerance is about dt sqrt(tol / worst); when even that level would be over budget,
+      // stop now instead of computing the levels on the way (a kink needs finer still).
+      if (grid.max_evaluations > 0) {
+        const double final_dt = dt * std::sqrt(0.5 * grid.interp_tol / worst);
+        const double predicted = static_cast<double>(np) * reach / final_dt;
+        if (predicted > grid.max_evaluations) {
+          gi.evaluations += predicted;
+          gi.over_budget = true;
+          return Waveform{};
+        }
+      }
       if (2 * count - 1 > grid.max_rows) {
         gi.warning = fmt::format(
             "LTI output grid stopped at {} rows (step {:g} s): linear interpolation between rows "

@@ -128,12 +128,20 @@ class LtiResponses {
     double interp_tol = 1e-3;       // V for voltage probes (A/1000 for currents: 1 uA)
     std::vector<bool> grid_probes;  // which probes the rule looks at (empty = all)
     long max_rows = 4'000'000;      // the rule stops refining here (a warning says so)
+    // 0: no limit. Otherwise the most probe evaluations one grid level's superposition may take:
+    // before each level the rule predicts them (probes x sum over ramps of the rows inside the
+    // march window), and after each it predicts the level that will meet interp_tol (the error
+    // of a smooth response falls as step^2); over the limit it stops with
+    // GridInfo::over_budget and an empty waveform (`auto` then runs the transient, cheaper there).
+    double max_evaluations = 0.0;
   };
   struct GridInfo {
     long corners = 0;  // ramps superposed
     long rows = 0;
     double step = 0.0;    // s, the grid's step
     std::string warning;  // set when the rule hit max_rows before meeting interp_tol
+    bool over_budget = false;   // stopped by max_evaluations: the waveform is empty
+    double evaluations = 0.0;   // predicted probe evaluations of the levels computed (or refused)
   };
   // The probes on a uniform grid from tstart to tstop (tstop included when the step divides it),
   // plus a row at every source corner when the rule chooses the step.

@@ -12,17 +12,19 @@ import sys
 
 ALLOWED = {
     "base": {"base"},
+    "protocol": {"base", "protocol"},
     "solver": {"base", "solver"},
     "config": {"base", "config"},
-    "netlists": {"base", "solver", "config", "netlists"},
-    "eye": {"base", "eye"},
-    "analysis": {"base", "solver", "config", "netlists", "eye", "analysis"},
-    "reports": {"base", "solver", "config", "netlists", "eye", "analysis", "reports"},
-    "cli": {"base", "solver", "config", "netlists", "eye", "analysis", "reports", "cli"},
-    "python": {"base", "solver", "config", "netlists", "eye", "analysis", "reports", "python"},
+    "netlists": {"base", "protocol", "solver", "config", "netlists"},
+    "eye": {"base", "protocol", "config", "eye"},
+    "analysis": {"base", "protocol", "solver", "config", "netlists", "eye", "analysis"},
+    "reports": {"base", "protocol", "solver", "config", "netlists", "eye", "analysis", "reports"},
+    "cli": {"base", "protocol", "solver", "config", "netlists", "eye", "analysis", "reports", "cli"},
+    "python": {"base", "protocol", "solver", "config", "netlists", "eye", "analysis", "reports",
+               "python"},
 }
-# netlists/traffic is the protocol: it sits on base alone, so eye/ could use it without circuits.
-SUBLAYERS = {"netlists/traffic": {"base", "netlists/traffic"}}
+# netlists/traffic is the stimulus side of the protocol: it sits on base and protocol alone.
+SUBLAYERS = {"netlists/traffic": {"base", "protocol", "netlists/traffic"}}
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"')
 
 

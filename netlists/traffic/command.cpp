@@ -8,6 +8,7 @@
 #include <optional>
 #include <utility>
 
+#include "base/hex.h"
 #include "netlists/traffic/crc.h"
 
 namespace isolink::traffic {
@@ -34,14 +35,6 @@ std::string lower(std::string_view s) {
   return out;
 }
 
-
-int hex_value(char ch) {
-  if (ch >= '0' && ch <= '9') return ch - '0';
-  if (ch >= 'a' && ch <= 'f') return ch - 'a' + 10;
-  if (ch >= 'A' && ch <= 'F') return ch - 'A' + 10;
-  return -1;
-}
-
 bool has_hex_prefix(std::string_view s) {
   return s.size() >= 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X');
 }
@@ -56,7 +49,7 @@ std::optional<long> parse_number(std::string_view s) {
   if (s.empty() || s.size() > 9) return std::nullopt;
   long v = 0;
   for (char ch : s) {
-    int d = base == 16 ? hex_value(ch) : (ch >= '0' && ch <= '9' ? ch - '0' : -1);
+    int d = base == 16 ? hex_digit(ch) : (ch >= '0' && ch <= '9' ? ch - '0' : -1);
     if (d < 0) return std::nullopt;
     v = v * base + d;
   }
@@ -134,22 +127,12 @@ bool has_device(CommandKind kind) {
   return kind == CommandKind::kSingleRead || kind == CommandKind::kSingleWrite;
 }
 
-std::string hex_bytes(const std::vector<uint8_t>& bytes) {
-  std::string out;
-  out.reserve(bytes.size() * 3);
-  for (size_t i = 0; i < bytes.size(); ++i) {
-    if (i) out += ' ';
-    out += fmt::format("{:02X}", bytes[i]);
-  }
-  return out;
-}
-
 StatusOr<std::vector<uint8_t>> parse_hex_bytes(std::string_view text, std::string_view field) {
   std::string_view digits = text;
   if (has_hex_prefix(digits)) digits.remove_prefix(2);
   if (digits.empty()) return Status::Error(fmt::format("{}='{}' has no hex digits", field, text));
   for (size_t i = 0; i < digits.size(); ++i) {
-    if (hex_value(digits[i]) < 0) {
+    if (hex_digit(digits[i]) < 0) {
       return Status::Error(fmt::format("{}={}: '{}' is not a hex digit", field, text, digits[i]));
     }
   }
@@ -161,7 +144,7 @@ StatusOr<std::vector<uint8_t>> parse_hex_bytes(std::string_view text, std::strin
   std::vector<uint8_t> out;
   out.reserve(digits.size() / 2);
   for (size_t i = 0; i < digits.size(); i += 2) {
-    out.push_back(static_cast<uint8_t>(hex_value(digits[i]) * 16 + hex_value(digits[i + 1])));
+    out.push_back(static_cast<uint8_t>(hex_digit(digits[i]) * 16 + hex_digit(digits[i + 1])));
   }
   return out;
 }

@@ -66,9 +66,8 @@ StatusOr<std::vector<uint8_t>> command_bytes(std::string_view text);
 // The whitespace-separated words of text (views into it).
 std::vector<std::string_view> split_ws(std::string_view text);
 
-// "B3 01 00 02" (upper-case, single spaces).
-std::string hex_bytes(const std::vector<uint8_t>& bytes);
-// Parses hex digits (optional 0x prefix) into bytes; field names the value in errors.
+// Parses one token of hex digits (optional 0x prefix, an even count) into bytes; field names the
+// value in errors. (Bytes print with to_hex, base/hex.h.)
 StatusOr<std::vector<uint8_t>> parse_hex_bytes(std::string_view text, std::string_view field);
 
 }  // namespace isolink::traffic

@@ -21,35 +21,15 @@ Status validate(const EncodingOptions& opt) {
 }
 
 std::vector<int> byte_wire_bits(uint8_t byte, const EncodingOptions& opt) {
-  std::vector<int> bits = {0, 0};
-  if (opt.sof) bits.push_back(opt.sof_value ? 1 : 0);
-  for (int i = 0; i < 8; ++i) {
-    const int k = opt.bit_order == BitOrder::kLsbFirst ? i : 7 - i;
-    bits.push_back((byte >> k) & 1);
-  }
-  bits.push_back(opt.error_bit ? 1 : 0);
-  return bits;
+  return frame_wire_bits(byte, opt, opt.error_bit != 0);
 }
 
 std::vector<int> byte_half_bits(uint8_t byte, const EncodingOptions& opt) {
-  std::vector<int> h;
-  h.reserve(26);
-  h.push_back(+1);  // preamble
-  for (int bit : byte_wire_bits(byte, opt)) {
-    if (bit) {
-      h.push_back(+1);
-      h.push_back(-1);
-    } else {
-      h.push_back(-1);
-      h.push_back(+1);
-    }
-  }
-  h.push_back(-1);  // postamble
-  return h;
+  return frame_half_bits(byte, opt, opt.error_bit != 0);
 }
 
 int byte_half_bit_count(const EncodingOptions& opt) {
-  return opt.sof ? 26 : 24;
+  return static_cast<int>(opt.half_bits());
 }
 
 double byte_duration(const EncodingOptions& opt) {

@@ -8,7 +8,8 @@
 // A byte frame on the wire: preamble (one + half bit), sync 00, SOF (default 1), 8 data bits
 // (default LSB first), error bit (default 0), postamble (one - half bit). A 0 is the couplet
 // (-, +), a 1 is (+, -). Adjacent same-sign half bits form one longer pulse ("double bit");
-// DriveBuilder (drive.h) merges them into segments.
+// DriveBuilder (drive.h) merges them into segments. The frame layout, the bit order and the
+// encoder itself are protocol/frame.h, which eye/ decodes with; this file adds the timing.
 #pragma once
 
 #include <cstdint>
@@ -16,17 +17,15 @@
 #include <vector>
 
 #include "base/status.h"
+#include "protocol/frame.h"
 
 namespace isolink::traffic {
 
-enum class BitOrder { kLsbFirst, kMsbFirst };
-
-struct EncodingOptions {
-  double half_bit = 250e-9;                  // pulse (half-bit) width, s
-  bool sof = true;                           // send the start-of-frame bit after the sync pair
-  int sof_value = 1;                         // SOF bit value (our reading: 1, see design.md)
-  BitOrder bit_order = BitOrder::kLsbFirst;  // data bit order on the wire
-  int error_bit = 0;                         // byte-error bit (1 asks the sender to resend)
+// The frame layout (sof, sof_value: our reading 1, see design.md; bit_order) plus the timing
+// and the error bit of the bytes sent.
+struct EncodingOptions : FrameFormat {
+  double half_bit = 250e-9;  // pulse (half-bit) width, s
+  int error_bit = 0;         // byte-error bit (1 asks the sender to resend)
 };
 
 // Ok, or an error naming the bad option (half_bit > 0, sof_value and error_bit 0 or 1).

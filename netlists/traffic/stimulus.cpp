@@ -5,9 +5,11 @@
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "base/si_number.h"
 #include "netlists/traffic/command.h"
 #include "netlists/traffic/patterns.h"
 
@@ -70,59 +72,28 @@ Status add_tone_item(DriveBuilder& b, std::string_view name,
 StatusOr<double> parse_time(std::string_view text) {
   const std::string s = lower(trim(text));
   if (s.empty()) return Status::Error("empty time: expected e.g. 250n or 1us");
-  char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  if (end == s.c_str()) {
+  std::string_view body = s;
+  const bool neg = body[0] == '-';
+  if (body[0] == '+' || body[0] == '-') body.remove_prefix(1);
+  // The one SPICE number scanner (base/si_number.h), stopping after the scale suffix: a time
+  // may end in "s" and nothing else.
+  const std::optional<SiNumber> n = scan_si_number(body, {.scale = true, .unit_letters = false});
+  if (!n) {
     return Status::Error(fmt::format("'{}' is not a time: expected e.g. 250n, 1us, 2.5e-7", text));
   }
-  std::string suffix(end);
-  int exp10 = 0;
-  if (suffix.rfind("meg", 0) == 0) {
-    exp10 = 6;
-    suffix.erase(0, 3);
-  } else if (!suffix.empty() && suffix != "s") {
-    switch (suffix[0]) {
-      case 'f':
-        exp10 = -15;
-        break;
-      case 'p':
-        exp10 = -12;
-        break;
-      case 'n':
-        exp10 = -9;
-        break;
-      case 'u':
-        exp10 = -6;
-        break;
-      case 'm':
-        exp10 = -3;
-        break;
-      case 'k':
-        exp10 = 3;
-        break;
-      case 'g':
-        exp10 = 9;
-        break;
-      default:
-        return Status::Error(fmt::format(
-            "'{}' has an unknown unit suffix '{}': use f p n u m k meg g", text, suffix));
+  const std::string_view rest = body.substr(n->length);
+  if (!rest.empty() && rest != "s") {
+    const char last = body[n->length - 1];
+    if ((last >= '0' && last <= '9') || last == '.') {
+      return Status::Error(fmt::format(
+          "'{}' has an unknown unit suffix '{}': use f p n u m k meg g t mil", text, rest));
     }
-    suffix.erase(0, 1);
-  }
-  if (!suffix.empty() && suffix != "s") {
     return Status::Error(fmt::format("'{}' has trailing text after the number", text));
   }
-  // Re-read mantissa and unit as one decimal ("3.8e-6") so the result is the double nearest the
-  // written value (3.8 * 1e-6 is one ulp off).
-  const std::string mantissa = s.substr(0, static_cast<size_t>(end - s.c_str()));
-  double out = v;
-  if (exp10 != 0 && mantissa.find('e') == std::string::npos) {
-    out = std::strtod(fmt::format("{}e{}", mantissa, exp10).c_str(), nullptr);
-  } else if (exp10 != 0) {
-    out = v * std::pow(10.0, exp10);
+  if (!std::isfinite(n->value)) {
+    return Status::Error(fmt::format("'{}' is not a finite time", text));
   }
-  if (!std::isfinite(out)) return Status::Error(fmt::format("'{}' is not a finite time", text));
-  return out;
+  return neg ? -n->value : n->value;
 }
 
 Status add_item(DriveBuilder& b, std::string_view item, const StimulusOptions& opt) {

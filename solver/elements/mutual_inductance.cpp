@@ -1,10 +1,13 @@
 // K: magnetic coupling between two inductors, M = k sqrt(L1 L2), dots on the first nodes.
-// Several K's may share inductors (a multi-winding transformer); check() tests each group.
+// Several K's may share inductors (a multi-winding transformer); the first K's check() tests
+// every group.
 #include <fmt/format.h>
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <unordered_map>
+#include <utility>
 
 #include "solver/circuit.h"
 #include "solver/elements/card_values.h"
@@ -43,45 +46,73 @@ class MutualInductance final : public Element {
   }
   // The inductance matrix of the group of inductors this K couples (directly or through other
   // K's) must be positive semi-definite, or the magnetic energy i'Li / 2 could be negative and
-  // the transient grows without bound (NaN). Reported once per group, by its first K.
+  // the transient grows without bound (NaN). Reported at the group's first K.
   Status check(const Circuit& circuit) const override {
+    // The circuit's first K checks every group at once (union-find over the inductors), so that
+    // a cable ladder's thousands of K's cost O(K), not O(K^2) (each K scanning all the others).
     std::vector<const MutualInductance*> ks;
     for (const auto& e : circuit.elements())
       if (auto* k = dynamic_cast<const MutualInductance*>(e.get())) ks.push_back(k);
-    // The group: inductors reachable from l_[0] through K's (a fixed point; groups are small).
-    std::vector<const Inductor*> group{l_[0]};
-    auto index = [&](const Inductor* l) {
-      return static_cast<int>(std::find(group.begin(), group.end(), l) - group.begin());
+    if (ks.empty() || ks[0] != this) return Status::Ok();
+    std::unordered_map<const Inductor*, int> id;
+    std::vector<const Inductor*> inductors;
+    std::vector<int> parent;
+    auto find = [&](int x) {
+      while (parent[x] != x) x = parent[x] = parent[parent[x]];
+      return x;
     };
-    for (bool grew = true; grew;) {
-      grew = false;
-      for (const MutualInductance* k : ks) {
-        const bool in0 = index(k->l_[0]) < static_cast<int>(group.size());
-        const bool in1 = index(k->l_[1]) < static_cast<int>(group.size());
-        if (in0 != in1) group.push_back(in0 ? k->l_[1] : k->l_[0]), grew = true;
-      }
-    }
-    const int n = static_cast<int>(group.size());
-    Eigen::MatrixXd l = Eigen::MatrixXd::Zero(n, n);
-    std::string names;
-    for (int i = 0; i < n; ++i) l(i, i) = group[i]->inductance();
     for (const MutualInductance* k : ks) {
-      const int a = index(k->l_[0]), b = index(k->l_[1]);
-      if (a >= n || b >= n) continue;
-      if (k != this && names.empty()) return Status::Ok();  // not the group's first K
-      names += (names.empty() ? "" : ", ") + k->name();
-      l(a, b) += k->m_, l(b, a) += k->m_;
+      for (const Inductor* l : k->l_)
+        if (id.emplace(l, static_cast<int>(inductors.size())).second) {
+          parent.push_back(static_cast<int>(inductors.size()));
+          inductors.push_back(l);
+        }
+      parent[find(id[k->l_[0]])] = find(id[k->l_[1]]);
     }
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(l, Eigen::EigenvaluesOnly);
-    const double lo = eig.eigenvalues().minCoeff(), hi = eig.eigenvalues().maxCoeff();
-    if (lo >= -1e-9 * hi) return Status::Ok();
-    std::string inductors;
-    for (const Inductor* x : group) inductors += (inductors.empty() ? "" : ", ") + x->name();
-    return error_at(loc_, fmt::format("the couplings {} make the inductance matrix of {} not "
-                                      "positive semi-definite (smallest eigenvalue {:.4g} H): "
-                                      "these k values cannot all hold at once, and the "
-                                      "transient would grow without bound",
-                                      names, inductors, lo));
+    // Groups in the order of their first K; members in the order they are first named.
+    std::unordered_map<int, std::vector<const MutualInductance*>> group_ks;
+    std::vector<int> roots;
+    for (const MutualInductance* k : ks) {
+      const int r = find(id[k->l_[0]]);
+      auto [it, fresh] = group_ks.try_emplace(r);
+      if (fresh) roots.push_back(r);
+      it->second.push_back(k);
+    }
+    for (int r : roots) {
+      const auto& gk = group_ks[r];
+      std::vector<const Inductor*> group;
+      auto index = [&](const Inductor* l) {
+        auto at = std::find(group.begin(), group.end(), l);
+        if (at != group.end()) return static_cast<int>(at - group.begin());
+        group.push_back(l);
+        return static_cast<int>(group.size()) - 1;
+      };
+      std::vector<std::pair<int, int>> pairs;
+      for (const MutualInductance* k : gk) {
+        const int a = index(k->l_[0]);  // in this order: the inductors as first named
+        pairs.emplace_back(a, index(k->l_[1]));
+      }
+      const int n = static_cast<int>(group.size());
+      Eigen::MatrixXd l = Eigen::MatrixXd::Zero(n, n);
+      for (int i = 0; i < n; ++i) l(i, i) = group[i]->inductance();
+      std::string names;
+      for (size_t q = 0; q < gk.size(); ++q) {
+        names += (names.empty() ? "" : ", ") + gk[q]->name();
+        l(pairs[q].first, pairs[q].second) += gk[q]->m_;
+        l(pairs[q].second, pairs[q].first) += gk[q]->m_;
+      }
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(l, Eigen::EigenvaluesOnly);
+      const double lo = eig.eigenvalues().minCoeff(), hi = eig.eigenvalues().maxCoeff();
+      if (lo >= -1e-9 * hi) continue;
+      std::string list;
+      for (const Inductor* x : group) list += (list.empty() ? "" : ", ") + x->name();
+      return error_at(gk[0]->loc(), fmt::format("the couplings {} make the inductance matrix of {} "
+                                                "not positive semi-definite (smallest eigenvalue "
+                                                "{:.4g} H): these k values cannot all hold at "
+                                                "once, and the transient would grow without bound",
+                                                names, list, lo));
+    }
+    return Status::Ok();
   }
   void declare(MnaPattern& p) override {
     s12_ = p.slot(l_[0]->branch(), l_[1]->branch());

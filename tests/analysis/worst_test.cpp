@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "analysis/link_run.h"
+#include "base/hex.h"
 #include "eye/check.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/traffic/command.h"
@@ -108,8 +109,8 @@ TEST(WorstCase, EdgeResponseSettlesAndSuperposesLikeTheTransient) {
   for (size_t i = 0; i < bytes.size(); ++i) {
     t.frames.push_back({bytes[i], i == 3 ? 1 : 0});
     t.gaps.push_back(i == 0 ? 1e-6 : 3.8e-6 + 50e-9 * static_cast<double>(i));
-    spec.stimulus.frames.push_back(std::string("raw ") + traffic::hex_bytes({bytes[i]}) + " nocrc" +
-                                   (i == 3 ? " err" : ""));
+    spec.stimulus.frames.push_back(std::string("raw ") + to_hex(std::vector<uint8_t>{bytes[i]}) +
+                                   " nocrc" + (i == 3 ? " err" : ""));
   }
   spec.stimulus.gaps = t.gaps;
   spec.sim.reltol = 1e-6;

@@ -13,10 +13,14 @@ StatusOr<Waveform> run_ngspice(const std::string& netlist, const std::vector<std
                                const std::string& work_dir, const std::string& extra,
                                const std::string& tran) {
   namespace fs = std::filesystem;
+  // Each call in a folder of its own under work_dir: ctest runs the Trap and Gear cases of one
+  // netlist at once, and a shared deck or data file raced (one run read the other's output).
   fs::create_directories(work_dir);
+  std::string unique = (fs::path(work_dir) / "run.XXXXXX").lexically_normal().string();
+  if (!mkdtemp(unique.data())) return Status::Error("cannot create a folder under " + work_dir);
   const std::string stem = fs::path(netlist).stem().string();
   // No "//" in paths: ngspice reads it as a comment.
-  const std::string dir = fs::path(work_dir).lexically_normal().string();
+  const std::string dir = unique;
   const std::string deck = dir + "/" + stem + ".ngspice.cir";
   const std::string data = dir + "/" + stem + ".ngspice.txt";
   std::ifstream in(netlist);
@@ -84,6 +88,8 @@ StatusOr<Waveform> run_ngspice(const std::string& netlist, const std::vector<std
       c.push_back(v);
     }
   }
+  din.close();
+  fs::remove_all(dir);  // kept only when ngspice failed, for its .log
   return w;
 }
 

@@ -31,6 +31,51 @@ TEST(ParseQuantity, SuffixesAndUnits) {
   EXPECT_FALSE(parse_quantity("12ft", Unit::kMetre, &v));
 }
 
+// The numbers come from the one scanner (base/si_number.h); the YAML rules stay on top of it.
+TEST(ParseQuantity, SharedScannerWithYamlRules) {
+  double v = 0;
+  // A unit symbol that is also a scale letter reads as the unit: 2.2 F, not 2.2 femto.
+  EXPECT_TRUE(parse_quantity("2.2f", Unit::kFarad, &v));
+  EXPECT_EQ(v, 2.2);
+  EXPECT_TRUE(parse_quantity("2.2ff", Unit::kFarad, &v));
+  EXPECT_EQ(v, 2.2e-15);
+  EXPECT_TRUE(parse_quantity("1s", Unit::kSecond, &v));
+  EXPECT_EQ(v, 1.0);
+  EXPECT_TRUE(parse_quantity("1ms", Unit::kSecond, &v));
+  EXPECT_EQ(v, 1e-3);
+  // The suffix set of the netlists: mil, t, RKM; the scale letters are exact decimals.
+  EXPECT_TRUE(parse_quantity("4k7", Unit::kOhm, &v));
+  EXPECT_EQ(v, 4700.0);
+  EXPECT_TRUE(parse_quantity("2R2ohm", Unit::kOhm, &v));
+  EXPECT_EQ(v, 2.2);
+  EXPECT_TRUE(parse_quantity("3.8us", Unit::kSecond, &v));
+  EXPECT_EQ(v, 3.8e-6);
+  EXPECT_TRUE(parse_quantity("1t", Unit::kHertz, &v));
+  EXPECT_EQ(v, 1e12);
+  EXPECT_TRUE(parse_quantity("2 nF", Unit::kFarad, &v));  // a blank before the suffix
+  EXPECT_EQ(v, 2e-9);
+  EXPECT_TRUE(parse_quantity("-5V", Unit::kVolt, &v));
+  EXPECT_EQ(v, -5.0);
+  EXPECT_TRUE(parse_quantity(" +5 ", Unit::kVolt, &v));
+  EXPECT_EQ(v, 5.0);
+  // Still refused: a blank inside RKM or before an exponent, trailing junk, a bare 'e', no unit
+  // words for plain numbers, scale suffixes on lengths and temperatures, infinities.
+  EXPECT_FALSE(parse_quantity("4 k7", Unit::kOhm, &v));
+  EXPECT_FALSE(parse_quantity("1 e5", Unit::kHertz, &v));
+  EXPECT_FALSE(parse_quantity("1kohmx", Unit::kOhm, &v));
+  EXPECT_FALSE(parse_quantity("2.2n f", Unit::kFarad, &v));
+  EXPECT_FALSE(parse_quantity("1e", Unit::kNone, &v));
+  EXPECT_FALSE(parse_quantity("1k", Unit::kNone, &v));
+  EXPECT_TRUE(parse_quantity("1e3", Unit::kNone, &v));
+  EXPECT_EQ(v, 1000.0);
+  EXPECT_FALSE(parse_quantity("25m", Unit::kCelsius, &v));
+  EXPECT_TRUE(parse_quantity("25 degc", Unit::kCelsius, &v));
+  EXPECT_EQ(v, 25.0);
+  EXPECT_FALSE(parse_quantity("1e400", Unit::kOhm, &v));
+  EXPECT_FALSE(parse_quantity("inf", Unit::kOhm, &v));
+  EXPECT_FALSE(parse_quantity("--1", Unit::kOhm, &v));
+}
+
 TEST(ReadMap, UnknownKeyNamesFileLineColumnAndKnownKeys) {
   auto doc = YamlDoc::from_text("cable:\n  length: 3\n  lenght: 4\n", "spec.yaml");
   ASSERT_TRUE(doc.ok());
@@ -38,8 +83,7 @@ TEST(ReadMap, UnknownKeyNamesFileLineColumnAndKnownKeys) {
   Status s = read_map(*doc, doc->root()["cable"], "cable",
                       {{"length", read_quantity(*doc, Unit::kMetre, Rule::kPositive, &length)}});
   ASSERT_FALSE(s.ok());
-  EXPECT_NE(s.message().find("spec.yaml:3:3: error: unknown key 'cable.lenght'"),
-            std::string::npos)
+  EXPECT_NE(s.message().find("spec.yaml:3:3: error: unknown key 'cable.lenght'"), std::string::npos)
       << s.message();
   EXPECT_NE(s.message().find("known keys: length"), std::string::npos);
   EXPECT_NE(s.message().find("   lenght: 4\n   ^"), std::string::npos) << s.message();
@@ -52,17 +96,14 @@ TEST(ReadMap, ValuesRulesAndChoices) {
   std::string b;
   std::vector<std::string> d;
   int e = 0;
-  auto one = [&](const char* key, FieldReader r) {
-    return r(doc->root()[key], key);
-  };
+  auto one = [&](const char* key, FieldReader r) { return r(doc->root()[key], key); };
   Status sa = one("a", read_quantity(*doc, Unit::kMetre, Rule::kPositive, &a));
   EXPECT_NE(sa.message().find("t.yaml:1:4: error: key 'a' = -1: must be > 0"), std::string::npos)
       << sa.message();
   Status sb = one("b", read_choice(*doc, {"pp", "pvc"}, &b));
   EXPECT_NE(sb.message().find("key 'b': expected pp | pvc, found 'pvcx'"), std::string::npos);
   Status sc = one("c", read_quantity(*doc, Unit::kFarad, Rule::kPositive, &c));
-  EXPECT_NE(sc.message().find("key 'c': expected a value in F"), std::string::npos)
-      << sc.message();
+  EXPECT_NE(sc.message().find("key 'c': expected a value in F"), std::string::npos) << sc.message();
   EXPECT_TRUE(one("d", read_text_list(*doc, &d)).ok());
   EXPECT_EQ(d, (std::vector<std::string>{"x", "y"}));
   Status se = one("e", read_int(*doc, 18, 30, &e));

@@ -43,7 +43,7 @@ class CliCheck : public ::testing::Test {
   }
   std::string write_frames(const std::string& name, const std::vector<uint8_t>& bytes,
                            double amp = 2.0) {
-    isolink::Waveform w = synth::ideal_frames(bytes, isolink::eye::FrameFormat{});
+    isolink::Waveform w = synth::ideal_frames(bytes, isolink::FrameFormat{});
     for (double& x : w.columns[0]) x *= amp / 2.0;
     const std::string path = (dir_ / name).string();
     EXPECT_TRUE(isolink::write_waveform_csv(w, path).ok());
@@ -110,7 +110,7 @@ TEST_F(CliCheck, BadInputExitsTwoWithFileAndLine) {
   const std::string rules = write_text("r.yaml", "base: bq7961x\nvth: 0\n");
   const std::string good = write_frames("good.csv", {0x15});
   EXPECT_EQ(run("check '" + good + "' --rules '" + rules + "'"), 2);
-  EXPECT_EQ(err_, "isolink check: " + rules + ":2: error: vth = 0: must be > 0\n");
+  EXPECT_EQ(err_, "isolink check: " + rules + ":2:1: error: vth = 0: must be > 0\n vth: 0\n ^\n");
   EXPECT_EQ(run("check '" + (dir_ / "missing.csv").string() + "'"), 2);
   EXPECT_EQ(run("check '" + good + "' --expect 'zz'"), 2);
   EXPECT_EQ(run("check '" + good + "' --diff nope"), 2);
@@ -119,7 +119,7 @@ TEST_F(CliCheck, BadInputExitsTwoWithFileAndLine) {
 
 TEST_F(CliCheck, TwoFilesPAndNWithWhatWasRead) {
   // R&S RTB style: one channel per file, units in the names; N in mV
-  isolink::Waveform w = synth::ideal_frames({0x80, 0x15}, isolink::eye::FrameFormat{});
+  isolink::Waveform w = synth::ideal_frames({0x80, 0x15}, isolink::FrameFormat{});
   std::string p = "in s,C1 in V\n", n = "in s,C2 in mV\n";
   for (size_t i = 0; i < w.samples(); ++i) {
     const double v = w.columns[0][i];

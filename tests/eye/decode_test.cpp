@@ -1,9 +1,8 @@
-#include "eye/decode.h"
-
 #include <gtest/gtest.h>
 
 #include "eye/check.h"
 #include "eye/rules.h"
+#include "protocol/frame.h"
 #include "synth.h"
 
 namespace isolink::eye {
@@ -166,21 +165,6 @@ TEST(Decode, Roles) {
   f.sof = false;
   EXPECT_EQ(half_bit_role(5, f), "bit 7");
   EXPECT_EQ(half_bit_role(23, f), "postamble");
-}
-
-TEST(Decode, HexBytes) {
-  auto a = parse_hex_bytes("80 00 02 15 0B CB 49");
-  ASSERT_TRUE(a.ok());
-  EXPECT_EQ(*a, (std::vector<uint8_t>{0x80, 0x00, 0x02, 0x15, 0x0B, 0xCB, 0x49}));
-  auto b = parse_hex_bytes("0x93,0x00 cb49");
-  ASSERT_TRUE(b.ok());
-  EXPECT_EQ(*b, (std::vector<uint8_t>{0x93, 0x00, 0xCB, 0x49}));
-  EXPECT_EQ(to_hex(*a), "80 00 02 15 0B CB 49");
-  auto bad = parse_hex_bytes("80 0G");
-  ASSERT_FALSE(bad.ok());
-  EXPECT_NE(bad.status().message().find("'0G'"), std::string::npos);
-  EXPECT_FALSE(parse_hex_bytes("  ").ok());
-  EXPECT_FALSE(parse_hex_bytes("123").ok());
 }
 
 // bytes -> ideal waveform -> check -> the same bytes: all 256 values, both orders, SOF or not.

@@ -116,6 +116,26 @@ TEST(Rules, SpiceSuffixesAndUnits) {
   EXPECT_DOUBLE_EQ(r->vth, 1.1);
 }
 
+// Rule files go through config's YAML reader: units are checked (a time in volts is refused), a
+// key given twice is an error, and errors show the source line with a caret.
+TEST(Rules, SharedYamlReaderRules) {
+  StatusOr<Rules> r =
+      parse_rules("base: bq7961x\ntiming: {edge_max: 55 ns}\nvth: 1100mV\n", "s.yaml");
+  ASSERT_TRUE(r.ok()) << msg(r);
+  EXPECT_EQ(r->edge_max, 55e-9);
+  EXPECT_EQ(r->vth, 1.1);
+  r = parse_rules("base: bq7961x\ntiming: {edge_max: 60nV}\n", "bad.yaml");
+  EXPECT_NE(msg(r).find("bad.yaml:2:20: error: key 'timing.edge_max': expected a value in s"),
+            std::string::npos)
+      << msg(r);
+  r = parse_rules("base: bq7961x\nvth: 1.1\nvth: 1.3\n", "bad.yaml");
+  EXPECT_NE(msg(r).find("bad.yaml:3:1: error: key 'vth' is given twice (first at line 2)"),
+            std::string::npos)
+      << msg(r);
+  r = parse_rules("base: bq7961x\nvth: -1\n", "bad.yaml");
+  EXPECT_EQ(msg(r), "bad.yaml:2:1: error: vth = -1: must be > 0\n vth: -1\n ^");
+}
+
 TEST(Rules, LoadsAUserFileFromDisk) {
   const auto path = std::filesystem::temp_directory_path() / "isolink_eye_rules_test.yaml";
   {
@@ -134,27 +154,27 @@ TEST(Rules, LoadsAUserFileFromDisk) {
 
 struct BadCase {
   std::string yaml;
-  std::string expect;  // substring of the message, which starts "bad.yaml:LINE: error: "
+  std::string expect;  // substring of the message, which starts "bad.yaml:LINE:COL: error: "
 };
 
 TEST(Rules, BrokenFilesNameKeyAndLine) {
   const std::vector<BadCase> cases = {
       {"name: x\nkind: data\nvth: 1: 2\nidle: 1\n",
-       "bad.yaml:3: error: YAML syntax: illegal map value"},
+       "bad.yaml:3:7: error: YAML syntax: illegal map value"},
       {"base: bq7961x\ntiming:\n  edge_maxx: 60n\n",
-       "bad.yaml:3: error: unknown key 'timing.edge_maxx'"},
-      {"base: bq7961x\nvth: abc\n", "bad.yaml:2: error: key 'vth': expected a number"},
+       "bad.yaml:3:3: error: unknown key 'timing.edge_maxx'"},
+      {"base: bq7961x\nvth: abc\n", "bad.yaml:2:6: error: key 'vth': expected a value in V"},
       {"base: bq7961x\ndecode:\n  sof: maybe\n",
-       "bad.yaml:3: error: key 'decode.sof': expected true or false"},
+       "bad.yaml:3:8: error: key 'decode.sof': expected true or false"},
       {"base: bq7961x\ndecode: {bit_order: middle}\n",
-       "bad.yaml:2: error: key 'decode.bit_order': expected lsb | msb"},
+       "bad.yaml:2:21: error: key 'decode.bit_order': expected lsb | msb"},
       {"base: bq7961x\nwidth:\n  - {class: 1, min: 220n}\n",
-       "bad.yaml:3: error: missing key 'width[0].max'"},
-      {"base: bq9999\n", "bad.yaml:1: error: key 'base': 'bq9999' is not a shipped rule set"},
-      {"base: tone\ndecode: {sof: true}\n", "bad.yaml:2: error: key 'decode': only data rules"},
+       "bad.yaml:3:5: error: missing key 'width[0].max'"},
+      {"base: bq9999\n", "bad.yaml:1:7: error: key 'base': 'bq9999' is not a shipped rule set"},
+      {"base: tone\ndecode: {sof: true}\n", "bad.yaml:2:9: error: key 'decode': only data rules"},
       {"base: bq7961x\namplitude: {rule: bridge, vend_knee: 1.3}\n",
        "unknown key 'amplitude.vend_knee'"},
-      {"- 1\n- 2\n", "bad.yaml:1: error: a rule file is a YAML map"},
+      {"- 1\n- 2\n", "bad.yaml:1:1: error: a rule file is a YAML map"},
   };
   for (const BadCase& c : cases) {
     StatusOr<Rules> r = parse_rules(c.yaml, "bad.yaml");
@@ -166,24 +186,24 @@ TEST(Rules, BrokenFilesNameKeyAndLine) {
   no_edge.replace(no_edge.find(" edge_max: 60n,"), 15, "");
   StatusOr<Rules> r = parse_rules(no_edge, "bad.yaml");
   ASSERT_FALSE(r.ok());
-  EXPECT_NE(msg(r).find("bad.yaml:4: error: missing key 'timing.edge_max'"), std::string::npos)
+  EXPECT_NE(msg(r).find("bad.yaml:4:9: error: missing key 'timing.edge_max'"), std::string::npos)
       << msg(r);
 }
 
 TEST(Rules, LimitsAreValidatedWithFieldValueAndRule) {
   const std::vector<BadCase> cases = {
-      {"base: bq7961x\nvth: -1\n", "bad.yaml:2: error: vth = -1: must be > 0"},
+      {"base: bq7961x\nvth: -1\n", "bad.yaml:2:1: error: vth = -1: must be > 0"},
       {"base: bq7961x\nwidth:\n  - {class: 1, min: 280n, max: 220n}\n",
-       "bad.yaml:3: error: width[0]: min 2.8e-07 >= max 2.2e-07: a window needs min < max"},
+       "bad.yaml:3:27: error: width[0]: min 2.8e-07 >= max 2.2e-07: a window needs min < max"},
       {"base: bq7961x\nwidth:\n  - {class: 1, min: 100n, max: 280n}\n",
        "must lie inside (1.25e-07, 3.75e-07)"},
       {"base: bq7961x\nwidth:\n  - {class: 1, min: 220n, max: 280n}\n  - {class: 1, min: 230n, "
        "max: 270n}\n",
-       "bad.yaml:4: error: width[1].class = 1: class listed twice"},
+       "bad.yaml:4:6: error: width[1].class = 1: class listed twice"},
       {"base: bq7961x\ntiming: {vend_offset: 150n}\n",
        "timing.vend_offset = 1.5e-07: must be >= 0 and < timing.min_pulse = 1e-07"},
       {"base: bq7961x\namplitude: {vend_knee: 1.1}\n",
-       "bad.yaml:2: error: amplitude.vend_knee = 1.1: must be >= amplitude.vend_min = 1.2"},
+       "bad.yaml:2:13: error: amplitude.vend_knee = 1.1: must be >= amplitude.vend_min = 1.2"},
       {"base: bq7961x\namplitude: {vstart_min_low_vend: 1.5}\n",
        "amplitude.vstart_min_low_vend = 1.5: must be >= amplitude.vstart_min = 1.6"},
       {"base: bq7961x\ndecode: {sof_value: 2}\n", "decode.sof_value = 2: must be 0 or 1"},

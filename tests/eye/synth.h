@@ -11,8 +11,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "eye/decode.h"
 #include "base/waveform.h"
+#include "protocol/frame.h"
 
 namespace synth {
 
@@ -146,7 +146,7 @@ inline isolink::Waveform sample(const Pwl& base, double dt, double t_end,
 
 // Bytes -> one ideal waveform: one frame per byte, frames `gap` apart.
 inline isolink::Waveform ideal_frames(const std::vector<uint8_t>& bytes,
-                                      const isolink::eye::FrameFormat& fmt, double gap = 2e-6,
+                                      const isolink::FrameFormat& fmt, double gap = 2e-6,
                                       double dt = 1e-9) {
   Pwl w;
   double t0 = 1e-6;
@@ -154,7 +154,7 @@ inline isolink::Waveform ideal_frames(const std::vector<uint8_t>& bytes,
   for (uint8_t b : bytes) {
     Train tr;
     tr.t0 = t0;
-    tr.pulses = pulses_from_half_bits(isolink::eye::frame_half_bits(b, fmt));
+    tr.pulses = pulses_from_half_bits(isolink::frame_half_bits(b, fmt));
     append_train(w, tr);
     t0 = tr.end() + gap;
   }

@@ -1,6 +1,7 @@
 // End to end: a command frame driven through a short link is decoded back to its bytes.
 #include <gtest/gtest.h>
 
+#include "base/hex.h"
 #include "eye/check.h"
 #include "netlists/link/board.h"
 #include "netlists/link/cards.h"
@@ -21,8 +22,10 @@ TEST(FrameThroughLink, StackWriteDecodesToTheSameBytes) {
   // BQ79600 pins and board -> direct short connection -> BQ7961x board and pins.
   std::vector<Card> cards;
   ASSERT_TRUE(add_tx_driver(cards, "tx", "txp", "txn", drive, TxDriverModel{}).ok());
-  ASSERT_TRUE(add_board_network(cards, "txb", "txp", "txn", "lp", "ln", *board_preset("bq79600")).ok());
-  ASSERT_TRUE(add_board_network(cards, "rxb", "rxp", "rxn", "lp", "ln", *board_preset("bq7961x")).ok());
+  ASSERT_TRUE(
+      add_board_network(cards, "txb", "txp", "txn", "lp", "ln", *board_preset("bq79600")).ok());
+  ASSERT_TRUE(
+      add_board_network(cards, "rxb", "rxp", "rxn", "lp", "ln", *board_preset("bq7961x")).ok());
   ASSERT_TRUE(add_rx_load(cards, "rx", "rxp", "rxn", RxLoadModel{}).ok());
   Circuit c;
   ASSERT_TRUE(add_cards(c, cards).ok());
@@ -38,7 +41,7 @@ TEST(FrameThroughLink, StackWriteDecodesToTheSameBytes) {
   opt.expect = *bytes;
   auto result = eye::check_waveform(*wave, *rules, opt);
   ASSERT_TRUE(result.ok()) << result.status().message();
-  EXPECT_EQ(traffic::hex_bytes(result->bytes), "B3 01 00 02 B7 78 BC 0A 35");
+  EXPECT_EQ(to_hex(result->bytes), "B3 01 00 02 B7 78 BC 0A 35");
   EXPECT_TRUE(result->expect_match) << result->expect_detail;
   EXPECT_TRUE(result->pass) << eye::summary_text(*result);
   // A short link keeps the full swing: 5 V through 2 x 49 ohm (+ driver) into ~0.9 kohm.

@@ -19,10 +19,10 @@
 #include <string>
 #include <vector>
 
-#include "eye/check.h"
-#include "eye/decode.h"
-#include "eye/rules.h"
 #include "base/waveform.h"
+#include "eye/check.h"
+#include "eye/rules.h"
+#include "protocol/frame.h"
 #include "tests/eye/synth.h"
 
 namespace isolink::reports::fixtures {
@@ -48,8 +48,8 @@ inline LinkWave link_wave(const std::vector<uint8_t>& bytes, const LinkWaveOptio
   for (size_t f = 0; f < bytes.size(); ++f) {
     synth::Train tr;
     tr.t0 = t0;
-    tr.pulses = synth::pulses_from_half_bits(eye::frame_half_bits(bytes[f], eye::FrameFormat{}),
-                                             o.amplitude);
+    tr.pulses = synth::pulses_from_half_bits(
+        isolink::frame_half_bits(bytes[f], isolink::FrameFormat{}), o.amplitude);
     if (static_cast<int>(f) == o.short_frame && o.short_pulse >= 0 &&
         o.short_pulse < static_cast<int>(tr.pulses.size()))
       tr.pulses[static_cast<size_t>(o.short_pulse)].shift = -100e-9;

@@ -254,6 +254,36 @@ TEST(Lti, RefusesAnInductorOpenedForTheDcPoint) {
   EXPECT_NE(s.message().find("opened for the DC"), std::string::npos) << s.message();
 }
 
+// The superposition's predicted cost is probes x sum over ramps of the rows inside the march
+// window; over max_evaluations the rule stops with an empty waveform (auto then runs the
+// transient).
+TEST(Lti, GridPredictsItsEvaluationsAndStopsOverBudget) {
+  auto b = make({card("v1", {"in", "0"}, {call("pwl", {0, 0, 10e-9, 1, 1e-6, 1})}),
+                 card("r1", {"in", "out"}, {num(1e3)}), card("c1", {"out", "0"}, {num(1e-9)})},
+                {"v(out)", "v(in)"});
+  LtiResponses lti = responses(*b, 2e-6);
+  const double end = lti.stats().settled_at;
+  ASSERT_GT(end, 0.0);
+  LtiResponses::GridOptions grid;
+  grid.tstop = 2e-6;
+  grid.step = 1e-8;
+  LtiResponses::GridInfo info;
+  // Ramps at 0, 10 ns (end of the rise) and 1 us (a slope change of 0: none).
+  const auto inputs = lti.netlist_inputs(2e-6);
+  ASSERT_EQ(inputs.size(), 1u);
+  ASSERT_EQ(inputs[0].ramps.size(), 2u);
+  const double expected =
+      2.0 * (std::min(2e-6, end) + std::min(2e-6 - 10e-9, end)) / 1e-8;  // 2 probes
+  Waveform w = lti.waveform(inputs, grid, &info);
+  EXPECT_FALSE(info.over_budget);
+  EXPECT_NEAR(info.evaluations, expected, 1e-6 * expected);
+  EXPECT_EQ(w.samples(), 201u);
+  grid.max_evaluations = 0.5 * expected;
+  w = lti.waveform(inputs, grid, &info);
+  EXPECT_TRUE(info.over_budget);
+  EXPECT_EQ(w.samples(), 0u);
+}
+
 // The output grid rule holds its 1 uA promise in the cell just after a corner too: an RL lag
 // of tau = 0.5 ns, driven by a 10 ns ramp whose end is inside the first 20 ns cell, read by
 // linear interpolation between the rows against the closed-form ramp response.

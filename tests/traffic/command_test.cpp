@@ -5,13 +5,15 @@
 #include <string>
 #include <vector>
 
+#include "base/hex.h"
+
 namespace isolink::traffic {
 namespace {
 
 std::string hex_of(const std::string& text) {
   StatusOr<std::vector<uint8_t>> b = command_bytes(text);
   if (!b) return "ERROR: " + b.status().message();
-  return hex_bytes(*b);
+  return to_hex(*b);
 }
 
 std::string error_of(const std::string& text) {

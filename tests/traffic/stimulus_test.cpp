@@ -31,6 +31,22 @@ TEST(ParseTime, SpiceSuffixes) {
   EXPECT_NE(parse_time("10nsec").status().message().find("trailing text"), std::string::npos);
 }
 
+// Times come from the one scanner (base/si_number.h): its whole suffix set, exact decimals, and
+// the traffic rule on top (the unit may only be "s").
+TEST(ParseTime, SharedScannerRules) {
+  EXPECT_EQ(*parse_time("1mil"), 25.4e-6);
+  EXPECT_EQ(*parse_time("2t"), 2e12);
+  EXPECT_EQ(*parse_time("1u5"), 1.5e-6);  // RKM
+  EXPECT_EQ(*parse_time(" 20US "), 20e-6);
+  EXPECT_EQ(*parse_time("1megs"), 1e6);
+  EXPECT_EQ(*parse_time("-1n"), -1e-9);  // the sign is read; callers check the range
+  EXPECT_FALSE(parse_time("1e").ok());
+  EXPECT_FALSE(parse_time("1nF").ok());
+  EXPECT_NE(parse_time("10 us").status().message().find("unknown unit suffix ' us'"),
+            std::string::npos);
+  EXPECT_NE(parse_time("1e400").status().message().find("not a finite time"), std::string::npos);
+}
+
 TEST(Stimulus, ScriptBuildsItemsInOrder) {
   StatusOr<Drive> d = build_drive(
       "wake couplets=2; stack-read reg=0x0215 n=12 # comment\n"

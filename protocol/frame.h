@@ -1,13 +1,14 @@
-// Frame decoding: half bits (pulse signs, a double pulse counting twice) -> couplets -> bits ->
-// bytes.
+// The daisy-chain byte frame, both ways: the one encoder (byte -> wire bits -> half bits) and
+// decoder (half bits -> couplets -> bits -> bytes) that traffic/ (stimulus) and eye/ (decoding a
+// measured waveform) share, with the one bit-order type.
 //
 // Usage:
 //   FrameFormat fmt;                                  // preamble +, sync 00, SOF 1, LSB first
+//   std::vector<int> w = frame_wire_bits(0x80, fmt);  // 0 0 1 00000001 0 (sync, SOF, data, err)
 //   std::vector<int> h = frame_half_bits(0x80, fmt);  // +1/-1 per half bit (26 with SOF)
 //   std::vector<DecodedByte> d = decode_half_bits(h, fmt);   // d[0].byte == 0x80
-//   StatusOr<std::vector<uint8_t>> e = parse_hex_bytes("80 00 02 15");
-// Encoding (design.md item 12): 0 = (-, +), 1 = (+, -); frame = preamble (+), sync 0 0,
-// [SOF], 8 data bits, error bit, postamble (-).
+// Encoding (design.md item 12, domain.md section 2): 0 = (-, +), 1 = (+, -); frame = preamble
+// (+), sync 0 0, [SOF], 8 data bits, error bit, postamble (-).
 #pragma once
 
 #include <cstddef>
@@ -15,12 +16,9 @@
 #include <optional>
 #include <span>
 #include <string>
-#include <string_view>
 #include <vector>
 
-#include "base/status.h"
-
-namespace isolink::eye {
+namespace isolink {
 
 enum class BitOrder { kLsbFirst, kMsbFirst };
 
@@ -34,7 +32,10 @@ struct FrameFormat {
   size_t half_bits() const { return 2 * bits() + 2; }        // plus preamble and postamble
 };
 
-// The half bits (+1 / -1) of one frame carrying byte.
+// The bits sent for one byte, in wire order: sync 0, 0, [SOF], 8 data bits, error bit.
+std::vector<int> frame_wire_bits(uint8_t byte, const FrameFormat& fmt, bool error_bit = false);
+// The half bits (+1 / -1) of one frame carrying byte: +1 preamble, the couplets of the wire
+// bits, -1 postamble.
 std::vector<int> frame_half_bits(uint8_t byte, const FrameFormat& fmt, bool error_bit = false);
 
 // One decoded byte (or the place where decoding stopped) inside a run of half bits.
@@ -54,9 +55,4 @@ std::vector<DecodedByte> decode_half_bits(std::span<const int> half_bits, const 
 // "sync 1", "SOF", "bit 0".."bit 7" (data bit number), "error bit", "postamble".
 std::string half_bit_role(size_t h, const FrameFormat& fmt);
 
-// "80 00 02" (upper case, space separated).
-std::string to_hex(std::span<const uint8_t> bytes);
-// Accepts "80 00 02", "0x80,0x00", "800002"; an error names the offending text.
-StatusOr<std::vector<uint8_t>> parse_hex_bytes(std::string_view text);
-
-}  // namespace isolink::eye
+}  // namespace isolink

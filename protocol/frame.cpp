@@ -1,8 +1,6 @@
-#include "eye/decode.h"
+#include "protocol/frame.h"
 
-#include <cctype>
-
-namespace isolink::eye {
+namespace isolink {
 namespace {
 
 const char* sign_char(int s) {
@@ -16,18 +14,23 @@ void push_bit(std::vector<int>& h, int bit) {
 
 }  // namespace
 
+std::vector<int> frame_wire_bits(uint8_t byte, const FrameFormat& fmt, bool error_bit) {
+  std::vector<int> bits = {0, 0};  // sync
+  bits.reserve(fmt.bits());
+  if (fmt.sof) bits.push_back(fmt.sof_value ? 1 : 0);
+  for (int i = 0; i < 8; ++i) {
+    const int n = fmt.bit_order == BitOrder::kLsbFirst ? i : 7 - i;
+    bits.push_back((byte >> n) & 1);
+  }
+  bits.push_back(error_bit ? 1 : 0);
+  return bits;
+}
+
 std::vector<int> frame_half_bits(uint8_t byte, const FrameFormat& fmt, bool error_bit) {
   std::vector<int> h;
   h.reserve(fmt.half_bits());
   h.push_back(+1);  // preamble
-  push_bit(h, 0);   // sync
-  push_bit(h, 0);
-  if (fmt.sof) push_bit(h, fmt.sof_value);
-  for (int i = 0; i < 8; ++i) {
-    int n = fmt.bit_order == BitOrder::kLsbFirst ? i : 7 - i;
-    push_bit(h, (byte >> n) & 1);
-  }
-  push_bit(h, error_bit ? 1 : 0);
+  for (int bit : frame_wire_bits(byte, fmt, error_bit)) push_bit(h, bit);
   h.push_back(-1);  // postamble
   return h;
 }
@@ -118,54 +121,4 @@ std::vector<DecodedByte> decode_half_bits(std::span<const int> hb, const FrameFo
   return out;
 }
 
-std::string to_hex(std::span<const uint8_t> bytes) {
-  static const char* kDigits = "0123456789ABCDEF";
-  std::string s;
-  for (size_t i = 0; i < bytes.size(); ++i) {
-    if (i) s += ' ';
-    s += kDigits[bytes[i] >> 4];
-    s += kDigits[bytes[i] & 15];
-  }
-  return s;
-}
-
-StatusOr<std::vector<uint8_t>> parse_hex_bytes(std::string_view text) {
-  std::vector<uint8_t> out;
-  size_t i = 0;
-  auto is_sep = [](char c) { return c == ' ' || c == ',' || c == ':' || c == '\t' || c == ';'; };
-  while (i < text.size()) {
-    if (is_sep(text[i])) {
-      ++i;
-      continue;
-    }
-    size_t j = i;
-    while (j < text.size() && !is_sep(text[j])) ++j;
-    std::string_view tok = text.substr(i, j - i);
-    std::string_view digits = tok;
-    if (digits.size() > 2 && digits[0] == '0' && (digits[1] == 'x' || digits[1] == 'X'))
-      digits.remove_prefix(2);
-    bool hex = !digits.empty();
-    for (char c : digits) hex = hex && std::isxdigit(static_cast<unsigned char>(c));
-    if (!hex || (digits.size() > 2 && digits.size() % 2 != 0))
-      return Status::Error("'" + std::string(tok) +
-                           "' is not a hex byte (expected e.g. \"80 00 02\")");
-    auto nibble = [](char c) {
-      return std::isdigit(static_cast<unsigned char>(c))
-                 ? c - '0'
-                 : std::tolower(static_cast<unsigned char>(c)) - 'a' + 10;
-    };
-    if (digits.size() <= 2) {
-      int v = 0;
-      for (char c : digits) v = v * 16 + nibble(c);
-      out.push_back(static_cast<uint8_t>(v));
-    } else {
-      for (size_t k = 0; k < digits.size(); k += 2)
-        out.push_back(static_cast<uint8_t>(nibble(digits[k]) * 16 + nibble(digits[k + 1])));
-    }
-    i = j;
-  }
-  if (out.empty()) return Status::Error("no hex bytes in '" + std::string(text) + "'");
-  return out;
-}
-
-}  // namespace isolink::eye
+}  // namespace isolink
