@@ -31,10 +31,10 @@
 #include "analysis/sweep_run.h"
 #include "analysis/sweep_spec.h"
 #include "base/csv.h"
+#include "base/hex.h"
 #include "base/status.h"
 #include "config/yaml_reader.h"
 #include "eye/check.h"
-#include "eye/decode.h"
 #include "eye/rules.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
@@ -166,7 +166,7 @@ py::dict check(const py::array_t<double, py::array::c_style | py::array::forceca
   eye::Rules rules = take(eye::load_rules(rules_name));
   eye::CheckOptions opt;
   if (expect) {
-    StatusOr<std::vector<uint8_t>> e = eye::parse_hex_bytes(*expect);
+    StatusOr<std::vector<uint8_t>> e = parse_hex_bytes(*expect);
     if (!e) raise(Status::Error("expect: error: " + e.status().message()));
     opt.expect = *e;
   }
