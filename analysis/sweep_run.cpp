@@ -494,7 +494,6 @@ ordered_json boundary_json(const SweepSpec& s, const std::vector<PointResult>& r
   return ordered_json{{"axis", x.key}, {"along", along}};
 }
 
-
 }  // namespace
 
 nlohmann::ordered_json summary_json(const SweepSpec& s, const std::vector<PointResult>& results) {
@@ -572,8 +571,8 @@ nlohmann::ordered_json summary_json(const SweepSpec& s, const std::vector<PointR
   return j;
 }
 
-Status finish_sweep(const SweepSpec& s, const std::vector<PointResult>& results,
-                    const SweepOptions& opt, SweepOutcome* out) {
+Status finish_sweep(const SweepSpec& s, std::vector<PointResult> results, const SweepOptions& opt,
+                    SweepOutcome* out) {
   out->points = s.size();
   out->pass = out->fail = out->error = 0;
   for (const PointResult& r : results) {
@@ -586,8 +585,11 @@ Status finish_sweep(const SweepSpec& s, const std::vector<PointResult>& results,
     return st;
   out->files.push_back("results.csv");
   out->files.push_back("summary.json");
-  if (!opt.plots || !opt.render_plots) return Status::Ok();
-  return opt.render_plots(s, results, opt.out_dir, &out->files);
+  Status plotted = opt.plots && opt.render_plots
+                       ? opt.render_plots(s, results, opt.out_dir, &out->files)
+                       : Status::Ok();
+  out->results = std::move(results);
+  return plotted;
 }
 
 StatusOr<SweepOutcome> run_sweep(const SweepSpec& s, const link::PartLibrary& parts,

@@ -42,8 +42,8 @@
 #include "analysis/link_run.h"
 #include "analysis/sweep_spec.h"
 #include "base/csv.h"
-#include "netlists/link/parts.h"
 #include "base/status.h"
+#include "netlists/link/parts.h"
 
 namespace isolink::analysis::sweep {
 
@@ -107,6 +107,9 @@ struct SweepOutcome {
   size_t skipped = 0;              // already in results.csv (--resume)
   double seconds = 0;              // wall time of this run
   std::vector<std::string> files;  // written, relative to out_dir
+  // Every point's result by point index (the rows kept by --resume included): what results.csv
+  // holds, for front ends that want the rows without reading the file back (python/).
+  std::vector<PointResult> results;
 };
 
 // results.csv while a sweep runs: the rows kept from an earlier run (--resume), then each new
@@ -151,9 +154,9 @@ class ResultLog {
 // summary.json: counts, pass yield, the worst point, the pass/fail boundary along the first axis.
 nlohmann::ordered_json summary_json(const SweepSpec& s, const std::vector<PointResult>& results);
 // summary.json and the plots from the results (sorted by point); the files written are added to
-// out->files.
-Status finish_sweep(const SweepSpec& s, const std::vector<PointResult>& results,
-                    const SweepOptions& opt, SweepOutcome* out);
+// out->files and the results kept in out->results.
+Status finish_sweep(const SweepSpec& s, std::vector<PointResult> results, const SweepOptions& opt,
+                    SweepOutcome* out);
 
 // The whole sweep on this machine's cores.
 StatusOr<SweepOutcome> run_sweep(const SweepSpec& s, const link::PartLibrary& parts,

@@ -11,6 +11,7 @@ PACKAGES=(
   libopenimageio-dev openimageio-tools libtbb-dev fonts-dejavu-core
   openmpi-bin libopenmpi-dev
   libgtest-dev libgmock-dev libbenchmark-dev ngspice
+  pybind11-dev python3-dev python3-numpy python3-pytest  # the Python module (python/) and its tests
   clang libclang-rt-14-dev  # libFuzzer targets (tests/fuzz) in CI
 )
 missing=()

@@ -1,0 +1,76 @@
+"""isolink.run against `isolink run --no-worst` on the same link (python/tests/one_byte.yaml)."""
+import csv
+import math
+
+import numpy as np
+import pytest
+
+import isolink
+from conftest import SPEC
+
+
+def same(a, b, rel=1e-9, path="$"):
+    """Recursive equality; floats within rel (the same computation in two processes)."""
+    if isinstance(a, float) or isinstance(b, float):
+        assert a == pytest.approx(b, rel=rel, abs=1e-15), path
+    elif isinstance(a, dict):
+        assert list(a) == list(b), path
+        for k in a:
+            same(a[k], b[k], rel, f"{path}.{k}")
+    elif isinstance(a, list):
+        assert len(a) == len(b), path
+        for i, (x, y) in enumerate(zip(a, b)):
+            same(x, y, rel, f"{path}[{i}]")
+    else:
+        assert a == b, path
+
+
+def test_verdict_and_metrics_equal_the_cli(cli_run, mod_run):
+    report, _ = cli_run
+    assert mod_run["verdict"] == report["verdict"] == "pass"
+    assert mod_run["pass"] is True
+    assert [d["direction"] for d in mod_run["directions"]] == ["down"]
+    d, c = mod_run["directions"][0], report["directions"][0]
+    assert d["pass"] is True and d["verdict"] == c["verdict"] == "pass"
+    # The whole check object (pulses, margins, decoded bytes) as report.json has it.
+    same(d["check"], c["check"])
+    same(d["check"]["summary"]["worst"]["vstart"], c["check"]["summary"]["worst"]["vstart"])
+    # The byte the spec sends comes back decoded.
+    assert d["check"]["decoded"]["bytes"] == "5A"
+    same(mod_run["spec"], report["spec"])
+
+
+def test_waveforms_are_numpy_and_match_wave_csv(cli_run, mod_run):
+    _, wave_csv = cli_run
+    w = mod_run["directions"][0]["wave"]
+    assert list(w) == ["time", "v(rxp,rxn)", "v(rxp)", "v(rxn)", "v(txp,txn)"]
+    t = w["time"]
+    assert isinstance(t, np.ndarray) and t.dtype == np.float64 and t.ndim == 1
+    assert np.all(np.diff(t) > 0)
+    for name in w:
+        assert w[name].shape == t.shape
+    # v(rxp,rxn) is V(rxp) - V(rxn) by definition.
+    np.testing.assert_allclose(w["v(rxp,rxn)"], w["v(rxp)"] - w["v(rxn)"], rtol=0, atol=1e-9)
+    # wave.csv is the same waveform resampled linearly onto the spec's tstep (1 ns) and printed
+    # with 9 significant digits.
+    with open(wave_csv, newline="") as f:
+        rows = list(csv.reader(f))
+    header, data = rows[0], np.array(rows[1:], dtype=float)
+    assert header[:2] == ["time", "down v(rxp,rxn)"]
+    assert data[1, 0] - data[0, 0] == pytest.approx(1e-9, rel=1e-6)
+    for k, name in enumerate(header[1:], 1):
+        probe = name.split(" ", 1)[1]
+        expected = np.interp(data[:, 0], t, w[probe])
+        np.testing.assert_allclose(data[:, k], expected, rtol=2e-8, atol=1e-12, err_msg=name)
+    # The receiver sees the pulses the checker measured: VSTART of the worst pulse is the peak
+    # of |v| over its first half, which the samples bound from below.
+    vstart = mod_run["directions"][0]["check"]["summary"]["vstart_min"]
+    assert np.max(np.abs(w["v(rxp,rxn)"])) >= vstart - 1e-12
+    assert math.isfinite(vstart) and vstart > 1.6
+
+
+def test_direction_and_engine_options():
+    with pytest.raises(isolink.Error, match="direction: 'sideways' is none of down, up, both"):
+        isolink.run(str(SPEC), direction="sideways")
+    with pytest.raises(isolink.Error, match="fast"):
+        isolink.run(str(SPEC), engine="fast")
