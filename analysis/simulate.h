@@ -19,8 +19,8 @@ namespace isolink::analysis {
 
 // auto: the LTI engine when the circuit allows it (check_lti: every element LTI, every source DC,
 // PULSE or PWL, no .tran uic) and it is the cheaper engine (responses settled within a quarter
-// of the run, kAutoLtiMaxSteps, kAutoLtiBudget), else the transient; lti: the LTI engine or an error naming the element;
-// transient: always the transient.
+// of the run, kAutoLtiMaxSteps, kAutoLtiBudget), else the transient; lti: the LTI engine or an
+// error naming the element; transient: always the transient.
 enum class Engine { Auto, Lti, Transient };
 const char* engine_name(Engine e);
 // "auto", "lti", "transient" -> Engine; an error names the value and the choices.

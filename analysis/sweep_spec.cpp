@@ -764,11 +764,11 @@ StatusOr<SweepSpec> read_sweep_text(const std::string& text, const std::string& 
       over = over || __builtin_mul_overflow(points, a.values.size(), &points);
   over = over || __builtin_mul_overflow(points, s.samples(), &points);
   if (over || points > kMaxSweepPoints)
-    return doc->error(sweep_node.IsDefined() ? sweep_node : root,
-                      fmt::format("the sweep has {} points; the limit is {} (fewer values per key, "
-                                  "fewer keys, or fewer Monte Carlo samples)",
-                                  over ? std::string("2^64 or more") : std::to_string(points),
-                                  kMaxSweepPoints));
+    return doc->error(
+        sweep_node.IsDefined() ? sweep_node : root,
+        fmt::format("the sweep has {} points; the limit is {} (fewer values per key, "
+                    "fewer keys, or fewer Monte Carlo samples)",
+                    over ? std::string("2^64 or more") : std::to_string(points), kMaxSweepPoints));
   return s;
 }
 

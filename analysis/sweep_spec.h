@@ -48,9 +48,9 @@
 #include <utility>
 #include <vector>
 
+#include "base/status.h"
 #include "config/yaml_reader.h"
 #include "netlists/link/link_spec.h"
-#include "base/status.h"
 
 namespace isolink::analysis::sweep {
 

@@ -23,8 +23,8 @@ struct SourceLoc;
 
 // One text file (or in-memory text) with its lines kept for diagnostics.
 struct SourceFile {
-  std::string path;                       // as the user named it (or "<string>")
-  std::vector<std::string> lines;         // without line terminators
+  std::string path;                                // as the user named it (or "<string>")
+  std::vector<std::string> lines;                  // without line terminators
   std::shared_ptr<const SourceLoc> included_from;  // the .include card that pulled it in, if any
 
   static std::shared_ptr<const SourceFile> FromText(std::string path, const std::string& text,

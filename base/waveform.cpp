@@ -3,9 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "base/file_io.h"
-
 #include "base/csv.h"
+#include "base/file_io.h"
 
 namespace isolink {
 

@@ -57,8 +57,9 @@ int run_export(const ExportArgs& a) {
 void add_export_command(CLI::App& app, int* exit_code) {
   auto args = std::make_shared<ExportArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "export-spice", "Write a link spec's expanded netlist (ngspice dialect, runs in ngspice and "
-                      "in `isolink sim`)");
+      "export-spice",
+      "Write a link spec's expanded netlist (ngspice dialect, runs in ngspice and "
+      "in `isolink sim`)");
   cmd->add_option("spec", args->spec, "Link spec (YAML)")->required();
   cmd->add_option("--direction", args->direction, "Which end transmits: down (tx end) or up")
       ->check(CLI::IsMember({"down", "up"}));

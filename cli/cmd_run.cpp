@@ -9,17 +9,17 @@
 #include <string>
 #include <vector>
 
-#include "analysis/pack_spec.h"
-#include "base/file_io.h"
 #include "analysis/link_run.h"
+#include "analysis/pack_spec.h"
 #include "analysis/worst.h"
+#include "base/file_io.h"
 #include "cli/commands.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
+#include "netlists/traffic/stimulus.h"
 #include "reports/run_images.h"
 #include "reports/run_report.h"
 #include "reports/worst_png.h"
-#include "netlists/traffic/stimulus.h"
 
 namespace isolink::cli {
 using namespace isolink::analysis;  // run_link, LinkRun, run_waveforms
@@ -118,7 +118,8 @@ int run_run(const RunArgs& a) {
     md += "\n## Worst case over all traffic\n\n" + analysis::worst_markdown(*worst);
     if (!a.no_images) {
       std::vector<std::string> files;
-      if (Status s = reports::render_worst_pngs(*worst, spec->name, {}, bundle->staging(), &files); !s.ok())
+      if (Status s = reports::render_worst_pngs(*worst, spec->name, {}, bundle->staging(), &files);
+          !s.ok())
         return fail(s);
       for (const std::string& f : files) md += fmt::format("![{}]({})\n\n", f, f);
     }

@@ -10,13 +10,13 @@
 #include <string>
 #include <vector>
 
+#include "analysis/sweep_run.h"
+#include "analysis/sweep_spec.h"
 #include "base/csv.h"
 #include "base/file_io.h"
 #include "cli/commands.h"
-#include "reports/sweep_report.h"
-#include "analysis/sweep_run.h"
-#include "analysis/sweep_spec.h"
 #include "netlists/link/parts.h"
+#include "reports/sweep_report.h"
 #ifdef ISOLINK_HAVE_MPI
 #include "analysis/sweep_mpi.h"
 #endif

@@ -339,13 +339,14 @@ class Reader {
       return error_at(
           where, fmt::format("includes nest deeper than the limit of {} files", kMaxIncludeDepth));
     if (fs::is_directory(p))
-      return error_at(where, std::string(section ? "library file '" : "include file '") + name + "' is a folder ('" + p.string() + "')");
+      return error_at(where, std::string(section ? "library file '" : "include file '") + name +
+                                 "' is a folder ('" + p.string() + "')");
     auto text = read_input_file(p.string());
     if (!text) {
       if (!fs::exists(p))
-        return error_at(
-            where, std::string(section ? "cannot open library file '" : "cannot open include file '") +
-                       name + "' (looked for '" + p.string() + "')");
+        return error_at(where, std::string(section ? "cannot open library file '"
+                                                   : "cannot open include file '") +
+                                   name + "' (looked for '" + p.string() + "')");
       const std::string& m = text.status().message();  // "PATH: error: REASON"
       const size_t at = m.find(": error: ");
       return error_at(where, std::string(section ? "library file '" : "include file '") + name +
@@ -968,12 +969,11 @@ class Reader {
       // TSTEP 0 (Xyce's habit): the engine picks its own print step (TSTOP / 1000).
       const bool ok = k == 2 ? (v[k] >= 0 && v[k] < v[1]) : k == 0 ? v[k] >= 0 : v[k] > 0;
       if (!ok || !std::isfinite(v[k]))
-        return error_at(line.at(at[k]),
-                        fmt::format(".tran {} must be {}, got {:g}", what[k],
-                                    k == 2   ? "zero or positive and below TSTOP"
-                                    : k == 0 ? "zero or positive"
-                                             : "positive",
-                                    v[k]));
+        return error_at(line.at(at[k]), fmt::format(".tran {} must be {}, got {:g}", what[k],
+                                                    k == 2   ? "zero or positive and below TSTOP"
+                                                    : k == 0 ? "zero or positive"
+                                                             : "positive",
+                                                    v[k]));
     }
     spec.tstep = v[0], spec.tstop = v[1];
     if (v.size() > 2) spec.tstart = v[2];

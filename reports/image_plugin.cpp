@@ -3,16 +3,16 @@
 // in the project that includes OpenImageIO outside the tests.
 #include "reports/image_plugin.h"
 
-#include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <cstring>
 #include <memory>
-#include <vector>
 #include <string>
+#include <vector>
 
 namespace {
 

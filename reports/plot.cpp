@@ -12,7 +12,6 @@
 #include <vector>
 
 #include "base/file_io.h"
-
 #include "reports/image_plugin.h"
 
 namespace isolink::reports {

@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "analysis/link_run.h"
-#include "netlists/link/link_spec.h"
 #include "base/waveform.h"
+#include "netlists/link/link_spec.h"
 
 namespace isolink::reports {
 

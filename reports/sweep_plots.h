@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "reports/plot.h"
 #include "base/status.h"
+#include "reports/plot.h"
 
 namespace isolink::reports {
 

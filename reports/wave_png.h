@@ -24,10 +24,10 @@
 #include <string>
 #include <vector>
 
+#include "base/status.h"
 #include "eye/check.h"
 #include "eye/rules.h"
 #include "reports/plot.h"
-#include "base/status.h"
 
 namespace isolink::reports {
 

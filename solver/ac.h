@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
+#include "base/status.h"
 #include "solver/circuit.h"
 #include "solver/probe.h"
-#include "base/status.h"
 
 namespace isolink {
 

@@ -26,8 +26,8 @@
 #include <memory>
 #include <string>
 
-#include "solver/mna.h"
 #include "base/status.h"
+#include "solver/mna.h"
 
 namespace isolink {
 

@@ -142,10 +142,10 @@ class LtiResponses {
   struct GridInfo {
     long corners = 0;  // ramps superposed
     long rows = 0;
-    double step = 0.0;    // s, the grid's step
-    std::string warning;  // set when the rule hit max_rows before meeting interp_tol
-    bool over_budget = false;   // stopped by max_evaluations: the waveform is empty
-    double evaluations = 0.0;   // predicted probe evaluations of the levels computed (or refused)
+    double step = 0.0;         // s, the grid's step
+    std::string warning;       // set when the rule hit max_rows before meeting interp_tol
+    bool over_budget = false;  // stopped by max_evaluations: the waveform is empty
+    double evaluations = 0.0;  // predicted probe evaluations of the levels computed (or refused)
   };
   // The probes on a uniform grid from tstart to tstop (tstop included when the step divides it),
   // plus a row at every source corner when the rule chooses the step.

@@ -21,10 +21,10 @@
 #include <utility>
 #include <vector>
 
+#include "base/waveform.h"
 #include "solver/card.h"
 #include "solver/circuit.h"
 #include "solver/probe.h"
-#include "base/waveform.h"
 
 namespace isolink {
 

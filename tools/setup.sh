@@ -13,6 +13,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev ngspice
   pybind11-dev python3-dev python3-numpy python3-pytest  # the Python module (python/) and its tests
   clang libclang-rt-14-dev  # libFuzzer targets (tests/fuzz) in CI
+  clang-format  # the `format` test (tools/check_format.sh)
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

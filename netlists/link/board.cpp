@@ -1,8 +1,8 @@
 #include "netlists/link/board.h"
 
-#include <cmath>
-
 #include <fmt/format.h>
+
+#include <cmath>
 
 #include "netlists/link/cards.h"
 
@@ -25,7 +25,9 @@ Status BoardNetwork::validate() const {
   return Status::Ok();
 }
 
-std::vector<std::string> board_preset_names() { return {"bq7961x", "bq79600", "bq79606a"}; }
+std::vector<std::string> board_preset_names() {
+  return {"bq7961x", "bq79600", "bq79606a"};
+}
 
 StatusOr<BoardNetwork> board_preset(const std::string& device) {
   if (device == "bq7961x") return BoardNetwork{0.0, 49.0, 220e-12, 1e3};
@@ -34,9 +36,10 @@ StatusOr<BoardNetwork> board_preset(const std::string& device) {
   return Status::Error("unknown device '" + device + "' (known: bq7961x, bq79600, bq79606a)");
 }
 
-Status add_board_network(std::vector<Card>& cards, const std::string& prefix, const std::string& pin_p,
-                         const std::string& pin_n, const std::string& line_p,
-                         const std::string& line_n, const BoardNetwork& b) {
+Status add_board_network(std::vector<Card>& cards, const std::string& prefix,
+                         const std::string& pin_p, const std::string& pin_n,
+                         const std::string& line_p, const std::string& line_n,
+                         const BoardNetwork& b) {
   if (Status s = b.validate(); !s.ok()) return s;
   for (auto [side, pin, line] : {std::tuple{"p", pin_p, line_p}, std::tuple{"n", pin_n, line_n}}) {
     std::string from = pin;

@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "solver/card.h"
 #include "base/status.h"
+#include "solver/card.h"
 
 namespace isolink::link {
 
@@ -33,8 +33,9 @@ struct BoardNetwork {
 StatusOr<BoardNetwork> board_preset(const std::string& device);
 std::vector<std::string> board_preset_names();
 
-Status add_board_network(std::vector<Card>& cards, const std::string& prefix, const std::string& pin_p,
-                         const std::string& pin_n, const std::string& line_p,
-                         const std::string& line_n, const BoardNetwork& board);
+Status add_board_network(std::vector<Card>& cards, const std::string& prefix,
+                         const std::string& pin_p, const std::string& pin_n,
+                         const std::string& line_p, const std::string& line_n,
+                         const BoardNetwork& board);
 
 }  // namespace isolink::link

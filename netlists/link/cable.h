@@ -31,8 +31,8 @@
 #include <string>
 #include <vector>
 
-#include "solver/card.h"
 #include "base/status.h"
+#include "solver/card.h"
 
 namespace isolink::link {
 

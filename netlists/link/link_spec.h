@@ -20,10 +20,10 @@
 #include <string>
 #include <vector>
 
-#include "config/yaml_reader.h"
-#include "netlists/link/cable.h"
 #include "base/source_loc.h"
 #include "base/status.h"
+#include "config/yaml_reader.h"
+#include "netlists/link/cable.h"
 
 namespace isolink::link {
 

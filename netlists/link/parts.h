@@ -28,9 +28,9 @@
 #include <string_view>
 #include <vector>
 
-#include "solver/card.h"
 #include "base/source_loc.h"
 #include "base/status.h"
+#include "solver/card.h"
 
 namespace isolink::link {
 

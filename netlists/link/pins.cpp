@@ -1,8 +1,8 @@
 #include "netlists/link/pins.h"
 
-#include <cmath>
-
 #include <fmt/format.h>
+
+#include <cmath>
 
 #include "netlists/link/cards.h"
 
@@ -28,7 +28,8 @@ Status RxLoadModel::validate() const {
 }
 
 Status add_tx_driver(std::vector<Card>& cards, const std::string& prefix, const std::string& p,
-                     const std::string& n, const traffic::Drive& drive, const TxDriverModel& model) {
+                     const std::string& n, const traffic::Drive& drive,
+                     const TxDriverModel& model) {
   if (Status s = model.validate(); !s.ok()) return s;
   for (int sign : {+1, -1}) {
     const std::string side = sign > 0 ? "p" : "n";
@@ -51,11 +52,11 @@ Status add_rx_load(std::vector<Card>& cards, const std::string& prefix, const st
   if (Status s = model.validate(); !s.ok()) return s;
   const std::string bias = prefix + "_bias";
   for (Card& c : std::vector<Card>{
-      make_card('v', "v" + prefix + "bias", {bias, "0"}, {number_arg(model.bias)}),
-      make_card('r', "r" + prefix + "inp", {p, bias}, {number_arg(model.r_in)}),
-      make_card('r', "r" + prefix + "inn", {n, bias}, {number_arg(model.r_in)}),
-      make_card('c', "c" + prefix + "inp", {p, "0"}, {number_arg(model.c_in)}),
-      make_card('c', "c" + prefix + "inn", {n, "0"}, {number_arg(model.c_in)}),
+           make_card('v', "v" + prefix + "bias", {bias, "0"}, {number_arg(model.bias)}),
+           make_card('r', "r" + prefix + "inp", {p, bias}, {number_arg(model.r_in)}),
+           make_card('r', "r" + prefix + "inn", {n, bias}, {number_arg(model.r_in)}),
+           make_card('c', "c" + prefix + "inp", {p, "0"}, {number_arg(model.c_in)}),
+           make_card('c', "c" + prefix + "inn", {n, "0"}, {number_arg(model.c_in)}),
        })
     cards.push_back(std::move(c));
   return Status::Ok();

@@ -15,27 +15,26 @@
 #pragma once
 
 #include <string>
-
-#include "netlists/traffic/drive.h"
 #include <vector>
 
-#include "solver/card.h"
 #include "base/status.h"
+#include "netlists/traffic/drive.h"
+#include "solver/card.h"
 
 namespace isolink::link {
 
 struct TxDriverModel {
-  double vdd = 5.0;       // V, line high level (CVDD)
-  double edge = 10e-9;    // s, 0-100 % transition time of each line
-  double r_out = 10.0;    // ohm, output resistance per line
+  double vdd = 5.0;     // V, line high level (CVDD)
+  double edge = 10e-9;  // s, 0-100 % transition time of each line
+  double r_out = 10.0;  // ohm, output resistance per line
 
   Status validate() const;  // names the field, its value and the rule
 };
 
 struct RxLoadModel {
-  double r_in = 10e3;     // ohm, per pin to the bias
-  double c_in = 5e-12;    // F, per pin to ground
-  double bias = 2.5;      // V, the receiver's common-mode bias
+  double r_in = 10e3;   // ohm, per pin to the bias
+  double c_in = 5e-12;  // F, per pin to ground
+  double bias = 2.5;    // V, the receiver's common-mode bias
 
   Status validate() const;
 };

@@ -26,9 +26,9 @@
 #include <string>
 #include <vector>
 
+#include "base/status.h"
 #include "netlists/traffic/encoding.h"
 #include "netlists/traffic/tones.h"
-#include "base/status.h"
 
 namespace isolink::traffic {
 

@@ -19,10 +19,10 @@
 
 #include <string_view>
 
+#include "base/status.h"
 #include "netlists/traffic/drive.h"
 #include "netlists/traffic/encoding.h"
 #include "netlists/traffic/tones.h"
-#include "base/status.h"
 
 namespace isolink::traffic {
 

@@ -18,9 +18,9 @@
 #include <string>
 #include <vector>
 
-#include "solver/card.h"
 #include "base/source_loc.h"
 #include "base/status.h"
+#include "solver/card.h"
 
 namespace isolink {
 

@@ -1,8 +1,9 @@
 // The one explicit table of element kinds (no static self-registration).
-#include <cmath>
 #include <fmt/format.h>
+
 #include <array>
 #include <cctype>
+#include <cmath>
 
 #include "solver/elements/kinds.h"
 
@@ -31,7 +32,8 @@ std::string cell(std::string s) {  // a Markdown table cell: escape the column b
 }  // namespace
 
 std::string element_reference_markdown() {
-  std::string out = "| kind | usage | parameter | default | unit | meaning |\n|---|---|---|---|---|---|\n";
+  std::string out =
+      "| kind | usage | parameter | default | unit | meaning |\n|---|---|---|---|---|---|\n";
   for (const ElementKind& k : element_kinds()) {
     bool first = true;
     for (const ParamSpec& p : k.params) {

@@ -8,8 +8,8 @@
 
 #include <vector>
 
-#include "solver/card.h"
 #include "base/status.h"
+#include "solver/card.h"
 
 namespace isolink {
 

@@ -1,8 +1,8 @@
 // The README's element reference is the program's own table, not a hand copy.
+#include <gtest/gtest.h>
+
 #include <fstream>
 #include <sstream>
-
-#include <gtest/gtest.h>
 
 #include "solver/elements/element.h"
 

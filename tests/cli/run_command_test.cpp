@@ -11,8 +11,8 @@
 #include <sstream>
 #include <string>
 
-#include "ngspice_runner.h"
 #include "base/waveform.h"
+#include "ngspice_runner.h"
 
 namespace {
 
@@ -62,9 +62,9 @@ TEST_P(RunExamples, BundleAndVerdict) {
   const std::string stem = fs::path(ex.file).stem().string();
   const std::string dir = ::testing::TempDir() + "/run_" + stem;
   fs::remove_all(dir);
-  Result r = run("run " + kExamples + "/" + ex.file + " -o " + dir + " -q" +
-                     (ex.worst ? "" : " --no-worst"),
-                 stem);
+  Result r = run(
+      "run " + kExamples + "/" + ex.file + " -o " + dir + " -q" + (ex.worst ? "" : " --no-worst"),
+      stem);
   const bool pass = std::string(ex.verdict) == "pass";
   EXPECT_EQ(r.code, pass ? 0 : 1) << r.err;
   for (const char* f : {"eye.png", "wave.png", "report.json", "report.md", "wave.csv"})

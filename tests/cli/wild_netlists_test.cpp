@@ -69,7 +69,8 @@ TEST_P(WildNetlist, MatchesNgspiceOrIsRefused) {
   ASSERT_TRUE(!h.probes.empty() || !h.refused.empty()) << path << ": no isolink-test header";
   StatusOr<Netlist> netlist = read_spice_file(path);
   StatusOr<analysis::SimulationResult> mine = Status::Error("not run");
-  if (netlist) mine = analysis::simulate_netlist(*netlist, analysis::SimulationRequest{.probes = h.probes});
+  if (netlist)
+    mine = analysis::simulate_netlist(*netlist, analysis::SimulationRequest{.probes = h.probes});
   const Status& status = !netlist ? netlist.status() : mine.status();
   if (!h.refused.empty()) {
     ASSERT_FALSE(status.ok()) << path << " ran, but must be refused with: " << h.refused;

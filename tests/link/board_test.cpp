@@ -26,7 +26,8 @@ TEST(Board, PresetsFollowTheApplicationNotes) {
 TEST(Board, DcThroughTheNetworkIsTheSeriesDivider) {
   // 1 V across the pins of a bq79606a network: the line nodes see the termination's share.
   std::vector<Card> cards{make_card('v', "v1", {"pp", "pn"}, {number_arg(1.0)})};
-  ASSERT_TRUE(add_board_network(cards, "b", "pp", "pn", "lp", "ln", *board_preset("bq79606a")).ok());
+  ASSERT_TRUE(
+      add_board_network(cards, "b", "pp", "pn", "lp", "ln", *board_preset("bq79606a")).ok());
   Circuit c;
   ASSERT_TRUE(add_cards(c, cards).ok());
   ASSERT_TRUE(c.finalize().ok());

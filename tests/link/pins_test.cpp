@@ -33,16 +33,17 @@ TEST(Pins, DriverIntoTerminatedReceiverGivesTheResistiveDivider) {
   auto w = run_transient(c, {.tstep = 1e-9, .tstop = 2.5e-6}, {*probe});
   ASSERT_TRUE(w.ok()) << w.status().message();
   const double rload = 1.0 / (1.0 / 1e3 + 1.0 / 20e3);  // termination || two 10 k pins
-  const double vplus = 5.0 * rload / (rload + 20.0);      // 4.8972 V
+  const double vplus = 5.0 * rload / (rload + 20.0);    // 4.8972 V
   EXPECT_NEAR(w->value_at(0, 1.24e-6), vplus, 1e-3);
   EXPECT_NEAR(w->value_at(0, 1.49e-6), -vplus, 1e-3);
   EXPECT_NEAR(w->value_at(0, 1.25e-6), 0.0, 0.05);  // edges centred on the corners
-  EXPECT_NEAR(w->value_at(0, 2.4e-6), 0.0, 1e-6);  // idle: both lines at 2.5 V
+  EXPECT_NEAR(w->value_at(0, 2.4e-6), 0.0, 1e-6);   // idle: both lines at 2.5 V
   EXPECT_NEAR(w->value_at(0, 0.5e-6), 0.0, 1e-9);
 }
 
 TEST(Pins, ModelsValidateTheirFields) {
-  EXPECT_EQ((TxDriverModel{.edge = 0}).validate().message(), "tx_driver.edge = 0: must be positive");
+  EXPECT_EQ((TxDriverModel{.edge = 0}).validate().message(),
+            "tx_driver.edge = 0: must be positive");
   EXPECT_EQ((RxLoadModel{.r_in = -1}).validate().message(), "rx_load.r_in = -1: must be positive");
 }
 
