@@ -16,6 +16,7 @@
 #include "netlists/link/parts.h"
 #include "netlists/spice_writer.h"
 #include "ngspice_runner.h"
+#include "run_isolink.h"
 
 namespace isolink {
 namespace {
@@ -101,10 +102,7 @@ void compare_spec(const std::string& yaml_text, const std::string& name, double 
   EXPECT_LE(d.lti, 2e-3) << name;
 }
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using isolink::testing::slurp;
 
 TEST(LtiVsNgspice, TransformerLink20m) {
   compare_spec(

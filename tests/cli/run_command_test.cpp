@@ -13,6 +13,7 @@
 
 #include "base/waveform.h"
 #include "ngspice_runner.h"
+#include "run_isolink.h"
 
 namespace {
 
@@ -20,24 +21,11 @@ namespace fs = std::filesystem;
 const std::string kBinary = ISOLINK_BINARY;
 const std::string kExamples = ISOLINK_EXAMPLES_DIR;
 
-struct Result {
-  int code;
-  std::string out, err;
-};
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using Result = isolink::testing::CliResult;
+using isolink::testing::slurp;
 
 Result run(const std::string& args, const std::string& tag) {
-  const std::string out_file = ::testing::TempDir() + "/" + tag + "_stdout.txt";
-  const std::string err_file = ::testing::TempDir() + "/" + tag + "_stderr.txt";
-  const std::string cmd = kBinary + " " + args + " >" + out_file + " 2>" + err_file;
-  int status = std::system(cmd.c_str());
-  return {WEXITSTATUS(status), slurp(out_file), slurp(err_file)};
+  return isolink::testing::run_isolink(kBinary, args, tag);
 }
 
 // Every example spec and the verdict its design gets (see the comment at the top of each file).

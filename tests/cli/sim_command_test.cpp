@@ -8,6 +8,8 @@
 #include <sstream>
 #include <string>
 
+#include "run_isolink.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -15,29 +17,11 @@ const std::string kBinary = ISOLINK_BINARY;
 const std::string kExamples = ISOLINK_EXAMPLES_DIR;
 const std::string kData = ISOLINK_TEST_DATA_DIR;
 
-struct Result {
-  int code;
-  std::string err;
-};
-
-// This test's own folder: ctest -j2 runs the tests of this file as separate processes at once,
-// so nothing may be shared between them (one fixed file made the suite nondeterministic).
-std::string test_dir() {
-  const ::testing::TestInfo* t = ::testing::UnitTest::GetInstance()->current_test_info();
-  const std::string dir = ::testing::TempDir() + "/sim_command_" + t->test_suite_name() + "_" +
-                          t->name() + "_" + std::to_string(::getpid());
-  fs::create_directories(dir);
-  return dir;
-}
+using Result = isolink::testing::CliResult;
+using isolink::testing::test_dir;
 
 Result run(const std::string& args) {
-  const std::string err_file = test_dir() + "/stderr.txt";
-  const std::string cmd = kBinary + " " + args + " >/dev/null 2>" + err_file;
-  int status = std::system(cmd.c_str());
-  std::ifstream in(err_file);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return {WEXITSTATUS(status), ss.str()};
+  return isolink::testing::run_isolink(kBinary, args);
 }
 
 std::string write_temp(const std::string& name, const std::string& text) {
