@@ -5,9 +5,10 @@
 //   StatusOr<LinkRun> run = run_link(spec, *parts, {});
 //   for (const DirectionRun& d : run->directions) ... d.data_check->pass, d.sim.wave ...
 //   return run->pass ? 0 : 1;
-// Each direction is its own simulation (the link is half-duplex): LTI engine by default, the
-// transient on request (RunOptions::engine). Data frames are scored with the
-// receiving device's rule set and tones with the tone rules, each over its own time windows.
+// Each direction is its own simulation (the link is half-duplex), by the engine RunOptions::engine
+// names (auto: LTI where it is the cheaper engine, else the transient; analysis/simulate.h). Data
+// frames are scored with the receiving device's rule set and tones with the tone rules, each over
+// its own time windows.
 #pragma once
 
 #include <optional>

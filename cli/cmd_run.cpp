@@ -157,8 +157,10 @@ void add_run_command(CLI::App& app, int* exit_code) {
   cmd->add_option("--parts", args->part_dirs, "Extra part-library folder (repeatable)");
   cmd->add_option("--direction", args->direction, "Override the spec: down | up | both")
       ->check(CLI::IsMember({"down", "up", "both"}));
-  cmd->add_option("--engine", args->engine,
-                  "auto (LTI, the default: every link is linear), lti, transient (the cross-check)")
+  cmd->add_option(
+         "--engine", args->engine,
+         "auto (the default: LTI where it is the cheaper engine, else transient), lti (exact "
+         "superposition), transient")
       ->check(CLI::IsMember({"auto", "lti", "transient"}));
   cmd->add_flag("--no-images", args->no_images, "Skip eye.png and wave.png");
   cmd->add_flag("--no-worst", args->no_worst,

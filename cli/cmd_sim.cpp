@@ -1,6 +1,6 @@
 // isolink sim NETLIST.cir --probe 'v(rxp,rxn)' [-o wave.csv] [--engine auto|lti|transient]: the
-// response of a SPICE netlist, by the LTI engine when the circuit allows it (see
-// analysis/simulate.h).
+// response of a SPICE netlist, by the LTI engine where it is the cheaper engine, else the
+// transient (see analysis/simulate.h).
 #include <fmt/format.h>
 
 #include <cstdio>
@@ -122,8 +122,10 @@ void add_sim_command(CLI::App& app, int* exit_code) {
   cmd->add_option("--step", args->step,
                   "output on a uniform grid of DT seconds (10n); default: LTI picks a grid where "
                   "linear interpolation is within 1 mV, the transient writes its steps");
-  cmd->add_option("--engine", args->engine,
-                  "auto (LTI when the circuit allows it), lti (error if not), transient")
+  cmd->add_option(
+         "--engine", args->engine,
+         "auto (LTI where the circuit allows it and it is the cheaper engine, else transient), lti "
+         "(error if the circuit does not allow it), transient")
       ->check(CLI::IsMember({"auto", "lti", "transient"}));
   cmd->add_option("--tstop", args->tstop, "end time in seconds (overrides .tran)");
   cmd->add_option("--tmax", args->tmax, "largest time step in seconds (overrides .tran)");

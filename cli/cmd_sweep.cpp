@@ -148,7 +148,9 @@ void add_sweep_command(CLI::App& app, int* exit_code) {
   cmd->add_option("-j,--jobs", args->jobs, "Points run at once (default: all cores)")
       ->check(CLI::Range(1, 4096));
   cmd->add_option("--parts", args->part_dirs, "Extra part-library folder (repeatable)");
-  cmd->add_option("--engine", args->engine, "auto (LTI, the default), lti, transient")
+  cmd->add_option(
+         "--engine", args->engine,
+         "auto (the default: LTI where it is the cheaper engine, else transient), lti, transient")
       ->check(CLI::IsMember({"auto", "lti", "transient"}));
   cmd->add_flag("--resume", args->resume, "Skip the points already in DIR/results.csv");
   cmd->add_flag("--keep-waves", args->keep_waves,

@@ -1,4 +1,4 @@
-// The LTI engine (what `isolink sim` and `isolink run` use by default) against ngspice at tight
+// The LTI engine (`--engine lti`, and `auto` where it is the cheaper one) against ngspice at tight
 // tolerances (reltol 1e-6) and against the transient engine, on the example netlists, the example
 // link specs (exported as `isolink export-spice` does) and 20 m and 40 m transformer links.
 // Windows are short (a few us) so that the tight ngspice runs stay a few seconds:
