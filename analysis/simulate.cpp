@@ -146,7 +146,11 @@ StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequ
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         return result;
       } else {
-        lti_ok = Status::Error("the LTI response march failed: " + responses.status().message());
+        // A march stopped by auto's settle_by is a choice, not a failure: its message says so.
+        const std::string& why = responses.status().message();
+        lti_ok = Status::Error(why.rfind("the responses have not settled", 0) == 0
+                                   ? "the LTI engine is not the cheaper one here: " + why
+                                   : "the LTI response march failed: " + why);
       }
     }
     result.engine_note = lti_ok.message();
