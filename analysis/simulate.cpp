@@ -146,11 +146,12 @@ StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequ
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         return result;
       } else {
-        // A march stopped by auto's settle_by is a choice, not a failure: its message says so.
-        const std::string& why = responses.status().message();
-        lti_ok = Status::Error(why.rfind("the responses have not settled", 0) == 0
-                                   ? "the LTI engine is not the cheaper one here: " + why
-                                   : "the LTI response march failed: " + why);
+        // Only auto gets here (a forced lti returned the error above), and auto's own limits
+        // (settle_by, kAutoLtiMaxSteps) are the usual reason: say so, without reading the text.
+        lti_ok = Status::Error(fmt::format(
+            "the LTI response march stopped: {}; auto stops it where it would cost more than the "
+            "transient (responses not settled by a quarter of the run, or over {} steps)",
+            responses.status().message(), kAutoLtiMaxSteps));
       }
     }
     result.engine_note = lti_ok.message();

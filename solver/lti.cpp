@@ -169,10 +169,8 @@ StatusOr<LtiResponses> LtiResponses::compute(const Circuit& circuit,
       return Status::Error(fmt::format("LTI march gave up at {:g} s after {} steps (max_steps)",
                                        tau, opt.max_steps));
     if (opt.settle_by > 0 && tau > opt.settle_by)
-      return Status::Error(fmt::format(
-          "the responses have not settled by {:g} s (settle_by, a quarter of the run): marching "
-          "them over the run would cost more than the transient",
-          opt.settle_by));
+      return Status::Error(
+          fmt::format("the responses have not settled by {:g} s (settle_by)", opt.settle_by));
     double step = std::min(h, horizon - tau);
     const bool euler = hist.count < 2;
     const double a0 = euler ? 1.0 / step : 2.0 / step;

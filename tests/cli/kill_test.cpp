@@ -19,27 +19,16 @@
 #include <thread>
 #include <vector>
 
+#include "run_isolink.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 const std::string kBinary = ISOLINK_BINARY;
 const std::string kExamples = ISOLINK_EXAMPLES_DIR;
 
-std::string test_dir() {
-  const ::testing::TestInfo* t = ::testing::UnitTest::GetInstance()->current_test_info();
-  const std::string dir =
-      ::testing::TempDir() + "/kill_" + t->name() + "_" + std::to_string(::getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using isolink::testing::slurp;
+using isolink::testing::test_dir;
 
 pid_t spawn(const std::vector<std::string>& args) {
   const pid_t pid = ::fork();
