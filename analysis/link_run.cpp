@@ -38,6 +38,10 @@ StatusOr<DirectionRun> run_direction(link::ExpandedLink link, const RunOptions& 
   // The LTI grid follows the receiver probes; v(txp,txn) is the ideal PWL drive, whose corners
   // a uniform grid could only meet within 1 mV at a few ps (it is only plotted).
   req.grid_probes = {true, true, true, false};
+  if (opt.progress)
+    req.progress = [&](const char* phase, double fraction) {
+      opt.progress(fmt::format("{} {}", link::direction_name(dr.link.direction), phase), fraction);
+    };
   StatusOr<SimulationResult> sim = simulate_netlist(dr.link.netlist, req);
   if (!sim) return sim.status().with_context(dr.link.description);
   dr.sim = std::move(*sim);

@@ -11,6 +11,7 @@
 // its own time windows.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -44,6 +45,8 @@ struct RunOptions {
   link::ExpandOptions expand;
   std::optional<double> reltol;  // overrides the spec's sim.reltol
   Engine engine = Engine::Auto;  // LTI when the link allows it (every link today)
+  // Progress for a display: what runs ("down transient") and the fraction done (0-1).
+  std::function<void(const std::string& what, double fraction)> progress;
 };
 
 // The probes recorded per direction, in column order.

@@ -108,6 +108,10 @@ StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequ
       for (const auto& e : circuit.elements()) e->bind_time(opt.tstep, opt.tstop);
       LtiOptions lo;
       lo.horizon = opt.tstop;
+      if (req.progress)
+        lo.on_progress = [&](double tau) {
+          req.progress("LTI responses", std::clamp(tau / opt.tstop, 0.0, 1.0));
+        };
       // auto: a march longer than kAutoLtiMaxSteps costs more than the transient of any example
       // link (the longest takes 190k steps), so auto stops there and runs the transient.
       if (req.engine == Engine::Auto) {
@@ -156,6 +160,10 @@ StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequ
     }
     result.engine_note = lti_ok.message();
   }
+  if (req.progress)
+    opt.on_progress = [&](double t) {
+      req.progress("transient", std::clamp(t / opt.tstop, 0.0, 1.0));
+    };
   StatusOr<Waveform> wave = run_transient(circuit, opt, probes, &result.stats);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!wave) return wave.status();

@@ -6,6 +6,7 @@
 //   for (auto& w : r->warnings) print(w);
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -48,6 +49,9 @@ struct SimulationRequest {
   // looks at (empty = all). The transient ignores both (its rows are its steps).
   double grid_step = 0.0;
   std::vector<bool> grid_probes;
+  // Progress of the engine for a display: its phase ("transient", "LTI responses") and the
+  // fraction of it done (0-1), every 1024 engine steps. Empty: none.
+  std::function<void(const char* phase, double fraction)> progress;
 };
 
 struct SimulationResult {

@@ -67,14 +67,6 @@ std::string first_line(const std::string& s) {
 
 }  // namespace
 
-std::string duration_text(double s) {
-  if (!(s >= 0) || !std::isfinite(s)) return "?";
-  if (s < 60) return fmt::format("{:.1f} s", s);
-  const long t = std::lround(s);
-  if (t < 3600) return fmt::format("{} min {:02} s", t / 60, t % 60);
-  return fmt::format("{} h {:02} min", t / 3600, (t % 3600) / 60);
-}
-
 std::vector<std::string> results_header(const SweepSpec& s) {
   std::vector<std::string> h{"point"};
   for (const std::string& c : s.point_columns()) h.push_back(c);
@@ -233,8 +225,8 @@ PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t
 StatusOr<std::unique_ptr<ResultLog>> ResultLog::open(const SweepSpec& s, const SweepOptions& opt) {
   std::unique_ptr<ResultLog> log(new ResultLog());
   log->spec_ = &s;
-  log->quiet_ = opt.quiet;
-  log->tty_ = isatty(STDERR_FILENO) != 0;
+  log->line_ = std::make_unique<ProgressLine>(
+      ProgressLine::Options{.label = "sweep", .enabled = !opt.quiet, .pipe_interval = 5.0});
   log->total_ = s.size();
   log->have_.assign(log->total_, false);
   log->ncells_ = s.point_columns().size();
@@ -300,7 +292,6 @@ StatusOr<std::unique_ptr<ResultLog>> ResultLog::open(const SweepSpec& s, const S
   log->file_ = std::fopen(log->path_.c_str(), "ab");
   if (!log->file_)
     return Status::Error(fmt::format("{}: error: cannot open for appending", log->path_));
-  log->start_ = now_seconds();
   return log;
 }
 
@@ -343,27 +334,20 @@ void ResultLog::add(const PointResult& in) {
 }
 
 void ResultLog::progress(const PointResult& r) {
-  if (quiet_) return;
-  if (r.verdict == "error") {
-    if (tty_) std::fputs("\r\033[K", stderr);
-    std::fprintf(stderr, "sweep: point %zu: error: %s\n", r.index, r.error.c_str());
-  }
-  const double t = now_seconds();
+  if (r.verdict == "error" && line_->active())
+    line_->note(fmt::format("sweep: point {}: error: {}", r.index, r.error));
   const bool last = done_now_ == todo_count_;
-  if (!last && last_print_ >= 0 && t - last_print_ < (tty_ ? 0.5 : 5.0)) return;
-  last_print_ = t;
-  const double elapsed = t - start_;
+  const double elapsed = line_->elapsed();
   const double rate = elapsed > 0 ? done_now_ / elapsed * 60.0 : 0.0;
   const double left = done_now_ > 0 ? elapsed / done_now_ * (todo_count_ - done_now_) : kNaN;
   const std::string line = fmt::format(
-      "sweep: {}/{} points ({} pass, {} fail, {} error), {:.1f} points/min, {}",
-      skipped_ + done_now_, total_, pass_, fail_, error_, rate,
+      "{}/{} points ({} pass, {} fail, {} error), {:.1f} points/min, {}", skipped_ + done_now_,
+      total_, pass_, fail_, error_, rate,
       last ? "done in " + duration_text(elapsed) : "about " + duration_text(left) + " left");
-  if (tty_)
-    std::fprintf(stderr, "\r\033[K%s%s", line.c_str(), last ? "\n" : "");
+  if (last)
+    line_->done(line);
   else
-    std::fprintf(stderr, "%s\n", line.c_str());
-  std::fflush(stderr);
+    line_->show(line);
 }
 
 std::vector<PointResult> ResultLog::results() const {

@@ -42,6 +42,7 @@
 #include "analysis/link_run.h"
 #include "analysis/sweep_spec.h"
 #include "base/csv.h"
+#include "base/progress.h"
 #include "base/status.h"
 #include "netlists/link/parts.h"
 
@@ -143,8 +144,7 @@ class ResultLog {
   std::FILE* file_ = nullptr;
   size_t ncells_ = 0, ncolumns_ = 0, total_ = 0, skipped_ = 0, done_now_ = 0, todo_count_ = 0;
   size_t pass_ = 0, fail_ = 0, error_ = 0;
-  bool quiet_ = false, tty_ = false;
-  double start_ = 0, last_print_ = -1;
+  std::unique_ptr<ProgressLine> line_;  // stderr: redrawn on a terminal, every 5 s on a pipe
   std::vector<PointResult> results_;
   std::vector<bool> have_;
   Status write_error_;
@@ -164,8 +164,5 @@ StatusOr<SweepOutcome> run_sweep(const SweepSpec& s, const link::PartLibrary& pa
 
 // The axes with more than one value (the fixed keys are not axes of a chart).
 std::vector<size_t> varying_axes(const SweepSpec& s);
-
-// "12.3 s", "4 min 05 s", "1 h 02 min" for progress lines.
-std::string duration_text(double seconds);
 
 }  // namespace isolink::analysis::sweep

@@ -332,6 +332,10 @@ StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::Par
     to.tstop = lead + span;
     to.tmax = opt.dt;
     to.reltol = opt.reltol;
+    if (opt.progress)
+      to.on_progress = [&](double t) {
+        opt.progress(fmt::format("edge response, {:g} us", span * 1e6), t / to.tstop);
+      };
     if (Status s = to.validate(); !s.ok()) return s;
     StatusOr<Waveform> w = run_transient(circuit, to, {*probe});
     if (!w) return w.status().with_context(link->description + ", edge response");
@@ -480,6 +484,8 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
   // Stage 1: every target pattern after idle.
   std::vector<Score> idle_scores(targets.size());
   for (size_t i = 0; i < targets.size(); ++i) {
+    if (opt.progress && i % 64 == 0)
+      opt.progress("search, idle targets", static_cast<double>(i) / targets.size());
     StatusOr<Score> sc = search.score(search.target_wave(targets[i]), targets[i]);
     if (!sc) return sc.status();
     idle_scores[i] = *sc;
@@ -546,7 +552,10 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
     for (const auto& c : cands) all.insert(all.end(), c.begin(), c.end());
     std::sort(all.begin(), all.end());
     all.erase(std::unique(all.begin(), all.end()), all.end());
-    for (size_t ci : all) {
+    for (size_t n = 0; n < all.size(); ++n) {
+      const size_t ci = all[n];
+      if (opt.progress)
+        opt.progress("search, histories", static_cast<double>(n) / static_cast<double>(all.size()));
       const int t = targets[ci];
       const std::vector<double> base = search.target_wave(t);
       StatusOr<eye::CheckResult> c = search.check(base, t);
@@ -646,9 +655,14 @@ StatusOr<WorstResult> worst_case(const link::LinkSpec& spec, const link::PartLib
     if (!ex) return ex.status();
     StatusOr<eye::Rules> rules = eye::load_rules(ex->rules);
     if (!rules) return rules.status();
-    StatusOr<EdgeResponse> e = edge_response(spec, parts, d, opt);
+    WorstOptions dopt = opt;  // progress says which direction
+    if (opt.progress)
+      dopt.progress = [&](const std::string& what, double fraction) {
+        opt.progress(fmt::format("{} {}", link::direction_name(d), what), fraction);
+      };
+    StatusOr<EdgeResponse> e = edge_response(spec, parts, d, dopt);
     if (!e) return e.status();
-    StatusOr<DirectionWorst> dw = worst_case_direction(*e, *rules, opt);
+    StatusOr<DirectionWorst> dw = worst_case_direction(*e, *rules, dopt);
     if (!dw) return dw.status().with_context(ex->description + ", worst case");
     dw->direction = d;
     dw->description = ex->description;

@@ -34,6 +34,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -85,6 +86,9 @@ struct WorstOptions {
   std::vector<int> targets;
   std::vector<int> previous;
   link::ExpandOptions expand;  // driver, load, encoding (its half bit is the T above)
+  // Progress for a display: what runs ("down edge response", "down search") and the fraction
+  // of it done (0-1). Empty: none.
+  std::function<void(const std::string& what, double fraction)> progress;
 
   Status validate() const;  // names the field, its value and the rule
 };

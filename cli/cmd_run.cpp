@@ -13,6 +13,7 @@
 #include "analysis/pack_spec.h"
 #include "analysis/worst.h"
 #include "base/file_io.h"
+#include "base/progress.h"
 #include "cli/commands.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
@@ -92,18 +93,26 @@ int run_run(const RunArgs& a) {
                    "shorten it to iterate faster\n",
                    d->duration() * 1e3, d->frames.size(), kLongTrafficSeconds * 1e3);
   }
+  // Progress on stderr while the engines run, when it is a terminal (base/progress.h).
+  ProgressLine line({.label = "isolink run", .enabled = !a.quiet});
+  auto progress = [&line](const std::string& what, double f) { line.show_fraction(what, f); };
   RunOptions ro;
   ro.engine = *parse_engine(a.engine);  // CLI11 checked the choice
+  ro.progress = progress;
   StatusOr<LinkRun> run = run_link(*spec, *parts, ro);
   if (!run) return fail(run.status().with_context(a.spec));
   // The worst case over all legal traffic, beside the spec's traffic (its own verdict).
   std::optional<analysis::WorstResult> worst;
   if (!a.no_worst) {
-    StatusOr<analysis::WorstResult> w = analysis::worst_case(*spec, *parts);
+    StatusOr<analysis::WorstResult> w =
+        analysis::worst_case(*spec, *parts, {.progress = [&](const std::string& what, double f) {
+          line.show_fraction("worst case, " + what, f);
+        }});
     if (!w) return fail(w.status().with_context(a.spec + ", worst case"));
     worst = std::move(*w);
   }
 
+  line.finish();
   std::vector<std::string> images;
   if (!a.no_images) {
     if (Status s = render_run_images(*spec, *run, bundle->staging(), &images); !s.ok())

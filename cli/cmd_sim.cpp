@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "analysis/simulate.h"
+#include "base/progress.h"
 #include "base/si_number.h"
 #include "cli/commands.h"
 
@@ -62,7 +63,11 @@ int run_sim(const SimArgs& a) {
   if (a.reltol > 0) req.reltol = a.reltol;
   if (a.method == "trap") req.method = IntegrationMethod::Trapezoidal;
   if (a.method == "gear") req.method = IntegrationMethod::Gear2;
+  // Progress on stderr while the engine runs, when it is a terminal (base/progress.h).
+  ProgressLine line({.label = "isolink sim", .enabled = !a.quiet});
+  req.progress = [&line](const char* phase, double f) { line.show_fraction(phase, f); };
   StatusOr<SimulationResult> r = simulate_netlist(*netlist, req);
+  line.finish();
   if (!r) {
     const std::string& m = r.status().message();  // diagnostics already say file:line:col
     std::cerr << (m.find(": error: ") == std::string::npos ? "isolink sim: error: " : "") << m

@@ -10,6 +10,7 @@
 
 #include "analysis/worst.h"
 #include "base/file_io.h"
+#include "base/progress.h"
 #include "cli/commands.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
@@ -42,7 +43,12 @@ int run_worst(const WorstArgs& a) {
     spec->stimulus.directions = {link::Direction::kDown, link::Direction::kUp};
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load(a.part_dirs);
   if (!parts) return fail(parts.status());
-  StatusOr<analysis::WorstResult> w = analysis::worst_case(*spec, *parts);
+  // Progress on stderr while it runs, when it is a terminal (base/progress.h).
+  ProgressLine line({.label = "isolink worst", .enabled = !a.quiet});
+  StatusOr<analysis::WorstResult> w = analysis::worst_case(
+      *spec, *parts,
+      {.progress = [&line](const std::string& what, double f) { line.show_fraction(what, f); }});
+  line.finish();
   if (!w) return fail(w.status().with_context(a.spec));
   const std::string json = analysis::worst_json(*w).dump(2) + "\n";
   if (!a.out_dir.empty()) {

@@ -219,6 +219,7 @@ StatusOr<LtiResponses> LtiResponses::compute(const Circuit& circuit,
 
     ++r.stats_.steps;
     tau = t1;
+    if (opt.on_progress && (r.stats_.steps & 1023) == 0) opt.on_progress(tau);
     for (size_t k = 0; k < nk; ++k) {
       for (int u = 1; u <= n; ++u) xdot[k][u] = a0 * xnew[k][u] + hist_part[k][u];
       std::swap(x[k], xnew[k]);

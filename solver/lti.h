@@ -41,6 +41,7 @@
 // over hours, so for them the march simply runs to the horizon with large steps on the slow tail.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -64,6 +65,8 @@ struct LtiOptions {
   // `auto` sets a quarter of the run, since a march over the whole run costs more than the
   // transient (one solve per source and step against one per step).
   double settle_by = 0.0;
+  // Called with the lag reached, every 1024 accepted march steps (a progress display).
+  std::function<void(double tau)> on_progress;
 
   // Errors name the field, its value and the rule it breaks.
   Status validate() const;

@@ -328,6 +328,7 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
 
     // Accept.
     ++stats.accepted;
+    if (opt.on_progress && (stats.accepted & 1023) == 0) opt.on_progress(t);
     for (int u = 1; u <= n; ++u) xdot[u] = a0 * xnew[u] + hist_part[u];
     t = lands ? bp : t + step;
     std::swap(x, xnew);

@@ -17,6 +17,7 @@
 //   |x| so far; steps come from a ladder tmax / 2^k so factorizations are reused.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -50,6 +51,8 @@ struct TransientOptions {
   // operating point is solved, then released; with uic it is the node's voltage at t = 0.
   std::vector<std::pair<int, double>> node_ic;
   long max_steps = 20'000'000;  // accepted + rejected steps before giving up
+  // Called with the time reached, every 1024 accepted steps (a progress display; empty: none).
+  std::function<void(double t)> on_progress;
 
   double effective_tmax() const;
   // Errors name the field, its value and the rule it breaks.

@@ -6,9 +6,11 @@
 #pragma once
 
 #include <gtest/gtest.h>
+#include <pty.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -48,6 +50,38 @@ inline CliResult run_isolink(const std::string& binary, const std::string& args,
   const int status = std::system(cmd.c_str());
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(base + "_stdout.txt"),
           slurp(base + "_stderr.txt")};
+}
+
+// The same with stderr on a pseudo-terminal (what a user at a terminal sees: progress lines);
+// stdout goes to a file of the test's folder. err holds everything written to the terminal.
+inline CliResult run_isolink_on_terminal(const std::string& binary, const std::string& args,
+                                         const std::string& tag = "tty") {
+  const std::string base = test_dir() + "/" + tag;
+  const std::string cmd = binary + " " + args + " >" + base + "_stdout.txt";
+  int master = -1;
+  const pid_t pid = forkpty(&master, nullptr, nullptr, nullptr);
+  if (pid < 0) return {};
+  if (pid == 0) {
+    execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  CliResult r;
+  char buf[4096];
+  for (;;) {
+    const ssize_t n = read(master, buf, sizeof buf);
+    if (n > 0) {
+      r.err.append(buf, static_cast<size_t>(n));
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    break;  // EIO once the child side is closed
+  }
+  close(master);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(base + "_stdout.txt");
+  return r;
 }
 
 }  // namespace isolink::testing

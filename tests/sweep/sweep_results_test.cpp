@@ -252,11 +252,5 @@ TEST(SweepResults, ResumeKeepsGoodRowsAndDropsACutRow) {
       << bad.status().message();
 }
 
-TEST(SweepResults, DurationText) {
-  EXPECT_EQ(duration_text(12.34), "12.3 s");
-  EXPECT_EQ(duration_text(245), "4 min 05 s");
-  EXPECT_EQ(duration_text(3720), "1 h 02 min");
-}
-
 }  // namespace
 }  // namespace isolink::analysis::sweep
