@@ -159,6 +159,23 @@ TEST(SweepSpec, UnknownTopLevelAndNestedKeys) {
             std::string::npos);
 }
 
+TEST(SweepSpec, OutputsAddTheNoiseFamilyAndRefuseUnknownOnes) {
+  StatusOr<SweepSpec> plain = read_sweep_text(kBase + "sweep: {cable.length: [1, 2]}\n", "s.yaml");
+  ASSERT_TRUE(plain.ok()) << plain.status().message();
+  EXPECT_FALSE(plain->noise_outputs);
+  for (const char* o : {"outputs: [noise]\n", "outputs: noise\n"}) {
+    StatusOr<SweepSpec> s =
+        read_sweep_text(kBase + "sweep: {cable.length: [1, 2]}\n" + o, "sweep.yaml");
+    ASSERT_TRUE(s.ok()) << s.status().message();
+    EXPECT_TRUE(s->noise_outputs) << o;
+  }
+  const std::string e = read_error(kBase + "sweep: {cable.length: [1]}\noutputs: [noise, nosie]\n");
+  EXPECT_NE(e.find("sweep.yaml:8:18: error: key 'outputs': 'nosie' is not a result family; the "
+                   "one known is noise"),
+            std::string::npos)
+      << e;
+}
+
 TEST(SweepSpec, BadValueIsReportedAtTheValue) {
   const std::string e = read_error(kBase + R"(sweep:
   cable.length: [1, -2]
