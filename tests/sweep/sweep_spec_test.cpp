@@ -176,6 +176,21 @@ TEST(SweepSpec, OutputsAddTheNoiseFamilyAndRefuseUnknownOnes) {
       << e;
 }
 
+// The example that sweeps TI's chokes against BCI immunity reads: 4 isolation variants x 3
+// lengths, with the noise columns.
+TEST(SweepSpec, ChokeImmunityExampleReads) {
+  StatusOr<SweepSpec> s =
+      read_sweep_file(std::string(ISOLINK_EXAMPLES_DIR) + "/sweep_choke_immunity.yaml");
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  EXPECT_TRUE(s->noise_outputs);
+  EXPECT_EQ(s->size(), 12u);
+  const PointOutcome p = make_point(*s, 4);  // ACT45B-510 at 5 m
+  ASSERT_TRUE(p.status.ok()) << p.status.message();
+  EXPECT_EQ(p.point.cells, (std::vector<std::string>{"ACT45B-510", "5"}));
+  EXPECT_EQ(p.point.spec.noise.injection, "bci");
+  EXPECT_DOUBLE_EQ(p.point.spec.noise.level, 0.1);
+}
+
 TEST(SweepSpec, BadValueIsReportedAtTheValue) {
   const std::string e = read_error(kBase + R"(sweep:
   cable.length: [1, -2]
