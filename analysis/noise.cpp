@@ -486,19 +486,24 @@ StatusOr<NoiseResult> analyze_noise(const link::LinkSpec& spec, const link::Part
   return r;
 }
 
-StatusOr<NoiseRun> run_noise(const link::LinkSpec& spec, const link::PartLibrary& parts) {
-  NoiseRun out;
-  StatusOr<LinkRun> run = run_link(spec, parts);
-  if (!run) return run.status();
-  out.run = std::move(*run);
+StatusOr<NoiseResult> analyze_noise_of_run(const link::LinkSpec& spec,
+                                           const link::PartLibrary& parts, const LinkRun& run) {
   std::vector<NoiseDirectionInput> inputs;
-  for (const DirectionRun& d : out.run.directions) {
+  for (const DirectionRun& d : run.directions) {
     const bool data = d.data.has_value();
     if (!data && !d.tones.has_value()) return Status::Error("noise: a direction without traffic");
     inputs.push_back({d.link.direction, data ? &*d.data : &*d.tones,
                       data ? &d.rules : &d.tone_rules, &d.sim.wave, d.link.expected});
   }
-  StatusOr<NoiseResult> noise = analyze_noise(spec, parts, inputs);
+  return analyze_noise(spec, parts, inputs);
+}
+
+StatusOr<NoiseRun> run_noise(const link::LinkSpec& spec, const link::PartLibrary& parts) {
+  NoiseRun out;
+  StatusOr<LinkRun> run = run_link(spec, parts);
+  if (!run) return run.status();
+  out.run = std::move(*run);
+  StatusOr<NoiseResult> noise = analyze_noise_of_run(spec, parts, out.run);
   if (!noise) return noise.status();
   out.noise = std::move(*noise);
   return out;

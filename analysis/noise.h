@@ -183,6 +183,11 @@ StatusOr<NoiseResult> analyze_noise(const link::LinkSpec& spec, const link::Part
                                     std::span<const NoiseDirectionInput> inputs,
                                     const NoiseOptions& opt = {});
 
+// analyze_noise on a link already simulated and scored per direction (run_link on the same
+// spec): each direction's data check (else its tone check), rules and waveform.
+StatusOr<NoiseResult> analyze_noise_of_run(const link::LinkSpec& spec,
+                                           const link::PartLibrary& parts, const LinkRun& run);
+
 // The link simulated and scored per direction (run_link), then analyze_noise on it: the work of
 // `isolink noise`.
 struct NoiseRun {

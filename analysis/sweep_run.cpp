@@ -26,12 +26,21 @@ namespace isolink::analysis::sweep {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-// The columns after the point's own: verdict .. error.
+// The columns after the point's own: verdict .. fail_reason, [the noise columns], seconds, error.
 const std::vector<std::string> kResultColumns = {
     "verdict",         "worst_metric",  "worst_margin_rel",
     "margin_vstart_V", "margin_vend_V", "margin_width_ns",
     "margin_edge_ns",  "decoded_ok",    "fail_reason",
     "seconds",         "error"};
+constexpr size_t kBeforeNoise = 9;  // verdict .. fail_reason
+const std::vector<std::string> kNoiseColumns = {"noise.verdict",
+                                                "noise.immunity_min_db",
+                                                "noise.down.immunity_min",
+                                                "noise.down.immunity_min_db",
+                                                "noise.down.freq_hz",
+                                                "noise.up.immunity_min",
+                                                "noise.up.immunity_min_db",
+                                                "noise.up.freq_hz"};
 // Scale of each kMetrics margin in the CSV (V, V, ns, ns).
 constexpr std::array<double, 4> kCsvScale = {1.0, 1.0, 1e9, 1e9};
 
@@ -70,7 +79,9 @@ std::string first_line(const std::string& s) {
 std::vector<std::string> results_header(const SweepSpec& s) {
   std::vector<std::string> h{"point"};
   for (const std::string& c : s.point_columns()) h.push_back(c);
-  h.insert(h.end(), kResultColumns.begin(), kResultColumns.end());
+  h.insert(h.end(), kResultColumns.begin(), kResultColumns.begin() + kBeforeNoise);
+  if (s.noise_outputs) h.insert(h.end(), kNoiseColumns.begin(), kNoiseColumns.end());
+  h.insert(h.end(), kResultColumns.begin() + kBeforeNoise, kResultColumns.end());
   return h;
 }
 
@@ -84,6 +95,16 @@ std::string results_row(const PointResult& r) {
   for (size_t m = 0; m < kMetrics.size(); ++m) add(num(r.margin[m] * kCsvScale[m]));
   add(r.decoded_ok ? (*r.decoded_ok ? "true" : "false") : "");
   add(r.reason);
+  if (r.noise) {
+    const PointResult::Noise& n = *r.noise;
+    add(n.verdict);
+    add(num(n.immunity_min_db));
+    for (size_t d = 0; d < 2; ++d) {
+      add(num(n.immunity_min[d]));
+      add(num(n.immunity_min_db_dir[d]));
+      add(num(n.freq_hz[d]));
+    }
+  }
   add(fmt::format("{:.2f}", r.seconds));
   add(r.error);
   return line + "\n";
@@ -114,6 +135,20 @@ StatusOr<PointResult> parse_results_row(std::string_view line, size_t ncells, si
   if (d == "true") r.decoded_ok = true;
   if (d == "false") r.decoded_ok = false;
   r.reason = f[k++];
+  if (ncolumns == 1 + ncells + kResultColumns.size() + kNoiseColumns.size()) {
+    PointResult::Noise n;
+    n.verdict = f[k++];
+    if (n.verdict != "pass" && n.verdict != "fail" && !n.verdict.empty())
+      return Status::Error("noise.verdict is not pass, fail or empty: '" + n.verdict + "'");
+    bool ok = parse_double(f[k++], &n.immunity_min_db);
+    for (size_t dir = 0; dir < 2; ++dir) {
+      ok = parse_double(f[k++], &n.immunity_min[dir]) && ok;
+      ok = parse_double(f[k++], &n.immunity_min_db_dir[dir]) && ok;
+      ok = parse_double(f[k++], &n.freq_hz[dir]) && ok;
+    }
+    if (!ok) return Status::Error("bad noise column");
+    r.noise = n;
+  }
   if (!parse_double(f[k++], &r.seconds)) return Status::Error("bad seconds");
   if (std::isnan(r.seconds)) r.seconds = 0;
   r.error = f[k++];
@@ -182,6 +217,19 @@ PointResult score_run(const LinkRun& run) {
   return r;
 }
 
+PointResult::Noise noise_cells(const NoiseResult& r) {
+  PointResult::Noise n;
+  n.verdict = r.pass ? "pass" : "fail";
+  n.immunity_min_db = noise_immunity_min_db(r);
+  for (const NoiseDirection& d : r.directions) {
+    const size_t k = d.direction == link::Direction::kDown ? 0 : 1;
+    n.immunity_min[k] = d.immunity_min;
+    n.immunity_min_db_dir[k] = 20 * std::log10(std::max(d.immunity_min / r.spec.level, 1e-20));
+    n.freq_hz[k] = d.immunity_min_freq;
+  }
+  return n;
+}
+
 PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t index,
                       const PointOptions& opt) {
   const double t0 = now_seconds();
@@ -195,6 +243,8 @@ PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t
     r.decoded_ok.reset();
     r.reason.clear();
     r.error = first_line(message);
+    r.noise.reset();
+    if (s.noise_outputs) r.noise.emplace();
     r.seconds = now_seconds() - t0;
     return r;
   };
@@ -208,6 +258,11 @@ PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t
     r = score_run(*run);
     r.index = index;
     r.cells = std::move(cells);
+    if (s.noise_outputs) {
+      StatusOr<NoiseResult> noise = analyze_noise_of_run(po.point.spec, parts, *run);
+      if (!noise) return fail("noise: " + noise.status().message());
+      r.noise = noise_cells(*noise);
+    }
     if (!opt.waves_dir.empty()) {
       const Waveform w = run_waveforms(*run, po.point.spec.sim.tstep);
       const std::string path = fmt::format("{}/point_{:05}.csv", opt.waves_dir, index);
@@ -310,6 +365,8 @@ std::vector<size_t> ResultLog::todo() const {
 void ResultLog::add(const PointResult& in) {
   PointResult padded = in;
   padded.cells.resize(ncells_);  // a point that failed before its cells were known
+  if (spec_->noise_outputs && !padded.noise) padded.noise.emplace();
+  if (!spec_->noise_outputs) padded.noise.reset();
   const PointResult r = round_trip(padded, ncells_, ncolumns_);
   const std::string row = results_row(r);
   std::lock_guard<std::mutex> lock(mu_);
@@ -552,6 +609,31 @@ nlohmann::ordered_json summary_json(const SweepSpec& s, const std::vector<PointR
     j["yield_by_grid_point"] = by;
   }
   j["boundary"] = boundary_json(s, results);
+  if (s.noise_outputs) {
+    // The noise verdicts and the point with the lowest immunity (dB re its test level).
+    size_t npass = 0, nfail = 0;
+    const PointResult* nworst = nullptr;
+    for (const PointResult& r : results) {
+      if (!r.noise) continue;
+      npass += r.noise->verdict == "pass";
+      nfail += r.noise->verdict == "fail";
+      if (!std::isnan(r.noise->immunity_min_db) &&
+          (!nworst || r.noise->immunity_min_db < nworst->noise->immunity_min_db))
+        nworst = &r;
+    }
+    ordered_json n{{"pass", npass}, {"fail", nfail}};
+    if (nworst) {
+      ordered_json w{{"point", nworst->index}};
+      const std::vector<std::string> cols = s.point_columns();
+      for (size_t i = 0; i < cols.size() && i < nworst->cells.size(); ++i)
+        w[cols[i]] = nworst->cells[i];
+      w["immunity_min_db"] = nworst->noise->immunity_min_db;
+      n["worst"] = w;
+    } else {
+      n["worst"] = nullptr;
+    }
+    j["noise"] = n;
+  }
   return j;
 }
 

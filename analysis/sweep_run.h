@@ -20,6 +20,18 @@
 // "none". fail_reason lists what failed, in short: the metrics of failing pulses (dip, width, edge,
 // vstart, vend), "decode: <fault>" for frames that do not decode, "bytes differ", "no signal" (no
 // pulse at all); a point can fail with every margin positive (a dip, a frame that does not decode).
+// With `outputs: [noise]` in the sweep file, each point also runs the noise analysis on its spec
+// (analyze_noise_of_run on the point's own run: what `isolink noise` gives for that spec) and
+// these columns follow fail_reason:
+//   noise.verdict                 pass | fail: the spec's noise test level against the immunity
+//   noise.immunity_min_db         the lowest immunity over the directions and the band, in dB re
+//                                 the test level (noise.level): 20 log10(immunity / level), > 0
+//                                 passes, -400 when the link has no noise budget at all
+//   noise.<dir>.immunity_min      per direction (down, up): the lowest immunity over the band, in
+//                                 the unit of noise.level (A for bci and dm, V for ground_shift)
+//   noise.<dir>.immunity_min_db   the same in dB re the test level
+//   noise.<dir>.freq_hz           the frequency of that minimum
+// Empty where a direction was not run or the point is an error. `verdict` stays the link's own.
 // A point whose spec is invalid or whose simulation fails has verdict "error", the message's
 // first line in `error` (CSV-quoted) and empty margins; the sweep goes on. Numbers are written with
 // 6 significant digits and every total (summary.json, plots) is computed from the rows as written,
@@ -40,6 +52,7 @@
 #include <vector>
 
 #include "analysis/link_run.h"
+#include "analysis/noise.h"
 #include "analysis/sweep_spec.h"
 #include "base/csv.h"
 #include "base/progress.h"
@@ -64,6 +77,18 @@ struct PointResult {
   std::string reason;              // fail_reason: why a failing point fails ("dip; decode: sync")
   double seconds = 0;              // wall time of the point
   std::string error;
+  // The noise columns (`outputs: [noise]`); present (maybe empty) exactly when the sweep has them.
+  struct Noise {
+    std::string verdict;                                                // pass | fail | ""
+    double immunity_min_db = std::numeric_limits<double>::quiet_NaN();  // over the directions
+    std::array<double, 2> immunity_min = {std::numeric_limits<double>::quiet_NaN(),
+                                          std::numeric_limits<double>::quiet_NaN()};
+    std::array<double, 2> immunity_min_db_dir = {std::numeric_limits<double>::quiet_NaN(),
+                                                 std::numeric_limits<double>::quiet_NaN()};
+    std::array<double, 2> freq_hz = {std::numeric_limits<double>::quiet_NaN(),
+                                     std::numeric_limits<double>::quiet_NaN()};
+  };
+  std::optional<Noise> noise;  // indexed by link::Direction (down, up)
 };
 
 // The results.csv header for a sweep.
@@ -79,6 +104,8 @@ using isolink::split_csv_line;
 
 // Scores a finished run: verdict, margins, decoded_ok.
 PointResult score_run(const LinkRun& run);
+// The noise columns of a noise result (analysis/noise.h).
+PointResult::Noise noise_cells(const NoiseResult& r);
 
 struct PointOptions {
   RunOptions run;

@@ -632,12 +632,14 @@ StatusOr<SweepSpec> read_sweep_text(const std::string& text, const std::string& 
   s.path = name;
   s.name = std::filesystem::path(name).stem().string();
   if (!root.IsMap())
-    return doc->error(root, "a sweep file is a YAML map with keys base, sweep, mode, monte_carlo");
+    return doc->error(
+        root, "a sweep file is a YAML map with keys base, sweep, mode, monte_carlo, outputs");
 
   // Keys in the order they are needed: base first, then sweep (checked against it), then Monte
   // Carlo (its tolerances can depend on the swept keys).
   YAML::Node base_node, sweep_node, mc_node;
   std::string mode = "grid";
+  std::vector<std::string> outputs;
   Status st = config::read_map(*doc, root, "",
                                {
                                    {"base",
@@ -657,8 +659,19 @@ StatusOr<SweepSpec> read_sweep_text(const std::string& text, const std::string& 
                                       mc_node.reset(n);
                                       return Status::Ok();
                                     }},
+                                   {"outputs", config::read_text_list(*doc, &outputs)},
                                });
   if (!st.ok()) return st;
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    const std::string& o = outputs[i];
+    const YAML::Node on = root["outputs"];
+    if (o != "noise")
+      return doc->error(on.IsSequence() ? YAML::Node(on[i]) : on,
+                        fmt::format("key 'outputs': '{}' is not a result family; the one known "
+                                    "is noise (the noise-immunity columns)",
+                                    o));
+    s.noise_outputs = true;
+  }
   s.mode = mode == "zip" ? Mode::kZip : Mode::kGrid;
   if (s.name.empty() || s.name.find_first_of("/\\") != std::string::npos)
     return doc->error(root["name"], "key 'name': a non-empty name without '/'");

@@ -19,6 +19,8 @@
 //       cap: {ends.isolation: {type: cap, cap: 2.2n}}
 //       transformer: {ends.isolation: {type: transformer, part: HMU1228NL}}
 //   mode: grid                        # grid: every combination | zip: the i-th values together
+//   outputs: [noise]                  # more result columns per point: noise = the point's noise
+//                                     # immunity (isolink noise on the point's spec; sweep_run.h)
 //   monte_carlo:
 //     samples: 500
 //     seed: 1
@@ -115,6 +117,9 @@ struct SweepSpec {
   Mode mode = Mode::kGrid;
   std::vector<Axis> axes;
   MonteCarlo mc;
+  // `outputs: [noise]`: every point also runs the noise analysis (analysis/noise.h) on its spec,
+  // and results.csv gets the noise columns (sweep_run.h).
+  bool noise_outputs = false;
 
   size_t grid_size() const;  // points before Monte Carlo (1 without axes)
   size_t samples() const { return mc.samples > 0 ? static_cast<size_t>(mc.samples) : 1; }

@@ -97,6 +97,65 @@ TEST(SweepResults, HeaderAndRowRoundTrip) {
             (std::vector<std::string>{"a", "b,c", "", "d\"e"}));
 }
 
+// With `outputs: [noise]` the noise columns sit between fail_reason and seconds; an error row
+// has them empty; rows read back to the same numbers (6 digits).
+TEST(SweepResults, NoiseColumnsRoundTrip) {
+  StatusOr<SweepSpec> ns = read_sweep_text(kSweep + "outputs: [noise]\n", "sweep.yaml");
+  ASSERT_TRUE(ns.ok()) << ns.status().message();
+  const std::vector<std::string> h = results_header(*ns);
+  EXPECT_EQ(h, (std::vector<std::string>{"point",
+                                         "cable.length",
+                                         "rx.isolation.cap",
+                                         "verdict",
+                                         "worst_metric",
+                                         "worst_margin_rel",
+                                         "margin_vstart_V",
+                                         "margin_vend_V",
+                                         "margin_width_ns",
+                                         "margin_edge_ns",
+                                         "decoded_ok",
+                                         "fail_reason",
+                                         "noise.verdict",
+                                         "noise.immunity_min_db",
+                                         "noise.down.immunity_min",
+                                         "noise.down.immunity_min_db",
+                                         "noise.down.freq_hz",
+                                         "noise.up.immunity_min",
+                                         "noise.up.immunity_min_db",
+                                         "noise.up.freq_hz",
+                                         "seconds",
+                                         "error"}));
+  PointResult r = result(3, *ns, "pass", 0.25);
+  PointResult::Noise n;
+  n.verdict = "fail";
+  n.immunity_min_db = -13.59751836;
+  n.immunity_min[0] = 0.0208989315;
+  n.immunity_min_db_dir[0] = -13.59751836;
+  n.freq_hz[0] = 8852367.9;
+  r.noise = n;
+  const std::string row = results_row(r);
+  EXPECT_EQ(row,
+            "3,2,4.7e-09,pass,vstart,0.25,0.4,0.5,20,30,true,,fail,-13.5975,0.0208989,-13.5975,"
+            "8.85237e+06,,,,1.25,\n");
+  StatusOr<PointResult> back = parse_results_row(row.substr(0, row.size() - 1), 2, h.size());
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  ASSERT_TRUE(back->noise.has_value());
+  EXPECT_EQ(back->noise->verdict, "fail");
+  EXPECT_DOUBLE_EQ(back->noise->immunity_min[0], 0.0208989);
+  EXPECT_DOUBLE_EQ(back->noise->freq_hz[0], 8.85237e6);
+  EXPECT_TRUE(std::isnan(back->noise->immunity_min[1]));
+  EXPECT_EQ(results_row(*back), row);
+  PointResult e = result(5, *ns, "error", 0);
+  e.noise.emplace();
+  const std::string erow = results_row(e);
+  EXPECT_NE(erow.find(",error,,,,,,,,,,,,,,,,,1.25,"), std::string::npos) << erow;
+  EXPECT_TRUE(parse_results_row(erow.substr(0, erow.size() - 1), 2, h.size()).ok());
+  // A bad noise verdict is refused.
+  EXPECT_FALSE(parse_results_row("3,2,4.7e-09,pass,,,,,,,,,maybe,,,,,,,,1,", 2, h.size()).ok());
+  // A sweep without the family has no such columns (and reads no such row).
+  EXPECT_EQ(results_header(spec()).size() + 8, h.size());
+}
+
 eye::WorstMargin wm(const std::string& metric, double value, double limit, double margin) {
   eye::WorstMargin w;
   w.metric = metric;

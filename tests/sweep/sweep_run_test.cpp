@@ -17,6 +17,10 @@
 #include <string>
 #include <vector>
 
+#include "analysis/noise.h"
+#include "analysis/sweep_spec.h"
+#include "netlists/link/parts.h"
+
 namespace isolink::analysis::sweep {
 namespace {
 
@@ -133,6 +137,61 @@ TEST(SweepSim, ResultsMatchIsolinkRunPointByPoint) {
   EXPECT_EQ(sum["pass"].get<int>() + sum["fail"].get<int>(), 3);
   EXPECT_TRUE(fs::exists(dir + "/out/sweep_margin.png"));
   EXPECT_FALSE(fs::exists(dir + "/out/sweep_heatmap.png"));  // one axis
+}
+
+// `outputs: [noise]`: each point's noise columns are exactly what run_noise (the work of
+// `isolink noise`) gives for that point's spec, in both directions; the row carries them.
+TEST(SweepSim, NoiseColumnsEqualRunNoiseOnThePointsSpec) {
+  const std::string text = R"(base:
+  name: t
+  tx: {device: bq7961x}
+  rx: {device: bq7961x}
+  cable: {length: 1, material: pp}
+  stimulus: {frames: ["single-read dev=1 reg=0x0215 n=1"]}
+  noise: {level: 10m, points_per_decade: 4, time_domain: false}
+outputs: [noise]
+sweep:
+  choke:
+    none: {ends.isolation: {type: cap, cap: 2.2n}}
+    ACT45B-510: {ends.isolation: {type: capchoke, cap: 2.2n, chokes: [ACT45B-510-2P-TL003]}}
+)";
+  StatusOr<SweepSpec> s = read_sweep_text(text, "sweep.yaml");
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
+  ASSERT_TRUE(parts.ok()) << parts.status().message();
+  const size_t ncolumns = results_header(*s).size();
+  for (size_t i = 0; i < s->size(); ++i) {
+    const PointResult r = run_point(*s, *parts, i, {});
+    ASSERT_EQ(r.verdict == "error", false) << r.error;
+    ASSERT_TRUE(r.noise.has_value());
+    const PointOutcome po = make_point(*s, i);
+    ASSERT_TRUE(po.status.ok());
+    StatusOr<NoiseRun> direct = run_noise(po.point.spec, *parts);
+    ASSERT_TRUE(direct.ok()) << direct.status().message();
+    const NoiseResult& n = direct->noise;
+    ASSERT_EQ(n.directions.size(), 2u);
+    EXPECT_EQ(r.noise->verdict, n.pass ? "pass" : "fail");
+    EXPECT_EQ(r.noise->immunity_min_db, noise_immunity_min_db(n));
+    for (const NoiseDirection& d : n.directions) {
+      const size_t k = d.direction == link::Direction::kDown ? 0 : 1;
+      EXPECT_EQ(r.noise->immunity_min[k], d.immunity_min) << "point " << i << " dir " << k;
+      EXPECT_EQ(r.noise->freq_hz[k], d.immunity_min_freq) << "point " << i << " dir " << k;
+      EXPECT_NEAR(r.noise->immunity_min_db_dir[k], 20 * std::log10(d.immunity_min / 10e-3), 1e-9);
+      EXPECT_GT(d.immunity_min, 0.0);
+    }
+    // The overall figure is the weaker direction's.
+    EXPECT_DOUBLE_EQ(r.noise->immunity_min_db,
+                     std::min(r.noise->immunity_min_db_dir[0], r.noise->immunity_min_db_dir[1]));
+    // The link's own columns are run_link's, as without the noise family.
+    EXPECT_EQ(r.verdict, direct->run.pass ? "pass" : "fail");
+    // Through the CSV: 6 significant digits.
+    const std::string row = results_row(r);
+    StatusOr<PointResult> back =
+        parse_results_row(row.substr(0, row.size() - 1), s->point_columns().size(), ncolumns);
+    ASSERT_TRUE(back.ok()) << back.status().message();
+    EXPECT_NEAR(back->noise->immunity_min[0], r.noise->immunity_min[0],
+                1e-5 * r.noise->immunity_min[0]);
+  }
 }
 
 TEST(SweepSim, AFailingPointIsRecordedAndTheSweepGoesOn) {

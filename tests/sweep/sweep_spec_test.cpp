@@ -159,6 +159,38 @@ TEST(SweepSpec, UnknownTopLevelAndNestedKeys) {
             std::string::npos);
 }
 
+TEST(SweepSpec, OutputsAddTheNoiseFamilyAndRefuseUnknownOnes) {
+  StatusOr<SweepSpec> plain = read_sweep_text(kBase + "sweep: {cable.length: [1, 2]}\n", "s.yaml");
+  ASSERT_TRUE(plain.ok()) << plain.status().message();
+  EXPECT_FALSE(plain->noise_outputs);
+  for (const char* o : {"outputs: [noise]\n", "outputs: noise\n"}) {
+    StatusOr<SweepSpec> s =
+        read_sweep_text(kBase + "sweep: {cable.length: [1, 2]}\n" + o, "sweep.yaml");
+    ASSERT_TRUE(s.ok()) << s.status().message();
+    EXPECT_TRUE(s->noise_outputs) << o;
+  }
+  const std::string e = read_error(kBase + "sweep: {cable.length: [1]}\noutputs: [noise, nosie]\n");
+  EXPECT_NE(e.find("sweep.yaml:8:18: error: key 'outputs': 'nosie' is not a result family; the "
+                   "one known is noise"),
+            std::string::npos)
+      << e;
+}
+
+// The example that sweeps TI's chokes against BCI immunity reads: 4 isolation variants x 3
+// lengths, with the noise columns.
+TEST(SweepSpec, ChokeImmunityExampleReads) {
+  StatusOr<SweepSpec> s =
+      read_sweep_file(std::string(ISOLINK_EXAMPLES_DIR) + "/sweep_choke_immunity.yaml");
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  EXPECT_TRUE(s->noise_outputs);
+  EXPECT_EQ(s->size(), 12u);
+  const PointOutcome p = make_point(*s, 4);  // ACT45B-510 at 5 m
+  ASSERT_TRUE(p.status.ok()) << p.status.message();
+  EXPECT_EQ(p.point.cells, (std::vector<std::string>{"ACT45B-510", "5"}));
+  EXPECT_EQ(p.point.spec.noise.injection, "bci");
+  EXPECT_DOUBLE_EQ(p.point.spec.noise.level, 0.1);
+}
+
 TEST(SweepSpec, BadValueIsReportedAtTheValue) {
   const std::string e = read_error(kBase + R"(sweep:
   cable.length: [1, -2]
