@@ -86,4 +86,9 @@ class Layout : public ::testing::Test {
   fs::path dir_;
 };
 
+// A real capture under tests/eye/data/real (SOURCES.md says where each comes from).
+inline std::string real(const char* name) {
+  return std::string(ISOLINK_EYE_DATA "/real/") + name;
+}
+
 }  // namespace isolink::eye::scope_test

@@ -296,6 +296,53 @@ TEST_F(Layout, BomCrOnlyBlankLinesAndFooter) {
             "to end there (a footer) or to go on as numbers");
 }
 
+// ---- real exports (tests/eye/data/real/SOURCES.md) ----
+
+struct RealCsv {
+  const char* file;
+  CsvColumns cols;
+  const char* layout;
+  size_t samples;
+  double t0, dt;
+  double first, last;  // volts, as the file's first and last data rows print them
+};
+
+TEST(RealCsvExports, ReadAsTheFilesPrintThemAndNeverPass) {
+  auto diff = [](const char* c) {
+    CsvColumns cols;
+    cols.diff = c;
+    return cols;
+  };
+  const RealCsv cases[] = {
+      // Rigol DS1054Z: X,CH1..CH4,Start,Increment then Sequence,Volt..,-3e-07,5e-10
+      {"DS1054Z-A.csv", {}, "rigol start/increment", 1200, -3e-7, 5e-10, 3.28, 4.08},
+      {"DS1054Z-A.csv", diff("CH4"), "rigol start/increment", 1200, -3e-7, 5e-10, 0.0, -0.2},
+      // Rigol DS1102E: X,CH1, then Second,Volt,
+      {"DS1102E-B.csv", {}, "header + units row", 600, -5.9999998e-06, 2e-8, 4.40, -1.36},
+      // Rigol DS1102D: X,CH 1 (V),CH 2 (V); no time unit (read as seconds, noted)
+      {"DS1102D-A.csv", diff("CH2"), "header", 1024, -0.004688, 1.001e-5, 8.40, 0.16},
+      // Rigol DS1052E: quoted preamble, "Time (s)","Voltage (V)","Voltage (V)", a ",," last line
+      {"DS1052E.csv", {}, "header", 8192, 0.0, 2e-9, 1.72, -0.04},
+      {"DS1052E.csv", diff("#3"), "header", 8192, 0.0, 2e-9, 9.92, 4.96},
+  };
+  for (const RealCsv& c : cases) {
+    SCOPED_TRACE(fmt::format("{} {}", c.file, c.cols.diff));
+    CaptureInfo info;
+    StatusOr<Waveform> w = read_capture({real(c.file)}, c.cols, &info);
+    ASSERT_TRUE(w.ok()) << w.status().message();
+    EXPECT_EQ(info.layouts[0], c.layout);
+    ASSERT_EQ(w->samples(), c.samples);
+    EXPECT_NEAR(w->time.front(), c.t0, 1e-9 * std::abs(c.t0) + 1e-18);
+    EXPECT_NEAR(info.interval, c.dt, 1e-4 * c.dt);
+    EXPECT_NEAR(w->columns[0].front(), c.first, 1e-9);
+    EXPECT_NEAR(w->columns[0].back(), c.last, 1e-9);
+    StatusOr<CheckResult> r = check_waveform(*w, *load_rules("bq7961x"));
+    ASSERT_TRUE(r.ok());
+    EXPECT_FALSE(r->pass);
+    EXPECT_TRUE(r->inconclusive) << summary_text(*r);
+  }
+}
+
 // ---- hazards ----
 
 CheckResult check_text(const std::string& text, const CsvColumns& c = {}) {
