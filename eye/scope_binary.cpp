@@ -591,7 +591,8 @@ StatusOr<std::vector<BinaryTrace>> read_tek_wfm(BinFile& f) {
   const size_t base = version == 1 ? 166 : 168;
   const size_t exp_size = version == 3 ? 160 : 156, imp_size = version == 3 ? 136 : 132;
   const size_t exp1 = base, imp1 = base + 2 * exp_size;
-  const size_t curve = imp1 + 2 * imp_size + 12 + 12 + 24;
+  const size_t update = imp1 + 2 * imp_size + 12 + 12;  // after the two time base blocks
+  const size_t curve = update + 24;
   StatusOr<Fields> hd = f.fields(0, curve + 30, s.big, "the waveform header");
   if (!hd) return hd.status();
   const Fields& h = *hd;
@@ -669,7 +670,12 @@ StatusOr<std::vector<BinaryTrace>> read_tek_wfm(BinFile& f) {
     return f.error(curve + 14, fmt::format("data from byte {} to {} of the curve buffer: expected "
                                            "two or more whole {}-byte points",
                                            data_start, post_start, bpp));
-  const uint64_t first = data_start / bpp, n = (post_start - data_start) / bpp;
+  const uint64_t n = (post_start - data_start) / bpp;
+  // the trigger's position within a sample (update spec "TT offset", in samples)
+  const double tt = h.f64(update + 4);
+  if (!std::isfinite(tt) || std::abs(tt) > 1)
+    return f.error(update + 4,
+                   fmt::format("trigger time offset {:g} samples: expected -1 to 1", tt));
   BinaryTrace tr;
   tr.name = s.text(40, 32);
   if (tr.name.empty()) tr.name = "waveform";
@@ -678,12 +684,13 @@ StatusOr<std::vector<BinaryTrace>> read_tek_wfm(BinFile& f) {
                              vscale * *ys, voffset * *ys, &tr.v, "the curve buffer's data");
       !st2.ok())
     return st2;
-  const double t_first = (toffset + static_cast<double>(first) * tscale) * *xs;
+  // The first point after the precharge is at imp_dim1.offset (Tektronix's own reader,
+  // tekwfm.py of Programmatic-Control-Examples, which also adds the TT offset).
+  const double t_first = (toffset + tt * tscale) * *xs;
   uniform_time(&tr, t_first, tscale * *xs);
-  tr.time_from = fmt::format(
-      "t = imp_dim1.offset + (precharge + i) * imp_dim1.scale ({:g} + i * "
-      "{:g} s)",
-      t_first, tscale * *xs);
+  tr.time_from =
+      fmt::format("t = imp_dim1.offset + (TT offset + i) * imp_dim1.scale ({:g} + i * {:g} s)",
+                  t_first, tscale * *xs);
   return std::vector<BinaryTrace>{std::move(tr)};
 }
 

@@ -8,9 +8,10 @@
 //    ":CURVE #<n><length><data>"; t = XZERO + (i - PT_OFF) * XINCR, v = (raw - YOFF) * YMULT +
 //    YZERO (Tektronix "MSO/DPO/TDS Series Programmer Manual", WFMOutpre and CURVe commands).
 //  - Tektronix .wfm (WFM#001, #002, #003, either byte order): static file info, waveform header,
-//    curve buffer with pre- and post-charge; v = exp_dim1.scale * adc + exp_dim1.offset, t =
-//    imp_dim1.offset + (data_start / bytes_per_point + i) * imp_dim1.scale (Tektronix "Reference
-//    Waveform File Format", 001-1378-03).
+//    curve buffer with pre- and post-charge (skipped); v = exp_dim1.scale * adc + exp_dim1.offset,
+//    t = imp_dim1.offset + (TT offset + i) * imp_dim1.scale from the first point after the
+//    precharge (Tektronix "Reference Waveform File Format", 077-0220-xx / 001-1378-03, and
+//    Tektronix's own reader tekwfm.py in Programmatic-Control-Examples).
 //  - Keysight/Agilent .bin ("AG" cookie) and Rigol .bin ("RG", MSO5000 / DS1000Z-E / MSO7000 /
 //    MSO8000, the same layout): file header, per waveform a header (points, x increment,
 //    x origin, units, label) and data buffers of float32 volts; t = XOrigin + i * XIncrement

@@ -295,7 +295,7 @@ std::string tek_wfm(bool p, int version, bool big, int32_t format = 0, size_t pr
   d.text(exp1 + 20, "V");
   d.put<int32_t>(exp1 + 72, format);
   d.put<double>(imp1, kDt);
-  d.put<double>(imp1 + 8, w.time[0] - static_cast<double>(pre) * kDt);
+  d.put<double>(imp1 + 8, w.time[0]);  // the first point after the precharge
   d.put<uint32_t>(imp1 + 16, static_cast<uint32_t>(n + pre + post));
   d.text(imp1 + 20, "s");
   d.put<uint32_t>(curve + 10, 0);
@@ -489,6 +489,17 @@ TEST(RealCaptures, ReadToTheFiguresTheirSourcesState) {
                                  5e-7,
                                  {{0, 1.8492462635}, {1, 1.8894472122}, {1999, 1.8090451955}},
                                  1e-9});
+  // Tektronix sample_1.wfm (WFM#003, int8): Tektronix's tekwfm.py gives volts = adc * 0.0024
+  // (a float32 scale stored as a double: 0.00239999995) + 0 for the 1000 points between the 16-byte
+  // precharge and the postcharge, t = tstart (-10 ns)
+  // + tfrac (0.8923646 samples) * tscale (20 ps) + i * tscale; adc 10, 32, 50 ... 11
+  expect_trace("tek_sample_1.wfm", {0,
+                                    "waveform",
+                                    1000,
+                                    -1e-8 + 0.8923646071698386 * 2e-11,
+                                    2e-11,
+                                    {{0, 0.024}, {1, 0.0768}, {2, 0.12}, {999, 0.0264}},
+                                    1e-8});
   // hand-decoded from the LECROY_2_3 template: 502 int16 points (LOFIRST) from byte 357, gain
   // 1.24995e-4 V, offset -1.0 V, HORIZ_INTERVAL 1 ns, HORIZ_OFFSET -120.745 ns, WAVE_SOURCE 1
   expect_trace("lecroy_4.trc", {0,
@@ -501,8 +512,8 @@ TEST(RealCaptures, ReadToTheFiguresTheirSourcesState) {
 }
 
 TEST(RealCaptures, NoPassOnCapturesThatAreNoDaisyChainRecord) {
-  for (const char* f :
-       {"DS1000E-A.wfm", "DS1102E-B.wfm", "MSO5000-A.bin", "agilent_1.bin", "lecroy_4.trc"}) {
+  for (const char* f : {"DS1000E-A.wfm", "DS1102E-B.wfm", "MSO5000-A.bin", "agilent_1.bin",
+                        "lecroy_4.trc", "tek_sample_1.wfm"}) {
     SCOPED_TRACE(f);
     StatusOr<Waveform> w = read_capture({real(f)}, {});
     ASSERT_TRUE(w.ok()) << w.status().message();
@@ -525,6 +536,10 @@ TEST(RealCaptures, RefusedWithTheReason) {
             real("lecroy_3.trc") +
                 ":byte 155: error: SUBARRAY_COUNT 20: a sequence of 20 segments; isolink reads one "
                 "record: save a single segment");
+  // five FastFrame frames (N frames - 1 at byte 72 of the static file information)
+  EXPECT_EQ(error_of(read_capture({real("tek_sample_ff1.wfm")}, {})),
+            real("tek_sample_ff1.wfm") +
+                ":byte 72: error: 5 FastFrame frames: one record is read; save a single frame");
   // a 10X probe: DS1000E and DS1000D differ in how they store it (RigolWFM channel.py)
   EXPECT_EQ(error_of(read_capture({real("DS1052E.wfm")}, {})),
             real("DS1052E.wfm") +
