@@ -324,6 +324,9 @@ TEST(RealCsvExports, ReadAsTheFilesPrintThemAndNeverPass) {
       // Rigol DS1052E: quoted preamble, "Time (s)","Voltage (V)","Voltage (V)", a ",," last line
       {"DS1052E.csv", {}, "header", 8192, 0.0, 2e-9, 1.72, -0.04},
       {"DS1052E.csv", diff("#3"), "header", 8192, 0.0, 2e-9, 9.92, 4.96},
+      // R&S RTP: values only; the XML header rs_rtp_01.bin beside it gives XStart -2.5 ms and
+      // Resolution 1.25 us (RigolWFM tests/test_rohde_schwarz.py: times[0] = -0.0025)
+      {"rs_rtp_01.Wfm.csv", {}, "no header", 4000, -0.0025, 1.25e-6, -0.031620555, 1.027668},
   };
   for (const RealCsv& c : cases) {
     SCOPED_TRACE(fmt::format("{} {}", c.file, c.cols.diff));
