@@ -362,14 +362,15 @@ StatusOr<std::vector<BinaryTrace>> read_ag_bin(BinFile& f, bool rigol) {
   std::vector<BinaryTrace> out;
   uint64_t pos = 12;
   for (int64_t w = 1; w <= count; ++w) {
-    StatusOr<Fields> h = f.fields(pos, 140, false, fmt::format("waveform {}'s header", w));
+    // 140 bytes; Rigol MSO7000/8000 write 128 (no time tag, no segment index)
+    StatusOr<Fields> h = f.fields(pos, 128, false, fmt::format("waveform {}'s header", w));
     if (!h) return h.status();
     const int64_t hsize = h->s(0, 4), type = h->s(4, 4), nbuf = h->s(8, 4), points = h->s(12, 4);
     const double xinc = h->f64(32), xorg = h->f64(40);
     const int64_t xunits = h->s(48, 4), yunits = h->s(52, 4);
-    if (hsize < 140)
+    if (hsize < 128)
       return f.error(pos,
-                     fmt::format("waveform {}: header size {}: expected at least 140", w, hsize));
+                     fmt::format("waveform {}: header size {}: expected 128 or more", w, hsize));
     // 1 normal, 2 peak detect, 3 average, 4/5 histograms, 6 logic
     if (type != 1 && type != 3)
       return f.error(h->at(4),

@@ -109,7 +109,7 @@ TEST_F(Layout, TektronixIsfBinary) {
 // bytes per point 4, int32 buffer size); float32 volts. Little-endian. Rigol's MSO5000 .bin
 // (programming guide, ":SAVE:WAVeform") is the same with the cookie "RG01", an empty label and
 // XOrigin counted from the first point to the trigger (t0 = -XOrigin).
-std::string ag_bin(bool rigol, int32_t type = 1) {
+std::string ag_bin(bool rigol, int32_t type = 1, int32_t header = 140) {
   const Waveform& w = record();
   const auto n = static_cast<int32_t>(w.samples());
   Image f;
@@ -117,7 +117,7 @@ std::string ag_bin(bool rigol, int32_t type = 1) {
   f.put<int32_t>(8, 2);
   size_t pos = 12;
   for (int ch = 0; ch < 2; ++ch) {
-    f.put<int32_t>(pos, 140);
+    f.put<int32_t>(pos, header);
     f.put<int32_t>(pos + 4, type);
     f.put<int32_t>(pos + 8, 1);  // one buffer
     f.put<int32_t>(pos + 12, n);
@@ -128,7 +128,7 @@ std::string ag_bin(bool rigol, int32_t type = 1) {
     f.put<int32_t>(pos + 48, 2);  // second
     f.put<int32_t>(pos + 52, 1);  // volt
     if (!rigol) f.text(pos + 112, fmt::format("Channel {}", ch + 1));
-    pos += 140;
+    pos += static_cast<size_t>(header);
     f.put<int32_t>(pos, 12);
     f.put<int16_t>(pos + 4, 1);
     f.put<int16_t>(pos + 6, 4);
@@ -167,6 +167,8 @@ TEST_F(Layout, RigolBinBinary) {
   EXPECT_EQ(info.columns[1].name, "waveform 2");
   EXPECT_NEAR(info.t_begin, record().time[0], 1e-15);
   EXPECT_NE(info.time_from.find("t = -XOrigin + i * XIncrement"), std::string::npos);
+  // MSO7000/8000: 128-byte waveform headers (no time tag, no segment index)
+  expect_pass({write("MSO8104.bin", ag_bin(true, 1, 128))}, c, nullptr, 2e-6);
 }
 
 // ---- LeCroy .trc ----
