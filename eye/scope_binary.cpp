@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <bit>
 #include <cctype>
 #include <cerrno>
 #include <charconv>
@@ -167,33 +168,58 @@ class BinFile {
       chunk.b.resize(m * w);
       if (std::fread(chunk.b.data(), w, m, f_.get()) != m)
         return error(at + i * w, fmt::format("cannot read {}", what));
-      for (uint64_t k = 0; k < m; ++k, ++i) {
-        const size_t o = k * w;
-        double raw = 0;
-        switch (kind) {
-          case Sample::kI8:
-          case Sample::kI16:
-          case Sample::kI32:
-            raw = static_cast<double>(chunk.s(o, w));
-            break;
-          case Sample::kU8:
-          case Sample::kU16:
-          case Sample::kU32:
-            raw = static_cast<double>(chunk.u(o, w));
-            break;
-          case Sample::kF32:
-            raw = chunk.f32(o);
-            break;
-          case Sample::kF64:
-            raw = chunk.f64(o);
-            break;
+      // one decoding loop per sample type; bytes swapped when the file's order is not the host's
+      const bool swap = big != (std::endian::native == std::endian::big);
+      uint64_t bad = m;
+      double bad_x = 0;
+      auto run = [&]<class T>() {
+        const unsigned char* p = chunk.b.data();
+        for (uint64_t k = 0; k < m; ++k, p += sizeof(T)) {
+          unsigned char b[sizeof(T)];
+          std::memcpy(b, p, sizeof(T));
+          if (swap) std::reverse(b, b + sizeof(T));
+          T raw;
+          std::memcpy(&raw, b, sizeof(T));
+          const double x = gain * static_cast<double>(raw) + offset;
+          if (!std::isfinite(x) || std::abs(x) > 1e30) {
+            bad = k;
+            bad_x = x;
+            return;
+          }
+          v->push_back(x);
         }
-        const double x = gain * raw + offset;
-        if (!std::isfinite(x) || std::abs(x) > 1e30)
-          return error(at + i * w, fmt::format("{}: sample {} is {:g}: a clipped or invalid sample",
-                                               what, i, x));
-        v->push_back(x);
+      };
+      switch (kind) {
+        case Sample::kI8:
+          run.template operator()<int8_t>();
+          break;
+        case Sample::kU8:
+          run.template operator()<uint8_t>();
+          break;
+        case Sample::kI16:
+          run.template operator()<int16_t>();
+          break;
+        case Sample::kU16:
+          run.template operator()<uint16_t>();
+          break;
+        case Sample::kI32:
+          run.template operator()<int32_t>();
+          break;
+        case Sample::kU32:
+          run.template operator()<uint32_t>();
+          break;
+        case Sample::kF32:
+          run.template operator()<float>();
+          break;
+        case Sample::kF64:
+          run.template operator()<double>();
+          break;
       }
+      if (bad < m)
+        return error(at + (i + bad) * w, fmt::format("{}: sample {} is {:g}: a clipped or invalid "
+                                                     "sample",
+                                                     what, i + bad, bad_x));
+      i += m;
     }
     return Status::Ok();
   }
@@ -207,8 +233,16 @@ class BinFile {
 
 // t = t0 + i * dt for every sample of tr.v.
 void uniform_time(BinaryTrace* tr, double t0, double dt) {
-  tr->t.resize(tr->v.size());
-  for (size_t i = 0; i < tr->t.size(); ++i) tr->t[i] = t0 + static_cast<double>(i) * dt;
+  tr->t.clear();
+  tr->t.reserve(tr->v.size());
+  for (size_t i = 0; i < tr->v.size(); ++i) tr->t.push_back(t0 + static_cast<double>(i) * dt);
+}
+
+// A reader's result of one trace, moved in (a braced list would copy the samples).
+std::vector<BinaryTrace> one_trace(BinaryTrace&& tr) {
+  std::vector<BinaryTrace> out;
+  out.push_back(std::move(tr));
+  return out;
 }
 
 // A unit written in a header, as a scale to volts (or seconds); nullopt when it is neither.
@@ -348,7 +382,7 @@ StatusOr<std::vector<BinaryTrace>> read_isf(BinFile& f) {
       !st.ok())
     return st;
   uniform_time(&tr, (xzero - ptoff * xincr) * xscale, xincr * xscale);
-  return std::vector<BinaryTrace>{std::move(tr)};
+  return one_trace(std::move(tr));
 }
 
 // ---- Keysight/Agilent .bin ("AG") and Rigol .bin ("RG01") ----
@@ -557,7 +591,7 @@ StatusOr<std::vector<BinaryTrace>> read_lecroy(BinFile& f) {
   uniform_time(&tr, t_first, dt * *xs);
   tr.time_from =
       fmt::format("t = HORIZ_OFFSET + i * HORIZ_INTERVAL ({:g} + i * {:g} s)", t_first, dt * *xs);
-  return std::vector<BinaryTrace>{std::move(tr)};
+  return one_trace(std::move(tr));
 }
 
 // ---- Tektronix .wfm (WFM#001/#002/#003) ----
@@ -692,7 +726,7 @@ StatusOr<std::vector<BinaryTrace>> read_tek_wfm(BinFile& f) {
   tr.time_from =
       fmt::format("t = imp_dim1.offset + (TT offset + i) * imp_dim1.scale ({:g} + i * {:g} s)",
                   t_first, tscale * *xs);
-  return std::vector<BinaryTrace>{std::move(tr)};
+  return one_trace(std::move(tr));
 }
 
 // ---- Rigol .wfm, DS1000E/D family ----

@@ -373,17 +373,22 @@ StatusOr<OneFile> read_binary_one(const std::string& path, const std::string& ki
   std::vector<double> sign;
   std::vector<std::string> how, notes;
   if (Status st = pick_terms(l, terms, path, &picked, &sign, &how, &notes); !st.ok()) return st;
-  const BinaryTrace& first = (*traces)[picked[0]];
-  OneFile out;
-  out.t = first.t;
-  out.v.assign(first.v.size(), 0.0);
-  for (size_t i = 0; i < picked.size(); ++i) {
-    const BinaryTrace& tr = (*traces)[picked[i]];
-    if (tr.t != first.t)
+  BinaryTrace& first = (*traces)[picked[0]];
+  for (size_t i = 1; i < picked.size(); ++i)
+    if ((*traces)[picked[i]].t != first.t)
       return Status::Error(
           fmt::format("{}: error: waveforms '{}' and '{}' have different time "
                       "bases: P and N must come from one acquisition",
-                      path, first.name, tr.name));
+                      path, first.name, (*traces)[picked[i]].name));
+  // The first trace's samples are moved, not copied: memory stays the samples read.
+  OneFile out;
+  const std::string time_from = first.time_from;
+  out.t = std::move(first.t);
+  out.v = std::move(first.v);
+  if (sign[0] != 1.0)
+    for (double& x : out.v) x *= sign[0];
+  for (size_t i = 1; i < picked.size(); ++i) {
+    const BinaryTrace& tr = (*traces)[picked[i]];
     for (size_t j = 0; j < tr.v.size(); ++j) out.v[j] += sign[i] * tr.v[j];
   }
   for (size_t j = 1; j < out.t.size(); ++j)
@@ -392,7 +397,7 @@ StatusOr<OneFile> read_binary_one(const std::string& path, const std::string& ki
   if (info) {
     info->files.push_back(path);
     info->layouts.push_back(kind);
-    if (info->time_from.empty()) info->time_from = first.time_from;
+    if (info->time_from.empty()) info->time_from = time_from;
     for (size_t i = 0; i < picked.size(); ++i) {
       const ScopeColumn& c = l.columns[picked[i]];
       info->columns.push_back(

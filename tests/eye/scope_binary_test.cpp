@@ -154,6 +154,13 @@ TEST_F(Layout, KeysightBinBinary) {
   EXPECT_EQ(error_of(read_capture({pk}, {})),
             pk + ":byte 16: error: waveform 1: waveform type 2 (peak detect, min/max pairs): only "
                  "normal (1) and average (3) records are read; acquire in normal mode");
+  // a NaN sample never reaches the check: refused at its byte (12 + 140 + 12 + 5 * 4)
+  Image nan;
+  nan.b = ag_bin(false);
+  nan.put<float>(184, std::nanf(""));
+  const std::string np = write("nan.bin", nan.b);
+  EXPECT_EQ(error_of(read_capture({np}, {})),
+            np + ":byte 184: error: waveform 1: sample 5 is nan: a clipped or invalid sample");
 }
 
 TEST_F(Layout, RigolBinBinary) {
