@@ -427,6 +427,16 @@ TEST_F(Layout, RigolWfmBinary) {
   EXPECT_EQ(error_of(read_capture({ip}, c)),
             ip + ":byte 74: error: CH2 is inverted on the scope: whether the saved counts are "
                  "inverted is not documented; turn Invert off");
+  // alternate trigger: CH2 has its own time base (at 236), here half the rate: P and N must
+  // share one acquisition
+  Image alt;
+  alt.b = rigol_wfm();
+  alt.put<uint8_t>(142, 4);
+  alt.put<float>(236 + 16, static_cast<float>(0.5 / kDt));
+  const std::string ap = write("alt.wfm", alt.b);
+  EXPECT_EQ(error_of(read_capture({ap}, c)),
+            ap + ": error: waveforms 'CH1' and 'CH2' have different time bases: P and N must come "
+                 "from one acquisition");
   // other Rigol .wfm families are refused with what to do
   const std::string z =
       write("DS1054Z.wfm", std::string("\x01\xff\xff\xff", 4) + std::string(60, '\0'));
