@@ -12,11 +12,12 @@
 //    t = imp_dim1.offset + (TT offset + i) * imp_dim1.scale from the first point after the
 //    precharge (Tektronix "Reference Waveform File Format", 077-0220-xx / 001-1378-03, and
 //    Tektronix's own reader tekwfm.py in Programmatic-Control-Examples).
-//  - Keysight/Agilent .bin ("AG" cookie) and Rigol .bin ("RG", MSO5000 / DS1000Z-E / MSO7000 /
-//    MSO8000, the same layout): file header, per waveform a header (points, x increment,
-//    x origin, units, label) and data buffers of float32 volts; t = XOrigin + i * XIncrement
-//    (Keysight InfiniiVision/Infiniium user's guides, "Binary Data File Format"; Rigol MSO5000
-//    programming guide, ":SAVE:WAVeform" binary format).
+//  - Keysight/Agilent .bin ("AG" cookie) and Rigol .bin ("RG01": MSO5000, MSO7000, MSO8000, the
+//    same layout; MSO7000/8000 waveform headers are 128 bytes, not 140): file header, per
+//    waveform a header (points, x increment, x origin, units, label) and data buffers of float32
+//    volts; t = XOrigin + i * XIncrement, for Rigol t = -XOrigin + i * XIncrement (Keysight
+//    InfiniiVision/Infiniium user's guides, "Binary Data File Format"; Rigol MSO5000 programming
+//    guide, ":SAVE:WAVeform"; RigolWFM's rigol_mso5000_bin.ksy and rigol_7000_8000_bin.ksy).
 //  - LeCroy .trc (WAVEDESC, template LECROY_2_3, optionally after a "#9nnnnnnnnn" block header):
 //    byte order from COMM_ORDER, 8- or 16-bit samples from COMM_TYPE; v = VERTICAL_GAIN * raw -
 //    VERTICAL_OFFSET, t = HORIZ_OFFSET + i * HORIZ_INTERVAL (Teledyne LeCroy remote control
@@ -25,8 +26,8 @@
 //    8-bit counts; v = (125 - raw) * scale/25 - shift * scale/25, scale in uV/div times the probe,
 //    t = offset - points * dt / 2 + i * dt, dt = 1 / sample rate (Rigol "DS1000E/D WFM structure
 //    instruction"; the Kaitai description rigol_1000e_wfm.ksy of the RigolWFM project).
-// Other Rigol .wfm families (DS1000Z, DS2000, DS4000, DS1000B/C, DHO) and other .bin layouts are
-// refused with a message saying to export CSV.
+// Other Rigol .wfm families (DS1000Z, DS2000, DS4000, DS1000B/C, DHO) and other .bin layouts
+// (Rigol DHO "RG03", Siglent, R&S .Wfm.bin) are refused with a message saying to export CSV.
 //
 // Usage:
 //   if (std::optional<std::string> kind = binary_kind("c1.isf")) {
