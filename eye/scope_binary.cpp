@@ -271,7 +271,7 @@ bool to_double(const std::string* s, double* x) {
   const char* b = s->data();
   while (b < s->data() + s->size() && *b == '+') ++b;
   auto [p, ec] = std::from_chars(b, s->data() + s->size(), *x);
-  return ec == std::errc() && std::isfinite(*x);
+  return ec == std::errc() && p == s->data() + s->size() && std::isfinite(*x);
 }
 
 StatusOr<std::vector<BinaryTrace>> read_isf(BinFile& f) {
@@ -316,10 +316,16 @@ StatusOr<std::vector<BinaryTrace>> read_isf(BinFile& f) {
     return f.error(0, "XINCR missing or not positive: expected the sample interval in seconds");
   if (!to_double(h.get({"YMULT", "YMU"}), &ymult))
     return f.error(0, "YMULT missing: expected the volts per count");
-  to_double(h.get({"XZERO", "XZE"}), &xzero);
-  to_double(h.get({"PT_OFF", "PT_O"}), &ptoff);
-  to_double(h.get({"YOFF", "YOF"}), &yoff);
-  to_double(h.get({"YZERO", "YZE"}), &yzero);
+  // optional: 0 when absent, refused when present but not a finite number
+  struct Optional {
+    const char* key;
+    const char* abbrev;
+    double* x;
+  };
+  for (const Optional& o : {Optional{"XZERO", "XZE", &xzero}, Optional{"PT_OFF", "PT_O", &ptoff},
+                            Optional{"YOFF", "YOF", &yoff}, Optional{"YZERO", "YZE", &yzero}})
+    if (const std::string* text = h.get({o.key, o.abbrev}); text && !to_double(text, o.x))
+      return f.error(0, fmt::format("{} \"{}\": expected a finite number", o.key, *text));
   const std::string* fmt_ = h.get({"BN_FMT", "BN_F"});
   const std::string* order = h.get({"BYT_OR", "BYT_O"});
   const std::string* enc = h.get({"ENCDG", "ENC"});
@@ -405,24 +411,24 @@ StatusOr<std::vector<BinaryTrace>> read_ag_bin(BinFile& f, bool rigol) {
     if (hsize < 128)
       return f.error(pos,
                      fmt::format("waveform {}: header size {}: expected 128 or more", w, hsize));
-    // 1 normal, 2 peak detect, 3 average, 4/5 histograms, 6 logic
-    if (type != 1 && type != 3)
+    // 1 normal, 2 peak detect, 3 average, 4/5 histograms, 6 logic (skipped: not a signal)
+    const bool logic = type == 6;
+    if (type != 1 && type != 3 && !logic)
       return f.error(h->at(4),
                      fmt::format("waveform {}: waveform type {} ({}): only normal (1) and "
                                  "average (3) records are read; acquire in normal mode",
                                  w, type,
                                  type == 2                ? "peak detect, min/max pairs"
-                                 : type == 6              ? "logic"
                                  : type == 4 || type == 5 ? "a histogram"
                                                           : "unknown"));
-    if (points < 2 || !(xinc > 0) || !std::isfinite(xinc) || !std::isfinite(xorg))
+    if (!logic && (points < 2 || !(xinc > 0) || !std::isfinite(xinc) || !std::isfinite(xorg)))
       return f.error(h->at(12), fmt::format("waveform {}: {} points, x increment {:g}: expected 2 "
                                             "or more points and a positive increment",
                                             w, points, xinc));
-    if (xunits != 2)
+    if (!logic && xunits != 2)
       return f.error(h->at(48),
                      fmt::format("waveform {}: x unit code {}: expected 2 (seconds)", w, xunits));
-    if (yunits != 1)
+    if (!logic && yunits != 1)
       return f.error(h->at(52),
                      fmt::format("waveform {}: y unit code {} (3 constant, 4 amps, 5 dB, "
                                  "6 Hz): only volts (1) are read",
@@ -456,7 +462,7 @@ StatusOr<std::vector<BinaryTrace>> read_ag_bin(BinFile& f, bool rigol) {
           !st.ok())
         return st;
       pos = data_at + static_cast<uint64_t>(bsize);
-      if (b > 1) continue;  // further buffers (counts, logic) are not signals
+      if (b > 1 || logic) continue;  // further buffers (counts), logic channels: not signals
       if (btype != 1 || bpp != 4)
         return f.error(d->at(4),
                        fmt::format("waveform {}: buffer type {} with {} bytes a point: only "
@@ -471,9 +477,11 @@ StatusOr<std::vector<BinaryTrace>> read_ag_bin(BinFile& f, bool rigol) {
           !st.ok())
         return st;
     }
+    if (logic) continue;
     uniform_time(&tr, t0, xinc);
     out.push_back(std::move(tr));
   }
+  if (out.empty()) return f.error(8, "only logic waveforms: no analog channel to read");
   return out;
 }
 

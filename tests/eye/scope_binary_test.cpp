@@ -87,6 +87,12 @@ TEST_F(Layout, TektronixIsfBinary) {
   EXPECT_EQ(info.columns[0].channel, "CH1");
   EXPECT_EQ(info.columns[1].channel, "CH2");
   EXPECT_NE(info.time_from.find("XZERO + (i - PT_OFF) * XINCR"), std::string::npos);
+  // a preamble number that is not one is refused, not read as 0
+  std::string bad = isf("Ch1", true);
+  bad.replace(bad.find("XZERO 0.0E+0"), 12, "XZERO 1.0E+x");
+  const std::string bp = write("bad.isf", bad);
+  EXPECT_EQ(error_of(read_capture({bp, b}, {})),
+            bp + ":byte 0: error: XZERO \"1.0E+x\": expected a finite number");
   // a cut curve is refused from the file's length, naming the block's offset
   std::string cut = isf("Ch1", true);
   const size_t data_at =
@@ -174,6 +180,16 @@ TEST_F(Layout, RigolBinBinary) {
   EXPECT_EQ(info.columns[1].name, "waveform 2");
   EXPECT_NEAR(info.t_begin, record().time[0], 1e-15);
   EXPECT_NE(info.time_from.find("t = -XOrigin + i * XIncrement"), std::string::npos);
+  // a logic waveform (type 6) among them is skipped, not read as a channel: waveform 2 is logic
+  // here, so waveform 1 is the only analog trace and #2 names nothing
+  Image lg;
+  lg.b = ag_bin(true);
+  lg.put<int32_t>(12 + 140 + 12 + 4 * record().samples() + 4, 6);
+  const std::string lp = write("logic.bin", lg.b);
+  StatusOr<std::vector<BinaryTrace>> tr = read_binary(lp);
+  ASSERT_TRUE(tr.ok()) << tr.status().message();
+  EXPECT_EQ(tr->size(), 1u);
+  EXPECT_FALSE(read_capture({lp}, c).ok());
   // MSO7000/8000: 128-byte waveform headers (no time tag, no segment index)
   expect_pass({write("MSO8104.bin", ag_bin(true, 1, 128))}, c, nullptr, 2e-6);
 }
