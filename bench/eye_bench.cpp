@@ -1,10 +1,15 @@
 // Eye checker throughput: isolink::eye::check_samples on a 10-million-sample waveform
 // (1 ns steps: about 1100 frames of 6.5 us with 2 us idle, droop, ringing-free edges, noise),
-// and CSV parsing of a 1-million-row capture. Run: build/bench/eye_bench
+// CSV parsing of a 1-million-row capture, and reading a 10-million-sample LeCroy .trc (binary,
+// from a file: the size-checked, chunked byte cursor of eye/scope_binary.cpp). Run:
+// build/bench/eye_bench
 #include <benchmark/benchmark.h>
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -92,6 +97,53 @@ void BM_ParseCsv1M(benchmark::State& state) {
   state.SetBytesProcessed(state.iterations() * static_cast<int64_t>(text.size()));
 }
 BENCHMARK(BM_ParseCsv1M)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
+
+// A LECROY_2_3 .trc (little-endian, 16-bit, 0.1 mV counts) of the same waveform, read from a
+// temporary file: header checks, chunked reads, the time axis, what-was-read.
+void BM_ReadTrc10M(benchmark::State& state) {
+  const size_t n = static_cast<size_t>(state.range(0));
+  const Wave w = make_wave(n, 1e-9);
+  std::string d(346, '\0');
+  auto put = [&](size_t off, const void* x, size_t len) { std::memcpy(&d[off], x, len); };
+  const int16_t comm_type = 1, comm_order = 1;
+  const int32_t desc = 346, bytes = static_cast<int32_t>(2 * n), count = static_cast<int32_t>(n),
+                last = count - 1, one = 1;
+  const float gain = 1e-4f, offset = 0.0f, interval = 1e-9f;
+  const double t0 = 0.0;
+  std::memcpy(&d[0], "WAVEDESC", 8);
+  std::memcpy(&d[16], "LECROY_2_3", 10);
+  put(32, &comm_type, 2);
+  put(34, &comm_order, 2);
+  put(36, &desc, 4);
+  put(60, &bytes, 4);
+  put(116, &count, 4);
+  put(128, &last, 4);
+  put(136, &one, 4);
+  put(144, &one, 4);
+  put(156, &gain, 4);
+  put(160, &offset, 4);
+  put(176, &interval, 4);
+  put(180, &t0, 8);
+  d[196] = 'V';
+  d[244] = 'S';
+  std::vector<int16_t> raw(n);
+  for (size_t i = 0; i < n; ++i) raw[i] = static_cast<int16_t>(std::lround(w.v[i] / 1e-4));
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "isolink_eye_bench.trc").string();
+  {
+    std::ofstream f(path, std::ios::binary);
+    f.write(d.data(), static_cast<std::streamsize>(d.size()));
+    f.write(reinterpret_cast<const char*>(raw.data()), static_cast<std::streamsize>(2 * n));
+  }
+  for (auto _ : state) {
+    auto r = isolink::eye::read_capture({path}, {});
+    benchmark::DoNotOptimize(r->time.data());
+  }
+  std::filesystem::remove(path);
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(n));
+  state.SetBytesProcessed(state.iterations() * static_cast<int64_t>(346 + 2 * n));
+}
+BENCHMARK(BM_ReadTrc10M)->Arg(10'000'000)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

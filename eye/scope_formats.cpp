@@ -565,7 +565,7 @@ StatusOr<ScopeLayout> detect_layout(
       return err(l.data_line,
                  "one column of values and no time: expected a time column, or the sample "
                  "interval in the preamble ('Sample Interval', 'XInc'; for an R&S .Wfm.csv keep "
-                 "its header file NAME.csv beside it)");
+                 "its header file NAME.csv or NAME.bin beside it)");
   }
   return l;
 }

@@ -36,23 +36,43 @@ std::string lower(std::string_view s) {
 }
 
 // R&S RTx exports NAME.Wfm.csv (data) beside NAME.csv ("Key:value:" lines).
+// The header file beside an R&S .Wfm.csv: NAME.csv of "Key:value:" lines (RTB, RTM, RTO), or
+// NAME.bin, an XML database of <Prop Name="XStart" Value="-0.0025" .../> entries (RTP, newer
+// RTO firmware). Its pairs join the preamble (XStart, Resolution give the time base).
 std::vector<std::pair<std::string, std::string>> rs_sibling_header(const std::string& path) {
   std::vector<std::pair<std::string, std::string>> out;
   const std::string lo = lower(path);
   const std::string tail = ".wfm.csv";
   if (lo.size() <= tail.size() || lo.compare(lo.size() - tail.size(), tail.size(), tail) != 0)
     return out;
-  const std::string header = path.substr(0, path.size() - tail.size()) + ".csv";
-  StatusOr<LineReader> in = LineReader::open(header);
-  if (!in) return out;
+  const std::string stem = path.substr(0, path.size() - tail.size());
   std::string_view line;
-  for (int i = 0; i < 500 && in->next(&line); ++i) {
-    const size_t c = line.find(':');
-    if (c == std::string_view::npos || c == 0) continue;
-    std::string_view v = line.substr(c + 1);
-    const size_t c2 = v.find(':');
-    if (c2 != std::string_view::npos) v = v.substr(0, c2);
-    out.emplace_back(std::string(trim_cell(line.substr(0, c))), std::string(trim_cell(v)));
+  if (StatusOr<LineReader> in = LineReader::open(stem + ".csv"); in) {
+    for (int i = 0; i < 500 && in->next(&line); ++i) {
+      const size_t c = line.find(':');
+      if (c == std::string_view::npos || c == 0) continue;
+      std::string_view v = line.substr(c + 1);
+      const size_t c2 = v.find(':');
+      if (c2 != std::string_view::npos) v = v.substr(0, c2);
+      out.emplace_back(std::string(trim_cell(line.substr(0, c))), std::string(trim_cell(v)));
+    }
+    return out;
+  }
+  StatusOr<LineReader> xml = LineReader::open(stem + ".bin");
+  if (!xml) return out;
+  auto attr = [](std::string_view tag, std::string_view name) -> std::optional<std::string_view> {
+    const std::string key = " " + std::string(name) + "=\"";
+    const size_t a = tag.find(key);
+    if (a == std::string_view::npos) return std::nullopt;
+    const size_t b = tag.find('"', a + key.size());
+    if (b == std::string_view::npos) return std::nullopt;
+    return tag.substr(a + key.size(), b - a - key.size());
+  };
+  for (int i = 0; i < 2000 && xml->next(&line); ++i) {
+    if (i == 0 && line.find("<?xml") == std::string_view::npos) return out;
+    if (line.find("<Prop") == std::string_view::npos) continue;
+    std::optional<std::string_view> name = attr(line, "Name"), value = attr(line, "Value");
+    if (name && value) out.emplace_back(std::string(*name), std::string(*value));
   }
   return out;
 }
@@ -353,17 +373,22 @@ StatusOr<OneFile> read_binary_one(const std::string& path, const std::string& ki
   std::vector<double> sign;
   std::vector<std::string> how, notes;
   if (Status st = pick_terms(l, terms, path, &picked, &sign, &how, &notes); !st.ok()) return st;
-  const BinaryTrace& first = (*traces)[picked[0]];
-  OneFile out;
-  out.t = first.t;
-  out.v.assign(first.v.size(), 0.0);
-  for (size_t i = 0; i < picked.size(); ++i) {
-    const BinaryTrace& tr = (*traces)[picked[i]];
-    if (tr.t != first.t)
+  BinaryTrace& first = (*traces)[picked[0]];
+  for (size_t i = 1; i < picked.size(); ++i)
+    if ((*traces)[picked[i]].t != first.t)
       return Status::Error(
           fmt::format("{}: error: waveforms '{}' and '{}' have different time "
                       "bases: P and N must come from one acquisition",
-                      path, first.name, tr.name));
+                      path, first.name, (*traces)[picked[i]].name));
+  // The first trace's samples are moved, not copied: memory stays the samples read.
+  OneFile out;
+  const std::string time_from = first.time_from;
+  out.t = std::move(first.t);
+  out.v = std::move(first.v);
+  if (sign[0] != 1.0)
+    for (double& x : out.v) x *= sign[0];
+  for (size_t i = 1; i < picked.size(); ++i) {
+    const BinaryTrace& tr = (*traces)[picked[i]];
     for (size_t j = 0; j < tr.v.size(); ++j) out.v[j] += sign[i] * tr.v[j];
   }
   for (size_t j = 1; j < out.t.size(); ++j)
@@ -372,7 +397,7 @@ StatusOr<OneFile> read_binary_one(const std::string& path, const std::string& ki
   if (info) {
     info->files.push_back(path);
     info->layouts.push_back(kind);
-    if (info->time_from.empty()) info->time_from = first.time_from;
+    if (info->time_from.empty()) info->time_from = time_from;
     for (size_t i = 0; i < picked.size(); ++i) {
       const ScopeColumn& c = l.columns[picked[i]];
       info->columns.push_back(

@@ -170,4 +170,21 @@ TEST_F(CliCheck, InconclusiveExitsOneWithReasonAndHint) {
   EXPECT_EQ(j["hints"].size(), 1u);
 }
 
+TEST_F(CliCheck, BinaryCapturesExitOneWhenReadAndTwoWhenRefused) {
+  // real LeCroy captures (tests/eye/data/real/SOURCES.md): a single record is read and is no
+  // daisy-chain record; a sequence of 20 segments is refused at its field's byte offset
+  const std::string real = ISOLINK_EYE_DATA "/real/";
+  EXPECT_EQ(run("check '" + real + "lecroy_4.trc' --json"), 1);
+  nlohmann::json j = nlohmann::json::parse(out_);
+  EXPECT_EQ(j["verdict"], "inconclusive");
+  EXPECT_EQ(j["input"]["layouts"][0], "lecroy trc");
+  EXPECT_EQ(j["input"]["samples"], 502);
+  EXPECT_EQ(run("check '" + real + "lecroy_3.trc'"), 2);
+  EXPECT_NE(err_.find("lecroy_3.trc:byte 155: error: SUBARRAY_COUNT 20: a sequence of 20 "
+                      "segments; isolink reads one record: save a single segment"),
+            std::string::npos)
+      << err_;
+  EXPECT_TRUE(out_.empty()) << out_;
+}
+
 }  // namespace

@@ -1,91 +1,19 @@
 // One test per oscilloscope export layout (issue 14): each file carries a known daisy-chain record
-// (synth::ideal_frames of known bytes, so the verdict is pass and the decoded bytes are known),
-// written here in that layout as the instrument's documentation and public example exports show
-// it. Then the hazards: units, swapped columns, truncated pulses, a flat record, long pulses.
+// (scope_fixture.h: synth::ideal_frames of known bytes, so the verdict is pass and the decoded
+// bytes are known), written here in that layout as the instrument's documentation and public
+// example exports show it. Then the hazards: units, swapped columns, truncated pulses, a flat
+// record, long pulses. Binary captures are in scope_binary_test.cpp.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include <cstdio>
-#include <cstring>
-#include <filesystem>
-#include <fstream>
-#include <functional>
 #include <nlohmann/json.hpp>
 
-#include "eye/check.h"
-#include "eye/waveform_csv.h"
-#include "synth.h"
+#include "scope_fixture.h"
 
 namespace isolink::eye {
 namespace {
 
-namespace fs = std::filesystem;
-
-const std::vector<uint8_t> kBytes = {0x80, 0x15};
-constexpr double kDt = 2e-9;  // sampling step of the record
-constexpr double kCm = 2.5;   // common mode on each leg (V)
-
-// The record: frames of kBytes, v = P - N with P = kCm + v/2, N = kCm - v/2.
-const Waveform& record() {
-  static const Waveform w = synth::ideal_frames(kBytes, FrameFormat{}, 2e-6, kDt);
-  return w;
-}
-
-std::string num(double x, bool comma = false) {
-  char b[40];
-  std::snprintf(b, sizeof b, "%.9g", x);
-  std::string s = b;
-  if (comma)
-    for (char& c : s)
-      if (c == '.') c = ',';
-  return s;
-}
-
-// Rows of the record: row(i, t, p, n) returns one line (without its end).
-std::string rows(const std::function<std::string(size_t, double, double, double)>& row,
-                 const char* eol = "\n") {
-  const Waveform& w = record();
-  std::string out;
-  for (size_t i = 0; i < w.time.size(); ++i) {
-    const double v = w.columns[0][i];
-    out += row(i, w.time[i], kCm + v / 2, kCm - v / 2) + eol;
-  }
-  return out;
-}
-
-class Layout : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("isolink_scope_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string write(const std::string& name, const std::string& text) {
-    const std::string path = (dir_ / name).string();
-    std::ofstream(path, std::ios::binary) << text;
-    return path;
-  }
-  // Reads, checks, and expects a pass decoding kBytes.
-  CheckResult expect_pass(const std::vector<std::string>& files, const CsvColumns& cols,
-                          CaptureInfo* info, double tol = 1e-6) {
-    StatusOr<Waveform> w = read_capture(files, cols, info);
-    EXPECT_TRUE(w.ok()) << (w.ok() ? "" : w.status().message());
-    if (!w.ok()) return {};
-    EXPECT_EQ(w->samples(), record().samples());
-    StatusOr<CheckResult> r = check_waveform(*w, *load_rules("bq7961x"));
-    EXPECT_TRUE(r.ok());
-    EXPECT_TRUE(r->pass) << summary_text(*r);
-    EXPECT_EQ(r->bytes, kBytes);
-    // v = P - N to the writer's 9 digits: the 2 V levels come back within 1 uV (binary
-    // formats: within their quantization, tol)
-    EXPECT_NEAR(*r->vstart_min(), 2.0, tol);
-    return *r;
-  }
-  fs::path dir_;
-};
-
+using namespace scope_test;  // NOLINT: the record and the fixture
 TEST_F(Layout, TektronixClassicOneFilePerChannel) {
   // TDS/TBS: metadata in fields 1-3 of the first rows, time and value in 4-5, a trailing comma
   auto tek = [](const char* src, bool p) {
@@ -368,111 +296,54 @@ TEST_F(Layout, BomCrOnlyBlankLinesAndFooter) {
             "to end there (a footer) or to go on as numbers");
 }
 
-// ---- binary captures, written here from the published format descriptions ----
+// ---- real exports (tests/eye/data/real/SOURCES.md) ----
 
-// Tektronix .isf: WFMOutpre preamble ("MSO/DPO Series Programmer Manual", WFMOutpre:BYT_Nr,
-// BN_Fmt, BYT_Or, NR_Pt, XINcr, XZEro, PT_Off, YMUlt, YOFf, YZEro, WFId) then CURVe's
-// definite-length block "#<n><length><data>"; 2-byte signed big-endian counts here.
-std::string isf(const char* ch, bool p) {
-  const Waveform& w = record();
-  const size_t n = w.samples();
-  std::string data;
-  for (size_t i = 0; i < n; ++i) {
-    const double v = w.columns[0][i];
-    const double leg = p ? kCm + v / 2 : kCm - v / 2;
-    const auto raw = static_cast<int16_t>(std::lround((leg - 2.5) / 1e-4 + 100));
-    data += static_cast<char>((static_cast<uint16_t>(raw) >> 8) & 0xFF);
-    data += static_cast<char>(static_cast<uint16_t>(raw) & 0xFF);
+struct RealCsv {
+  const char* file;
+  CsvColumns cols;
+  const char* layout;
+  size_t samples;
+  double t0, dt;
+  double first, last;  // volts, as the file's first and last data rows print them
+};
+
+TEST(RealCsvExports, ReadAsTheFilesPrintThemAndNeverPass) {
+  auto diff = [](const char* c) {
+    CsvColumns cols;
+    cols.diff = c;
+    return cols;
+  };
+  const RealCsv cases[] = {
+      // Rigol DS1054Z: X,CH1..CH4,Start,Increment then Sequence,Volt..,-3e-07,5e-10
+      {"DS1054Z-A.csv", {}, "rigol start/increment", 1200, -3e-7, 5e-10, 3.28, 4.08},
+      {"DS1054Z-A.csv", diff("CH4"), "rigol start/increment", 1200, -3e-7, 5e-10, 0.0, -0.2},
+      // Rigol DS1102E: X,CH1, then Second,Volt,
+      {"DS1102E-B.csv", {}, "header + units row", 600, -5.9999998e-06, 2e-8, 4.40, -1.36},
+      // Rigol DS1102D: X,CH 1 (V),CH 2 (V); no time unit (read as seconds, noted)
+      {"DS1102D-A.csv", diff("CH2"), "header", 1024, -0.004688, 1.001e-5, 8.40, 0.16},
+      // Rigol DS1052E: quoted preamble, "Time (s)","Voltage (V)","Voltage (V)", a ",," last line
+      {"DS1052E.csv", {}, "header", 8192, 0.0, 2e-9, 1.72, -0.04},
+      {"DS1052E.csv", diff("#3"), "header", 8192, 0.0, 2e-9, 9.92, 4.96},
+      // R&S RTP: values only; the XML header rs_rtp_01.bin beside it gives XStart -2.5 ms and
+      // Resolution 1.25 us (RigolWFM tests/test_rohde_schwarz.py: times[0] = -0.0025)
+      {"rs_rtp_01.Wfm.csv", {}, "no header", 4000, -0.0025, 1.25e-6, -0.031620555, 1.027668},
+  };
+  for (const RealCsv& c : cases) {
+    SCOPED_TRACE(fmt::format("{} {}", c.file, c.cols.diff));
+    CaptureInfo info;
+    StatusOr<Waveform> w = read_capture({real(c.file)}, c.cols, &info);
+    ASSERT_TRUE(w.ok()) << w.status().message();
+    EXPECT_EQ(info.layouts[0], c.layout);
+    ASSERT_EQ(w->samples(), c.samples);
+    EXPECT_NEAR(w->time.front(), c.t0, 1e-9 * std::abs(c.t0) + 1e-18);
+    EXPECT_NEAR(info.interval, c.dt, 1e-4 * c.dt);
+    EXPECT_NEAR(w->columns[0].front(), c.first, 1e-9);
+    EXPECT_NEAR(w->columns[0].back(), c.last, 1e-9);
+    StatusOr<CheckResult> r = check_waveform(*w, *load_rules("bq7961x"));
+    ASSERT_TRUE(r.ok());
+    EXPECT_FALSE(r->pass);
+    EXPECT_TRUE(r->inconclusive) << summary_text(*r);
   }
-  const std::string len = std::to_string(data.size());
-  return fmt::format(
-             ":WFMPRE:BYT_NR 2;BIT_NR 16;ENCDG BIN;BN_FMT RI;BYT_OR MSB;WFID \"{}, DC coupling, "
-             "1.0E+0 V/div, 2.0E-6 s/div, {} points, Sample mode\";NR_PT {};PT_FMT Y;XUNIT "
-             "\"s\";XINCR 2.0E-9;XZERO 0.0E+0;PT_OFF 0;YUNIT \"V\";YMULT 1.0E-4;YOFF 1.0E+2;"
-             "YZERO 2.5E+0;:CURVE #{}{}",
-             ch, n, n, len.size(), len) +
-         data + "\n";
-}
-
-TEST_F(Layout, TektronixIsfBinary) {
-  const std::string a = write("CH1.ISF", isf("Ch1", true));
-  const std::string b = write("CH2.ISF", isf("Ch2", false));
-  CaptureInfo info;
-  // 0.1 mV counts on each leg: v within 0.1 mV
-  expect_pass({a, b}, {}, &info, 1e-4);
-  EXPECT_EQ(info.layouts[0], "tektronix isf");
-  EXPECT_EQ(info.columns[0].channel, "CH1");
-  EXPECT_EQ(info.columns[1].channel, "CH2");
-  EXPECT_NE(info.time_from.find("XZERO + (i - PT_OFF) * XINCR"), std::string::npos);
-  // a cut curve is refused with the count
-  std::string cut = isf("Ch1", true);
-  cut.resize(cut.size() / 2);
-  StatusOr<Waveform> w = read_capture({write("cut.isf", cut), b}, {});
-  ASSERT_FALSE(w.ok());
-  EXPECT_NE(w.status().message().find("the curve ends after"), std::string::npos)
-      << w.status().message();
-}
-
-// Keysight/Agilent .bin (InfiniiVision/Infiniium user's guides, "Binary Data File Format"):
-// file header "AG" "10" int32 size, int32 count; waveform header of 140 bytes (int32 header
-// size, type, buffers, points, count; float32 x display range; double x display origin, x
-// increment, x origin; int32 x units, y units; char date[16], time[16], frame[24], label[16];
-// double time tag; uint32 segment); data header (int32 size 12, int16 type 1 = float, int16
-// bytes per point 4, int32 buffer size); float32 volts. Little-endian.
-template <class T>
-void put(std::string* s, T x) {
-  char b[sizeof(T)];
-  std::memcpy(b, &x, sizeof(T));
-  s->append(b, sizeof(T));
-}
-std::string keysight_bin() {
-  const Waveform& w = record();
-  const auto n = static_cast<int32_t>(w.samples());
-  std::string body;
-  for (int ch = 0; ch < 2; ++ch) {
-    put<int32_t>(&body, 140);
-    put<int32_t>(&body, 1);  // normal
-    put<int32_t>(&body, 1);  // one buffer
-    put<int32_t>(&body, n);
-    put<int32_t>(&body, 1);
-    put<float>(&body, static_cast<float>(w.time.back()));
-    put<double>(&body, 0.0);
-    put<double>(&body, kDt);
-    put<double>(&body, 0.0);
-    put<int32_t>(&body, 2);  // second
-    put<int32_t>(&body, 1);  // volt
-    char text[16 + 16 + 24 + 16] = {};
-    std::snprintf(text + 56, 16, "Channel %d", ch + 1);
-    body.append(text, sizeof text);
-    put<double>(&body, 0.0);
-    put<uint32_t>(&body, 0);
-    put<int32_t>(&body, 12);
-    put<int16_t>(&body, 1);
-    put<int16_t>(&body, 4);
-    put<int32_t>(&body, n * 4);
-    for (double v : w.columns[0])
-      put<float>(&body, static_cast<float>(ch == 0 ? kCm + v / 2 : kCm - v / 2));
-  }
-  std::string file = "AG10";
-  put<int32_t>(&file, static_cast<int32_t>(12 + body.size()));
-  put<int32_t>(&file, 2);
-  return file + body;
-}
-
-TEST_F(Layout, KeysightBinBinary) {
-  CsvColumns c;
-  c.p = "CH1";  // "Channel 1" by channel
-  c.n = "Channel 2";
-  CaptureInfo info;
-  expect_pass({write("scope_1.bin", keysight_bin())}, c, &info, 2e-6);  // float32 legs
-  EXPECT_EQ(info.layouts[0], "keysight bin");
-  EXPECT_EQ(info.columns[0].how, "by channel CH1");
-  // formats not read are refused with what to do
-  StatusOr<Waveform> w = read_capture({write("C1Trace00000.trc", "LECROY_2_3 binary")}, {});
-  ASSERT_FALSE(w.ok());
-  EXPECT_NE(w.status().message().find("lecroy trc captures are not read yet: export the waveform "
-                                      "as CSV"),
-            std::string::npos);
 }
 
 // ---- hazards ----
