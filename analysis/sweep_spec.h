@@ -19,6 +19,9 @@
 //       cap: {ends.isolation: {type: cap, cap: 2.2n}}
 //       transformer: {ends.isolation: {type: transformer, part: HMU1228NL}}
 //   mode: grid                        # grid: every combination | zip: the i-th values together
+// A pack base (base: pack.yaml, a pack spec file): keys are hops.<K>.<key> (hop K, 1..N, N + 1
+// the ring's return hop) or hops.*.<key> (every hop), e.g. hops.9.cable.length: [1, 5, 10];
+// each point is a pack run (PointSpec::pack); no Monte Carlo.
 //   monte_carlo:
 //     samples: 500
 //     seed: 1
