@@ -259,7 +259,7 @@ StatusOr<PackResult> run_pack(const PackSpec& pack, const link::PartLibrary& par
     if (!opt.worst) continue;
     for (size_t k = 0; k < hr.runs.size(); ++k) {
       DirectionWorst w = *distinct[hr.runs[k]].worst;
-      w.direction = own[i][k].direction;  // a symmetric hop's up shares its down's circuit
+      w.direction = own[i][k].direction;      // a symmetric hop's up shares its down's circuit
       w.description = own[i][k].description;  // this hop's direction, its device names
       w.receiver = own[i][k].receiver;
       hr.worst_pass = hr.worst_pass && w.pass;
