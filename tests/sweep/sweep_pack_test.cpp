@@ -57,6 +57,16 @@ std::string pack_text(const std::string& hop_1 = "", const std::string& hop_2 = 
   return t;
 }
 
+// The simulating tests' pack: two hops (fewer simulations), hop 2 with extra keys.
+std::string two_hop_pack(const std::string& hop_2 = "") {
+  return "name: p\n"
+         "stimulus: {frames: [\"stack-write reg=0x0100 data=02\"], direction: down}\n"
+         "hops:\n"
+         "  - {spec: module.yaml, cable: {length: 0.5}}\n"
+         "  - {spec: module.yaml" +
+         hop_2 + "}\n";
+}
+
 const char* kModule =
     "name: module\n"
     "tx: {isolation: {type: cap, cap: 2.2n}}\n"
@@ -178,6 +188,7 @@ TEST(SweepPack, ExtraColumnsRoundTrip) {
 // Each point's row is score_pack of run_pack on the pack written out by hand with that value.
 TEST(SweepPackSim, PointsEqualRunPackOnThePackEditedByHand) {
   const std::string d = setup("sim", "  hops.2.cable.length: [2, 4]\n");
+  write(d + "/pack.yaml", two_hop_pack());
   StatusOr<SweepSpec> s = read_sweep_file(d + "/sweep.yaml");
   ASSERT_TRUE(s.ok()) << s.status().message();
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
@@ -187,7 +198,7 @@ TEST(SweepPackSim, PointsEqualRunPackOnThePackEditedByHand) {
   for (size_t i = 0; i < 2; ++i) {
     const PointResult got = round_trip(run_point(*s, *parts, i, {}), ncells, ncolumns);
     ASSERT_EQ(got.verdict == "error", false) << got.error;
-    write(d + "/hand.yaml", pack_text("", ", cable: {length: " + lengths[i] + "}"));
+    write(d + "/hand.yaml", two_hop_pack(", cable: {length: " + lengths[i] + "}"));
     StatusOr<PackSpec> hand = read_pack_spec_file(d + "/hand.yaml");
     ASSERT_TRUE(hand.ok()) << hand.status().message();
     StatusOr<PackResult> pr = run_pack(*hand, *parts, {});
@@ -211,12 +222,13 @@ TEST(SweepPackSim, PointsEqualRunPackOnThePackEditedByHand) {
 // the pack columns.
 TEST(SweepPackSim, ResumeSkipsThePointsAlreadyDone) {
   const std::string d = setup("resume", "  hops.2.cable.length: [2, 3]\n");
+  write(d + "/pack.yaml", two_hop_pack());
   StatusOr<SweepSpec> s = read_sweep_file(d + "/sweep.yaml");
   ASSERT_TRUE(s.ok()) << s.status().message();
   fs::create_directories(d + "/out");
   std::string header;
   for (const std::string& h : results_header(*s)) header += (header.empty() ? "" : ",") + h;
-  const std::string done = "0,2,pass,width,0.5,0.8,0.6,30,40,true,,99.00,,2,,0.6,0.5,0.7\n";
+  const std::string done = "0,2,pass,width,0.5,0.8,0.6,30,40,true,,99.00,,2,,0.6,0.5\n";
   write(d + "/out/results.csv", header + "\n" + done);
   const std::string cmd = std::string(ISOLINK_BINARY) + " sweep " + d + "/sweep.yaml -o " + d +
                           "/out --resume -q --no-plots > " + d + "/log 2>&1";
