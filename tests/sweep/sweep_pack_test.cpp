@@ -247,5 +247,39 @@ TEST(SweepPackSim, ResumeSkipsThePointsAlreadyDone) {
   EXPECT_NE(f[11], "99.00");
 }
 
+// A point that cannot run (a part that is not in the library: found when the hop is expanded)
+// is an error row with the pack columns present and empty; the sweep goes on and exits 1.
+TEST(SweepPackSim, AFailingPointIsRecordedAndTheSweepGoesOn) {
+  const std::string d = setup("error",
+                              "  hops.2.ends.isolation:\n"
+                              "    - {type: transformer, part: NOPE-123}\n"
+                              "    - {type: cap, cap: 2.2n}\n");
+  write(d + "/pack.yaml", two_hop_pack());
+  StatusOr<SweepSpec> s = read_sweep_file(d + "/sweep.yaml");
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  const std::string cmd = std::string(ISOLINK_BINARY) + " sweep " + d + "/sweep.yaml -o " + d +
+                          "/out -q --no-plots > " + d + "/log 2>&1";
+  EXPECT_EQ(WEXITSTATUS(std::system(cmd.c_str())), 1) << slurp(d + "/log");
+  std::istringstream in(slurp(d + "/out/results.csv"));
+  std::vector<std::vector<std::string>> rows;
+  for (std::string l; std::getline(in, l);) rows.push_back(split_csv_line(l));
+  ASSERT_EQ(rows.size(), 3u);
+  const size_t ncol = results_header(*s).size();
+  for (const auto& r : rows) EXPECT_EQ(r.size(), ncol);
+  for (size_t k = 1; k < 3; ++k) {
+    const std::vector<std::string>& r = rows[k];
+    if (r[0] == "0") {
+      EXPECT_EQ(r[2], "error");
+      EXPECT_NE(r[12].find("NOPE-123"), std::string::npos) << r[12];
+      for (size_t c = 13; c < ncol; ++c) EXPECT_EQ(r[c], "") << c;
+    } else {
+      EXPECT_TRUE(r[2] == "pass" || r[2] == "fail") << r[2];
+      EXPECT_TRUE(r[13] == "1" || r[13] == "2") << r[13];  // weakest_hop
+      EXPECT_NE(r[15], "");                                // hop 1's margin
+      EXPECT_NE(r[16], "");                                // hop 2's margin
+    }
+  }
+}
+
 }  // namespace
 }  // namespace isolink::analysis::sweep
