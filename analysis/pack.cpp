@@ -289,14 +289,21 @@ StatusOr<PackResult> run_pack(const PackSpec& pack, const link::PartLibrary& par
       const HopResult& hr = out.hops[u.hop - 1];
       const link::Direction command = u.reversed ? link::Direction::kUp : link::Direction::kDown;
       const link::Direction reply = u.reversed ? link::Direction::kDown : link::Direction::kUp;
-      for (const DirectionRun& d : hr.run.directions) {
+      for (size_t k = 0; k < hr.run.directions.size(); ++k) {
+        const DirectionRun& d = hr.run.directions[k];
         const bool needed =
             d.link.direction == command || (d.link.direction == reply && has_reads(h.spec));
-        if (needed && !d.pass) {
+        if (!needed) continue;
+        const std::string what =
+            fmt::format("hop {} {} ({})", u.hop, u.reversed ? "reversed" : "normal",
+                        link::direction_name(d.link.direction));
+        if (!d.pass) {
           b.pass = false;
-          b.failing.push_back(fmt::format("hop {} {} ({})", u.hop,
-                                          u.reversed ? "reversed" : "normal",
-                                          link::direction_name(d.link.direction)));
+          b.failing.push_back(what);
+        }
+        if (k < hr.worst.size() && !hr.worst[k].pass) {
+          b.worst_pass = false;
+          b.worst_failing.push_back(what);
         }
       }
     }

@@ -105,6 +105,9 @@ struct BreakResult {
   BreakCase c;
   bool pass = false;                 // every carried hop passes in the directions it carries
   std::vector<std::string> failing;  // "hop 3 reversed (up)"
+  // The same over all traffic (PackOptions::worst; true and empty without it).
+  bool worst_pass = true;
+  std::vector<std::string> worst_failing;
 };
 
 struct PackResult {

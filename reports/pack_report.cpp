@@ -125,7 +125,9 @@ nlohmann::ordered_json pack_report_json(const PackSpec& pack, const PackResult& 
                                   {"unreached", b.c.unreached},
                                   {"carried", carried},
                                   {"verdict", b.pass ? "pass" : "fail"},
-                                  {"failing", b.failing}});
+                                  {"failing", b.failing},
+                                  {"worst_verdict", worst_verdict(r, b.worst_pass)},
+                                  {"worst_failing", b.worst_failing}});
   }
   ordered_json commands = ordered_json::array();
   for (const CommandTiming& c : r.timing.commands) {
@@ -286,6 +288,11 @@ std::string pack_report_markdown(const PackSpec& pack, const PackResult& r,
       for (size_t k = 0; k < b.failing.size(); ++k) verdict += (k ? ", " : "") + b.failing[k];
     }
     if (!b.c.unreached.empty()) verdict += b.failing.empty() ? ": devices cut off" : "";
+    if (r.worst_done && !b.worst_pass) {
+      verdict += "; worst case **FAIL**: ";
+      for (size_t k = 0; k < b.worst_failing.size(); ++k)
+        verdict += (k ? ", " : "") + b.worst_failing[k];
+    }
     md += fmt::format("| {} | {} | {} | {} | {} | {} |\n",
                       b.c.broken == 0 ? "none" : fmt::format("{}", b.c.broken),
                       devices_text(b.c.normal_side), devices_text(b.c.reverse_side),

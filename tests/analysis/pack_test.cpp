@@ -266,6 +266,61 @@ TEST(PackDedupe, IdenticalCircuitsAreSimulatedOnce) {
   }
 }
 
+// With the worst case, a break case also says which hops in use fail theirs: here hop 2 (the
+// only 3 m cable) fails its worst case, so every case that uses it fails over all traffic, and
+// only breaking hop 2 itself passes; the spec traffic passes everywhere.
+TEST(PackWorst, BreakCasesJudgeTheHopsInUseOverAllTraffic) {
+  const std::string text =
+      "hops:\n"
+      "  - spec: {cable: {length: 1}}\n"
+      "  - spec: {cable: {length: 3}}\n"
+      "  - spec: {cable: {length: 1}}\n"
+      "ring: true\n"
+      "ring_return: {spec: {cable: {length: 2}}}\n";
+  StatusOr<PackSpec> p = read_pack_spec_text(text, ::testing::TempDir() + "/break_worst.yaml");
+  ASSERT_TRUE(p.ok()) << p.status().message();
+  StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
+  ASSERT_TRUE(parts.ok());
+  PackOptions opt;
+  opt.runner = [](link::ExpandedLink x, const RunOptions&) -> StatusOr<DirectionRun> {
+    DirectionRun d;
+    d.link = std::move(x);
+    d.pass = true;
+    return d;
+  };
+  opt.worst = WorstOptions{};
+  opt.worst_runner = [](const link::LinkSpec& spec, link::Direction d,
+                        const WorstOptions&) -> StatusOr<DirectionWorst> {
+    DirectionWorst w;
+    w.direction = d;
+    w.pass = spec.cable.length != 3;
+    w.metrics.push_back({.name = "vend", .value = 1.0, .limit = 1.2, .margin = -0.2});
+    if (w.pass) w.metrics.back() = {.name = "vend", .value = 1.5, .limit = 1.2, .margin = 0.3};
+    return w;
+  };
+  StatusOr<PackResult> r = run_pack(*p, *parts, opt);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_TRUE(r->pass);
+  EXPECT_FALSE(r->worst_pass);
+  EXPECT_EQ(r->worst_weakest, 2);
+  EXPECT_DOUBLE_EQ(r->hops[1].worst_case_rel, -0.2 / 1.2);
+  EXPECT_DOUBLE_EQ(r->hops[0].worst_case_rel, 0.3 / 1.2);
+  ASSERT_EQ(r->breaks.size(), 5u);  // none, hops 1-3, the return hop 4
+  for (const BreakResult& b : r->breaks) {
+    EXPECT_TRUE(b.pass) << b.c.broken;
+    EXPECT_EQ(b.worst_pass, b.c.broken == 2) << b.c.broken;
+  }
+  // No break: hop 2 carries commands down (no reads: down only).
+  EXPECT_EQ(r->breaks[0].worst_failing, std::vector<std::string>{"hop 2 normal (down)"});
+  // Hop 1 broken: hops 4, 3r, 2r in use; hop 2 reversed carries commands up.
+  EXPECT_EQ(r->breaks[1].worst_failing, std::vector<std::string>{"hop 2 reversed (up)"});
+  const nlohmann::ordered_json j = reports::pack_report_json(*p, *r);
+  EXPECT_EQ(j["worst_verdict"], "fail");
+  EXPECT_EQ(j["verdict"], "pass");
+  EXPECT_EQ(j["ring_breaks"][2]["worst_verdict"], "pass");
+  EXPECT_EQ(j["ring_breaks"][3]["worst_verdict"], "fail");
+}
+
 // A pack hop's worst case is worst_case() of that hop's link spec alone, bit for bit; hops 2 and
 // 3 (the same module) share one. A reduced search (16 targets, 4 previous bytes) keeps it short:
 // the pack and the direct call get the same options.
