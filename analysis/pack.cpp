@@ -47,6 +47,19 @@ bool has_reads(const link::LinkSpec& spec) {
 
 }  // namespace
 
+double worst_rel_of(const DirectionWorst& w, std::string* metric) {
+  double rel = std::numeric_limits<double>::quiet_NaN();
+  for (const WorstMetric& m : w.metrics) {
+    if (m.limit == 0 || !std::isfinite(m.margin)) continue;
+    const double r = m.margin / std::abs(m.limit);
+    if (std::isnan(rel) || r < rel) {
+      rel = r;
+      if (metric) *metric = m.name;
+    }
+  }
+  return rel;
+}
+
 std::vector<BreakCase> ring_breaks(int n, bool ring) {
   std::vector<BreakCase> out;
   const int last = ring ? n + 1 : n;
@@ -142,7 +155,10 @@ StatusOr<PackResult> run_pack(const PackSpec& pack, const link::PartLibrary& par
   std::vector<std::vector<link::ExpandedLink>> own(pack.hops.size());  // per hop and direction
   struct Distinct {
     link::ExpandedLink link;
+    const link::LinkSpec* spec = nullptr;  // the first hop's spec with this circuit
+    link::Direction direction = link::Direction::kDown;
     StatusOr<DirectionRun> run = Status::Error("not run");
+    StatusOr<DirectionWorst> worst = Status::Error("not run");
   };
   std::vector<Distinct> distinct;
   std::map<std::string, int> by_key;
@@ -159,7 +175,7 @@ StatusOr<PackResult> run_pack(const PackSpec& pack, const link::PartLibrary& par
       // roles), so it dedupes too.
       const std::string key = circuit_key(*ex);
       auto [it, added] = by_key.emplace(key, static_cast<int>(distinct.size()));
-      if (added) distinct.push_back({*ex, Status::Error("not run")});
+      if (added) distinct.push_back({*ex, &h.spec, d, Status::Error("not run"), Status::Error("")});
       hr.runs.push_back(it->second);
       own[out.hops.size()].push_back(std::move(*ex));
     }
@@ -171,17 +187,42 @@ StatusOr<PackResult> run_pack(const PackSpec& pack, const link::PartLibrary& par
       opt.runner ? opt.runner : DirectionRunner([](link::ExpandedLink x, const RunOptions& o) {
         return run_direction(std::move(x), o);
       });
+  const WorstRunner worst_runner =
+      opt.worst_runner ? opt.worst_runner
+                       : WorstRunner([&parts](const link::LinkSpec& spec, link::Direction d,
+                                              const WorstOptions& o) -> StatusOr<DirectionWorst> {
+                           link::LinkSpec one = spec;
+                           one.stimulus.directions = {d};
+                           StatusOr<WorstResult> w = worst_case(one, parts, o);
+                           if (!w) return w.status();
+                           return std::move(w->directions.front());
+                         });
+  // Jobs 0..n-1: the spec traffic's runs; n..2n-1: the worst cases (the longer jobs, first).
+  const size_t n = distinct.size();
+  const size_t jobs = opt.worst ? 2 * n : n;
   tbb::task_arena arena(opt.jobs > 0 ? opt.jobs : tbb::task_arena::automatic);
   arena.execute([&] {
-    tbb::parallel_for(size_t{0}, distinct.size(),
-                      [&](size_t i) { distinct[i].run = runner(distinct[i].link, opt.run); });
+    tbb::parallel_for(size_t{0}, jobs, [&](size_t j) {
+      const size_t i = j < n ? j : j - n;
+      Distinct& d = distinct[i];
+      if (opt.worst && j < n)
+        d.worst = worst_runner(*d.spec, d.direction, *opt.worst);
+      else
+        d.run = runner(d.link, opt.run);
+    });
   });
-  for (const Distinct& d : distinct)
+  for (const Distinct& d : distinct) {
     if (!d.run) return d.run.status();
+    if (opt.worst && !d.worst)
+      return d.worst.status().with_context(d.link.description + ", worst case");
+  }
+  out.worst_done = opt.worst.has_value();
+  out.worst_cases = opt.worst ? static_cast<int>(n) : 0;
 
   // Per hop: its directions, verdict and worst margin.
   out.pass = true;
   double weakest_rel = std::numeric_limits<double>::infinity();
+  double rank_worst = std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < out.hops.size(); ++i) {
     HopResult& hr = out.hops[i];
     hr.run.pass = true;
@@ -214,6 +255,28 @@ StatusOr<PackResult> run_pack(const PackSpec& pack, const link::PartLibrary& par
     // A failing hop is weaker than any passing one.
     const double rank = (hr.pass ? 0.0 : -1e9) + (std::isnan(hr.worst_rel) ? -1.0 : hr.worst_rel);
     if (rank < weakest_rel) weakest_rel = rank, out.weakest = hr.index;
+
+    if (!opt.worst) continue;
+    for (size_t k = 0; k < hr.runs.size(); ++k) {
+      DirectionWorst w = *distinct[hr.runs[k]].worst;
+      w.direction = own[i][k].direction;      // a symmetric hop's up shares its down's circuit
+      w.description = own[i][k].description;  // this hop's direction, its device names
+      w.receiver = own[i][k].receiver;
+      hr.worst_pass = hr.worst_pass && w.pass;
+      std::string metric;
+      const double rel = worst_rel_of(w, &metric);
+      if (!std::isnan(rel) && (std::isnan(hr.worst_case_rel) || rel < hr.worst_case_rel)) {
+        hr.worst_case_rel = rel;
+        hr.worst_case_metric = metric;
+        hr.worst_case_direction = link::direction_name(w.direction);
+      }
+      hr.worst.push_back(std::move(w));
+    }
+    out.worst_pass = out.worst_pass && hr.worst_pass;
+    const double wrank =
+        (hr.worst_pass ? 0.0 : -1e9) + (std::isnan(hr.worst_case_rel) ? -1.0 : hr.worst_case_rel);
+    if (rank_worst > wrank || out.worst_weakest == 0)
+      rank_worst = wrank, out.worst_weakest = hr.index;
   }
 
   // Ring breaks: every hop still carrying traffic must pass in the directions it now carries.
@@ -226,14 +289,21 @@ StatusOr<PackResult> run_pack(const PackSpec& pack, const link::PartLibrary& par
       const HopResult& hr = out.hops[u.hop - 1];
       const link::Direction command = u.reversed ? link::Direction::kUp : link::Direction::kDown;
       const link::Direction reply = u.reversed ? link::Direction::kDown : link::Direction::kUp;
-      for (const DirectionRun& d : hr.run.directions) {
+      for (size_t k = 0; k < hr.run.directions.size(); ++k) {
+        const DirectionRun& d = hr.run.directions[k];
         const bool needed =
             d.link.direction == command || (d.link.direction == reply && has_reads(h.spec));
-        if (needed && !d.pass) {
+        if (!needed) continue;
+        const std::string what =
+            fmt::format("hop {} {} ({})", u.hop, u.reversed ? "reversed" : "normal",
+                        link::direction_name(d.link.direction));
+        if (!d.pass) {
           b.pass = false;
-          b.failing.push_back(fmt::format("hop {} {} ({})", u.hop,
-                                          u.reversed ? "reversed" : "normal",
-                                          link::direction_name(d.link.direction)));
+          b.failing.push_back(what);
+        }
+        if (k < hr.worst.size() && !hr.worst[k].pass) {
+          b.worst_pass = false;
+          b.worst_failing.push_back(what);
         }
       }
     }

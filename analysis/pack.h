@@ -10,29 +10,44 @@
 // each distinct one is simulated and scored once (oneTBB across them); hops with the same
 // circuit share the result. With ring: true every hop is run in both directions: in the
 // reversed ring a hop carries commands in its link spec's "up" direction.
+//
+// With PackOptions::worst set, each distinct circuit and direction also gets the worst case over
+// all legal traffic (analysis/worst.h: worst_case of the hop's link spec in that direction, the
+// same figures as `isolink worst` on the hop alone), beside the spec traffic's result: its own
+// verdict per hop (HopResult::worst_pass) and for the pack (PackResult::worst_pass). The spec
+// traffic's verdict (PackResult::pass) stays the pack's verdict, as in `isolink run`. Both kinds
+// of job (a circuit's spec-traffic run, a circuit's worst case) share one oneTBB loop.
 #pragma once
 
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "analysis/link_run.h"
 #include "analysis/pack_spec.h"
+#include "analysis/worst.h"
 #include "base/status.h"
 #include "netlists/link/parts.h"
 
 namespace isolink::analysis {
 
-// The hook for a direction's simulation and scoring: run_direction by default; the worst case
-// over legal traffic (the LTI engine) plugs in here.
+// The hook for a direction's simulation and scoring with the spec's traffic: run_direction by
+// default (tests count calls through it).
 using DirectionRunner =
     std::function<StatusOr<DirectionRun>(link::ExpandedLink, const RunOptions&)>;
+
+// The hook for a direction's worst case: worst_case(spec with only that direction) by default.
+using WorstRunner = std::function<StatusOr<DirectionWorst>(const link::LinkSpec&, link::Direction,
+                                                           const WorstOptions&)>;
 
 struct PackOptions {
   int jobs = 0;  // threads across distinct circuits (0: all cores)
   RunOptions run;
-  DirectionRunner runner;  // empty: run_direction
+  DirectionRunner runner;             // empty: run_direction
+  std::optional<WorstOptions> worst;  // set: the worst case over all traffic too
+  WorstRunner worst_runner;           // empty: worst_case
 };
 
 struct HopResult {
@@ -44,6 +59,12 @@ struct HopResult {
   std::string worst_direction;  // down | up
   int same_as = 0;              // the first hop with the same circuits (its own index if none)
   std::vector<int> runs;        // per direction, the distinct simulation it took
+  // The worst case over all traffic (PackOptions::worst), per direction as run.directions.
+  std::vector<DirectionWorst> worst;
+  bool worst_pass = true;
+  double worst_case_rel = std::numeric_limits<double>::quiet_NaN();  // smallest margin / |limit|
+  std::string worst_case_metric;     // vstart | vend | width_min | width_max | edge
+  std::string worst_case_direction;  // down | up
 };
 
 // The chain after one cable break (or none).
@@ -84,6 +105,9 @@ struct BreakResult {
   BreakCase c;
   bool pass = false;                 // every carried hop passes in the directions it carries
   std::vector<std::string> failing;  // "hop 3 reversed (up)"
+  // The same over all traffic (PackOptions::worst; true and empty without it).
+  bool worst_pass = true;
+  std::vector<std::string> worst_failing;
 };
 
 struct PackResult {
@@ -92,10 +116,18 @@ struct PackResult {
   int simulations = 0;          // distinct circuits simulated
   bool pass = false;            // every hop passes
   int weakest = 0;              // index of the hop with the smallest worst_rel
+  bool worst_done = false;      // the worst case was computed (PackOptions::worst)
+  int worst_cases = 0;          // distinct circuits whose worst case was computed
+  bool worst_pass = true;       // every hop passes its worst case (true when not computed)
+  int worst_weakest = 0;        // the hop with the smallest worst_case_rel (0: not computed)
   std::vector<BreakResult> breaks;
   PackTiming timing;
   double seconds = 0;
 };
+
+// The smallest margin / |limit| over a direction's worst-case metrics (NaN: none); metric gets
+// its name.
+double worst_rel_of(const DirectionWorst& w, std::string* metric = nullptr);
 
 StatusOr<PackResult> run_pack(const PackSpec& pack, const link::PartLibrary& parts,
                               const PackOptions& opt = {});

@@ -41,6 +41,7 @@ struct Reader {
   std::string name;  // its path
   std::string bridge, stack;
   bool has_stimulus = false;
+  HopEdit edit;
   // Files already read (a module spec used by many hops is read once).
   std::vector<std::pair<std::string, std::string>> files;
 
@@ -141,6 +142,8 @@ struct Reader {
       if (key != "spec" && key != "repeat") overrides[key] = it->second;
     }
     if (Status s = doc->merge(overrides, *over); !s.ok()) return s;
+    if (edit)
+      if (Status s = edit(ring_return ? to + 1 : to, *doc); !s.ok()) return s;
 
     const std::string hop_words =
         ring_return ? "the ring's return hop joins the bridge to the top device; its tx end"
@@ -177,7 +180,8 @@ Status read_timing(const YamlDoc& doc, const YAML::Node& node, TimingSpec* t) {
 
 }  // namespace
 
-StatusOr<PackSpec> read_pack_spec_text(const std::string& text, const std::string& name) {
+StatusOr<PackSpec> read_pack_spec_text(const std::string& text, const std::string& name,
+                                       const HopEdit& edit) {
   StatusOr<YamlDoc> doc = YamlDoc::from_text(text, name);
   if (!doc) return doc.status();
   const YAML::Node& root = std::as_const(*doc).root();
@@ -189,7 +193,7 @@ StatusOr<PackSpec> read_pack_spec_text(const std::string& text, const std::strin
                       "a pack spec is a YAML map with keys name, bridge, stack, stimulus, "
                       "hops, ring, ring_return, timing");
   YAML::Node hops_node, return_node;
-  Reader reader{text, name, "", "", false, {}};
+  Reader reader{text, name, "", "", false, edit, {}};
   Status s = read_map(
       *doc, root, "",
       {
@@ -238,11 +242,18 @@ StatusOr<PackSpec> read_pack_spec_text(const std::string& text, const std::strin
         reader.read_hop(*doc, hops_node[i], static_cast<int>(i), from, from + 1, false, &repeat);
     if (!hop) return hop.status();
     // A repeated first hop: the bridge at the first one's tx end, stack devices at the others'.
+    // With an edit, every copy is read on its own (the edit may differ per hop).
     StatusOr<HopSpec> next = hop;
-    if (from == 0 && repeat > 1)
-      next = reader.read_hop(*doc, hops_node[i], static_cast<int>(i), 1, 2, false, &repeat);
+    if ((from == 0 || edit) && repeat > 1)
+      next = reader.read_hop(*doc, hops_node[i], static_cast<int>(i), from + 1, from + 2, false,
+                             &repeat);
     if (!next) return next.status();
     for (int r = 0; r < repeat; ++r) {
+      if (edit && r > 1) {
+        next = reader.read_hop(*doc, hops_node[i], static_cast<int>(i), from + r, from + r + 1,
+                               false, &repeat);
+        if (!next) return next.status();
+      }
       HopSpec h = r == 0 ? *hop : *next;
       h.index = h.from = pack.chain_hops();
       h.index += 1;

@@ -27,6 +27,7 @@
 // of the key, whether it sits in the hop spec or in the pack file.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -70,9 +71,15 @@ struct PackSpec {
   int chain_hops() const;  // N (hops without the ring's return hop)
 };
 
+// An edit of one hop's link spec tree before it is read (sweeps over packs set keys this way):
+// called with the hop's index (1..N, N + 1 for the ring's return hop) and its YAML tree, after
+// the pack entry's overrides are merged.
+using HopEdit = std::function<Status(int hop, config::YamlDoc& doc)>;
+
 StatusOr<PackSpec> read_pack_spec_file(const std::string& path);
 // The text of a pack file named name (hop spec paths are taken from name's folder).
-StatusOr<PackSpec> read_pack_spec_text(const std::string& text, const std::string& name);
+StatusOr<PackSpec> read_pack_spec_text(const std::string& text, const std::string& name,
+                                       const HopEdit& edit = {});
 // Whether a parsed YAML file is a pack spec (a map with a `hops` key) rather than a link spec.
 bool is_pack_spec(const config::YamlDoc& doc);
 

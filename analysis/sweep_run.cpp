@@ -82,7 +82,35 @@ std::vector<std::string> results_header(const SweepSpec& s) {
   h.insert(h.end(), kResultColumns.begin(), kResultColumns.begin() + kBeforeNoise);
   if (s.noise_outputs) h.insert(h.end(), kNoiseColumns.begin(), kNoiseColumns.end());
   h.insert(h.end(), kResultColumns.begin() + kBeforeNoise, kResultColumns.end());
+  for (const std::string& c : pack_columns(s)) h.push_back(c);
   return h;
+}
+
+std::vector<std::string> pack_columns(const SweepSpec& s) {
+  if (!s.pack) return {};
+  std::vector<std::string> c{"weakest_hop", "failing_hops"};
+  for (int k = 1; k <= s.pack_hops; ++k) c.push_back(fmt::format("hop_{}_margin_rel", k));
+  return c;
+}
+
+PointResult score_pack(const PackResult& p) {
+  PointResult r;
+  if (p.weakest > 0) r = score_run(p.hops[static_cast<size_t>(p.weakest - 1)].run);
+  r.verdict = p.pass ? "pass" : "fail";
+  r.decoded_ok.reset();
+  r.reason.clear();
+  std::string failing;
+  for (const HopResult& h : p.hops) {
+    const PointResult hr = score_run(h.run);
+    if (hr.decoded_ok) r.decoded_ok = r.decoded_ok.value_or(true) && *hr.decoded_ok;
+    if (h.pass) continue;
+    r.reason += fmt::format("{}hop {}: {}", r.reason.empty() ? "" : "; ", h.index, hr.reason);
+    failing += fmt::format("{}{}", failing.empty() ? "" : " ", h.index);
+  }
+  r.extra = {fmt::format("{}", p.weakest), failing};
+  for (const HopResult& h : p.hops) r.extra.push_back(num(h.worst_rel));
+  r.seconds = p.seconds;
+  return r;
 }
 
 std::string results_row(const PointResult& r) {
@@ -107,6 +135,7 @@ std::string results_row(const PointResult& r) {
   }
   add(fmt::format("{:.2f}", r.seconds));
   add(r.error);
+  for (const std::string& c : r.extra) add(c);
   return line + "\n";
 }
 
@@ -152,6 +181,7 @@ StatusOr<PointResult> parse_results_row(std::string_view line, size_t ncells, si
   if (!parse_double(f[k++], &r.seconds)) return Status::Error("bad seconds");
   if (std::isnan(r.seconds)) r.seconds = 0;
   r.error = f[k++];
+  r.extra.assign(f.begin() + static_cast<long>(k), f.end());
   return r;
 }
 
@@ -245,6 +275,7 @@ PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t
     r.error = first_line(message);
     r.noise.reset();
     if (s.noise_outputs) r.noise.emplace();
+    r.extra.clear();
     r.seconds = now_seconds() - t0;
     return r;
   };
@@ -252,6 +283,25 @@ PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t
     PointOutcome po = make_point(s, index);
     r.cells = po.point.cells;
     if (!po.status.ok()) return fail(po.status.message());
+    if (po.point.pack) {
+      PackOptions popt;
+      popt.run = opt.run;
+      StatusOr<PackResult> pr = run_pack(*po.point.pack, parts, popt);
+      if (!pr) return fail(pr.status().message());
+      std::vector<std::string> cells = std::move(r.cells);
+      r = score_pack(*pr);
+      r.index = index;
+      r.cells = std::move(cells);
+      for (size_t k = 0; k < pr->hops.size() && !opt.waves_dir.empty(); ++k) {
+        const HopResult& h = pr->hops[k];
+        const Waveform w = run_waveforms(h.run, po.point.pack->hops[k].spec.sim.tstep);
+        const std::string path =
+            fmt::format("{}/point_{:05}_hop_{:02}.csv", opt.waves_dir, index, h.index);
+        if (Status st = write_waveform_csv(w, path); !st.ok()) return fail(st.message());
+      }
+      r.seconds = now_seconds() - t0;
+      return r;
+    }
     StatusOr<LinkRun> run = run_link(po.point.spec, parts, opt.run);
     if (!run) return fail(run.status().message());
     std::vector<std::string> cells = std::move(r.cells);
@@ -367,6 +417,8 @@ void ResultLog::add(const PointResult& in) {
   padded.cells.resize(ncells_);  // a point that failed before its cells were known
   if (spec_->noise_outputs && !padded.noise) padded.noise.emplace();
   if (!spec_->noise_outputs) padded.noise.reset();
+  padded.extra.resize(ncolumns_ - 1 - ncells_ - kResultColumns.size() -
+                      (spec_->noise_outputs ? kNoiseColumns.size() : 0));  // an error's: empty
   const PointResult r = round_trip(padded, ncells_, ncolumns_);
   const std::string row = results_row(r);
   std::lock_guard<std::mutex> lock(mu_);

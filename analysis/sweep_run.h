@@ -36,6 +36,15 @@
 // first line in `error` (CSV-quoted) and empty margins; the sweep goes on. Numbers are written with
 // 6 significant digits and every total (summary.json, plots) is computed from the rows as written,
 // so a resumed or MPI run gives the same files as one threaded run.
+//
+// A pack sweep (the base is a pack spec) runs each point through run_pack (spec traffic; the
+// worst case over all traffic is `isolink pack`'s, not the sweep's). The columns above describe
+// the pack: verdict is the pack's (every hop passes), worst_metric .. margin_edge_ns are the
+// weakest hop's (PackResult::weakest), decoded_ok covers every hop, fail_reason names each
+// failing hop ("hop 3: width; hop 9: vstart"); after error come weakest_hop (its index),
+// failing_hops (their indices, space-separated) and hop_<K>_margin_rel per hop K (its smallest
+// margin / |limit| over its directions, the ring's return hop included). --keep-waves writes
+// point_NNNNN_hop_KK.csv per hop.
 #pragma once
 
 #include <array>
@@ -53,6 +62,7 @@
 
 #include "analysis/link_run.h"
 #include "analysis/noise.h"
+#include "analysis/pack.h"
 #include "analysis/sweep_spec.h"
 #include "base/csv.h"
 #include "base/progress.h"
@@ -89,13 +99,22 @@ struct PointResult {
                                      std::numeric_limits<double>::quiet_NaN()};
   };
   std::optional<Noise> noise;  // indexed by link::Direction (down, up)
+  // A pack sweep's extra cells (pack_columns()): weakest_hop, failing_hops, hop_<K>_margin_rel.
+  std::vector<std::string> extra;
 };
+
+// The columns a pack sweep adds after `error` (none for a link sweep).
+std::vector<std::string> pack_columns(const SweepSpec& s);
+// Scores a pack run: the pack's verdict; worst_metric, worst_margin_rel and the margins of the
+// weakest hop; decoded_ok over every hop; fail_reason per failing hop ("hop 3: width"); extra.
+PointResult score_pack(const PackResult& r);
 
 // The results.csv header for a sweep.
 std::vector<std::string> results_header(const SweepSpec& s);
 // One CSV line (with '\n').
 std::string results_row(const PointResult& r);
-// Parses a line written by results_row under header (ncells = point_columns().size()).
+// Parses a line written by results_row under header (ncells = point_columns().size(); fields
+// after `error` go to extra).
 StatusOr<PointResult> parse_results_row(std::string_view line, size_t ncells, size_t ncolumns);
 // The result as the CSV stores it (numbers rounded to what is written).
 PointResult round_trip(const PointResult& r, size_t ncells, size_t ncolumns);

@@ -40,9 +40,31 @@ std::string last_key(const std::string& path) {
   return dot == std::string::npos ? path : path.substr(dot + 1);
 }
 
-// "ends.x" -> tx.x and rx.x; anything else as it is.
+// A pack sweep's key: "hops.3.cable.length" -> {3, "cable.length"}, "hops.*.x" -> {0, "x"};
+// anything else (a link spec's key, or a malformed hop key) -> {-1, path}.
+struct HopPath {
+  int hop = -1;
+  std::string path;
+};
+HopPath hop_path(const std::string& path) {
+  if (path.rfind("hops.", 0) != 0) return {-1, path};
+  const size_t dot = path.find('.', 5);
+  if (dot == std::string::npos || dot + 1 == path.size()) return {-1, path};
+  const std::string k = path.substr(5, dot - 5);
+  if (k == "*") return {0, path.substr(dot + 1)};
+  if (k.empty() || k.size() > 4 || k.find_first_not_of("0123456789") != std::string::npos ||
+      k[0] == '0')
+    return {-1, path};
+  return {std::stoi(k), path.substr(dot + 1)};
+}
+
+// "ends.x" -> tx.x and rx.x (also after a pack's "hops.K."); anything else as it is.
 std::vector<std::string> expand_ends(const std::string& path) {
-  if (path.rfind("ends.", 0) == 0) return {"tx." + path.substr(5), "rx." + path.substr(5)};
+  const HopPath h = hop_path(path);
+  const std::string prefix = h.hop >= 0 ? path.substr(0, path.size() - h.path.size()) : "";
+  const std::string rest = h.hop >= 0 ? h.path : path;
+  if (rest.rfind("ends.", 0) == 0)
+    return {prefix + "tx." + rest.substr(5), prefix + "rx." + rest.substr(5)};
   return {path};
 }
 
@@ -113,6 +135,57 @@ Status apply(YAML::Node root, const std::vector<Assignment>& assign) {
   return Status::Ok();
 }
 
+// The base with assign applied: a link spec, or for a pack sweep the pack, each "hops.K." /
+// "hops.*." assignment set in its hops' link spec trees as the pack is read.
+struct Built {
+  link::LinkSpec spec;
+  std::optional<PackSpec> pack;
+};
+StatusOr<Built> build(const SweepSpec& s, const std::vector<Assignment>& assign) {
+  Built out;
+  if (s.pack) {
+    const HopEdit edit = [&assign](int hop, YamlDoc& doc) -> Status {
+      for (const Assignment& a : assign) {
+        const HopPath h = hop_path(a.path);
+        if (h.hop != 0 && h.hop != hop) continue;
+        if (Status st = set_path(doc.root(), h.path, a); !st.ok())
+          return st.with_context(fmt::format("hop {}", hop));
+      }
+      return Status::Ok();
+    };
+    StatusOr<PackSpec> p = read_pack_spec_text(s.base_text, s.base_path, edit);
+    if (!p) return p.status();
+    out.pack = std::move(*p);
+    return out;
+  }
+  StatusOr<YamlDoc> doc = base_doc(s);
+  if (!doc) return doc.status();
+  if (Status st = apply(doc->root(), assign); !st.ok()) return st;
+  StatusOr<link::LinkSpec> spec = link::read_link_spec(*doc);
+  if (!spec) return spec.status();
+  out.spec = std::move(*spec);
+  return out;
+}
+
+// A pack sweep's key must address a hop of the pack: hops.<K>.<key> or hops.*.<key>.
+Status check_hop_key(const SweepSpec& s, const YamlDoc& doc, const YAML::Node& key_node,
+                     const std::string& key, const std::vector<Assignment>& assign) {
+  if (!s.pack) return Status::Ok();
+  const std::string usage = fmt::format(
+      "a pack sweep's keys address hops: hops.<K>.<link-spec key> with K = 1..{}{}, or "
+      "hops.*.<key> for every hop",
+      s.pack_hops, s.pack_ring ? fmt::format(" ({} is the ring's return hop)", s.pack_hops) : "");
+  for (const Assignment& a : assign) {
+    const HopPath h = hop_path(a.path);
+    if (h.hop < 0) return doc.error(key_node, fmt::format("sweep key '{}': {}", key, usage));
+    if (h.hop > s.pack_hops)
+      return doc.error(key_node,
+                       fmt::format("sweep key '{}': hop {} is not in the pack ({} hops): {}", key,
+                                   h.hop, s.pack_hops, usage));
+  }
+  return Status::Ok();
+}
+
 // A value node of the sweep file as an assignment to each of paths.
 std::vector<Assignment> assignments(const std::vector<std::string>& paths, const YAML::Node& v) {
   std::vector<Assignment> out;
@@ -134,7 +207,7 @@ std::vector<Assignment> assignments(const std::vector<std::string>& paths, const
 
 bool is_unknown_key_error(const std::string& msg, const std::vector<Assignment>& assign) {
   for (const Assignment& a : assign) {
-    const std::vector<std::string> keys = split_path(a.path);
+    const std::vector<std::string> keys = split_path(hop_path(a.path).path);
     std::string prefix;
     for (const std::string& k : keys) {
       prefix += (prefix.empty() ? "" : ".") + k;
@@ -150,14 +223,10 @@ bool is_unknown_key_error(const std::string& msg, const std::vector<Assignment>&
 Status check_value(const SweepSpec& s, const YamlDoc& sweep_doc, const std::string& key,
                    const std::vector<Assignment>& assign, const YAML::Node& key_node,
                    const YAML::Node& value_node, const std::string& value_text) {
-  StatusOr<YamlDoc> doc = base_doc(s);
-  if (!doc) return doc.status();
-  Status st = apply(doc->root(), assign);
-  if (st.ok()) {
-    StatusOr<link::LinkSpec> spec = link::read_link_spec(*doc);
-    if (spec) return Status::Ok();
-    st = spec.status();
-  }
+  if (Status st = check_hop_key(s, sweep_doc, key_node, key, assign); !st.ok()) return st;
+  StatusOr<Built> built = build(s, assign);
+  if (built) return Status::Ok();
+  const Status st = built.status();
   const std::string msg = bare_message(st.message());
   if (is_unknown_key_error(msg, assign))
     return sweep_doc.error(key_node,
@@ -577,6 +646,19 @@ PointOutcome make_point(const SweepSpec& s, size_t index) {
   for (size_t k = 0; k < s.axes.size(); ++k) p.cells.push_back(s.axes[k].values[p.axis[k]].label);
   if (p.sample >= 0) p.cells.push_back(fmt::format("{}", p.sample));
 
+  if (s.pack) {  // no Monte Carlo (refused when the file is read): the axes' values only
+    std::vector<Assignment> all;
+    for (size_t k = 0; k < s.axes.size(); ++k) {
+      const std::vector<Assignment>& a = s.axes[k].values[p.axis[k]].assign;
+      all.insert(all.end(), a.begin(), a.end());
+    }
+    StatusOr<Built> built = build(s, all);
+    if (!built)
+      out.status = built.status();
+    else
+      p.pack = std::move(built->pack);
+    return out;
+  }
   StatusOr<YamlDoc> doc = base_doc(s);
   if (!doc) {
     out.status = doc.status();
@@ -701,8 +783,32 @@ StatusOr<SweepSpec> read_sweep_text(const std::string& text, const std::string& 
   }
   StatusOr<YamlDoc> bdoc = base_doc(s);
   if (!bdoc) return bdoc.status();
-  StatusOr<link::LinkSpec> base = link::read_link_spec(*bdoc);
-  if (!base) return base.status().with_context(fmt::format("{}: the base spec", name));
+  link::LinkSpec base_spec;
+  if (is_pack_spec(*bdoc)) {
+    // A pack: every point is a pack run; the keys address its hops.
+    if (s.base_inline)
+      return doc->error(base_node,
+                        "key 'base': an inline base is a link spec; give a pack spec "
+                        "as a file (base: pack.yaml)");
+    StatusOr<PackSpec> pack = read_pack_spec_text(s.base_text, s.base_path);
+    if (!pack) return pack.status().with_context(fmt::format("{}: the base pack", name));
+    s.pack = true;
+    s.pack_hops = static_cast<int>(pack->hops.size());
+    s.pack_ring = pack->ring;
+    if (mc_node.IsDefined() && !mc_node.IsNull())
+      return doc->error(mc_node,
+                        "key 'monte_carlo': not available when the base is a pack spec "
+                        "(sweep the hops' keys on a grid instead)");
+    if (s.noise_outputs)
+      return doc->error(root["outputs"],
+                        "key 'outputs': noise is not available when the base is a pack spec "
+                        "(sweep a hop's own link spec with outputs: [noise] instead)");
+  } else {
+    StatusOr<link::LinkSpec> spec = link::read_link_spec(*bdoc);
+    if (!spec) return spec.status().with_context(fmt::format("{}: the base spec", name));
+    base_spec = std::move(*spec);
+  }
+  const link::LinkSpec* base = &base_spec;
 
   // The swept keys.
   if (sweep_node.IsDefined() && !sweep_node.IsNull()) {

@@ -21,6 +21,9 @@
 //   mode: grid                        # grid: every combination | zip: the i-th values together
 //   outputs: [noise]                  # more result columns per point: noise = the point's noise
 //                                     # immunity (isolink noise on the point's spec; sweep_run.h)
+// A pack base (base: pack.yaml, a pack spec file): keys are hops.<K>.<key> (hop K, 1..N, N + 1
+// the ring's return hop) or hops.*.<key> (every hop), e.g. hops.9.cable.length: [1, 5, 10];
+// each point is a pack run (PointSpec::pack); no Monte Carlo.
 //   monte_carlo:
 //     samples: 500
 //     seed: 1
@@ -50,6 +53,7 @@
 #include <utility>
 #include <vector>
 
+#include "analysis/pack_spec.h"
 #include "base/status.h"
 #include "config/yaml_reader.h"
 #include "netlists/link/link_spec.h"
@@ -114,6 +118,11 @@ struct SweepSpec {
   std::string base_path;  // the base spec's file (the sweep file for an inline base)
   std::string base_text;  // its text
   bool base_inline = false;
+  // The base is a pack spec (analysis/pack_spec.h): each point is a pack run, keys are
+  // hops.<K>.<key> or hops.*.<key>, no Monte Carlo.
+  bool pack = false;
+  int pack_hops = 0;  // its hops, the ring's return hop included (index pack_hops)
+  bool pack_ring = false;
   Mode mode = Mode::kGrid;
   std::vector<Axis> axes;
   MonteCarlo mc;
@@ -143,7 +152,8 @@ struct PointSpec {
   std::vector<size_t> axis;        // value index per axis
   std::vector<std::string> cells;  // point_columns() values
   std::vector<double> mc_values;   // per tolerance, the value drawn (SI)
-  link::LinkSpec spec;
+  link::LinkSpec spec;             // a link sweep's point
+  std::optional<PackSpec> pack;    // a pack sweep's point (spec unused)
 };
 
 // The point's description (cells) even when its spec is invalid; spec is read only when ok.

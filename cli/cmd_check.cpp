@@ -1,4 +1,4 @@
-// isolink check WAVE.csv [N.csv]: score a waveform (simulated or a scope capture) against a rule
+// isolink check WAVE [N]: score a waveform (simulated or a scope capture) against a rule
 // set. The work is in eye/check.h and eye/waveform_csv.h; this file maps flags and prints.
 #include <cstdio>
 #include <memory>
@@ -76,8 +76,9 @@ void add_check_command(CLI::App& app, int* exit_code) {
       "Score a waveform CSV or scope export against the receiver rules (exit 0 pass, 1 fail or "
       "inconclusive, 2 bad input)");
   cmd->add_option("wave", args->files,
-                  "WAVE.csv: time and a differential (or P and N) column; or P.csv N.csv: P from "
-                  "the first file, N from the second")
+                  "WAVE: a CSV with time and a differential (or P and N) column, or a scope file "
+                  "(Tektronix .isf/.wfm, Keysight/Rigol .bin, LeCroy .trc, Rigol DS1000E/D .wfm); "
+                  "or P N: P from the first file, N from the second")
       ->required()
       ->expected(1, 2);
   cmd->add_option("--rules", args->rules,

@@ -66,7 +66,7 @@ int run_run(const RunArgs& a) {
           Status::Error(fmt::format("{}: error: --direction is for link specs; a pack "
                                     "runs each hop in the directions it carries",
                                     a.spec)));
-    return run_pack_command({a.spec, a.out_dir, a.part_dirs, 0, a.no_images, a.quiet});
+    return run_pack_command({a.spec, a.out_dir, a.part_dirs, 0, a.no_images, a.quiet, a.no_worst});
   }
   StatusOr<link::LinkSpec> spec = link::read_link_spec_file(a.spec);
   if (!spec) return fail(spec.status());

@@ -1,4 +1,5 @@
-// isolink sweep: a link spec over a grid of key values and / or Monte Carlo tolerances, every point
+// isolink sweep: a link spec (or a whole pack: a pack spec base, keys hops.K.key) over a grid of
+// key values and / or Monte Carlo tolerances (link specs only), every point
 // simulated and checked, into results.csv, summary.json and plots (analysis/sweep_spec.h,
 // analysis/sweep_run.h; across machines with mpirun: analysis/sweep_mpi.h).
 // Exit status: 0 every point passes, 1 some point fails or could not be simulated, 2 bad input.
@@ -136,10 +137,11 @@ int run_sweep_command(const SweepArgs& a) {
 
 void add_sweep_command(CLI::App& app, int* exit_code) {
   auto args = std::make_shared<SweepArgs>();
-  CLI::App* cmd =
-      app.add_subcommand("sweep",
-                         "Run a link spec over a grid of values and / or Monte Carlo tolerances: "
-                         "results.csv, summary.json, margin / heatmap / histogram PNGs");
+  CLI::App* cmd = app.add_subcommand(
+      "sweep",
+      "Run a link spec (or a pack spec, keys hops.K.key / hops.*.key) over a grid "
+      "of values and / or Monte Carlo tolerances: results.csv, summary.json, "
+      "margin / heatmap / histogram PNGs");
   cmd->add_option("sweep", args->file,
                   "Sweep file (YAML), e.g. netlists/examples/"
                   "sweep_cap_length.yaml")

@@ -29,6 +29,7 @@ struct PackArgs {
   int jobs = 0;
   bool no_images = false;
   bool quiet = false;
+  bool no_worst = false;  // skip the worst case over all traffic
 };
 int run_pack_command(const PackArgs& a);
 

@@ -3,8 +3,10 @@
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 
 #include "analysis/sweep_run.h"
 #include "base/file_io.h"
@@ -51,6 +53,24 @@ std::string margin_text(double v, double scale, const char* unit) {
   return std::isfinite(v) ? fmt::format("{:+.3g} {}", v * scale, unit) : "-";
 }
 
+// "pass" | "fail", or null when the worst case was not computed (--no-worst).
+ordered_json worst_verdict(const PackResult& r, bool pass) {
+  return r.worst_done ? ordered_json(pass ? "pass" : "fail") : ordered_json(nullptr);
+}
+
+// Per metric (vstart, vend, width, edge as sweep::kMetrics) the smallest worst-case margin over
+// a hop's directions, in SI units; width is the smaller of width_min and width_max.
+std::array<double, 4> worst_case_margins(const HopResult& h) {
+  std::array<double, 4> out;
+  out.fill(std::numeric_limits<double>::quiet_NaN());
+  for (const analysis::DirectionWorst& d : h.worst)
+    for (const analysis::WorstMetric& m : d.metrics) {
+      const size_t k = m.name == "vstart" ? 0 : m.name == "vend" ? 1 : m.name == "edge" ? 3 : 2;
+      if (std::isnan(out[k]) || m.margin < out[k]) out[k] = m.margin;
+    }
+  return out;
+}
+
 }  // namespace
 
 std::string isolation_short(const link::IsolationSpec& iso) {
@@ -65,7 +85,17 @@ nlohmann::ordered_json pack_report_json(const PackSpec& pack, const PackResult& 
   for (size_t i = 0; i < r.hops.size(); ++i) {
     const HopResult& h = r.hops[i];
     const HopSpec& s = pack.hops[i];
-    const ordered_json run = run_report_json(s.spec, h.run);
+    ordered_json run = run_report_json(s.spec, h.run);
+    // The worst case over all traffic beside each direction, as `isolink worst --json` has it.
+    for (size_t k = 0; k < h.worst.size() && k < run["directions"].size(); ++k) {
+      analysis::WorstResult one;
+      one.directions = {h.worst[k]};
+      one.pass = h.worst[k].pass;
+      const ordered_json wj = analysis::worst_json(one)["directions"][0];
+      run["directions"][k]["worst_verdict"] = wj["verdict"];
+      run["directions"][k]["worst_reasons"] = wj["reasons"];
+      run["directions"][k]["worst"] = wj["worst"];
+    }
     hops.push_back(ordered_json{{"index", h.index},
                                 {"from", s.from},
                                 {"to", s.to},
@@ -75,6 +105,10 @@ nlohmann::ordered_json pack_report_json(const PackSpec& pack, const PackResult& 
                                 {"worst_margin_rel", finite(h.worst_rel)},
                                 {"worst_metric", h.worst_metric},
                                 {"worst_direction", h.worst_direction},
+                                {"worst_case_verdict", worst_verdict(r, h.worst_pass)},
+                                {"worst_case_margin_rel", finite(h.worst_case_rel)},
+                                {"worst_case_metric", h.worst_case_metric},
+                                {"worst_case_direction", h.worst_case_direction},
                                 {"same_circuit_as", h.same_as},
                                 {"cable_delay_s", finite(r.timing.cable_delay[i])},
                                 {"directions", run["directions"]},
@@ -91,7 +125,9 @@ nlohmann::ordered_json pack_report_json(const PackSpec& pack, const PackResult& 
                                   {"unreached", b.c.unreached},
                                   {"carried", carried},
                                   {"verdict", b.pass ? "pass" : "fail"},
-                                  {"failing", b.failing}});
+                                  {"failing", b.failing},
+                                  {"worst_verdict", worst_verdict(r, b.worst_pass)},
+                                  {"worst_failing", b.worst_failing}});
   }
   ordered_json commands = ordered_json::array();
   for (const CommandTiming& c : r.timing.commands) {
@@ -114,20 +150,24 @@ nlohmann::ordered_json pack_report_json(const PackSpec& pack, const PackResult& 
                       {"response_delay_s", t.response_delay},
                       {"timeout_s", t.timeout ? ordered_json(*t.timeout) : ordered_json(nullptr)},
                       {"commands", commands}};
-  return ordered_json{{"verdict", r.pass ? "pass" : "fail"},
-                      {"name", pack.name},
-                      {"source", pack.source},
-                      {"bridge", pack.bridge},
-                      {"stack", pack.stack},
-                      {"devices", pack.devices()},
-                      {"ring", pack.ring},
-                      {"weakest_hop", r.weakest},
-                      {"run_time_s", r.seconds},
-                      {"expansions", r.expansions},
-                      {"simulations", r.simulations},
-                      {"hops", hops},
-                      {"ring_breaks", breaks},
-                      {"timing", timing}};
+  return ordered_json{
+      {"verdict", r.pass ? "pass" : "fail"},
+      {"worst_verdict", worst_verdict(r, r.worst_pass)},
+      {"name", pack.name},
+      {"source", pack.source},
+      {"bridge", pack.bridge},
+      {"stack", pack.stack},
+      {"devices", pack.devices()},
+      {"ring", pack.ring},
+      {"weakest_hop", r.weakest},
+      {"worst_weakest_hop", r.worst_done ? ordered_json(r.worst_weakest) : ordered_json(nullptr)},
+      {"worst_cases", r.worst_cases},
+      {"run_time_s", r.seconds},
+      {"expansions", r.expansions},
+      {"simulations", r.simulations},
+      {"hops", hops},
+      {"ring_breaks", breaks},
+      {"timing", timing}};
 }
 
 std::string pack_report_markdown(const PackSpec& pack, const PackResult& r,
@@ -143,17 +183,40 @@ std::string pack_report_markdown(const PackSpec& pack, const PackResult& r,
       "simulated for {} hop directions in {:.2f} s)\n\n",
       r.hops.size() - failing, r.hops.size(), pack.bridge, pack.devices(), pack.stack,
       pack.ring ? ", ring" : "", pack.source, r.simulations, r.expansions, r.seconds);
+  if (r.worst_done) {
+    int worst_failing = 0;
+    for (const HopResult& h : r.hops) worst_failing += h.worst_pass ? 0 : 1;
+    md += fmt::format(
+        "**Worst case over all traffic: {}** ({} of {} hops pass; {} worst cases computed, one "
+        "per distinct circuit and direction).\n\n",
+        r.worst_pass ? "PASS" : "FAIL", r.hops.size() - worst_failing, r.hops.size(),
+        r.worst_cases);
+  }
   if (r.weakest > 0)
     md += fmt::format("Weakest hop: **hop {}** ({}).\n\n", r.weakest,
                       hop_devices(pack, pack.hops[r.weakest - 1]));
+  if (r.worst_done && r.worst_weakest > 0)
+    md += fmt::format("Weakest hop over all traffic: **hop {}** ({}).\n\n", r.worst_weakest,
+                      hop_devices(pack, pack.hops[r.worst_weakest - 1]));
   if (!diagram.empty()) md += fmt::format("![pack diagram]({})\n\n", diagram);
 
   md +=
       "## Hops\n\nMargins are the worst over the hop's directions (positive = inside the "
       "limit); the relative margin is margin / |limit| of the worst metric.\n\n";
+  if (r.worst_done)
+    md +=
+        "The worst-case columns (WC) are the worst over all legal traffic (`isolink worst` on the "
+        "hop alone: the lowest VSTART and VEND, the narrowest and widest pulse, the slowest edge "
+        "any legal traffic produces); WC width is the smaller of the narrowest and widest pulse's "
+        "margins.\n\n";
   md +=
       "| hop | devices | isolation (tx / rx) | cable | verdict | worst (rel) | VSTART | VEND | "
-      "width | edge | images |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+      "width | edge |";
+  if (r.worst_done)
+    md += " worst case | WC worst (rel) | WC VSTART | WC VEND | WC width | WC edge |";
+  md += " images |\n|---|---|---|---|---|---|---|---|---|---|";
+  if (r.worst_done) md += "---|---|---|---|---|---|";
+  md += "---|\n";
   for (size_t i = 0; i < r.hops.size(); ++i) {
     const HopResult& h = r.hops[i];
     const HopSpec& s = pack.hops[i];
@@ -168,14 +231,25 @@ std::string pack_report_markdown(const PackSpec& pack, const PackResult& r,
                              ? fmt::format("[eye]({0}/eye.png), [wave]({0}/wave.png)", hop_dirs[i])
                              : "-";
     if (h.same_as != h.index) images += fmt::format(" (same circuit as hop {})", h.same_as);
-    md +=
-        fmt::format("| {b}{}{}{b} | {} | {} / {} | {} | {} | {b}{}{b} | {} | {} | {} | {} | {} |\n",
-                    h.index, weakest ? " (weakest)" : "", hop_devices(pack, s),
-                    isolation_short(s.spec.tx.isolation), isolation_short(s.spec.rx.isolation),
-                    fmt::format("{:g} m {}", s.spec.cable.length, s.spec.cable.material),
-                    h.pass ? "pass" : "**FAIL**", worst, margin_text(p.margin[0], 1, "V"),
-                    margin_text(p.margin[1], 1, "V"), margin_text(p.margin[2], 1e9, "ns"),
-                    margin_text(p.margin[3], 1e9, "ns"), images, fmt::arg("b", b));
+    md += fmt::format("| {b}{}{}{b} | {} | {} / {} | {} | {} | {b}{}{b} | {} | {} | {} | {} |",
+                      h.index, weakest ? " (weakest)" : "", hop_devices(pack, s),
+                      isolation_short(s.spec.tx.isolation), isolation_short(s.spec.rx.isolation),
+                      fmt::format("{:g} m {}", s.spec.cable.length, s.spec.cable.material),
+                      h.pass ? "pass" : "**FAIL**", worst, margin_text(p.margin[0], 1, "V"),
+                      margin_text(p.margin[1], 1, "V"), margin_text(p.margin[2], 1e9, "ns"),
+                      margin_text(p.margin[3], 1e9, "ns"), fmt::arg("b", b));
+    if (r.worst_done) {
+      const std::array<double, 4> wc = worst_case_margins(h);
+      const std::string wb = h.index == r.worst_weakest ? "**" : "";
+      md += fmt::format(
+          " {} | {wb}{}{wb} | {} | {} | {} | {} |", h.worst_pass ? "pass" : "**FAIL**",
+          std::isfinite(h.worst_case_rel) ? fmt::format("{:+.1f} % {} ({})", h.worst_case_rel * 100,
+                                                        h.worst_case_metric, h.worst_case_direction)
+                                          : "-",
+          margin_text(wc[0], 1, "V"), margin_text(wc[1], 1, "V"), margin_text(wc[2], 1e9, "ns"),
+          margin_text(wc[3], 1e9, "ns"), fmt::arg("wb", wb));
+    }
+    md += fmt::format(" {} |\n", images);
   }
   md += "\n";
   for (size_t i = 0; i < r.hops.size(); ++i) {
@@ -183,6 +257,17 @@ std::string pack_report_markdown(const PackSpec& pack, const PackResult& r,
     if (h.pass || h.same_as != h.index) continue;
     const analysis::sweep::PointResult p = analysis::sweep::score_run(h.run);
     md += fmt::format("Hop {} fails: {}.\n\n", h.index, p.reason);
+  }
+  for (size_t i = 0; i < r.hops.size(); ++i) {
+    const HopResult& h = r.hops[i];
+    if (h.worst_pass || h.same_as != h.index) continue;
+    std::string why;
+    for (const analysis::DirectionWorst& d : h.worst)
+      for (const std::string& reason : d.reasons)
+        why += fmt::format("{}{}: {}", why.empty() ? "" : "; ", link::direction_name(d.direction),
+                           reason);
+    md +=
+        fmt::format("Hop {} fails its worst case{}{}.\n\n", h.index, why.empty() ? "" : ": ", why);
   }
 
   md += "## Ring and cable breaks\n\n";
@@ -203,6 +288,11 @@ std::string pack_report_markdown(const PackSpec& pack, const PackResult& r,
       for (size_t k = 0; k < b.failing.size(); ++k) verdict += (k ? ", " : "") + b.failing[k];
     }
     if (!b.c.unreached.empty()) verdict += b.failing.empty() ? ": devices cut off" : "";
+    if (r.worst_done && !b.worst_pass) {
+      verdict += "; worst case **FAIL**: ";
+      for (size_t k = 0; k < b.worst_failing.size(); ++k)
+        verdict += (k ? ", " : "") + b.worst_failing[k];
+    }
     md += fmt::format("| {} | {} | {} | {} | {} | {} |\n",
                       b.c.broken == 0 ? "none" : fmt::format("{}", b.c.broken),
                       devices_text(b.c.normal_side), devices_text(b.c.reverse_side),
@@ -345,8 +435,15 @@ Status write_pack_bundle(const PackSpec& pack, const PackResult& r, const std::s
 std::string pack_summary_text(const PackSpec& pack, const PackResult& r) {
   std::string s = fmt::format("{}: {} ({} hops, {} circuits simulated, {:.2f} s)\n", pack.name,
                               r.pass ? "pass" : "FAIL", r.hops.size(), r.simulations, r.seconds);
+  if (r.worst_done)
+    s += fmt::format("  worst case over all traffic: {} ({} computed)\n",
+                     r.worst_pass ? "pass" : "FAIL", r.worst_cases);
   for (const HopResult& h : r.hops)
-    if (!h.pass) s += fmt::format("  hop {}: FAIL\n", h.index);
+    if (!h.pass || !h.worst_pass)
+      s += fmt::format("  hop {}: {}\n", h.index,
+                       !h.pass && !h.worst_pass ? "FAIL (spec traffic and worst case)"
+                       : !h.pass                ? "FAIL (spec traffic)"
+                                                : "FAIL (worst case)");
   if (r.weakest > 0) {
     const HopResult& w = r.hops[r.weakest - 1];
     s += fmt::format(

@@ -1,6 +1,7 @@
 // The pack: ring break cases for N = 2, 3, 16 (hand-listed), command timing against hand-worked
-// figures for N = 1, 2, 8, identical hops simulated once (counted through the runner hook), a
-// two-hop pack against two single-hop runs, and the 16-device example through the binary.
+// figures for N = 1, 2, 8, identical hops simulated once (counted through the runner hooks, the
+// worst case's too), a hop's worst case against worst_case() of its spec alone, a two-hop pack
+// against two single-hop runs, and the 16-device example through the binary.
 #include "analysis/pack.h"
 
 #include <fmt/format.h>
@@ -212,7 +213,7 @@ TEST(PackDedupe, IdenticalCircuitsAreSimulatedOnce) {
   ASSERT_TRUE(p.ok()) << p.status().message();
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
   ASSERT_TRUE(parts.ok());
-  std::atomic<int> calls{0};
+  std::atomic<int> calls{0}, worst_calls{0};
   PackOptions opt;
   opt.runner = [&calls](link::ExpandedLink x, const RunOptions&) -> StatusOr<DirectionRun> {
     ++calls;
@@ -220,6 +221,16 @@ TEST(PackDedupe, IdenticalCircuitsAreSimulatedOnce) {
     d.link = std::move(x);
     d.pass = true;
     return d;
+  };
+  // The worst case is deduped as the runs are: one per distinct circuit.
+  opt.worst = WorstOptions{};
+  opt.worst_runner = [&worst_calls](const link::LinkSpec&, link::Direction d,
+                                    const WorstOptions&) -> StatusOr<DirectionWorst> {
+    ++worst_calls;
+    DirectionWorst w;
+    w.direction = d;
+    w.metrics.push_back({.name = "vstart", .value = 2.5, .limit = 2.0, .margin = 0.5});
+    return w;
   };
   StatusOr<PackResult> r = run_pack(*p, *parts, opt);
   ASSERT_TRUE(r.ok()) << r.status().message();
@@ -241,6 +252,144 @@ TEST(PackDedupe, IdenticalCircuitsAreSimulatedOnce) {
   EXPECT_EQ(r->hops[3].same_as, 2);
   EXPECT_EQ(r->hops[4].same_as, 5);
   EXPECT_TRUE(r->pass);
+  EXPECT_EQ(worst_calls.load(), 4);
+  EXPECT_EQ(r->worst_cases, 4);
+  EXPECT_TRUE(r->worst_done);
+  EXPECT_TRUE(r->worst_pass);
+  // Every hop direction has its worst case, in its own direction, margin 0.5 / 2.0.
+  for (const HopResult& h : r->hops) {
+    ASSERT_EQ(h.worst.size(), 2u);
+    EXPECT_EQ(h.worst[0].direction, link::Direction::kDown);
+    EXPECT_EQ(h.worst[1].direction, link::Direction::kUp);
+    EXPECT_DOUBLE_EQ(h.worst_case_rel, 0.25);
+    EXPECT_EQ(h.worst_case_metric, "vstart");
+  }
+}
+
+// With the worst case, a break case also says which hops in use fail theirs: here hop 2 (the
+// only 3 m cable) fails its worst case, so every case that uses it fails over all traffic, and
+// only breaking hop 2 itself passes; the spec traffic passes everywhere.
+TEST(PackWorst, BreakCasesJudgeTheHopsInUseOverAllTraffic) {
+  const std::string text =
+      "hops:\n"
+      "  - spec: {cable: {length: 1}}\n"
+      "  - spec: {cable: {length: 3}}\n"
+      "  - spec: {cable: {length: 1}}\n"
+      "ring: true\n"
+      "ring_return: {spec: {cable: {length: 2}}}\n";
+  StatusOr<PackSpec> p = read_pack_spec_text(text, ::testing::TempDir() + "/break_worst.yaml");
+  ASSERT_TRUE(p.ok()) << p.status().message();
+  StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
+  ASSERT_TRUE(parts.ok());
+  PackOptions opt;
+  opt.runner = [](link::ExpandedLink x, const RunOptions&) -> StatusOr<DirectionRun> {
+    DirectionRun d;
+    d.link = std::move(x);
+    d.pass = true;
+    return d;
+  };
+  opt.worst = WorstOptions{};
+  opt.worst_runner = [](const link::LinkSpec& spec, link::Direction d,
+                        const WorstOptions&) -> StatusOr<DirectionWorst> {
+    DirectionWorst w;
+    w.direction = d;
+    w.pass = spec.cable.length != 3;
+    w.metrics.push_back({.name = "vend", .value = 1.0, .limit = 1.2, .margin = -0.2});
+    if (w.pass) w.metrics.back() = {.name = "vend", .value = 1.5, .limit = 1.2, .margin = 0.3};
+    return w;
+  };
+  StatusOr<PackResult> r = run_pack(*p, *parts, opt);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_TRUE(r->pass);
+  EXPECT_FALSE(r->worst_pass);
+  EXPECT_EQ(r->worst_weakest, 2);
+  EXPECT_DOUBLE_EQ(r->hops[1].worst_case_rel, -0.2 / 1.2);
+  EXPECT_DOUBLE_EQ(r->hops[0].worst_case_rel, 0.3 / 1.2);
+  ASSERT_EQ(r->breaks.size(), 5u);  // none, hops 1-3, the return hop 4
+  for (const BreakResult& b : r->breaks) {
+    EXPECT_TRUE(b.pass) << b.c.broken;
+    EXPECT_EQ(b.worst_pass, b.c.broken == 2) << b.c.broken;
+  }
+  // No break: hop 2 carries commands down (no reads: down only).
+  EXPECT_EQ(r->breaks[0].worst_failing, std::vector<std::string>{"hop 2 normal (down)"});
+  // Hop 1 broken: hops 4, 3r, 2r in use; hop 2 reversed carries commands up.
+  EXPECT_EQ(r->breaks[1].worst_failing, std::vector<std::string>{"hop 2 reversed (up)"});
+  const nlohmann::ordered_json j = reports::pack_report_json(*p, *r);
+  EXPECT_EQ(j["worst_verdict"], "fail");
+  EXPECT_EQ(j["verdict"], "pass");
+  EXPECT_EQ(j["ring_breaks"][2]["worst_verdict"], "pass");
+  EXPECT_EQ(j["ring_breaks"][3]["worst_verdict"], "fail");
+}
+
+// A pack hop's worst case is worst_case() of that hop's link spec alone, bit for bit; hops 2 and
+// 3 (the same module) share one. A reduced search (16 targets, 4 previous bytes) keeps it short:
+// the pack and the direct call get the same options.
+TEST(PackWorst, HopWorstEqualsWorstCaseOfItsSpecAlone) {
+  const std::string text =
+      "stimulus: {frames: [\"single-read dev=2 reg=0x0215 n=1\"]}\n"
+      "hops:\n"
+      "  - spec: {cable: {length: 1}}\n"
+      "  - {spec: {name: m, cable: {length: 2}}, repeat: 2}\n";
+  StatusOr<PackSpec> p = read_pack_spec_text(text, ::testing::TempDir() + "/worst_pack.yaml");
+  ASSERT_TRUE(p.ok()) << p.status().message();
+  StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
+  ASSERT_TRUE(parts.ok());
+  WorstOptions wo;
+  for (int b : {0x00, 0x01, 0x0F, 0x3C, 0x55, 0x7E, 0xAA, 0xFF})
+    wo.targets.push_back(b), wo.targets.push_back(b | 0x100);
+  wo.previous = {0x00, 0xFF, 0x155, 0xAA};
+  PackOptions opt;
+  opt.worst = wo;
+  StatusOr<PackResult> r = run_pack(*p, *parts, opt);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  ASSERT_EQ(r->hops.size(), 3u);
+  // A read: both directions; hop 1 has the bridge at one end (2 circuits), hops 2 and 3 are one
+  // symmetric circuit (up is down's).
+  EXPECT_EQ(r->worst_cases, 3);
+  bool all_pass = true;
+  nlohmann::ordered_json first_alone;  // hop 1's, as `isolink worst --json` prints it
+  for (size_t k = 0; k < r->hops.size(); ++k) {
+    const HopResult& h = r->hops[k];
+    StatusOr<WorstResult> alone = worst_case(p->hops[k].spec, *parts, wo);
+    ASSERT_TRUE(alone.ok()) << alone.status().message();
+    ASSERT_EQ(h.worst.size(), alone->directions.size());
+    if (k == 0) first_alone = worst_json(*alone);
+    bool hop_pass = true;
+    for (size_t d = 0; d < h.worst.size(); ++d) {
+      const DirectionWorst& x = h.worst[d];
+      const DirectionWorst& y = alone->directions[d];
+      EXPECT_EQ(x.direction, y.direction);
+      EXPECT_EQ(x.description, y.description);
+      EXPECT_EQ(x.pass, y.pass);
+      EXPECT_EQ(x.memory, y.memory);
+      EXPECT_EQ(x.scored, y.scored);
+      EXPECT_EQ(x.edge.e, y.edge.e);  // bit for bit
+      ASSERT_EQ(x.metrics.size(), 5u);
+      ASSERT_EQ(x.metrics.size(), y.metrics.size());
+      for (size_t m = 0; m < x.metrics.size(); ++m) {
+        EXPECT_EQ(x.metrics[m].name, y.metrics[m].name);
+        EXPECT_EQ(x.metrics[m].value, y.metrics[m].value) << k << " " << x.metrics[m].name;
+        EXPECT_EQ(x.metrics[m].margin, y.metrics[m].margin);
+        EXPECT_EQ(x.metrics[m].bound, y.metrics[m].bound);
+        EXPECT_EQ(x.metrics[m].traffic.gaps, y.metrics[m].traffic.gaps);
+      }
+      hop_pass = hop_pass && y.pass;
+    }
+    EXPECT_EQ(h.worst_pass, hop_pass);
+    all_pass = all_pass && hop_pass;
+    // The hop's worst-case margin is the smallest margin / |limit| of the direct call.
+    double rel = 1e9;
+    for (const DirectionWorst& y : alone->directions)
+      for (const WorstMetric& m : y.metrics) rel = std::min(rel, m.margin / std::abs(m.limit));
+    EXPECT_EQ(h.worst_case_rel, rel);
+  }
+  EXPECT_EQ(r->worst_pass, all_pass);
+  // report.json: each hop direction's `worst` is `isolink worst --json`'s directions[].worst.
+  const nlohmann::ordered_json pj = reports::pack_report_json(*p, *r);
+  EXPECT_EQ(pj["worst_verdict"], all_pass ? "pass" : "fail");
+  EXPECT_EQ(pj["verdict"], r->pass ? "pass" : "fail");
+  for (size_t d = 0; d < 2; ++d)
+    EXPECT_EQ(pj["hops"][0]["directions"][d]["worst"], first_alone["directions"][d]["worst"]);
 }
 
 std::string slurp(const std::string& path) {
@@ -307,7 +456,10 @@ TEST(PackSim, ExamplePackThroughTheBinary) {
   const int status = std::system(cmd.c_str());
   const nlohmann::json j = nlohmann::json::parse(slurp(dir + "/report.json"));
   const int code = WEXITSTATUS(status);
-  EXPECT_EQ(code, j["verdict"] == "pass" ? 0 : 1) << slurp(dir + ".out");
+  // Exit 1 when a hop fails the spec traffic or its worst case over all traffic.
+  EXPECT_EQ(code, j["verdict"] == "pass" && j["worst_verdict"] == "pass" ? 0 : 1)
+      << slurp(dir + ".out");
+  EXPECT_EQ(j["worst_cases"], 7);  // one per distinct circuit, as the simulations
   ASSERT_EQ(j["hops"].size(), 17u);
   EXPECT_EQ(j["devices"], 16);
   // Distinct circuits: the bridge hop (0.5 m) and the 4 m return hop in each direction (a
@@ -320,6 +472,9 @@ TEST(PackSim, ExamplePackThroughTheBinary) {
   int weakest = 0;
   for (const auto& h : j["hops"]) {
     EXPECT_EQ(h["directions"].size(), 2u);
+    for (const auto& d : h["directions"])
+      for (const char* m : {"vstart", "vend", "width_min", "width_max", "edge"})
+        EXPECT_TRUE(d["worst"][m]["margin"].is_number()) << h["index"] << " " << m;
     const double m = h["worst_margin_rel"].get<double>() - (h["verdict"] == "pass" ? 0 : 1e9);
     if (m < worst) worst = m, weakest = h["index"];
     EXPECT_TRUE(fs::exists(fmt::format("{}/hop_{:02}/eye.png", dir, h["index"].get<int>())));

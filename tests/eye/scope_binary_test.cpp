@@ -524,17 +524,18 @@ TEST(RealCaptures, ReadToTheFiguresTheirSourcesState) {
                                  5e-7,
                                  {{0, 1.8492462635}, {1, 1.8894472122}, {1999, 1.8090451955}},
                                  1e-9});
-  // Tektronix sample_1.wfm (WFM#003, int8): Tektronix's tekwfm.py gives volts = adc * 0.0024
-  // (a float32 scale stored as a double: 0.00239999995) + 0 for the 1000 points between the 16-byte
-  // precharge and the postcharge, t = tstart (-10 ns)
-  // + tfrac (0.8923646 samples) * tscale (20 ps) + i * tscale; adc 10, 32, 50 ... 11
-  expect_trace("tek_sample_1.wfm", {0,
-                                    "waveform",
-                                    1000,
-                                    -1e-8 + 0.8923646071698386 * 2e-11,
-                                    2e-11,
-                                    {{0, 0.024}, {1, 0.0768}, {2, 0.12}, {999, 0.0264}},
-                                    1e-8});
+  // Tektronix golden_analog.wfm (WFM#003, int16), written by Tektronix's tm_data_types in its
+  // test_wfm: the values int16 10, 11, 12, 32222, 32223, 32224 at y spacing 1/32767 V (so volts =
+  // adc / 32767); hand-decoded header: imp_dim1 scale 1 s, offset -3 s, and the writer's default
+  // trigger time offset 0.5 samples, so t = -3 + (0.5 + i) * 1 s
+  expect_trace("tek_golden_analog.wfm",
+               {0,
+                "waveform",
+                6,
+                -2.5,
+                1.0,
+                {{0, 10.0 / 32767}, {1, 11.0 / 32767}, {2, 12.0 / 32767}, {5, 32224.0 / 32767}},
+                1e-9});
   // hand-decoded from the LECROY_2_3 template: 502 int16 points (LOFIRST) from byte 357, gain
   // 1.24995e-4 V, offset -1.0 V, HORIZ_INTERVAL 1 ns, HORIZ_OFFSET -120.745 ns, WAVE_SOURCE 1
   expect_trace("lecroy_4.trc", {0,
@@ -548,7 +549,7 @@ TEST(RealCaptures, ReadToTheFiguresTheirSourcesState) {
 
 TEST(RealCaptures, NoPassOnCapturesThatAreNoDaisyChainRecord) {
   for (const char* f : {"DS1000E-A.wfm", "DS1102E-B.wfm", "MSO5000-A.bin", "agilent_1.bin",
-                        "lecroy_4.trc", "tek_sample_1.wfm"}) {
+                        "lecroy_4.trc", "tek_golden_analog.wfm"}) {
     SCOPED_TRACE(f);
     StatusOr<Waveform> w = read_capture({real(f)}, {});
     ASSERT_TRUE(w.ok()) << w.status().message();
@@ -571,10 +572,6 @@ TEST(RealCaptures, RefusedWithTheReason) {
             real("lecroy_3.trc") +
                 ":byte 155: error: SUBARRAY_COUNT 20: a sequence of 20 segments; isolink reads one "
                 "record: save a single segment");
-  // five FastFrame frames (N frames - 1 at byte 72 of the static file information)
-  EXPECT_EQ(error_of(read_capture({real("tek_sample_ff1.wfm")}, {})),
-            real("tek_sample_ff1.wfm") +
-                ":byte 72: error: 5 FastFrame frames: one record is read; save a single frame");
   // a 10X probe: DS1000E and DS1000D differ in how they store it (RigolWFM channel.py)
   EXPECT_EQ(error_of(read_capture({real("DS1052E.wfm")}, {})),
             real("DS1052E.wfm") +
