@@ -135,8 +135,23 @@ StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const d
   r.t_begin = t.front();
   r.t_end = t.back();
 
-  const Segmentation seg = segment(t, v, segment_params(rules));
+  Segmentation seg = segment(t, v, segment_params(rules));
   r.pulses = measure_pulses(t, v, seg, rules);
+  if (!rules.tone) {
+    // Item 4a: when a run's half bits make whole frames up to its second-last pulse, its last
+    // pulse is the line's kickback after the postamble (AC coupling swinging back past the
+    // threshold when the driver goes idle), not the start of a frame: the receiver blanks it
+    // (tblank), and joining it would stretch the postamble's width to the kickback's start.
+    const size_t frame_len = r.frame_format.half_bits();
+    std::vector<size_t> tails;
+    for (const FrameSpan& fs : seg.frames) {
+      size_t acc = 0;
+      for (size_t p = fs.first; p < fs.last; ++p) acc += r.pulses[p].half_bits;
+      if (fs.last > fs.first && acc % frame_len == 0) tails.push_back(fs.last);
+    }
+    for (auto it = tails.rbegin(); it != tails.rend(); ++it) drop_frame_tail(&seg, *it);
+    if (!tails.empty()) r.pulses = measure_pulses(t, v, seg, rules);
+  }
   r.ringing = seg.ringing;
   r.idle = find_idle_undershoots(t, v, seg, rules);
   const FrameFormat& fmt_ = r.frame_format;
@@ -405,7 +420,8 @@ json to_json(const CheckResult& r) {
                          {"duration_ns", ns(g.end - g.start)},
                          {"sign", g.sign},
                          {"peak", g.peak},
-                         {"peak_s", g.peak_t}});
+                         {"peak_s", g.peak_t},
+                         {"after_frame", g.after_frame}});
   j["ringing"] = std::move(ringing);
   json idle = json::array();
   for (const IdleUndershoot& u : r.idle)
@@ -496,9 +512,14 @@ std::string summary_text(const CheckResult& r, const std::string& source) {
                                  r.frames[i].fault, r.frames[i].detail));
   for (const Ringing& g : r.ringing)
     warns.push_back(
-        fmt::format("ringing: {} excursion of {:.1f} ns at {:.4f} us, peak {:.3f} V "
-                    "(not a pulse)",
-                    sign_str(g.sign), ns(g.end - g.start), g.start * 1e6, g.peak));
+        g.after_frame
+            ? fmt::format("kickback after a frame: {} excursion of {:.1f} ns at {:.4f} us, peak "
+                          "{:.3f} V (the line swinging back past the threshold after the "
+                          "postamble; allowed: the receiver blanks it)",
+                          sign_str(g.sign), ns(g.end - g.start), g.start * 1e6, g.peak)
+            : fmt::format("ringing: {} excursion of {:.1f} ns at {:.4f} us, peak {:.3f} V "
+                          "(not a pulse)",
+                          sign_str(g.sign), ns(g.end - g.start), g.start * 1e6, g.peak));
   for (const IdleUndershoot& u : r.idle)
     warns.push_back(fmt::format("idle undershoot: {} to {:.3f} V at {:.4f} us after pulse {}",
                                 sign_str(u.sign), u.sign * u.peak, u.peak_t * 1e6, u.after_pulse));

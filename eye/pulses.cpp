@@ -124,13 +124,37 @@ Segmentation segment(std::span<const double> t, std::span<const double> v, const
     const PulseSpan& y = seg.pulses[i + 1];
     seg.joined_next[i] = y.sign == -x.sign && y.a - x.b < p.transition_gap;
   }
+  build_frames(&seg);
+  return seg;
+}
+
+void build_frames(Segmentation* seg) {
+  const size_t np = seg->pulses.size();
+  seg->frames.clear();
   for (size_t i = 0; i < np;) {
     FrameSpan f{i, i};
-    while (f.last + 1 < np && seg.joined_next[f.last]) ++f.last;
-    seg.frames.push_back(f);
+    while (f.last + 1 < np && seg->joined_next[f.last]) ++f.last;
+    seg->frames.push_back(f);
     i = f.last + 1;
   }
-  return seg;
+}
+
+void drop_frame_tail(Segmentation* seg, size_t i) {
+  const PulseSpan& ps = seg->pulses.at(i);
+  Ringing g;
+  g.sign = ps.sign;
+  g.start = ps.a;
+  g.end = ps.b;
+  g.peak = ps.peak;
+  g.peak_t = ps.peak_t;
+  g.after_frame = true;
+  auto at = std::lower_bound(seg->ringing.begin(), seg->ringing.end(), g.start,
+                             [](const Ringing& x, double t) { return x.start < t; });
+  seg->ringing.insert(at, g);
+  seg->pulses.erase(seg->pulses.begin() + static_cast<std::ptrdiff_t>(i));
+  seg->joined_next.erase(seg->joined_next.begin() + static_cast<std::ptrdiff_t>(i));
+  if (i > 0) seg->joined_next[i - 1] = false;
+  build_frames(seg);
 }
 
 }  // namespace isolink::eye

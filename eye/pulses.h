@@ -45,12 +45,14 @@ struct PulseSpan {
   bool truncated = false;  // cut by the start or end of the record
 };
 
-// An excursion shorter than min_pulse: overshoot, not a pulse.
+// An excursion shorter than min_pulse: overshoot, not a pulse. Or (after_frame) the kickback of
+// the line right after a complete frame (drop_frame_tail): allowed, inside the receiver's blanking.
 struct Ringing {
   int sign = 0;
   double start = 0, end = 0;  // crossings (s)
   double peak = 0;            // max of s * v (V)
   double peak_t = 0;
+  bool after_frame = false;  // the kickback after a frame's postamble, not a short excursion
 };
 
 // Pulses first..last (inclusive), each joined to the next by a transition.
@@ -77,5 +79,10 @@ std::vector<Excursion> find_excursions(std::span<const double> t, std::span<cons
                                        double vth);
 // Items 1-4.
 Segmentation segment(std::span<const double> t, std::span<const double> v, const SegmentParams& p);
+// Rebuilds frames from pulses and joined_next.
+void build_frames(Segmentation* seg);
+// Item 4a: pulse i is the line's kickback after a complete frame, not a pulse: it moves to ringing
+// (after_frame), the pulse before it runs into idle, and the frames are rebuilt.
+void drop_frame_tail(Segmentation* seg, size_t i);
 
 }  // namespace isolink::eye

@@ -125,6 +125,56 @@ TEST(Check, RecordCutMidFrameIsTruncatedAndInconclusive) {
   EXPECT_EQ(r->failing(), 0u);
 }
 
+// Item 4a: an AC-coupled line swings back past the threshold when the driver goes idle after a
+// frame ending in a double pulse (error bit 1, postamble). That kickback is no pulse: the receiver
+// blanks it (tblank), and the postamble runs into idle instead of being stretched to it.
+TEST(Check, KickbackAfterACompleteFrameIsNoPulse) {
+  synth::Train tr;
+  tr.pulses = synth::pulses_from_half_bits(frame_half_bits(0xF9, FrameFormat{}, true));
+  synth::Pwl base;
+  synth::append_train(base, tr);
+  // +1.5 V from 30 to 200 ns after the frame's end: past +1.2 V from 26 ns to 204 ns (178 ns)
+  const double end = tr.end();
+  synth::Pwl kick;
+  kick.add(end + 10 * ns, 0);
+  kick.add(end + 30 * ns, 1.5);
+  kick.add(end + 200 * ns, 1.5);
+  kick.add(end + 220 * ns, 0);
+  const Waveform w = synth::sample(base, 1 * ns, end + 2e-6, {kick});
+  StatusOr<CheckResult> r = check_waveform(w, rules());
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_TRUE(r->pass) << summary_text(*r);
+  EXPECT_EQ(r->bytes, std::vector<uint8_t>{0xF9});
+  ASSERT_EQ(r->frames.size(), 1u);
+  EXPECT_TRUE(r->frames[0].error_bit);
+  ASSERT_EQ(r->ringing.size(), 1u);
+  EXPECT_TRUE(r->ringing[0].after_frame);
+  EXPECT_EQ(r->ringing[0].sign, +1);
+  EXPECT_NEAR(r->ringing[0].peak, 1.5, 1e-9);
+  EXPECT_NEAR(r->ringing[0].start, end + 26 * ns, 0.01 * ns);
+  EXPECT_NEAR(r->ringing[0].end, end + 204 * ns, 0.01 * ns);
+  // the last pulse is the double negative (error bit's second half + postamble): it runs into
+  // idle, width b - a = 2 T (its crossings are 6 ns after each boundary, the last at 6 ns before)
+  const PulseMetrics& last = r->pulses.back();
+  EXPECT_EQ(last.sign, -1);
+  EXPECT_TRUE(last.idle);
+  EXPECT_NEAR(last.width.value, 500 * ns - 12 * ns, 0.01 * ns);
+  EXPECT_FALSE(last.failing());
+
+  // Without SOF a frame has 24 half bits: the 26 before the kickback are no whole frame, so the
+  // kickback stays a pulse, joined to the postamble, which is then measured to its start.
+  CheckOptions no_sof;
+  no_sof.sof = false;
+  r = check_waveform(w, rules(), no_sof);
+  ASSERT_TRUE(r.ok());
+  EXPECT_TRUE(r->ringing.empty());
+  EXPECT_EQ(r->pulses.back().sign, +1);
+  const PulseMetrics& post = r->pulses[r->pulses.size() - 2];
+  EXPECT_FALSE(post.idle);
+  // from -1.2 V at 494 ns before the frame's end to the kickback's +1.2 V at 26 ns after it
+  EXPECT_NEAR(post.width.value, 520 * ns, 0.01 * ns);
+}
+
 // Tone rules: 1 us pulses +/- 8 % (920..1080 ns); nothing is decoded.
 TEST(Check, ToneWidthLimits) {
   for (double d : {79.0, 81.0}) {
