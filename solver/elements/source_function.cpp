@@ -10,7 +10,6 @@
 namespace isolink {
 
 namespace {
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 double or_default(const std::vector<double>& p, size_t i, double d) {
   return i < p.size() && !std::isnan(p[i]) ? p[i] : d;
 }

@@ -21,6 +21,10 @@
 #include "eye/waveform_csv.h"
 #elif ISOLINK_FUZZ_READER == 7
 #include "netlists/traffic/stimulus.h"
+#elif ISOLINK_FUZZ_READER == 8
+#include <cstdio>
+
+#include "eye/scope_binary.h"
 #endif
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -39,6 +43,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   (void)isolink::eye::parse_differential_csv(text, "fuzz.csv");
 #elif ISOLINK_FUZZ_READER == 7
   (void)isolink::traffic::build_drive(text);
+#elif ISOLINK_FUZZ_READER == 8
+  // The binary readers take a path (they read headers in place, not the whole file): the bytes
+  // go to a file in the working directory; the format is told by its first bytes, .isf by
+  // ":WFMP"/":WFMO" (the extension is .bin, whose own readers are told by their magic too).
+  const char* path = "fuzz_scope_input.bin";
+  if (std::FILE* f = std::fopen(path, "wb")) {
+    const size_t wrote = std::fwrite(data, 1, size, f);
+    std::fclose(f);
+    if (wrote == size) (void)isolink::eye::read_binary(path);
+  }
 #endif
   return 0;
 }
