@@ -108,14 +108,14 @@ StatusOr<SweepOutcome> run_sweep_mpi(const SweepSpec& s, const link::PartLibrary
   ResultLog& L = **log;
   const std::vector<size_t> todo_list = L.todo();
   std::deque<size_t> todo(todo_list.begin(), todo_list.end());
-  const size_t ncells = s.point_columns().size(), ncolumns = results_header(s).size();
+  const RowShape shape = row_shape(s);
   int active = world.size - 1;
   while (active > 0) {
     const auto [from, row] = receive_result();
     if (!row.empty()) {
       std::string line = row;
       while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.pop_back();
-      StatusOr<PointResult> r = parse_results_row(line, ncells, ncolumns);
+      StatusOr<PointResult> r = parse_results_row(line, shape);
       if (r)
         L.add(*r);
       else

@@ -43,6 +43,20 @@ const std::vector<std::string> kNoiseColumns = {"noise.verdict",
                                                 "noise.up.freq_hz"};
 // Scale of each kMetrics margin in the CSV (V, V, ns, ns).
 constexpr std::array<double, 4> kCsvScale = {1.0, 1.0, 1e9, 1e9};
+// The same for each kWorstMetrics margin (V, V, ns, ns, ns) and the units the columns name.
+constexpr std::array<double, 5> kWorstCsvScale = {1.0, 1.0, 1e9, 1e9, 1e9};
+constexpr std::array<const char*, 5> kWorstCsvUnit = {"V", "V", "ns", "ns", "ns"};
+constexpr std::array<const char*, 2> kDirections = {"down", "up"};  // by link::Direction
+
+// worst.verdict, worst.worst_metric, worst.margin_rel, worst.<dir>.<metric>_margin_<unit>.
+std::vector<std::string> worst_columns() {
+  std::vector<std::string> c = {"worst.verdict", "worst.worst_metric", "worst.margin_rel"};
+  for (const char* d : kDirections)
+    for (size_t m = 0; m < kWorstMetrics.size(); ++m)
+      c.push_back(fmt::format("worst.{}.{}_margin_{}", d, kWorstMetrics[m], kWorstCsvUnit[m]));
+  return c;
+}
+const std::vector<std::string> kWorstColumns = worst_columns();
 
 double now_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -81,9 +95,22 @@ std::vector<std::string> results_header(const SweepSpec& s) {
   for (const std::string& c : s.point_columns()) h.push_back(c);
   h.insert(h.end(), kResultColumns.begin(), kResultColumns.begin() + kBeforeNoise);
   if (s.noise_outputs) h.insert(h.end(), kNoiseColumns.begin(), kNoiseColumns.end());
+  if (s.worst_outputs) h.insert(h.end(), kWorstColumns.begin(), kWorstColumns.end());
   h.insert(h.end(), kResultColumns.begin() + kBeforeNoise, kResultColumns.end());
   for (const std::string& c : pack_columns(s)) h.push_back(c);
   return h;
+}
+
+size_t RowShape::columns() const {
+  return 1 + cells + kResultColumns.size() + (noise ? kNoiseColumns.size() : 0) +
+         (worst ? kWorstColumns.size() : 0) + extra;
+}
+
+RowShape row_shape(const SweepSpec& s) {
+  return {.cells = s.point_columns().size(),
+          .noise = s.noise_outputs,
+          .worst = s.worst_outputs,
+          .extra = pack_columns(s).size()};
 }
 
 std::vector<std::string> pack_columns(const SweepSpec& s) {
@@ -133,23 +160,32 @@ std::string results_row(const PointResult& r) {
       add(num(n.freq_hz[d]));
     }
   }
+  if (r.worst) {
+    const PointResult::Worst& w = *r.worst;
+    add(w.verdict);
+    add(w.worst_metric);
+    add(num(w.margin_rel));
+    for (size_t d = 0; d < 2; ++d)
+      for (size_t m = 0; m < kWorstMetrics.size(); ++m)
+        add(num(w.margin[d][m] * kWorstCsvScale[m]));
+  }
   add(fmt::format("{:.2f}", r.seconds));
   add(r.error);
   for (const std::string& c : r.extra) add(c);
   return line + "\n";
 }
 
-StatusOr<PointResult> parse_results_row(std::string_view line, size_t ncells, size_t ncolumns) {
+StatusOr<PointResult> parse_results_row(std::string_view line, const RowShape& shape) {
   const std::vector<std::string> f = split_csv_line(line);
-  if (f.size() != ncolumns)
-    return Status::Error(fmt::format("{} fields, expected {}", f.size(), ncolumns));
+  if (f.size() != shape.columns())
+    return Status::Error(fmt::format("{} fields, expected {}", f.size(), shape.columns()));
   PointResult r;
   char* end = nullptr;
   const unsigned long long idx = std::strtoull(f[0].c_str(), &end, 10);
   if (f[0].empty() || *end != '\0') return Status::Error("point is not a number: '" + f[0] + "'");
   r.index = static_cast<size_t>(idx);
   size_t k = 1;
-  for (size_t i = 0; i < ncells; ++i) r.cells.push_back(f[k++]);
+  for (size_t i = 0; i < shape.cells; ++i) r.cells.push_back(f[k++]);
   r.verdict = f[k++];
   if (r.verdict != "pass" && r.verdict != "fail" && r.verdict != "error")
     return Status::Error("verdict is not pass, fail or error: '" + r.verdict + "'");
@@ -164,7 +200,7 @@ StatusOr<PointResult> parse_results_row(std::string_view line, size_t ncells, si
   if (d == "true") r.decoded_ok = true;
   if (d == "false") r.decoded_ok = false;
   r.reason = f[k++];
-  if (ncolumns == 1 + ncells + kResultColumns.size() + kNoiseColumns.size()) {
+  if (shape.noise) {
     PointResult::Noise n;
     n.verdict = f[k++];
     if (n.verdict != "pass" && n.verdict != "fail" && !n.verdict.empty())
@@ -178,6 +214,27 @@ StatusOr<PointResult> parse_results_row(std::string_view line, size_t ncells, si
     if (!ok) return Status::Error("bad noise column");
     r.noise = n;
   }
+  if (shape.worst) {
+    PointResult::Worst w;
+    w.verdict = f[k++];
+    if (w.verdict != "pass" && w.verdict != "fail" && !w.verdict.empty())
+      return Status::Error("worst.verdict is not pass, fail or empty: '" + w.verdict + "'");
+    w.worst_metric = f[k++];
+    if (!w.worst_metric.empty() &&
+        std::find_if(kWorstMetrics.begin(), kWorstMetrics.end(),
+                     [&](const char* m) { return w.worst_metric == m; }) == kWorstMetrics.end())
+      return Status::Error("worst.worst_metric is not a worst-case metric: '" + w.worst_metric +
+                           "'");
+    bool ok = parse_double(f[k++], &w.margin_rel);
+    for (size_t dir = 0; dir < 2; ++dir)
+      for (size_t m = 0; m < kWorstMetrics.size(); ++m) {
+        double v = 0;
+        ok = parse_double(f[k++], &v) && ok;
+        w.margin[dir][m] = v / kWorstCsvScale[m];
+      }
+    if (!ok) return Status::Error("bad worst column");
+    r.worst = w;
+  }
   if (!parse_double(f[k++], &r.seconds)) return Status::Error("bad seconds");
   if (std::isnan(r.seconds)) r.seconds = 0;
   r.error = f[k++];
@@ -185,10 +242,10 @@ StatusOr<PointResult> parse_results_row(std::string_view line, size_t ncells, si
   return r;
 }
 
-PointResult round_trip(const PointResult& r, size_t ncells, size_t ncolumns) {
+PointResult round_trip(const PointResult& r, const RowShape& shape) {
   std::string row = results_row(r);
   row.pop_back();
-  StatusOr<PointResult> p = parse_results_row(row, ncells, ncolumns);
+  StatusOr<PointResult> p = parse_results_row(row, shape);
   return p ? *p : r;
 }
 
@@ -260,6 +317,27 @@ PointResult::Noise noise_cells(const NoiseResult& r) {
   return n;
 }
 
+PointResult::Worst worst_cells(const WorstResult& r) {
+  PointResult::Worst w;
+  w.verdict = r.pass ? "pass" : "fail";
+  for (const DirectionWorst& d : r.directions) {
+    const size_t k = d.direction == link::Direction::kDown ? 0 : 1;
+    for (size_t m = 0; m < kWorstMetrics.size(); ++m) {
+      const WorstMetric* wm = d.metric(kWorstMetrics[m]);
+      if (!wm || !std::isfinite(wm->margin)) continue;
+      w.margin[k][m] = wm->margin;
+      // The smallest margin / |limit|, as score_run's worst_margin_rel.
+      const double lim = std::abs(wm->limit);
+      const double rel = lim > 0 ? wm->margin / lim : kNaN;
+      if (std::isfinite(rel) && (std::isnan(w.margin_rel) || rel < w.margin_rel)) {
+        w.margin_rel = rel;
+        w.worst_metric = kWorstMetrics[m];
+      }
+    }
+  }
+  return w;
+}
+
 PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t index,
                       const PointOptions& opt) {
   const double t0 = now_seconds();
@@ -275,6 +353,8 @@ PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t
     r.error = first_line(message);
     r.noise.reset();
     if (s.noise_outputs) r.noise.emplace();
+    r.worst.reset();
+    if (s.worst_outputs) r.worst.emplace();
     r.extra.clear();
     r.seconds = now_seconds() - t0;
     return r;
@@ -313,6 +393,12 @@ PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t
       if (!noise) return fail("noise: " + noise.status().message());
       r.noise = noise_cells(*noise);
     }
+    if (s.worst_outputs) {
+      // The default options, as `isolink run` and `isolink worst` use, on the run's expansion.
+      StatusOr<WorstResult> w = worst_case(po.point.spec, parts, {.expand = opt.run.expand});
+      if (!w) return fail("worst: " + w.status().message());
+      r.worst = worst_cells(*w);
+    }
     if (!opt.waves_dir.empty()) {
       const Waveform w = run_waveforms(*run, po.point.spec.sim.tstep);
       const std::string path = fmt::format("{}/point_{:05}.csv", opt.waves_dir, index);
@@ -334,9 +420,8 @@ StatusOr<std::unique_ptr<ResultLog>> ResultLog::open(const SweepSpec& s, const S
       ProgressLine::Options{.label = "sweep", .enabled = !opt.quiet, .pipe_interval = 5.0});
   log->total_ = s.size();
   log->have_.assign(log->total_, false);
-  log->ncells_ = s.point_columns().size();
+  log->shape_ = row_shape(s);
   const std::vector<std::string> header = results_header(s);
-  log->ncolumns_ = header.size();
   log->path_ = opt.out_dir + "/results.csv";
   std::string header_line;
   for (const std::string& h : header) header_line += (header_line.empty() ? "" : ",") + cell(h);
@@ -365,7 +450,7 @@ StatusOr<std::unique_ptr<ResultLog>> ResultLog::open(const SweepSpec& s, const S
           continue;
         }
         if (line.empty()) continue;
-        StatusOr<PointResult> r = parse_results_row(line, log->ncells_, log->ncolumns_);
+        StatusOr<PointResult> r = parse_results_row(line, log->shape_);
         if (!r)
           return Status::Error(fmt::format("{}:{}: error: --resume: cannot read the row: {}",
                                            log->path_, line_no, r.status().message()));
@@ -414,12 +499,13 @@ std::vector<size_t> ResultLog::todo() const {
 
 void ResultLog::add(const PointResult& in) {
   PointResult padded = in;
-  padded.cells.resize(ncells_);  // a point that failed before its cells were known
-  if (spec_->noise_outputs && !padded.noise) padded.noise.emplace();
-  if (!spec_->noise_outputs) padded.noise.reset();
-  padded.extra.resize(ncolumns_ - 1 - ncells_ - kResultColumns.size() -
-                      (spec_->noise_outputs ? kNoiseColumns.size() : 0));  // an error's: empty
-  const PointResult r = round_trip(padded, ncells_, ncolumns_);
+  padded.cells.resize(shape_.cells);  // a point that failed before its cells were known
+  if (shape_.noise && !padded.noise) padded.noise.emplace();
+  if (!shape_.noise) padded.noise.reset();
+  if (shape_.worst && !padded.worst) padded.worst.emplace();
+  if (!shape_.worst) padded.worst.reset();
+  padded.extra.resize(shape_.extra);  // an error's: empty
+  const PointResult r = round_trip(padded, shape_);
   const std::string row = results_row(r);
   std::lock_guard<std::mutex> lock(mu_);
   if (r.index >= total_ || have_[r.index] || !write_error_.ok()) return;
@@ -482,6 +568,14 @@ using nlohmann::ordered_json;
 
 ordered_json num_json(double v) {
   return std::isnan(v) ? ordered_json(nullptr) : ordered_json(v);
+}
+
+// A point named in summary.json: its index and its point_columns() cells.
+ordered_json point_json(const SweepSpec& s, const PointResult& r) {
+  ordered_json w{{"point", r.index}};
+  const std::vector<std::string> cols = s.point_columns();
+  for (size_t i = 0; i < cols.size() && i < r.cells.size(); ++i) w[cols[i]] = r.cells[i];
+  return w;
 }
 
 // A grid point's verdict and margin over its Monte Carlo samples (pass only when all pass).
@@ -629,10 +723,7 @@ nlohmann::ordered_json summary_json(const SweepSpec& s, const std::vector<PointR
   j["pass_yield"] = done ? ordered_json(static_cast<double>(pass) / done) : ordered_json(nullptr);
   j["worst_metric_counts"] = worst_metrics;
   if (worst) {
-    ordered_json w{{"point", worst->index}};
-    const std::vector<std::string> cols = s.point_columns();
-    for (size_t i = 0; i < cols.size() && i < worst->cells.size(); ++i)
-      w[cols[i]] = worst->cells[i];
+    ordered_json w = point_json(s, *worst);
     w["verdict"] = worst->verdict;
     w["worst_metric"] = worst->worst_metric;
     w["worst_margin_rel"] = worst->worst_rel;
@@ -675,16 +766,38 @@ nlohmann::ordered_json summary_json(const SweepSpec& s, const std::vector<PointR
     }
     ordered_json n{{"pass", npass}, {"fail", nfail}};
     if (nworst) {
-      ordered_json w{{"point", nworst->index}};
-      const std::vector<std::string> cols = s.point_columns();
-      for (size_t i = 0; i < cols.size() && i < nworst->cells.size(); ++i)
-        w[cols[i]] = nworst->cells[i];
+      ordered_json w = point_json(s, *nworst);
       w["immunity_min_db"] = nworst->noise->immunity_min_db;
       n["worst"] = w;
     } else {
       n["worst"] = nullptr;
     }
     j["noise"] = n;
+  }
+  if (s.worst_outputs) {
+    // The worst-case verdicts and the point with the smallest worst.margin_rel ("worst" is taken
+    // by the spec traffic's worst point).
+    size_t wpass = 0, wfail = 0;
+    const PointResult* wworst = nullptr;
+    for (const PointResult& r : results) {
+      if (!r.worst) continue;
+      wpass += r.worst->verdict == "pass";
+      wfail += r.worst->verdict == "fail";
+      if (!std::isnan(r.worst->margin_rel) &&
+          (!wworst || r.worst->margin_rel < wworst->worst->margin_rel))
+        wworst = &r;
+    }
+    ordered_json n{{"pass", wpass}, {"fail", wfail}};
+    if (wworst) {
+      ordered_json w = point_json(s, *wworst);
+      w["verdict"] = wworst->worst->verdict;
+      w["worst_metric"] = wworst->worst->worst_metric;
+      w["margin_rel"] = wworst->worst->margin_rel;
+      n["worst"] = w;
+    } else {
+      n["worst"] = nullptr;
+    }
+    j["worst_case"] = n;
   }
   return j;
 }

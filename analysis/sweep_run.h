@@ -32,6 +32,22 @@
 //   noise.<dir>.immunity_min_db   the same in dB re the test level
 //   noise.<dir>.freq_hz           the frequency of that minimum
 // Empty where a direction was not run or the point is an error. `verdict` stays the link's own.
+// With `outputs: [worst]`, each point also runs the worst case over all legal traffic on its spec
+// (worst_case with the default WorstOptions: what `isolink worst` and `isolink run` give for that
+// spec) and these columns follow (after the noise columns when both are asked for):
+//   worst.verdict                 pass | fail: WorstResult::pass (every direction's worst traffic
+//                                 passes its receiver's rules)
+//   worst.worst_metric            the metric with the smallest margin / |limit| below (vstart,
+//                                 vend, width_min, width_max, edge)
+//   worst.margin_rel              that smallest margin / |limit| over the directions and metrics
+//                                 (as worst_margin_rel is for the spec's traffic)
+//   worst.<dir>.<metric>_margin_<unit>  per direction (down, up) and metric, the worst traffic's
+//                                 margin: vstart_margin_V, vend_margin_V, width_min_margin_ns,
+//                                 width_max_margin_ns, edge_margin_ns (the units of the margin_*
+//                                 columns)
+// Empty where a direction was not run or the point is an error. `verdict` stays the spec
+// traffic's, so the two can be compared point by point. A worst case that cannot be computed
+// makes the point an error ("worst: ..."), as a noise analysis that fails does.
 // A point whose spec is invalid or whose simulation fails has verdict "error", the message's
 // first line in `error` (CSV-quoted) and empty margins; the sweep goes on. Numbers are written with
 // 6 significant digits and every total (summary.json, plots) is computed from the rows as written,
@@ -64,6 +80,7 @@
 #include "analysis/noise.h"
 #include "analysis/pack.h"
 #include "analysis/sweep_spec.h"
+#include "analysis/worst.h"
 #include "base/csv.h"
 #include "base/progress.h"
 #include "base/status.h"
@@ -72,6 +89,9 @@
 namespace isolink::analysis::sweep {
 
 inline constexpr std::array<const char*, 4> kMetrics = {"vstart", "vend", "width", "edge"};
+// The worst case's metrics (WorstMetric::name), in the order of the worst.* columns.
+inline constexpr std::array<const char*, 5> kWorstMetrics = {"vstart", "vend", "width_min",
+                                                             "width_max", "edge"};
 
 struct PointResult {
   size_t index = 0;
@@ -99,6 +119,20 @@ struct PointResult {
                                      std::numeric_limits<double>::quiet_NaN()};
   };
   std::optional<Noise> noise;  // indexed by link::Direction (down, up)
+  // The worst-case columns (`outputs: [worst]`); present (maybe empty) exactly when the sweep has
+  // them.
+  struct Worst {
+    std::string verdict;       // pass | fail | ""
+    std::string worst_metric;  // one of kWorstMetrics, or ""
+    double margin_rel = std::numeric_limits<double>::quiet_NaN();
+    // [direction (down, up)][kWorstMetrics entry]: the margin in SI units (V or s); NaN when the
+    // direction was not run or the metric not found.
+    std::array<std::array<double, 5>, 2> margin;
+    Worst() {
+      for (auto& d : margin) d.fill(std::numeric_limits<double>::quiet_NaN());
+    }
+  };
+  std::optional<Worst> worst;
   // A pack sweep's extra cells (pack_columns()): weakest_hop, failing_hops, hop_<K>_margin_rel.
   std::vector<std::string> extra;
 };
@@ -111,13 +145,23 @@ PointResult score_pack(const PackResult& r);
 
 // The results.csv header for a sweep.
 std::vector<std::string> results_header(const SweepSpec& s);
+// What a results.csv row of a sweep holds: the point's cells, the optional families, the pack's
+// columns after `error`.
+struct RowShape {
+  size_t cells = 0;        // point_columns().size()
+  bool noise = false;      // the noise columns
+  bool worst = false;      // the worst.* columns
+  size_t extra = 0;        // pack_columns().size()
+  size_t columns() const;  // results_header().size()
+};
+RowShape row_shape(const SweepSpec& s);
 // One CSV line (with '\n').
 std::string results_row(const PointResult& r);
-// Parses a line written by results_row under header (ncells = point_columns().size(); fields
-// after `error` go to extra).
-StatusOr<PointResult> parse_results_row(std::string_view line, size_t ncells, size_t ncolumns);
+// Parses a line written by results_row for a sweep of that shape (fields after `error` go to
+// extra).
+StatusOr<PointResult> parse_results_row(std::string_view line, const RowShape& shape);
 // The result as the CSV stores it (numbers rounded to what is written).
-PointResult round_trip(const PointResult& r, size_t ncells, size_t ncolumns);
+PointResult round_trip(const PointResult& r, const RowShape& shape);
 // One CSV line back into its fields (base/csv.h; results.csv has no newlines inside fields).
 using isolink::split_csv_line;
 
@@ -125,6 +169,8 @@ using isolink::split_csv_line;
 PointResult score_run(const LinkRun& run);
 // The noise columns of a noise result (analysis/noise.h).
 PointResult::Noise noise_cells(const NoiseResult& r);
+// The worst-case columns of a worst-case result (analysis/worst.h).
+PointResult::Worst worst_cells(const WorstResult& r);
 
 struct PointOptions {
   RunOptions run;
@@ -188,7 +234,8 @@ class ResultLog {
   const SweepSpec* spec_ = nullptr;
   std::string path_;
   std::FILE* file_ = nullptr;
-  size_t ncells_ = 0, ncolumns_ = 0, total_ = 0, skipped_ = 0, done_now_ = 0, todo_count_ = 0;
+  RowShape shape_;
+  size_t total_ = 0, skipped_ = 0, done_now_ = 0, todo_count_ = 0;
   size_t pass_ = 0, fail_ = 0, error_ = 0;
   std::unique_ptr<ProgressLine> line_;  // stderr: redrawn on a terminal, every 5 s on a pipe
   std::vector<PointResult> results_;

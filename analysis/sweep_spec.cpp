@@ -747,12 +747,16 @@ StatusOr<SweepSpec> read_sweep_text(const std::string& text, const std::string& 
   for (size_t i = 0; i < outputs.size(); ++i) {
     const std::string& o = outputs[i];
     const YAML::Node on = root["outputs"];
-    if (o != "noise")
+    if (o == "noise")
+      s.noise_outputs = true;
+    else if (o == "worst")
+      s.worst_outputs = true;
+    else
       return doc->error(on.IsSequence() ? YAML::Node(on[i]) : on,
-                        fmt::format("key 'outputs': '{}' is not a result family; the one known "
-                                    "is noise (the noise-immunity columns)",
+                        fmt::format("key 'outputs': '{}' is not a result family; the ones known "
+                                    "are noise (the noise-immunity columns) and worst (the worst "
+                                    "case over all legal traffic)",
                                     o));
-    s.noise_outputs = true;
   }
   s.mode = mode == "zip" ? Mode::kZip : Mode::kGrid;
   if (s.name.empty() || s.name.find_first_of("/\\") != std::string::npos)
@@ -799,10 +803,14 @@ StatusOr<SweepSpec> read_sweep_text(const std::string& text, const std::string& 
       return doc->error(mc_node,
                         "key 'monte_carlo': not available when the base is a pack spec "
                         "(sweep the hops' keys on a grid instead)");
-    if (s.noise_outputs)
-      return doc->error(root["outputs"],
-                        "key 'outputs': noise is not available when the base is a pack spec "
-                        "(sweep a hop's own link spec with outputs: [noise] instead)");
+    for (const auto& [on, family] :
+         {std::pair{s.noise_outputs, "noise"}, std::pair{s.worst_outputs, "worst"}})
+      if (on)
+        return doc->error(root["outputs"],
+                          fmt::format("key 'outputs': {0} is not available when the base is a "
+                                      "pack spec (sweep a hop's own link spec with outputs: [{0}] "
+                                      "instead)",
+                                      family));
   } else {
     StatusOr<link::LinkSpec> spec = link::read_link_spec(*bdoc);
     if (!spec) return spec.status().with_context(fmt::format("{}: the base spec", name));

@@ -19,11 +19,12 @@
 //       cap: {ends.isolation: {type: cap, cap: 2.2n}}
 //       transformer: {ends.isolation: {type: transformer, part: HMU1228NL}}
 //   mode: grid                        # grid: every combination | zip: the i-th values together
-//   outputs: [noise]                  # more result columns per point: noise = the point's noise
-//                                     # immunity (isolink noise on the point's spec; sweep_run.h)
+//   outputs: [noise, worst]           # more result columns per point (sweep_run.h): noise = the
+//                                     # point's noise immunity (isolink noise on its spec); worst =
+//                                     # the worst case over all legal traffic (isolink worst on it)
 // A pack base (base: pack.yaml, a pack spec file): keys are hops.<K>.<key> (hop K, 1..N, N + 1
 // the ring's return hop) or hops.*.<key> (every hop), e.g. hops.9.cable.length: [1, 5, 10];
-// each point is a pack run (PointSpec::pack); no Monte Carlo.
+// each point is a pack run (PointSpec::pack); no Monte Carlo, no outputs.
 //   monte_carlo:
 //     samples: 500
 //     seed: 1
@@ -129,6 +130,9 @@ struct SweepSpec {
   // `outputs: [noise]`: every point also runs the noise analysis (analysis/noise.h) on its spec,
   // and results.csv gets the noise columns (sweep_run.h).
   bool noise_outputs = false;
+  // `outputs: [worst]`: every point also runs the worst case over all legal traffic
+  // (analysis/worst.h, default WorstOptions) on its spec, and results.csv gets the worst.* columns.
+  bool worst_outputs = false;
 
   size_t grid_size() const;  // points before Monte Carlo (1 without axes)
   size_t samples() const { return mc.samples > 0 ? static_cast<size_t>(mc.samples) : 1; }

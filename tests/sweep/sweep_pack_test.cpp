@@ -172,6 +172,14 @@ TEST(SweepPack, BadHopIndexOrKeyIsRefusedAtItsLine) {
                    "is a pack spec"),
             std::string::npos)
       << e;
+  // The worst case over all traffic is `isolink pack`'s, not a pack sweep's.
+  write(d + "/sweep.yaml",
+        "base: pack.yaml\nsweep:\n  hops.2.cable.length: [1]\noutputs: [worst]\n");
+  e = read_error(d);
+  EXPECT_NE(e.find("sweep.yaml:4:10: error: key 'outputs': worst is not available when the base "
+                   "is a pack spec (sweep a hop's own link spec with outputs: [worst] instead)"),
+            std::string::npos)
+      << e;
 }
 
 TEST(SweepPack, ExtraColumnsRoundTrip) {
@@ -186,10 +194,19 @@ TEST(SweepPack, ExtraColumnsRoundTrip) {
   std::string row = results_row(r);
   EXPECT_EQ(row.substr(row.size() - 19), ",2,2,0.1,-0.25,0.3\n") << row;
   row.pop_back();
-  StatusOr<PointResult> back = parse_results_row(row, 1, 1 + 1 + 11 + 5);
+  StatusOr<PointResult> back = parse_results_row(row, {.cells = 1, .extra = 5});
   ASSERT_TRUE(back.ok()) << back.status().message();
   EXPECT_EQ(back->extra, r.extra);
   EXPECT_EQ(back->reason, r.reason);
+  // Six hops make 8 pack columns, as many as the noise family has: they are still read as the
+  // pack's (the row's shape comes from the sweep, not from its field count).
+  r.extra = {"2", "2", "0.1", "-0.25", "0.3", "0.4", "0.5", "0.6"};
+  row = results_row(r);
+  row.pop_back();
+  back = parse_results_row(row, {.cells = 1, .extra = 8});
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ(back->extra, r.extra);
+  EXPECT_FALSE(back->noise.has_value());
 }
 
 // Each point's row is score_pack of run_pack on the pack written out by hand with that value.
@@ -201,9 +218,10 @@ TEST(SweepPackSim, PointsEqualRunPackOnThePackEditedByHand) {
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
   ASSERT_TRUE(parts.ok());
   const std::vector<std::string> lengths = {"2", "4"};
-  const size_t ncells = 1, ncolumns = results_header(*s).size();
+  const RowShape shape = row_shape(*s);
+  EXPECT_EQ(shape.columns(), results_header(*s).size());
   for (size_t i = 0; i < 2; ++i) {
-    const PointResult got = round_trip(run_point(*s, *parts, i, {}), ncells, ncolumns);
+    const PointResult got = round_trip(run_point(*s, *parts, i, {}), shape);
     ASSERT_EQ(got.verdict == "error", false) << got.error;
     write(d + "/hand.yaml", two_hop_pack(", cable: {length: " + lengths[i] + "}"));
     StatusOr<PackSpec> hand = read_pack_spec_file(d + "/hand.yaml");
@@ -214,7 +232,7 @@ TEST(SweepPackSim, PointsEqualRunPackOnThePackEditedByHand) {
     want.index = i;
     want.cells = {lengths[i]};
     want.seconds = got.seconds;
-    want = round_trip(want, ncells, ncolumns);
+    want = round_trip(want, shape);
     EXPECT_EQ(results_row(got), results_row(want));
     // The columns say what they claim: the pack's verdict, the weakest hop's margin, per hop
     // margins.

@@ -58,6 +58,8 @@ PointResult result(size_t index, const SweepSpec& s, const std::string& verdict,
 TEST(SweepResults, HeaderAndRowRoundTrip) {
   const SweepSpec s = spec();
   const std::vector<std::string> h = results_header(s);
+  const RowShape shape = row_shape(s);
+  EXPECT_EQ(shape.columns(), h.size());
   EXPECT_EQ(h, (std::vector<std::string>{"point", "cable.length", "rx.isolation.cap", "verdict",
                                          "worst_metric", "worst_margin_rel", "margin_vstart_V",
                                          "margin_vend_V", "margin_width_ns", "margin_edge_ns",
@@ -68,7 +70,7 @@ TEST(SweepResults, HeaderAndRowRoundTrip) {
   EXPECT_EQ(row,
             "3,2,4.7e-09,fail,vstart,-0.0123457,-0.0197531,0.5,20,30,false,vstart; decode: "
             "weak bit,1.25,\n");
-  StatusOr<PointResult> back = parse_results_row(row.substr(0, row.size() - 1), 2, h.size());
+  StatusOr<PointResult> back = parse_results_row(row.substr(0, row.size() - 1), shape);
   ASSERT_TRUE(back.ok()) << back.status().message();
   EXPECT_EQ(back->index, 3u);
   EXPECT_EQ(back->cells, (std::vector<std::string>{"2", "4.7e-09"}));
@@ -84,15 +86,15 @@ TEST(SweepResults, HeaderAndRowRoundTrip) {
   EXPECT_EQ(erow,
             "5,5,4.7e-09,error,,,,,,,,,1.25,\"link.yaml:3:5: error: unknown part 'X, "
             "\"\"Y\"\"'\"\n");
-  StatusOr<PointResult> eback = parse_results_row(erow.substr(0, erow.size() - 1), 2, h.size());
+  StatusOr<PointResult> eback = parse_results_row(erow.substr(0, erow.size() - 1), shape);
   ASSERT_TRUE(eback.ok()) << eback.status().message();
   EXPECT_EQ(eback->error, e.error);
   EXPECT_TRUE(std::isnan(eback->worst_rel));
   EXPECT_FALSE(eback->decoded_ok.has_value());
   // Malformed rows.
-  EXPECT_FALSE(parse_results_row("3,2,4.7e-09,fail", 2, h.size()).ok());
-  EXPECT_FALSE(parse_results_row("x,2,4.7e-09,fail,,,,,,,,,1,", 2, h.size()).ok());
-  EXPECT_FALSE(parse_results_row("3,2,4.7e-09,maybe,,,,,,,,,1,", 2, h.size()).ok());
+  EXPECT_FALSE(parse_results_row("3,2,4.7e-09,fail", shape).ok());
+  EXPECT_FALSE(parse_results_row("x,2,4.7e-09,fail,,,,,,,,,1,", shape).ok());
+  EXPECT_FALSE(parse_results_row("3,2,4.7e-09,maybe,,,,,,,,,1,", shape).ok());
   EXPECT_EQ(split_csv_line("a,\"b,c\",,\"d\"\"e\""),
             (std::vector<std::string>{"a", "b,c", "", "d\"e"}));
 }
@@ -103,6 +105,8 @@ TEST(SweepResults, NoiseColumnsRoundTrip) {
   StatusOr<SweepSpec> ns = read_sweep_text(kSweep + "outputs: [noise]\n", "sweep.yaml");
   ASSERT_TRUE(ns.ok()) << ns.status().message();
   const std::vector<std::string> h = results_header(*ns);
+  const RowShape shape = row_shape(*ns);
+  EXPECT_EQ(shape.columns(), h.size());
   EXPECT_EQ(h, (std::vector<std::string>{"point",
                                          "cable.length",
                                          "rx.isolation.cap",
@@ -137,7 +141,7 @@ TEST(SweepResults, NoiseColumnsRoundTrip) {
   EXPECT_EQ(row,
             "3,2,4.7e-09,pass,vstart,0.25,0.4,0.5,20,30,true,,fail,-13.5975,0.0208989,-13.5975,"
             "8.85237e+06,,,,1.25,\n");
-  StatusOr<PointResult> back = parse_results_row(row.substr(0, row.size() - 1), 2, h.size());
+  StatusOr<PointResult> back = parse_results_row(row.substr(0, row.size() - 1), shape);
   ASSERT_TRUE(back.ok()) << back.status().message();
   ASSERT_TRUE(back->noise.has_value());
   EXPECT_EQ(back->noise->verdict, "fail");
@@ -149,11 +153,129 @@ TEST(SweepResults, NoiseColumnsRoundTrip) {
   e.noise.emplace();
   const std::string erow = results_row(e);
   EXPECT_NE(erow.find(",error,,,,,,,,,,,,,,,,,1.25,"), std::string::npos) << erow;
-  EXPECT_TRUE(parse_results_row(erow.substr(0, erow.size() - 1), 2, h.size()).ok());
+  EXPECT_TRUE(parse_results_row(erow.substr(0, erow.size() - 1), shape).ok());
   // A bad noise verdict is refused.
-  EXPECT_FALSE(parse_results_row("3,2,4.7e-09,pass,,,,,,,,,maybe,,,,,,,,1,", 2, h.size()).ok());
+  EXPECT_FALSE(parse_results_row("3,2,4.7e-09,pass,,,,,,,,,maybe,,,,,,,,1,", shape).ok());
   // A sweep without the family has no such columns (and reads no such row).
   EXPECT_EQ(results_header(spec()).size() + 8, h.size());
+}
+
+// With `outputs: [noise, worst]` the worst.* columns follow the noise columns; rows read back to
+// the same numbers (6 digits, widths and edges in ns); an error row has them empty.
+TEST(SweepResults, WorstColumnsRoundTrip) {
+  StatusOr<SweepSpec> ws = read_sweep_text(kSweep + "outputs: [noise, worst]\n", "sweep.yaml");
+  ASSERT_TRUE(ws.ok()) << ws.status().message();
+  const std::vector<std::string> h = results_header(*ws);
+  const RowShape shape = row_shape(*ws);
+  EXPECT_EQ(shape.columns(), h.size());
+  ASSERT_EQ(h.size(), 14u + 8u + 13u);
+  EXPECT_EQ(h[11], "fail_reason");
+  EXPECT_EQ(h[12], "noise.verdict");
+  EXPECT_EQ(
+      std::vector<std::string>(h.begin() + 20, h.end()),
+      (std::vector<std::string>{
+          "worst.verdict", "worst.worst_metric", "worst.margin_rel", "worst.down.vstart_margin_V",
+          "worst.down.vend_margin_V", "worst.down.width_min_margin_ns",
+          "worst.down.width_max_margin_ns", "worst.down.edge_margin_ns", "worst.up.vstart_margin_V",
+          "worst.up.vend_margin_V", "worst.up.width_min_margin_ns", "worst.up.width_max_margin_ns",
+          "worst.up.edge_margin_ns", "seconds", "error"}));
+  // Worst alone: 13 columns more than the plain sweep, in the same place.
+  StatusOr<SweepSpec> wo = read_sweep_text(kSweep + "outputs: [worst]\n", "sweep.yaml");
+  ASSERT_TRUE(wo.ok()) << wo.status().message();
+  EXPECT_EQ(results_header(*wo).size(), results_header(spec()).size() + 13);
+  EXPECT_EQ(results_header(*wo)[12], "worst.verdict");
+
+  PointResult r = result(3, *wo, "pass", 0.25);
+  PointResult::Worst w;
+  w.verdict = "fail";
+  w.worst_metric = "width_min";
+  w.margin_rel = -10e-9 / 280e-9;
+  w.margin[0] = {0.4, 0.3, -10e-9, 200.00004e-9, 15e-9};
+  r.worst = w;
+  const std::string row = results_row(r);
+  EXPECT_EQ(row,
+            "3,2,4.7e-09,pass,vstart,0.25,0.4,0.5,20,30,true,,fail,width_min,-0.0357143,0.4,0.3,"
+            "-10,200,15,,,,,,1.25,\n");
+  StatusOr<PointResult> back = parse_results_row(row.substr(0, row.size() - 1), row_shape(*wo));
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  ASSERT_TRUE(back->worst.has_value());
+  EXPECT_FALSE(back->noise.has_value());
+  EXPECT_EQ(back->verdict, "pass");  // the spec traffic's, apart from worst.verdict
+  EXPECT_EQ(back->worst->verdict, "fail");
+  EXPECT_EQ(back->worst->worst_metric, "width_min");
+  EXPECT_DOUBLE_EQ(back->worst->margin_rel, -0.0357143);
+  EXPECT_DOUBLE_EQ(back->worst->margin[0][2], -10e-9);
+  EXPECT_DOUBLE_EQ(back->worst->margin[0][3], 200e-9);
+  EXPECT_TRUE(std::isnan(back->worst->margin[1][0]));
+  EXPECT_EQ(results_row(*back), row);
+  // An error row: every worst cell empty.
+  PointResult e = result(5, *wo, "error", 0);
+  e.worst.emplace();
+  const std::string erow = results_row(e);
+  EXPECT_NE(erow.find(",error,,,,,,,,,,,,,,,,,,,,,,1.25,"), std::string::npos) << erow;
+  EXPECT_TRUE(parse_results_row(erow.substr(0, erow.size() - 1), row_shape(*wo)).ok());
+  // A bad worst.verdict or worst.worst_metric is refused.
+  std::string bad = row;
+  bad.replace(bad.find(",fail,width_min,"), 16, ",maybe,width_min,");
+  EXPECT_FALSE(parse_results_row(bad.substr(0, bad.size() - 1), row_shape(*wo)).ok());
+  bad = row;
+  bad.replace(bad.find(",fail,width_min,"), 16, ",fail,width,");
+  EXPECT_FALSE(parse_results_row(bad.substr(0, bad.size() - 1), row_shape(*wo)).ok());
+}
+
+// --resume reads rows with the worst.* columns back (the points are skipped, their numbers kept);
+// a row added without them (a point that failed early) is padded with empty cells.
+TEST(SweepResults, ResumeReadsTheWorstColumns) {
+  StatusOr<SweepSpec> ws = read_sweep_text(kSweep + "outputs: [worst]\n", "sweep.yaml");
+  ASSERT_TRUE(ws.ok()) << ws.status().message();
+  const std::string dir = temp_dir("resume_worst");
+  std::string header;
+  for (const std::string& h : results_header(*ws)) header += (header.empty() ? "" : ",") + h;
+  PointResult r2 = result(2, *ws, "pass", 0.2), r6 = result(6, *ws, "fail", -0.1);
+  r2.worst.emplace();
+  r2.worst->verdict = "fail";
+  r2.worst->worst_metric = "vend";
+  r2.worst->margin_rel = -0.05;
+  r2.worst->margin[0] = {0.2, -0.06, 30e-9, 100e-9, 20e-9};
+  r6.worst.emplace();
+  r6.worst->verdict = "pass";
+  r6.worst->worst_metric = "edge";
+  r6.worst->margin_rel = 0.1;
+  r6.worst->margin[0] = {0.5, 0.4, 60e-9, 150e-9, 6e-9};
+  const std::string row2 = results_row(r2), row6 = results_row(r6);
+  {
+    std::ofstream out(dir + "/results.csv");
+    out << header << "\n" << row2 << row6;
+  }
+  SweepOptions opt;
+  opt.out_dir = dir;
+  opt.resume = true;
+  opt.quiet = true;
+  {
+    StatusOr<std::unique_ptr<ResultLog>> log = ResultLog::open(*ws, opt);
+    ASSERT_TRUE(log.ok()) << log.status().message();
+    EXPECT_EQ((*log)->skipped(), 2u);
+    EXPECT_EQ((*log)->todo(), (std::vector<size_t>{0, 1, 3, 4, 5, 7}));
+    const std::vector<PointResult> kept = (*log)->results();
+    ASSERT_EQ(kept.size(), 2u);
+    ASSERT_TRUE(kept[0].worst.has_value());
+    EXPECT_EQ(kept[0].worst->verdict, "fail");
+    EXPECT_DOUBLE_EQ(kept[0].worst->margin[0][1], -0.06);
+    EXPECT_DOUBLE_EQ(kept[1].worst->margin[0][4], 6e-9);
+    (*log)->add(result(4, *ws, "error", 0));  // no worst cells: padded
+    EXPECT_TRUE((*log)->results()[1].worst.has_value());
+    // summary.json: the worst-case verdicts and the point with the smallest worst.margin_rel.
+    const nlohmann::ordered_json j = summary_json(*ws, (*log)->results());
+    EXPECT_EQ(j["worst_case"]["pass"], 1);
+    EXPECT_EQ(j["worst_case"]["fail"], 1);
+    EXPECT_EQ(j["worst_case"]["worst"]["point"], 2);
+    EXPECT_EQ(j["worst_case"]["worst"]["worst_metric"], "vend");
+    EXPECT_DOUBLE_EQ(j["worst_case"]["worst"]["margin_rel"].get<double>(), -0.05);
+    EXPECT_EQ(j["worst"]["point"], 6);  // the spec traffic's worst point is another
+    EXPECT_FALSE(summary_json(spec(), (*log)->results()).contains("worst_case"));
+  }
+  const std::string all = slurp(dir + "/results.csv");
+  EXPECT_NE(all.find("\n4,5,1e-09,error,,,,,,,,,,,,,,,,,,,,,,"), std::string::npos) << all;
 }
 
 eye::WorstMargin wm(const std::string& metric, double value, double limit, double margin) {

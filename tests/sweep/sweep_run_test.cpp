@@ -19,6 +19,7 @@
 
 #include "analysis/noise.h"
 #include "analysis/sweep_spec.h"
+#include "analysis/worst.h"
 #include "netlists/link/parts.h"
 
 namespace isolink::analysis::sweep {
@@ -159,7 +160,7 @@ sweep:
   ASSERT_TRUE(s.ok()) << s.status().message();
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
   ASSERT_TRUE(parts.ok()) << parts.status().message();
-  const size_t ncolumns = results_header(*s).size();
+  const RowShape shape = row_shape(*s);
   for (size_t i = 0; i < s->size(); ++i) {
     const PointResult r = run_point(*s, *parts, i, {});
     ASSERT_EQ(r.verdict == "error", false) << r.error;
@@ -186,11 +187,66 @@ sweep:
     EXPECT_EQ(r.verdict, direct->run.pass ? "pass" : "fail");
     // Through the CSV: 6 significant digits.
     const std::string row = results_row(r);
-    StatusOr<PointResult> back =
-        parse_results_row(row.substr(0, row.size() - 1), s->point_columns().size(), ncolumns);
+    StatusOr<PointResult> back = parse_results_row(row.substr(0, row.size() - 1), shape);
     ASSERT_TRUE(back.ok()) << back.status().message();
     EXPECT_NEAR(back->noise->immunity_min[0], r.noise->immunity_min[0],
                 1e-5 * r.noise->immunity_min[0]);
+  }
+}
+
+// `outputs: [worst]`: each point's worst.* columns are what worst_case (the work of `isolink
+// worst`, default options) gives for that point's spec; `verdict` stays run_link's on the spec's
+// traffic; the row carries both to 6 digits.
+TEST(SweepSim, WorstColumnsEqualWorstCaseOnThePointsSpec) {
+  const std::string text = "base: link.yaml\nsweep:\n  cable.length: [1, 4]\noutputs: [worst]\n";
+  const std::string dir = temp_dir("worst");
+  write(dir + "/link.yaml", cap_link(1));
+  write(dir + "/sweep.yaml", text);
+  StatusOr<SweepSpec> s = read_sweep_file(dir + "/sweep.yaml");
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
+  ASSERT_TRUE(parts.ok()) << parts.status().message();
+  const RowShape shape = row_shape(*s);
+  for (size_t i = 0; i < s->size(); ++i) {
+    const PointResult r = run_point(*s, *parts, i, {});
+    ASSERT_NE(r.verdict, "error") << r.error;
+    ASSERT_TRUE(r.worst.has_value());
+    const PointOutcome po = make_point(*s, i);
+    ASSERT_TRUE(po.status.ok());
+    StatusOr<WorstResult> direct = worst_case(po.point.spec, *parts, {});
+    ASSERT_TRUE(direct.ok()) << direct.status().message();
+    ASSERT_EQ(direct->directions.size(), 1u);  // the spec runs down only
+    const DirectionWorst& d = direct->directions[0];
+    ASSERT_EQ(d.direction, link::Direction::kDown);
+    EXPECT_EQ(r.worst->verdict, direct->pass ? "pass" : "fail");
+    // Through the CSV (6 significant digits) against worst_case's numbers.
+    const std::string row = results_row(r);
+    StatusOr<PointResult> back = parse_results_row(row.substr(0, row.size() - 1), shape);
+    ASSERT_TRUE(back.ok()) << back.status().message();
+    ASSERT_TRUE(back->worst.has_value());
+    double rel_min = 1e300;
+    std::string rel_metric;
+    for (size_t m = 0; m < kWorstMetrics.size(); ++m) {
+      const WorstMetric* wm = d.metric(kWorstMetrics[m]);
+      ASSERT_NE(wm, nullptr) << kWorstMetrics[m];
+      EXPECT_NEAR(back->worst->margin[0][m], wm->margin, 1e-5 * std::abs(wm->margin) + 1e-15)
+          << "point " << i << " " << kWorstMetrics[m];
+      EXPECT_TRUE(std::isnan(back->worst->margin[1][m]));  // up is not run: empty
+      const double rel = wm->margin / std::abs(wm->limit);
+      if (rel < rel_min) {
+        rel_min = rel;
+        rel_metric = kWorstMetrics[m];
+      }
+    }
+    EXPECT_EQ(back->worst->worst_metric, rel_metric);
+    EXPECT_NEAR(back->worst->margin_rel, rel_min, 1e-5 * std::abs(rel_min));
+    // The spec's own traffic through run_link: the `verdict` column is its verdict.
+    StatusOr<LinkRun> run = run_link(po.point.spec, *parts, {});
+    ASSERT_TRUE(run.ok()) << run.status().message();
+    EXPECT_EQ(r.verdict, run->pass ? "pass" : "fail");
+    EXPECT_EQ(back->verdict, r.verdict);
+    // The spec's frames are legal traffic: its VSTART cannot be lower than the worst case's.
+    EXPECT_LE(d.metric("vstart")->margin, r.margin[0] + 1e-3) << "point " << i;
   }
 }
 

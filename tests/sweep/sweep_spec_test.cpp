@@ -159,7 +159,7 @@ TEST(SweepSpec, UnknownTopLevelAndNestedKeys) {
             std::string::npos);
 }
 
-TEST(SweepSpec, OutputsAddTheNoiseFamilyAndRefuseUnknownOnes) {
+TEST(SweepSpec, OutputsAddTheNoiseAndWorstFamiliesAndRefuseUnknownOnes) {
   StatusOr<SweepSpec> plain = read_sweep_text(kBase + "sweep: {cable.length: [1, 2]}\n", "s.yaml");
   ASSERT_TRUE(plain.ok()) << plain.status().message();
   EXPECT_FALSE(plain->noise_outputs);
@@ -171,9 +171,21 @@ TEST(SweepSpec, OutputsAddTheNoiseFamilyAndRefuseUnknownOnes) {
   }
   const std::string e = read_error(kBase + "sweep: {cable.length: [1]}\noutputs: [noise, nosie]\n");
   EXPECT_NE(e.find("sweep.yaml:8:18: error: key 'outputs': 'nosie' is not a result family; the "
-                   "one known is noise"),
+                   "ones known are noise (the noise-immunity columns) and worst (the worst case "
+                   "over all legal traffic)"),
             std::string::npos)
       << e;
+  // worst alone and both.
+  StatusOr<SweepSpec> w =
+      read_sweep_text(kBase + "sweep: {cable.length: [1, 2]}\noutputs: [worst]\n", "sweep.yaml");
+  ASSERT_TRUE(w.ok()) << w.status().message();
+  EXPECT_TRUE(w->worst_outputs);
+  EXPECT_FALSE(w->noise_outputs);
+  EXPECT_FALSE(plain->worst_outputs);
+  StatusOr<SweepSpec> both = read_sweep_text(
+      kBase + "sweep: {cable.length: [1, 2]}\noutputs: [worst, noise]\n", "sweep.yaml");
+  ASSERT_TRUE(both.ok()) << both.status().message();
+  EXPECT_TRUE(both->worst_outputs && both->noise_outputs);
 }
 
 // The example that sweeps TI's chokes against BCI immunity reads: 4 isolation variants x 3
