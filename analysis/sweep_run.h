@@ -40,7 +40,8 @@
 //   worst.worst_metric            the metric with the smallest margin / |limit| below (vstart,
 //                                 vend, width_min, width_max, edge)
 //   worst.margin_rel              that smallest margin / |limit| over the directions and metrics
-//                                 (as worst_margin_rel is for the spec's traffic)
+//                                 (as worst_margin_rel is for the spec's traffic); both empty
+//                                 when the search found no pulse at all (worst.verdict fail)
 //   worst.<dir>.<metric>_margin_<unit>  per direction (down, up) and metric, the worst traffic's
 //                                 margin: vstart_margin_V, vend_margin_V, width_min_margin_ns,
 //                                 width_max_margin_ns, edge_margin_ns (the units of the margin_*

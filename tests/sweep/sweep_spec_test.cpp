@@ -203,6 +203,21 @@ TEST(SweepSpec, ChokeImmunityExampleReads) {
   EXPECT_DOUBLE_EQ(p.point.spec.noise.level, 0.1);
 }
 
+// The example that puts the worst case beside the capacitor link's length sweep reads: 6
+// lengths, down, with the worst.* columns only.
+TEST(SweepSpec, CapLengthWorstExampleReads) {
+  StatusOr<SweepSpec> s =
+      read_sweep_file(std::string(ISOLINK_EXAMPLES_DIR) + "/sweep_cap_length_worst.yaml");
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  EXPECT_TRUE(s->worst_outputs);
+  EXPECT_FALSE(s->noise_outputs);
+  EXPECT_EQ(s->size(), 6u);
+  const PointOutcome p = make_point(*s, 5);
+  ASSERT_TRUE(p.status.ok()) << p.status.message();
+  EXPECT_DOUBLE_EQ(p.point.spec.cable.length, 20.0);
+  EXPECT_EQ(p.point.spec.stimulus.directions, std::vector<link::Direction>{link::Direction::kDown});
+}
+
 TEST(SweepSpec, BadValueIsReportedAtTheValue) {
   const std::string e = read_error(kBase + R"(sweep:
   cable.length: [1, -2]
