@@ -73,6 +73,20 @@ namespace isolink::analysis::sweep {
 
 inline constexpr std::array<const char*, 4> kMetrics = {"vstart", "vend", "width", "edge"};
 
+// A point's noise columns (PointResult::noise). At namespace scope, not nested: clang cannot
+// default-construct a nested struct with member initializers before its enclosing class is
+// complete.
+struct PointNoise {
+  std::string verdict;                                                // pass | fail | ""
+  double immunity_min_db = std::numeric_limits<double>::quiet_NaN();  // over the directions
+  std::array<double, 2> immunity_min = {std::numeric_limits<double>::quiet_NaN(),
+                                        std::numeric_limits<double>::quiet_NaN()};
+  std::array<double, 2> immunity_min_db_dir = {std::numeric_limits<double>::quiet_NaN(),
+                                               std::numeric_limits<double>::quiet_NaN()};
+  std::array<double, 2> freq_hz = {std::numeric_limits<double>::quiet_NaN(),
+                                   std::numeric_limits<double>::quiet_NaN()};
+};
+
 struct PointResult {
   size_t index = 0;
   std::vector<std::string> cells;  // SweepSpec::point_columns()
@@ -88,16 +102,7 @@ struct PointResult {
   double seconds = 0;              // wall time of the point
   std::string error;
   // The noise columns (`outputs: [noise]`); present (maybe empty) exactly when the sweep has them.
-  struct Noise {
-    std::string verdict;                                                // pass | fail | ""
-    double immunity_min_db = std::numeric_limits<double>::quiet_NaN();  // over the directions
-    std::array<double, 2> immunity_min = {std::numeric_limits<double>::quiet_NaN(),
-                                          std::numeric_limits<double>::quiet_NaN()};
-    std::array<double, 2> immunity_min_db_dir = {std::numeric_limits<double>::quiet_NaN(),
-                                                 std::numeric_limits<double>::quiet_NaN()};
-    std::array<double, 2> freq_hz = {std::numeric_limits<double>::quiet_NaN(),
-                                     std::numeric_limits<double>::quiet_NaN()};
-  };
+  using Noise = PointNoise;
   std::optional<Noise> noise;  // indexed by link::Direction (down, up)
   // A pack sweep's extra cells (pack_columns()): weakest_hop, failing_hops, hop_<K>_margin_rel.
   std::vector<std::string> extra;
