@@ -94,6 +94,20 @@ inline constexpr std::array<const char*, 4> kMetrics = {"vstart", "vend", "width
 inline constexpr std::array<const char*, 5> kWorstMetrics = {"vstart", "vend", "width_min",
                                                              "width_max", "edge"};
 
+// A point's noise columns (PointResult::noise). At namespace scope, not nested: clang cannot
+// default-construct a nested struct with member initializers before its enclosing class is
+// complete.
+struct PointNoise {
+  std::string verdict;                                                // pass | fail | ""
+  double immunity_min_db = std::numeric_limits<double>::quiet_NaN();  // over the directions
+  std::array<double, 2> immunity_min = {std::numeric_limits<double>::quiet_NaN(),
+                                        std::numeric_limits<double>::quiet_NaN()};
+  std::array<double, 2> immunity_min_db_dir = {std::numeric_limits<double>::quiet_NaN(),
+                                               std::numeric_limits<double>::quiet_NaN()};
+  std::array<double, 2> freq_hz = {std::numeric_limits<double>::quiet_NaN(),
+                                   std::numeric_limits<double>::quiet_NaN()};
+};
+
 struct PointResult {
   size_t index = 0;
   std::vector<std::string> cells;  // SweepSpec::point_columns()
@@ -109,16 +123,7 @@ struct PointResult {
   double seconds = 0;              // wall time of the point
   std::string error;
   // The noise columns (`outputs: [noise]`); present (maybe empty) exactly when the sweep has them.
-  struct Noise {
-    std::string verdict;                                                // pass | fail | ""
-    double immunity_min_db = std::numeric_limits<double>::quiet_NaN();  // over the directions
-    std::array<double, 2> immunity_min = {std::numeric_limits<double>::quiet_NaN(),
-                                          std::numeric_limits<double>::quiet_NaN()};
-    std::array<double, 2> immunity_min_db_dir = {std::numeric_limits<double>::quiet_NaN(),
-                                                 std::numeric_limits<double>::quiet_NaN()};
-    std::array<double, 2> freq_hz = {std::numeric_limits<double>::quiet_NaN(),
-                                     std::numeric_limits<double>::quiet_NaN()};
-  };
+  using Noise = PointNoise;
   std::optional<Noise> noise;  // indexed by link::Direction (down, up)
   // The worst-case columns (`outputs: [worst]`); present (maybe empty) exactly when the sweep has
   // them.

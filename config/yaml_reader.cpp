@@ -1,12 +1,15 @@
 #include "config/yaml_reader.h"
 
 #include <fmt/format.h>
+#include <yaml-cpp/eventhandler.h>
+#include <yaml-cpp/parser.h>
 
 #include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
 #include <optional>
+#include <sstream>
 #include <string_view>
 
 #include "base/file_io.h"
@@ -183,6 +186,48 @@ Status check_duplicate_keys(const YamlDoc& doc, const YAML::Node& node) {
   return Status::Ok();
 }
 
+// Records where a document's first node starts (no node: an empty document).
+class FirstNode : public YAML::EventHandler {
+ public:
+  std::optional<YAML::Mark> mark;
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark& m, YAML::anchor_t) override { note(m); }
+  void OnScalar(const YAML::Mark& m, const std::string&, YAML::anchor_t,
+                const std::string&) override {
+    note(m);
+  }
+  void OnSequenceStart(const YAML::Mark& m, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {
+    note(m);
+  }
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark& m, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {
+    note(m);
+  }
+  void OnMapEnd() override {}
+
+ private:
+  void note(const YAML::Mark& m) {
+    if (!mark) mark = m;
+  }
+};
+
+// Where a second document with content starts, if there is one. Not YAML::LoadAll: in yaml-cpp
+// 0.7 (Debian 12) it never returns on some malformed text ("," alone), adding a null document per
+// turn until memory runs out (jbeder/yaml-cpp#1040, fixed upstream by #1319 after 0.7; found by
+// tests/fuzz). At most two documents are read here.
+std::optional<YAML::Mark> second_document(const std::string& text) {
+  std::istringstream in(text);
+  YAML::Parser parser(in);
+  FirstNode first, second;
+  if (!parser.HandleNextDocument(first)) return std::nullopt;
+  if (!parser.HandleNextDocument(second)) return std::nullopt;
+  return second.mark;
+}
+
 }  // namespace
 
 StatusOr<YamlDoc> YamlDoc::from_text(const std::string& text, const std::string& name) {
@@ -203,12 +248,11 @@ StatusOr<YamlDoc> YamlDoc::from_text(const std::string& text, const std::string&
     return Status::Error(
         fmt::format("{}: error: a NUL byte at offset {} (is this a text file?)", name, nul));
   try {
-    std::vector<YAML::Node> docs = YAML::LoadAll(text);
-    if (docs.size() > 1)
-      return doc.error(docs[1],
-                       "a second YAML document ('---') in the file: isolink reads one "
-                       "document per file; remove it or move it to its own file");
-    if (!docs.empty()) doc.root_ = docs[0];
+    if (const std::optional<YAML::Mark> m = second_document(text))
+      return error_at(SourceLoc{doc.file_, m->line + 1, m->column + 1},
+                      "a second YAML document ('---') in the file: isolink reads one "
+                      "document per file; remove it or move it to its own file");
+    doc.root_ = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     SourceLoc loc{doc.file_, e.mark.line + 1, e.mark.column + 1};
     if (e.mark.line < 0) loc.line = 0;
