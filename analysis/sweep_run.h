@@ -108,6 +108,19 @@ struct PointNoise {
                                    std::numeric_limits<double>::quiet_NaN()};
 };
 
+// A point's worst-case columns (PointResult::worst); at namespace scope like PointNoise.
+struct PointWorst {
+  std::string verdict;       // pass | fail | ""
+  std::string worst_metric;  // one of kWorstMetrics, or ""
+  double margin_rel = std::numeric_limits<double>::quiet_NaN();
+  // [direction (down, up)][kWorstMetrics entry]: the margin in SI units (V or s); NaN when the
+  // direction was not run or the metric not found.
+  std::array<std::array<double, 5>, 2> margin;
+  PointWorst() {
+    for (auto& d : margin) d.fill(std::numeric_limits<double>::quiet_NaN());
+  }
+};
+
 struct PointResult {
   size_t index = 0;
   std::vector<std::string> cells;  // SweepSpec::point_columns()
@@ -127,17 +140,7 @@ struct PointResult {
   std::optional<Noise> noise;  // indexed by link::Direction (down, up)
   // The worst-case columns (`outputs: [worst]`); present (maybe empty) exactly when the sweep has
   // them.
-  struct Worst {
-    std::string verdict;       // pass | fail | ""
-    std::string worst_metric;  // one of kWorstMetrics, or ""
-    double margin_rel = std::numeric_limits<double>::quiet_NaN();
-    // [direction (down, up)][kWorstMetrics entry]: the margin in SI units (V or s); NaN when the
-    // direction was not run or the metric not found.
-    std::array<std::array<double, 5>, 2> margin;
-    Worst() {
-      for (auto& d : margin) d.fill(std::numeric_limits<double>::quiet_NaN());
-    }
-  };
+  using Worst = PointWorst;
   std::optional<Worst> worst;
   // A pack sweep's extra cells (pack_columns()): weakest_hop, failing_hops, hop_<K>_margin_rel.
   std::vector<std::string> extra;
