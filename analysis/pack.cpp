@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <mutex>
 
 #include "analysis/sweep_run.h"
 #include "base/hex.h"
@@ -201,6 +202,8 @@ StatusOr<PackResult> run_pack(const PackSpec& pack, const link::PartLibrary& par
   const size_t n = distinct.size();
   const size_t jobs = opt.worst ? 2 * n : n;
   tbb::task_arena arena(opt.jobs > 0 ? opt.jobs : tbb::task_arena::automatic);
+  std::mutex done_mu;
+  size_t done = 0;
   arena.execute([&] {
     tbb::parallel_for(size_t{0}, jobs, [&](size_t j) {
       const size_t i = j < n ? j : j - n;
@@ -209,6 +212,10 @@ StatusOr<PackResult> run_pack(const PackSpec& pack, const link::PartLibrary& par
         d.worst = worst_runner(*d.spec, d.direction, *opt.worst);
       else
         d.run = runner(d.link, opt.run);
+      if (opt.on_job_done) {
+        std::lock_guard<std::mutex> lock(done_mu);
+        opt.on_job_done(++done, jobs);
+      }
     });
   });
   for (const Distinct& d : distinct) {

@@ -48,6 +48,9 @@ struct PackOptions {
   DirectionRunner runner;             // empty: run_direction
   std::optional<WorstOptions> worst;  // set: the worst case over all traffic too
   WorstRunner worst_runner;           // empty: worst_case
+  // Called (from the worker threads, one at a time) after each distinct simulation or worst case
+  // finishes: how many are done of how many (a progress line; may be empty).
+  std::function<void(size_t done, size_t total)> on_job_done;
 };
 
 struct HopResult {

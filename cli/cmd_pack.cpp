@@ -11,6 +11,7 @@
 
 #include "analysis/pack.h"
 #include "analysis/pack_spec.h"
+#include "base/progress.h"
 #include "cli/commands.h"
 #include "netlists/link/parts.h"
 #include "reports/pack_report.h"
@@ -32,7 +33,15 @@ int run_pack_command(const PackArgs& a) {
   analysis::PackOptions opt;
   opt.jobs = a.jobs;
   if (!a.no_worst) opt.worst = analysis::WorstOptions{};
+  // Progress on stderr while it runs, when it is a terminal (base/progress.h).
+  ProgressLine line({.label = "isolink pack", .enabled = !a.quiet});
+  opt.on_job_done = [&line, worst = !a.no_worst](size_t done, size_t total) {
+    line.show_fraction(fmt::format("{} of {} {}", done, total,
+                                   worst ? "simulations and worst cases" : "simulations"),
+                       static_cast<double>(done) / static_cast<double>(total));
+  };
   StatusOr<analysis::PackResult> r = analysis::run_pack(*pack, *parts, opt);
+  line.finish();
   if (!r) return fail(r.status().with_context(a.spec));
 
   const std::string dir = a.out_dir.empty() ? "reports/out/" + pack->name : a.out_dir;

@@ -232,8 +232,14 @@ TEST(PackDedupe, IdenticalCircuitsAreSimulatedOnce) {
     w.metrics.push_back({.name = "vstart", .value = 2.5, .limit = 2.0, .margin = 0.5});
     return w;
   };
+  // Progress: one call per finished job (4 simulations + 4 worst cases), counting up to 8.
+  std::vector<std::pair<size_t, size_t>> progress;
+  opt.on_job_done = [&progress](size_t done, size_t total) { progress.push_back({done, total}); };
   StatusOr<PackResult> r = run_pack(*p, *parts, opt);
   ASSERT_TRUE(r.ok()) << r.status().message();
+  ASSERT_EQ(progress.size(), 8u);
+  for (size_t k = 0; k < progress.size(); ++k)
+    EXPECT_EQ(progress[k], (std::pair<size_t, size_t>{k + 1, 8}));
   // 5 hops x 2 directions expanded. The bridge hop's two directions differ (a bq79600 board at
   // one end); a module hop has the same devices and parts at both ends, so its up direction is
   // the same circuit as its down (node names follow the roles): 2 + 1 + 1 circuits.
