@@ -12,6 +12,7 @@
 
 #include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -22,6 +23,7 @@ namespace isolink::testing {
 struct CliResult {
   int code = -1;
   std::string out, err;
+  std::string no_terminal;  // run_isolink_on_terminal: why no pseudo-terminal could be opened
 };
 
 inline std::string slurp(const std::string& path) {
@@ -60,7 +62,11 @@ inline CliResult run_isolink_on_terminal(const std::string& binary, const std::s
   const std::string cmd = binary + " " + args + " >" + base + "_stdout.txt";
   int master = -1;
   const pid_t pid = forkpty(&master, nullptr, nullptr, nullptr);
-  if (pid < 0) return {};
+  if (pid < 0) {  // no /dev/ptmx or devpts (a bare chroot): the caller skips, saying why
+    CliResult r;
+    r.no_terminal = std::string("forkpty: ") + std::strerror(errno);
+    return r;
+  }
   if (pid == 0) {
     execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
     _exit(127);
