@@ -752,53 +752,44 @@ nlohmann::ordered_json summary_json(const SweepSpec& s, const std::vector<PointR
     j["yield_by_grid_point"] = by;
   }
   j["boundary"] = boundary_json(s, results);
-  if (s.noise_outputs) {
-    // The noise verdicts and the point with the lowest immunity (dB re its test level).
+  // A result family's verdict counts and its point with the smallest figure (the noise immunity
+  // in dB, the worst case's relative margin).
+  auto family = [&](auto has, auto verdict, auto figure, auto extra) {
     size_t npass = 0, nfail = 0;
-    const PointResult* nworst = nullptr;
+    const PointResult* low = nullptr;
     for (const PointResult& r : results) {
-      if (!r.noise) continue;
-      npass += r.noise->verdict == "pass";
-      nfail += r.noise->verdict == "fail";
-      if (!std::isnan(r.noise->immunity_min_db) &&
-          (!nworst || r.noise->immunity_min_db < nworst->noise->immunity_min_db))
-        nworst = &r;
+      if (!has(r)) continue;
+      npass += verdict(r) == "pass";
+      nfail += verdict(r) == "fail";
+      if (!std::isnan(figure(r)) && (!low || figure(r) < figure(*low))) low = &r;
     }
     ordered_json n{{"pass", npass}, {"fail", nfail}};
-    if (nworst) {
-      ordered_json w = point_json(s, *nworst);
-      w["immunity_min_db"] = nworst->noise->immunity_min_db;
+    if (low) {
+      ordered_json w = point_json(s, *low);
+      extra(*low, w);
       n["worst"] = w;
     } else {
       n["worst"] = nullptr;
     }
-    j["noise"] = n;
-  }
-  if (s.worst_outputs) {
-    // The worst-case verdicts and the point with the smallest worst.margin_rel ("worst" is taken
-    // by the spec traffic's worst point).
-    size_t wpass = 0, wfail = 0;
-    const PointResult* wworst = nullptr;
-    for (const PointResult& r : results) {
-      if (!r.worst) continue;
-      wpass += r.worst->verdict == "pass";
-      wfail += r.worst->verdict == "fail";
-      if (!std::isnan(r.worst->margin_rel) &&
-          (!wworst || r.worst->margin_rel < wworst->worst->margin_rel))
-        wworst = &r;
-    }
-    ordered_json n{{"pass", wpass}, {"fail", wfail}};
-    if (wworst) {
-      ordered_json w = point_json(s, *wworst);
-      w["verdict"] = wworst->worst->verdict;
-      w["worst_metric"] = wworst->worst->worst_metric;
-      w["margin_rel"] = wworst->worst->margin_rel;
-      n["worst"] = w;
-    } else {
-      n["worst"] = nullptr;
-    }
-    j["worst_case"] = n;
-  }
+    return n;
+  };
+  if (s.noise_outputs)
+    j["noise"] = family([](const PointResult& r) { return r.noise.has_value(); },
+                        [](const PointResult& r) { return r.noise->verdict; },
+                        [](const PointResult& r) { return r.noise->immunity_min_db; },
+                        [](const PointResult& r, ordered_json& w) {
+                          w["immunity_min_db"] = r.noise->immunity_min_db;
+                        });
+  // "worst" is taken by the spec traffic's worst point.
+  if (s.worst_outputs)
+    j["worst_case"] = family([](const PointResult& r) { return r.worst.has_value(); },
+                             [](const PointResult& r) { return r.worst->verdict; },
+                             [](const PointResult& r) { return r.worst->margin_rel; },
+                             [](const PointResult& r, ordered_json& w) {
+                               w["verdict"] = r.worst->verdict;
+                               w["worst_metric"] = r.worst->worst_metric;
+                               w["margin_rel"] = r.worst->margin_rel;
+                             });
   return j;
 }
 

@@ -5,6 +5,11 @@
 namespace isolink::eye {
 namespace {
 
+// A pulse span reported as ringing (or, after_frame, as the kickback after a frame).
+Ringing ringing_of(const PulseSpan& ps, bool after_frame) {
+  return Ringing{ps.sign, ps.a, ps.b, ps.peak, ps.peak_t, after_frame};
+}
+
 // Time where the segment (t0, x0)-(t1, x1) crosses level.
 inline double cross(double t0, double x0, double t1, double x1, double level) {
   return t0 + (level - x0) / (x1 - x0) * (t1 - t0);
@@ -104,13 +109,7 @@ Segmentation segment(std::span<const double> t, std::span<const double> v, const
   for (size_t k = 0; k < merged.size(); ++k) {
     PulseSpan& ps = merged[k];
     if (ps.b - ps.a < p.min_pulse && !ps.truncated) {
-      Ringing r;
-      r.sign = ps.sign;
-      r.start = ps.a;
-      r.end = ps.b;
-      r.peak = ps.peak;
-      r.peak_t = ps.peak_t;
-      seg.ringing.push_back(r);
+      seg.ringing.push_back(ringing_of(ps, false));
     } else {
       seg.pulses.push_back(std::move(ps));
     }
@@ -140,14 +139,7 @@ void build_frames(Segmentation* seg) {
 }
 
 void drop_frame_tail(Segmentation* seg, size_t i) {
-  const PulseSpan& ps = seg->pulses.at(i);
-  Ringing g;
-  g.sign = ps.sign;
-  g.start = ps.a;
-  g.end = ps.b;
-  g.peak = ps.peak;
-  g.peak_t = ps.peak_t;
-  g.after_frame = true;
+  const Ringing g = ringing_of(seg->pulses.at(i), true);
   auto at = std::lower_bound(seg->ringing.begin(), seg->ringing.end(), g.start,
                              [](const Ringing& x, double t) { return x.start < t; });
   seg->ringing.insert(at, g);
