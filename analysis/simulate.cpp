@@ -108,6 +108,7 @@ StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequ
       for (const auto& e : circuit.elements()) e->bind_time(opt.tstep, opt.tstop);
       LtiOptions lo;
       lo.horizon = opt.tstop;
+      lo.method = req.lti_method;
       if (req.progress)
         lo.on_progress = [&](double tau) {
           req.progress("LTI responses", std::clamp(tau / opt.tstop, 0.0, 1.0));
@@ -130,7 +131,7 @@ StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequ
         grid.grid_probes = req.grid_probes;
         // auto: the LTI output only when it costs about what the transient would (a transient
         // step costs about an unknown's worth of work per unknown, as does a probe evaluation).
-        if (req.engine == Engine::Auto)
+        if (req.engine == Engine::Auto && !responses->reduced())
           grid.max_evaluations =
               kAutoLtiBudget * static_cast<double>(responses->stats().steps) * result.unknowns;
         result.wave = responses->waveform(responses->netlist_inputs(opt.tstop), grid, &result.grid);

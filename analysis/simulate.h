@@ -45,6 +45,8 @@ struct SimulationRequest {
   std::optional<IntegrationMethod> method;   // override .options method
   std::optional<double> reltol;              // override .options reltol (transient engine)
   Engine engine = Engine::Auto;
+  // The LTI engine's method (solver/lti.h): auto = the reduced model when it passes its check.
+  LtiOptions::Method lti_method = LtiOptions::Method::Auto;
   // LTI output grid: step (0 = the 1 mV rule, LtiResponses::GridOptions) and the probes the rule
   // looks at (empty = all). The transient ignores both (its rows are its steps).
   double grid_step = 0.0;

@@ -12,6 +12,7 @@
 #include "netlists/traffic/command.h"
 #include "netlists/traffic/encoding.h"
 #include "solver/circuit.h"
+#include "solver/lti.h"
 #include "solver/probe.h"
 #include "solver/transient.h"
 
@@ -314,6 +315,81 @@ StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::Par
   out.dt = opt.dt;
   out.pre = to_samples(50e-9, opt.dt);
   const double lead = kLead;
+  const long half = to_samples(opt.expand.stimulus.encoding.half_bit, opt.dt);
+  // Settling of a sampled record (see EdgeResponse): true when it has settled.
+  auto settled = [&](double span) {
+    const long n = static_cast<long>(out.e.size());
+    out.span = span;
+    out.settle = 0;
+    out.drift = 0;
+    for (long i = n - n / 10; i < n; ++i) {
+      out.settle = std::max(out.settle, std::abs(out.e[static_cast<size_t>(i)] - out.e.back()));
+      out.drift = std::max(out.drift, std::abs(out.e[static_cast<size_t>(i)] -
+                                               out.e[static_cast<size_t>(i - half)]));
+    }
+    return out.drift <= opt.settle_tol;
+  };
+  auto unsettled = [&](const std::string& what, double span) {
+    return Status::Error(fmt::format(
+        "{}: the edge response has not settled {:g} us after the edge (a half bit's response is "
+        "still {:.1f} uV, more than {:.1f} uV): the link's memory is too long for the "
+        "worst-case search",
+        what, span * 1e6, out.drift * 1e6, opt.settle_tol * 1e6));
+  };
+  auto finite = [&](const std::string& what) {
+    for (double x : out.e)
+      if (!std::isfinite(x)) return Status::Error(what + ": the edge response is not finite");
+    return Status::Ok();
+  };
+
+  if (opt.edge_engine == WorstOptions::EdgeEngine::Auto) {
+    // The reduced model in closed form: one model, sampled on longer records until settled.
+    traffic::Drive drive;
+    drive.encoding = opt.expand.stimulus.encoding;
+    drive.segments = {{0.0, lead, 0}, {lead, lead + opt.max_span, +1}};
+    link::ExpandOptions ex = opt.expand;
+    ex.drive = drive;
+    StatusOr<link::ExpandedLink> link = link::expand_link(spec, parts, d, ex);
+    if (!link) return link.status();
+    Circuit circuit;
+    for (const Card& card : link->netlist.cards)
+      if (Status s = circuit.add(card); !s.ok()) return s;
+    if (Status s = circuit.finalize(); !s.ok()) return s;
+    StatusOr<Probe> probe = parse_probe(circuit, "v(rxp,rxn)");
+    if (!probe) return probe.status();
+    for (const auto& e : circuit.elements()) e->bind_time(opt.dt, lead + opt.max_span);
+    LtiOptions lo;
+    lo.method = LtiOptions::Method::Reduced;
+    lo.horizon = lead + opt.max_span;
+    if (opt.progress) opt.progress("edge response, reduced model", 0.0);
+    StatusOr<LtiResponses> lti = LtiResponses::compute(circuit, {*probe}, lo);
+    if (lti) {
+      const std::vector<SourceInput> inputs = lti->netlist_inputs(lead + opt.max_span);
+      out.v_idle = lti->value(0, lead - 2 * out.pre * opt.dt, inputs);
+      out.e.clear();
+      for (double span = 40e-6;; span *= 2) {
+        // Only the samples the longer record adds: the model starts them from the edge exactly.
+        const long from = static_cast<long>(out.e.size()), n = out.pre + to_samples(span, opt.dt);
+        std::vector<double> times(static_cast<size_t>(n - from));
+        for (long i = from; i < n; ++i)
+          times[static_cast<size_t>(i - from)] = lead + static_cast<double>(i - out.pre) * opt.dt;
+        const std::vector<std::vector<double>> v = lti->values(inputs, times);
+        for (double x : v[0]) out.e.push_back(x - out.v_idle);
+        if (Status s = finite(link->description); !s.ok()) return s;
+        if (settled(span)) break;
+        if (span * 2 > opt.max_span) return unsettled(link->description, span);
+      }
+      const ReducedModelStats& m = lti->stats().model;
+      out.engine = fmt::format(
+          "reduced model (order {}, {} poles, {} expansion points, AC error {:.1e} of peak up to "
+          "3 GHz), sampled on a {:g} ns grid",
+          m.order, m.poles, m.expansion_points, m.error, opt.dt * 1e9);
+      out.seconds = seconds_since(start);
+      return out;
+    }
+    out.engine_note = "reduced model not used: " + lti.status().message();
+  }
+
   for (double span = 40e-6;; span *= 2) {
     traffic::Drive drive;
     drive.encoding = opt.expand.stimulus.encoding;
@@ -350,25 +426,9 @@ StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::Par
     for (long i = 0; i < n; ++i)
       out.e[static_cast<size_t>(i)] =
           w->value_at(0, lead + static_cast<double>(i - out.pre) * opt.dt) - out.v_idle;
-    out.span = span;
-    out.settle = 0;
-    out.drift = 0;
-    const long half = to_samples(opt.expand.stimulus.encoding.half_bit, opt.dt);
-    for (long i = n - n / 10; i < n; ++i) {
-      out.settle = std::max(out.settle, std::abs(out.e[static_cast<size_t>(i)] - out.e.back()));
-      out.drift = std::max(out.drift, std::abs(out.e[static_cast<size_t>(i)] -
-                                               out.e[static_cast<size_t>(i - half)]));
-    }
-    for (double x : out.e)
-      if (!std::isfinite(x))
-        return Status::Error(link->description + ": the edge response is not finite");
-    if (out.drift <= opt.settle_tol) break;
-    if (span * 2 > opt.max_span)
-      return Status::Error(fmt::format(
-          "{}: the edge response has not settled {:g} us after the edge (a half bit's response is "
-          "still {:.1f} uV, more than {:.1f} uV): the link's memory is too long for the "
-          "worst-case search",
-          link->description, span * 1e6, out.drift * 1e6, opt.settle_tol * 1e6));
+    if (Status s = finite(link->description); !s.ok()) return s;
+    if (settled(span)) break;
+    if (span * 2 > opt.max_span) return unsettled(link->description, span);
   }
   out.engine = fmt::format("transient, reltol {:g}, tmax {:g} ns, sampled on a {:g} ns grid",
                            opt.reltol, kEdgeTmaxSamples * opt.dt * 1e9, opt.dt * 1e9);
@@ -760,6 +820,7 @@ nlohmann::ordered_json worst_json(const WorstResult& r) {
         {"engine", d.edge.engine},          {"span_us", d.edge.span * 1e6},
         {"settle_mV", d.edge.settle * 1e3}, {"half_bit_residue_uV", d.edge.drift * 1e6},
         {"v_idle", d.edge.v_idle},          {"seconds", d.edge.seconds}};
+    if (!d.edge.engine_note.empty()) dj["edge_response"]["engine_note"] = d.edge.engine_note;
     ordered_json w = ordered_json::object();
     for (const WorstMetric& m : d.metrics) {
       ordered_json mj;
@@ -819,6 +880,7 @@ std::string worst_markdown(const WorstResult& r) {
         "(bound); {} waveforms scored, {} histories ranked, {:.1f} s. Edge response: {}.\n\n",
         d.memory * 1e6, d.gap_min * 1e6, d.previous_bound * 1e3, d.older_bound * 1e3, d.scored,
         d.ranked, d.seconds + d.edge.seconds, d.edge.engine);
+    if (!d.edge.engine_note.empty()) md += "Edge response: " + d.edge.engine_note + ".\n\n";
     for (const std::string& why : d.reasons) md += "- " + why + "\n";
     if (!d.reasons.empty()) md += "\n";
     md += "Replay any row in `isolink run` with its stimulus block:\n\n```yaml\n";

@@ -24,6 +24,7 @@ struct WorstArgs {
   std::string out_dir;
   std::vector<std::string> part_dirs;
   std::string direction;
+  std::string edge_engine = "auto";
   bool json = false;
   bool no_images = false;
   bool quiet = false;
@@ -45,9 +46,10 @@ int run_worst(const WorstArgs& a) {
   if (!parts) return fail(parts.status());
   // Progress on stderr while it runs, when it is a terminal (base/progress.h).
   ProgressLine line({.label = "isolink worst", .enabled = !a.quiet});
-  StatusOr<analysis::WorstResult> w = analysis::worst_case(
-      *spec, *parts,
-      {.progress = [&line](const std::string& what, double f) { line.show_fraction(what, f); }});
+  analysis::WorstOptions opt;
+  opt.progress = [&line](const std::string& what, double f) { line.show_fraction(what, f); };
+  if (a.edge_engine == "transient") opt.edge_engine = analysis::WorstOptions::EdgeEngine::Transient;
+  StatusOr<analysis::WorstResult> w = analysis::worst_case(*spec, *parts, opt);
   line.finish();
   if (!w) return fail(w.status().with_context(a.spec));
   const std::string json = analysis::worst_json(*w).dump(2) + "\n";
@@ -94,6 +96,10 @@ void add_worst_command(CLI::App& app, int* exit_code) {
   cmd->add_option("--parts", args->part_dirs, "Extra part-library folder (repeatable)");
   cmd->add_option("--direction", args->direction, "Override the spec: down | up | both")
       ->check(CLI::IsMember({"down", "up", "both"}));
+  cmd->add_option("--edge-engine", args->edge_engine,
+                  "Edge response: auto (the reduced model, checked against the exact AC solution; "
+                  "the transient when it does not pass) | transient")
+      ->check(CLI::IsMember({"auto", "transient"}));
   cmd->add_flag("--json", args->json, "Print the JSON instead of the summary");
   cmd->add_flag("--no-images", args->no_images,
                 "With -o: skip the worst_<dir>_<metric>.png images");

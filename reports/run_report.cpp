@@ -102,6 +102,18 @@ nlohmann::ordered_json run_report_json(const link::LinkSpec& spec, const LinkRun
                         {"cable_segments", d.link.cable_segments},
                         {"warnings", d.sim.warnings}};
     if (lti) {
+      solver["lti_method"] = d.sim.lti.method;
+      if (d.sim.lti.method == "reduced model") {
+        const ReducedModelStats& m = d.sim.lti.model;
+        solver["reduced_model"] = {{"order", m.order},
+                                   {"poles", m.poles},
+                                   {"expansion_points", m.expansion_points},
+                                   {"check_points", m.check_points},
+                                   {"ac_error", m.error},
+                                   {"ac_error_hz", m.error_frequency}};
+      } else if (!d.sim.lti.note.empty()) {
+        solver["lti_note"] = d.sim.lti.note;
+      }
       solver["response_span_s"] = d.sim.lti.settled_at;
       solver["grid_step_s"] = d.sim.grid.step;
       solver["rows"] = d.sim.grid.rows;
@@ -192,7 +204,16 @@ std::string run_report_markdown(const link::LinkSpec& spec, const LinkRun& run,
                       lti ? d.sim.lti.factorizations : d.sim.stats.factorizations, d.sim.seconds);
   }
   for (const DirectionRun& d : run.directions)
-    if (d.sim.engine == analysis::Engine::Lti)
+    if (d.sim.engine == analysis::Engine::Lti && d.sim.lti.method == "reduced model")
+      md += fmt::format(
+          "\n{}: waveform by the LTI engine from a reduced model (order {}, {} poles, {} "
+          "expansion points; its transfer within {:.1e} of the peak of the exact AC solution at "
+          "{} frequencies from 1 kHz to 3 GHz), superposing {} source corners in closed form; "
+          "output every {:.3g} ns (linear interpolation within 1 mV).\n",
+          d.link.description, d.sim.lti.model.order, d.sim.lti.model.poles,
+          d.sim.lti.model.expansion_points, d.sim.lti.model.error, d.sim.lti.model.check_points,
+          d.sim.grid.corners, d.sim.grid.step * 1e9);
+    else if (d.sim.engine == analysis::Engine::Lti)
       md += fmt::format(
           "\n{}: waveform by the LTI engine, superposing {} source corners on step "
           "responses marched to {:.3g} us; output every {:.3g} ns (linear "

@@ -42,6 +42,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,17 +51,24 @@
 #include "solver/circuit.h"
 #include "solver/elements/source_function.h"
 #include "solver/probe.h"
+#include "solver/reduced_model.h"
 
 namespace isolink {
 
 struct LtiOptions {
-  double horizon = 0.0;        // s, longest lag needed (> 0); the simulated span
-  double step_reltol = 1e-5;   // truncation error per unit time, relative to peak |S|
-  double step_abstol = 1e-7;   // same, absolute (V/V for nodes, A/V for branch currents)
-  double settle_tol = 1e-6;    // V/V (A/V): early stop, see above
-  double first_step = 0.0;     // s; 0 = min(1e-12, horizon * 1e-9)
-  double max_step = 0.0;       // s; 0 = horizon / 64
-  long max_steps = 5'000'000;  // accepted + rejected march steps before giving up
+  // How the responses are computed: `march` (above), `reduced` (a reduced model in closed form,
+  // solver/reduced_model.h: no march, no settling, any lag at the same cost), or `auto`: the
+  // reduced model when it passes its check, else the march (LtiStats::note says why).
+  enum class Method { Auto, March, Reduced };
+  Method method = Method::Auto;
+  ReducedModelOptions reduced;  // its horizon is set from `horizon`
+  double horizon = 0.0;         // s, longest lag needed (> 0); the simulated span
+  double step_reltol = 1e-5;    // truncation error per unit time, relative to peak |S|
+  double step_abstol = 1e-7;    // same, absolute (V/V for nodes, A/V for branch currents)
+  double settle_tol = 1e-6;     // V/V (A/V): early stop, see above
+  double first_step = 0.0;      // s; 0 = min(1e-12, horizon * 1e-9)
+  double max_step = 0.0;        // s; 0 = horizon / 64
+  long max_steps = 5'000'000;   // accepted + rejected march steps before giving up
   // s; 0 = no limit. The march gives up (an error) when the responses have not settled by then:
   // `auto` sets a quarter of the run, since a march over the whole run costs more than the
   // transient (one solve per source and step against one per step).
@@ -89,6 +97,9 @@ struct LtiStats {
   int factorizations = 0;   // numeric (march + DC)
   double settled_at = 0.0;  // s, end of the march (the horizon unless it settled before)
   bool settled = false;     // stopped early by the settling criterion
+  std::string method;       // "march" or "reduced model"
+  std::string note;         // auto: why the reduced model was not used
+  ReducedModelStats model;  // the reduced model's figures (method "reduced model")
 };
 
 // Why the circuit cannot take the LTI engine (an element that is not LTI, a source that is not
@@ -156,9 +167,23 @@ class LtiResponses {
   Waveform waveform(const std::vector<SourceInput>& inputs, const GridOptions& grid,
                     GridInfo* info = nullptr) const;
 
+  // Every probe at the given times (ascending), for the given inputs: out[p][j]. With the reduced
+  // model one pass over the times and corners (closed-form steps between them), so any number of
+  // times costs O(times + corners) per mode.
+  std::vector<std::vector<double>> values(const std::vector<SourceInput>& inputs,
+                                          const std::vector<double>& times) const;
+
   const LtiStats& stats() const { return stats_; }
+  bool reduced() const { return model_.has_value(); }
 
  private:
+  // Reduced model: adds the ramps' response (without the base) at times[0..count) into out[p][j].
+  // uniform_dt > 0 says that most consecutive times are that far apart (its step is cached).
+  void modal_add(const std::vector<SourceInput>& inputs, const std::vector<double>& times,
+                 double uniform_dt, std::vector<std::vector<double>>& out) const;
+  Waveform modal_waveform(const std::vector<SourceInput>& inputs, const GridOptions& grid,
+                          const std::vector<double>& base, GridInfo& gi) const;
+
   struct Source {
     std::string name;
     const SourceFunction* function = nullptr;
@@ -178,6 +203,7 @@ class LtiResponses {
   std::vector<double> tau_;                              // march times, tau_[0] = 0
   std::vector<std::vector<std::vector<double>>> r_, s_;  // [k][p][i]: R and S at tau_[i]
   std::vector<std::vector<double>> end_slope_;           // [k][p]: R's slope beyond the march
+  std::optional<ReducedModel> model_;                    // set: responses from the model
   LtiStats stats_;
 };
 

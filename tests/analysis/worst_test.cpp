@@ -283,6 +283,28 @@ TEST(WorstCase, ReproduceBlocksShowTheWorstValueInTheTransient) {
   }
 }
 
+// The edge response from the reduced model (the default) against the transient at reltol 1e-6:
+// the same record within 0.2 mV (the worst-case search adds up at most a few dozen edges, and
+// the examples' worst values agree within 0.11 mV and 1 ps, bench/README.md).
+TEST(WorstCase, ReducedModelEdgeResponseMatchesTheTransient) {
+  const Fixture& f = fixture();
+  EXPECT_NE(f.edge.engine.find("reduced model"), std::string::npos) << f.edge.engine_note;
+  WorstOptions o = f.opt;
+  o.edge_engine = WorstOptions::EdgeEngine::Transient;
+  StatusOr<EdgeResponse> t = edge_response(f.spec, f.parts, link::Direction::kDown, o);
+  ASSERT_TRUE(t.ok()) << t.status().message();
+  EXPECT_NE(t->engine.find("transient"), std::string::npos);
+  EXPECT_NEAR(f.edge.v_idle, t->v_idle, 1e-6);
+  double dev = 0, peak = 0;
+  const long n = static_cast<long>(std::min(f.edge.e.size(), t->e.size())) - f.edge.pre;
+  for (long i = -f.edge.pre; i < n; ++i) {
+    dev = std::max(dev, std::abs(f.edge.at(i) - t->at(i)));
+    peak = std::max(peak, std::abs(t->at(i)));
+  }
+  EXPECT_GT(peak, 1.0);  // a real edge (V)
+  EXPECT_LT(dev, 0.2e-3);
+}
+
 TEST(WorstCase, OptionsAreValidatedUpFront) {
   WorstOptions o;
   o.gap_step = 0;

@@ -148,8 +148,10 @@ TEST(LtiEngineChoice, AutoFallsBackOnSinAndLtiRefusesNamingTheSource) {
       << forced.status().message();
 }
 
-// auto takes the LTI engine when the responses settle early in the run, and the transient when
-// they do not settle within a quarter of it (the march would then cost more than the transient).
+// With the march (the reduced model's fallback), auto takes the LTI engine when the responses
+// settle early in the run, and the transient when they do not settle within a quarter of it (the
+// march would then cost more than the transient). The reduced model needs no settling: auto
+// takes it for both.
 // RC step responses, tau = 0.5 us (the march calls it settled at about 14 us of a 100 us run) and
 // tau = 100 us (still moving at 25 us); each against v = 1 - exp(-t / tau).
 TEST(LtiEngineChoice, AutoTakesTheLtiEngineOnlyWhenTheResponsesSettleEarly) {
@@ -160,6 +162,17 @@ TEST(LtiEngineChoice, AutoTakesTheLtiEngineOnlyWhenTheResponsesSettleEarly) {
     auto netlist = read_spice_file(path);
     ASSERT_TRUE(netlist.ok()) << netlist.status().message();
     analysis::SimulationRequest req{.probes = {"v(out)"}};
+    auto reduced = analysis::simulate_netlist(*netlist, req);
+    ASSERT_TRUE(reduced.ok()) << reduced.status().message();
+    EXPECT_EQ(reduced->engine, analysis::Engine::Lti);
+    EXPECT_EQ(reduced->lti.method, "reduced model");
+    for (size_t i = 0; i < reduced->wave.samples(); ++i) {
+      const double t = reduced->wave.time[i];
+      if (t >= 1e-9) {
+        ASSERT_NEAR(reduced->wave.columns[0][i], 1 - std::exp(-(t - 0.5e-9) / tau), 1e-3) << t;
+      }
+    }
+    req.lti_method = LtiOptions::Method::March;
     auto r = analysis::simulate_netlist(*netlist, req);
     ASSERT_TRUE(r.ok()) << r.status().message();
     const bool settles = tau < 10e-6;

@@ -1,0 +1,332 @@
+#include "solver/reduced_model.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/Dense>
+#include <Eigen/Sparse>
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "solver/ac.h"
+
+namespace isolink {
+
+Status ReducedModelOptions::validate() const {
+  auto bad = [](const char* field, double v, const char* rule) {
+    return Status::Error(fmt::format("reduced model option {} = {:g}: {}", field, v, rule));
+  };
+  if (!(tol > 0 && tol < 1)) return bad("tol", tol, "must be in (0, 1)");
+  if (!(f_min > 0)) return bad("f_min", f_min, "must be positive");
+  if (!(f_max > f_min) || !std::isfinite(f_max)) return bad("f_max", f_max, "must exceed f_min");
+  if (check_points < 8) return bad("check_points", check_points, "must be at least 8");
+  if (max_check_points < check_points)
+    return bad("max_check_points", max_check_points, "must be at least check_points");
+  if (moments < 1 || moments > 20) return bad("moments", moments, "must be in 1..20");
+  if (max_points < 1) return bad("max_points", max_points, "must be positive");
+  if (max_order < 1) return bad("max_order", max_order, "must be positive");
+  if (!(horizon > 0) || !std::isfinite(horizon)) return bad("horizon", horizon, "must be positive");
+  return Status::Ok();
+}
+
+std::complex<double> ReducedModel::transfer(size_t k, size_t p, std::complex<double> s) const {
+  std::complex<double> h = direct[k][p];
+  for (size_t i = 0; i < poles.size(); ++i) {
+    const std::complex<double> z = s - poles[i];  // 1 / z as conj(z) / |z|^2: no __divdc3
+    h += output[p][i] * input[k][i] * std::conj(z) / std::norm(z);
+  }
+  return h;
+}
+
+namespace {
+
+using Cplx = std::complex<double>;
+
+// The growing orthonormal basis and its images under G and C.
+struct Basis {
+  Eigen::MatrixXd v, gv, cv;  // n x q
+  int q = 0;
+  // Orthogonalises x against the basis (twice, modified Gram-Schmidt) and appends it unless
+  // nothing new is left (|x| below 1e-9 of what it was). Returns whether it was appended.
+  bool add(Eigen::VectorXd x, const Eigen::SparseMatrix<double>& g,
+           const Eigen::SparseMatrix<double>& c) {
+    const double norm0 = x.norm();
+    if (!(norm0 > 0) || !std::isfinite(norm0)) return false;
+    for (int pass = 0; pass < 2; ++pass)
+      for (int j = 0; j < q; ++j) x -= v.col(j).dot(x) * v.col(j);
+    const double norm = x.norm();
+    if (!(norm > 1e-9 * norm0)) return false;
+    x /= norm;
+    if (q == v.cols()) {
+      const int grow = std::max(16, q);
+      v.conservativeResize(Eigen::NoChange, q + grow);
+      gv.conservativeResize(Eigen::NoChange, q + grow);
+      cv.conservativeResize(Eigen::NoChange, q + grow);
+    }
+    v.col(q) = x;
+    gv.col(q) = g * x;
+    cv.col(q) = c * x;
+    ++q;
+    return true;
+  }
+};
+
+}  // namespace
+
+StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,
+                                      const std::vector<std::vector<double>>& excitations,
+                                      const std::vector<std::vector<double>>& dc_solutions,
+                                      const std::vector<Probe>& probes,
+                                      const ReducedModelOptions& opt) {
+  if (Status s = opt.validate(); !s.ok()) return s;
+  StatusOr<AcAnalysis> ac = AcAnalysis::create(circuit);
+  if (!ac) return ac.status();
+  const int n = circuit.unknown_count();
+  const size_t nk = excitations.size(), np = probes.size();
+  ReducedModel model;
+  ReducedModelStats& st = model.stats;
+
+  // G and C as real sparse matrices over unknowns 1..n (index 0 = unknown 1).
+  Eigen::SparseMatrix<double> g(n, n), c(n, n);
+  {
+    std::vector<Eigen::Triplet<double>> tg, tc;
+    const auto& cp = ac->col_start();
+    const auto& ri = ac->row_index();
+    for (int col = 0; col < n; ++col)
+      for (int k = cp[col]; k < cp[col + 1]; ++k) {
+        if (ac->g_values()[k] != 0) tg.emplace_back(ri[k], col, ac->g_values()[k]);
+        if (ac->c_values()[k] != 0) tc.emplace_back(ri[k], col, ac->c_values()[k]);
+      }
+    g.setFromTriplets(tg.begin(), tg.end());
+    c.setFromTriplets(tc.begin(), tc.end());
+  }
+  auto to_full = [n](const Eigen::VectorXcd& x) {
+    AcAnalysis::Vector out(n + 1, 0.0);
+    for (int i = 0; i < n; ++i) out[i + 1] = x[i];
+    return out;
+  };
+  auto probe_of = [](const Probe& p, const AcAnalysis::Vector& x) { return x[p.a] - x[p.b]; };
+
+  // The exact transfer at the check frequencies, and each (k, p)'s scale: peak |H| with DC.
+  std::vector<double> freqs;
+  std::vector<std::vector<std::vector<Cplx>>> exact;  // [check][k][p]
+  std::vector<std::vector<double>> scale(nk, std::vector<double>(np, 0.0));
+  for (size_t k = 0; k < nk; ++k)
+    for (size_t p = 0; p < np; ++p)
+      scale[k][p] =
+          std::max(1e-15, std::fabs(dc_solutions[k][probes[p].a] - dc_solutions[k][probes[p].b]));
+  auto add_checks = [&](const std::vector<double>& fs) -> Status {
+    for (double f : fs) {
+      if (Status s = ac->factor(f); !s.ok()) return s;
+      ++st.factorizations;
+      freqs.push_back(f);
+      exact.emplace_back(nk);
+      for (size_t k = 0; k < nk; ++k) {
+        AcAnalysis::Vector b(excitations[k].begin(), excitations[k].end());
+        b[0] = 0.0;
+        const AcAnalysis::Vector x = ac->solve_factored(b);
+        for (size_t p = 0; p < np; ++p) {
+          exact.back()[k].push_back(probe_of(probes[p], x));
+          scale[k][p] = std::max(scale[k][p], std::abs(exact.back()[k][p]));
+        }
+      }
+    }
+    return Status::Ok();
+  };
+  {
+    std::vector<double> fs(opt.check_points);
+    for (int i = 0; i < opt.check_points; ++i)
+      fs[i] = opt.f_min *
+              std::pow(opt.f_max / opt.f_min, static_cast<double>(i) / (opt.check_points - 1));
+    if (Status s = add_checks(fs); !s.ok()) return s;
+  }
+
+  Basis basis;
+  basis.v.resize(n, 0);
+  basis.gv.resize(n, 0);
+  basis.cv.resize(n, 0);
+  for (size_t k = 0; k < nk; ++k) {
+    Eigen::VectorXd x(n);
+    for (int i = 0; i < n; ++i) x[i] = dc_solutions[k][i + 1];
+    basis.add(x, g, c);
+  }
+  // Adds the Krylov vectors at j 2 pi f; false when none was new.
+  auto expand_at = [&](double f) -> StatusOr<bool> {
+    if (Status s = ac->factor(f); !s.ok()) return s;
+    ++st.factorizations;
+    bool added = false;
+    for (size_t k = 0; k < nk; ++k) {
+      AcAnalysis::Vector b(excitations[k].begin(), excitations[k].end());
+      b[0] = 0.0;
+      for (int m = 0; m < opt.moments; ++m) {
+        AcAnalysis::Vector x = ac->solve_factored(b);
+        Eigen::VectorXd re(n), im(n);
+        for (int i = 0; i < n; ++i) re[i] = x[i + 1].real(), im[i] = x[i + 1].imag();
+        const double norm = std::sqrt(re.squaredNorm() + im.squaredNorm());
+        if (!(norm > 0) || !std::isfinite(norm)) break;
+        added |= basis.add(re, g, c);
+        added |= basis.add(im, g, c);
+        // Next moment: A^-1 C x (normalised; only the direction matters).
+        Eigen::VectorXcd xc(n);
+        for (int i = 0; i < n; ++i) xc[i] = x[i + 1] / norm;
+        const Eigen::VectorXcd cx = c.cast<Cplx>() * xc;
+        b = to_full(cx);
+      }
+    }
+    ++st.expansion_points;
+    return added;
+  };
+
+  // Builds the pole-residue model from the current basis and measures its error.
+  auto build = [&]() -> Status {
+    const int q = basis.q;
+    const auto v = basis.v.leftCols(q);
+    const Eigen::MatrixXd gr = v.transpose() * basis.gv.leftCols(q);
+    const Eigen::MatrixXd cr = v.transpose() * basis.cv.leftCols(q);
+    Eigen::MatrixXd br(q, nk), lr(np, q);
+    for (size_t k = 0; k < nk; ++k) {
+      Eigen::VectorXd e(n);
+      for (int i = 0; i < n; ++i) e[i] = excitations[k][i + 1];
+      br.col(k) = v.transpose() * e;
+    }
+    for (size_t p = 0; p < np; ++p)
+      for (int j = 0; j < q; ++j)
+        lr(p, j) = (probes[p].a > 0 ? v(probes[p].a - 1, j) : 0.0) -
+                   (probes[p].b > 0 ? v(probes[p].b - 1, j) : 0.0);
+    // sigma: the middle of the band on a log scale, where G + sigma C is far from singular.
+    const double sigma = 2 * std::numbers::pi * std::sqrt(opt.f_min * opt.f_max);
+    Eigen::PartialPivLU<Eigen::MatrixXd> a(gr + sigma * cr);
+    const Eigen::MatrixXd m = a.solve(cr);
+    const Eigen::MatrixXd ab = a.solve(br);
+    if (!m.allFinite() || !ab.allFinite())
+      return Status::Error("reduced model: the projected system is singular");
+    Eigen::EigenSolver<Eigen::MatrixXd> es(m);
+    if (es.info() != Eigen::Success)
+      return Status::Error("reduced model: the eigenvalue problem did not converge");
+    const Eigen::VectorXcd lambda = es.eigenvalues();
+    const Eigen::MatrixXcd w = es.eigenvectors();
+    Eigen::PartialPivLU<Eigen::MatrixXcd> wlu(w);
+    const Eigen::MatrixXcd d = wlu.solve(ab.cast<Cplx>());  // q x nk
+    const Eigen::MatrixXcd cw = lr.cast<Cplx>() * w;        // np x q
+    if (!d.allFinite() || !cw.allFinite())
+      return Status::Error("reduced model: the eigenvectors are singular");
+    double lmax = 0;
+    for (int i = 0; i < q; ++i) lmax = std::max(lmax, std::abs(lambda[i]));
+    ReducedModel mod;
+    mod.direct.assign(nk, std::vector<double>(np, 0.0));
+    mod.input.assign(nk, {});
+    mod.output.assign(np, {});
+    mod.stats = st;
+    mod.stats.order = q;
+    for (int i = 0; i < q; ++i) {
+      if (std::abs(lambda[i]) <= 1e-14 * lmax) {
+        ++mod.stats.direct_modes;
+        for (size_t k = 0; k < nk; ++k)
+          for (size_t p = 0; p < np; ++p) mod.direct[k][p] += (cw(p, i) * d(i, k)).real();
+        continue;
+      }
+      const Cplx pole = sigma - 1.0 / lambda[i];
+      if (pole.real() > 0 && pole.real() * opt.horizon >= 1e-3) {
+        // Dropped; the check below sees what that costs (a pole with weight fails it).
+        double weight = 0;
+        for (size_t k = 0; k < nk; ++k)
+          for (size_t p = 0; p < np; ++p)
+            weight =
+                std::max(weight, std::abs(cw(p, i) * d(i, k) / lambda[i] / pole) / scale[k][p]);
+        ++mod.stats.dropped;
+        mod.stats.dropped_weight = std::max(mod.stats.dropped_weight, weight);
+        continue;
+      }
+      mod.poles.push_back(pole);
+      for (size_t k = 0; k < nk; ++k) mod.input[k].push_back(d(i, k) / lambda[i]);
+      for (size_t p = 0; p < np; ++p) mod.output[p].push_back(cw(p, i));
+    }
+    mod.stats.poles = static_cast<int>(mod.poles.size());
+    double worst = 0, worst_f = 0;
+    for (size_t f = 0; f < freqs.size(); ++f) {
+      const Cplx s(0.0, 2 * std::numbers::pi * freqs[f]);
+      for (size_t k = 0; k < nk; ++k)
+        for (size_t p = 0; p < np; ++p) {
+          const double e = std::abs(mod.transfer(k, p, s) - exact[f][k][p]) / scale[k][p];
+          if (!(e <= worst)) worst = e, worst_f = freqs[f];
+        }
+    }
+    mod.stats.error = worst;
+    mod.stats.error_frequency = worst_f;
+    model = std::move(mod);
+    return Status::Ok();
+  };
+
+  std::vector<double> used;
+  for (double f : {opt.f_min, opt.f_max / 10}) {
+    StatusOr<bool> added = expand_at(f);
+    if (!added) return added.status();
+    used.push_back(f);
+  }
+  while (true) {
+    if (Status s = build(); !s.ok()) return s;
+    if (model.stats.error <= opt.tol) {
+      // Refinement: the check grid's geometric midpoints must pass too (a resonance can hide
+      // between check points); those that do not join the grid and the search goes on.
+      std::vector<double> sorted = freqs, mids;
+      std::sort(sorted.begin(), sorted.end());
+      for (size_t i = 0; i + 1 < sorted.size(); ++i)
+        if (sorted[i + 1] > sorted[i] * (1 + 1e-9))
+          mids.push_back(std::sqrt(sorted[i] * sorted[i + 1]));
+      if (freqs.size() + mids.size() > static_cast<size_t>(opt.max_check_points)) break;
+      const size_t before = freqs.size();
+      if (Status s = add_checks(mids); !s.ok()) return s;
+      double worst = 0, worst_f = 0;
+      for (size_t f = before; f < freqs.size(); ++f) {
+        const Cplx sj(0.0, 2 * std::numbers::pi * freqs[f]);
+        for (size_t k = 0; k < nk; ++k)
+          for (size_t p = 0; p < np; ++p) {
+            const double e = std::abs(model.transfer(k, p, sj) - exact[f][k][p]) / scale[k][p];
+            if (!(e <= worst)) worst = e, worst_f = freqs[f];
+          }
+      }
+      if (worst <= opt.tol) break;
+      model.stats.error = worst;
+      model.stats.error_frequency = worst_f;
+    }
+    if (static_cast<int>(used.size()) >= opt.max_points || basis.q >= opt.max_order)
+      return Status::Error(fmt::format(
+          "reduced model: error {:.2g} at {:.4g} Hz after {} expansion points (order {}), over "
+          "the {:.2g} allowed",
+          model.stats.error, model.stats.error_frequency, used.size(), basis.q, opt.tol));
+    // Check frequencies by the error there, worst first; the first one whose vectors are new.
+    std::vector<std::pair<double, double>> ranked;  // (error, f)
+    for (size_t f = 0; f < freqs.size(); ++f) {
+      const Cplx s(0.0, 2 * std::numbers::pi * freqs[f]);
+      double e = 0;
+      for (size_t k = 0; k < nk; ++k)
+        for (size_t p = 0; p < np; ++p)
+          e = std::max(e, std::abs(model.transfer(k, p, s) - exact[f][k][p]) / scale[k][p]);
+      if (e > opt.tol) ranked.emplace_back(e, freqs[f]);
+    }
+    std::sort(ranked.rbegin(), ranked.rend());
+    bool grew = false;
+    for (const auto& [e, f] : ranked) {
+      if (std::find(used.begin(), used.end(), f) != used.end()) continue;
+      StatusOr<bool> added = expand_at(f);
+      if (!added) return added.status();
+      used.push_back(f);
+      if (*added) {
+        grew = true;
+        break;
+      }
+      if (static_cast<int>(used.size()) >= opt.max_points) break;
+    }
+    if (!grew)
+      return Status::Error(fmt::format(
+          "reduced model: error {:.2g} at {:.4g} Hz and no expansion point adds a new direction "
+          "(order {})",
+          model.stats.error, model.stats.error_frequency, basis.q));
+  }
+  model.stats.factorizations = st.factorizations;
+  model.stats.check_points = static_cast<int>(freqs.size());
+  model.stats.expansion_points = st.expansion_points;
+  return model;
+}
+
+}  // namespace isolink

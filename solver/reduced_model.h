@@ -1,0 +1,97 @@
+// Reduced model: a linear circuit's transfer from its time-varying sources to its probes as poles
+// and residues, H_kp(s) = D_kp + sum_i out_pi in_ki / (s - p_i), built by Krylov projection and
+// checked against the full circuit's exact AC solution. The LTI engine (solver/lti.h) evaluates
+// it in closed form instead of marching the circuit.
+//
+//   StatusOr<ReducedModel> m = reduce_circuit(circuit, excitations, dc_solutions, probes, {});
+//   m->stats.error, m->stats.order ...   // the check it passed
+//
+// Method (PRIMA-style moment matching, e.g. Odabasioglu, Celik and Pileggi, IEEE TCAD 1998):
+// 1. The circuit is C x' + G x = sum_k e_k u_k, probes y_p = l_p . x. A real orthonormal basis V
+//    gathers, for every source k: its DC solution G^-1 e_k (so the model's DC gain is exact), and
+//    at each expansion point s0 = j 2 pi f the Krylov vectors A^-1 e_k, (A^-1 C) A^-1 e_k, ...
+//    (`moments` of them; A = G + s0 C), real and imaginary parts added separately so that the
+//    moments at s0 and its conjugate both match. Vectors already in the span are dropped.
+// 2. The projected system Gr = V'GV, Cr = V'CV, br = V'e, lr = l V is diagonalised through
+//    M = (Gr + sigma Cr)^-1 Cr = W diag(lambda) W^-1 (sigma real, where Gr + sigma Cr is
+//    regular, so singular G or C are fine): a mode with lambda = 0 is instantaneous and joins the
+//    direct term D, every other is a pole p = sigma - 1/lambda.
+// 3. The check: at `check_points` log-spaced frequencies from f_min to f_max, the model's
+//    H_kp(j w) is compared with the full circuit's (one sparse LU per frequency, exact). The error
+//    is max |H_r - H| over the peak |H| of that source and probe (DC gain included). Expansion
+//    points are added greedily at the check frequency with the largest error (the next-worst
+//    when its vectors are already in the basis) until the error is at most `tol`. Then the
+//    grid is refined: the model must also pass at the geometric midpoints of the check points
+//    (a resonance can hide between them); if it does not, they join the grid and the search
+//    goes on, up to max_check_points.
+// 4. A pole in the right half plane is a projection artefact (the circuits here are passive). It
+//    is kept when it is so slow that it cannot grow over `horizon` (Re p horizon < 1e-3), and
+//    dropped otherwise, before the check: a model that needed it fails the check there, and the
+//    greedy search expands at that frequency.
+//
+// What the check covers: the frequency band f_min..f_max (default 1 kHz - 3 GHz). Edges faster
+// than 1 / (2 pi f_max) (50 ps) excite what lies above it, and responses slower than
+// 1 / (2 pi f_min) rest on the exact DC gain and the 1 kHz expansion.
+#pragma once
+
+#include <complex>
+#include <string>
+#include <vector>
+
+#include "base/status.h"
+#include "solver/circuit.h"
+#include "solver/probe.h"
+
+namespace isolink {
+
+struct ReducedModelOptions {
+  double tol = 2e-5;   // relative error allowed at every check frequency
+  double f_min = 1e3;  // Hz, check band
+  double f_max = 3e9;  // Hz
+  // Log-spaced over the band, then refined (step 3). A resonance narrower than their spacing can
+  // hide between them: 96 points (15 a decade) and no refinement missed a 40-section LC
+  // ladder's modes near its cutoff by 0.47 of the peak (tests/solver/reduced_model_test.cpp).
+  int check_points = 128;
+  int max_check_points = 4096;  // refinement stops here (accepted: spacing 0.4 % by then)
+  int moments = 3;              // Krylov vectors per source and expansion point
+  int max_points = 40;          // expansion points before giving up
+  int max_order = 1200;         // basis size before giving up
+  double horizon = 0.0;         // s, the longest time the model is evaluated over (step 4); > 0
+  Status validate() const;      // names the field, its value and the rule
+};
+
+struct ReducedModelStats {
+  int order = 0;              // basis size
+  int poles = 0;              // modes kept
+  int direct_modes = 0;       // modes with lambda = 0
+  int dropped = 0;            // right-half-plane poles dropped (step 4)
+  double dropped_weight = 0;  // the largest of their weights |out in / p| over the peak
+  int expansion_points = 0;
+  double error = 0.0;          // the check's error (relative)
+  double error_frequency = 0;  // Hz, where it is largest
+  int factorizations = 0;      // complex sparse LUs (expansion points and check)
+  int check_points = 0;        // frequencies checked, refinement included
+};
+
+struct ReducedModel {
+  std::vector<std::complex<double>> poles;                // [i], 1/s
+  std::vector<std::vector<std::complex<double>>> input;   // [k][i]: in_ki
+  std::vector<std::vector<std::complex<double>>> output;  // [p][i]: out_pi
+  std::vector<std::vector<double>> direct;                // [k][p]: D_kp
+  ReducedModelStats stats;
+
+  // H_kp(s).
+  std::complex<double> transfer(size_t k, size_t p, std::complex<double> s) const;
+};
+
+// excitations: per source, its unit excitation indexed by unknown ([0] ground, ignored).
+// dc_solutions: per source, G^-1 e_k (same indexing), from the caller's DC solve.
+// Errors: the check not met within max_points / max_order (with the error reached), a growing
+// mode, a singular projection.
+StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,
+                                      const std::vector<std::vector<double>>& excitations,
+                                      const std::vector<std::vector<double>>& dc_solutions,
+                                      const std::vector<Probe>& probes,
+                                      const ReducedModelOptions& options);
+
+}  // namespace isolink
