@@ -1,6 +1,7 @@
 #include "base/waveform.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cstdio>
 
 #include "base/csv.h"
@@ -63,17 +64,26 @@ Status write_waveform_csv(const Waveform& w, const std::string& path) {
   header.insert(header.end(), w.names.begin(), w.names.end());
   std::string line = csv_row(header);
   if (Status s = f->write(line); !s.ok()) return s;
+  // std::to_chars with a precision writes exactly what printf's %.12g / %.9g would (C locale),
+  // several times faster; rows are written in blocks.
   char cell[64];
+  auto put = [&](double v, int precision) {
+    const auto r =
+        std::to_chars(cell, cell + sizeof cell, v, std::chars_format::general, precision);
+    line.append(cell, r.ptr);
+  };
+  line.clear();
   for (size_t i = 0; i < w.time.size(); ++i) {
-    line.clear();
-    std::snprintf(cell, sizeof cell, "%.12g", w.time[i]);
-    line += cell;
+    put(w.time[i], 12);
     for (const auto& c : w.columns) {
-      std::snprintf(cell, sizeof cell, ",%.9g", c[i]);
-      line += cell;
+      line += ',';
+      put(c[i], 9);
     }
     line += '\n';
-    if (Status s = f->write(line); !s.ok()) return s;
+    if (line.size() >= (1 << 16) || i + 1 == w.time.size()) {
+      if (Status s = f->write(line); !s.ok()) return s;
+      line.clear();
+    }
   }
   return f->commit();
 }

@@ -95,13 +95,24 @@ int run_sim(const SimArgs& a) {
               << "\n";
     return 2;
   }
-  if (!a.quiet && r->engine == Engine::Lti)
+  const std::string target = a.output.empty() || a.output == "-" ? "" : " -> " + a.output;
+  if (!a.quiet && r->engine == Engine::Lti && r->lti.method == "reduced model")
+    std::cerr << fmt::format(
+        "isolink sim: LTI engine, reduced model: {} nodes, {} unknowns; order {} ({} poles, {} "
+        "expansion points), transfer within {:.1e} of the peak at {} check frequencies ({} "
+        "factorizations); {} corners; {:.3f} s; {} rows every {:g} s{}\n",
+        r->nodes, r->unknowns, r->lti.model.order, r->lti.model.poles,
+        r->lti.model.expansion_points, r->lti.model.error, r->lti.model.check_points,
+        r->lti.factorizations, r->grid.corners, r->seconds, out.samples(), r->grid.step, target);
+  else if (!a.quiet && r->engine == Engine::Lti)
     std::cerr << fmt::format(
         "isolink sim: LTI engine: {} nodes, {} unknowns; responses to {:g} s in {} steps ({} "
         "rejected, {} factorizations){}; {} corners; {:.3f} s; {} rows every {:g} s{}\n",
         r->nodes, r->unknowns, r->lti.settled_at, r->lti.steps, r->lti.rejected,
         r->lti.factorizations, r->lti.settled ? ", settled" : "", r->grid.corners, r->seconds,
-        out.samples(), r->grid.step, a.output.empty() || a.output == "-" ? "" : " -> " + a.output);
+        out.samples(), r->grid.step, target);
+  if (!a.quiet && r->engine == Engine::Lti && !r->lti.note.empty())
+    std::cerr << "isolink sim: LTI march (reduced model not used: " << r->lti.note << ")\n";
   if (!a.quiet && r->engine == Engine::Transient && !r->engine_note.empty())
     std::cerr << "isolink sim: transient engine (not LTI: " << r->engine_note << ")\n";
   if (!a.quiet && r->engine == Engine::Transient)
@@ -109,8 +120,7 @@ int run_sim(const SimArgs& a) {
         "isolink sim: {} nodes, {} unknowns; {} steps accepted, {} rejected, {} factorizations "
         "({} reused), {:.3f} s; {} rows{}\n",
         r->nodes, r->unknowns, r->stats.accepted, r->stats.rejected, r->stats.factorizations,
-        r->stats.reuses, r->seconds, out.samples(),
-        a.output.empty() || a.output == "-" ? "" : " -> " + a.output);
+        r->stats.reuses, r->seconds, out.samples(), target);
   return 0;
 }
 }  // namespace

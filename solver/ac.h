@@ -5,7 +5,7 @@
 //   StatusOr<AcAnalysis> ac = AcAnalysis::create(c);              // pattern and LU analysis once
 //   StatusOr<AcSolution> x = ac->solve("vin", 1e6);               // 1 V (or 1 A) at 1 MHz
 //   std::complex<double> v = x->voltage(probe);                   // a Probe from parse_probe
-// Solves (G + j 2 pi f C) x = b with Eigen's sparse LU; the G and C stamps are the ones the
+// Solves (G + j 2 pi f C) x = b with KLU's complex LU; the G and C stamps are the ones the
 // transient engine uses, floating nodes tied as there. Used for impedances, attenuation and
 // filter responses (cable and part-library checks), not for time-domain results.
 #pragma once

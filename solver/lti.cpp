@@ -468,7 +468,6 @@ void LtiResponses::superpose(const std::vector<SourceInput>& inputs, double t0, 
 void LtiResponses::modal_add(const std::vector<SourceInput>& inputs,
                              const std::vector<double>& times, double uniform_dt,
                              std::vector<std::vector<double>>& out) const {
-  using Cplx = std::complex<double>;
   const ReducedModel& m = *model_;
   const size_t nm = m.poles.size(), np = labels_.size();
   const size_t nk = std::min(sources_.size(), inputs.size());
@@ -482,19 +481,26 @@ void LtiResponses::modal_add(const std::vector<SourceInput>& inputs,
     for (const Ramp& r : inputs[k].ramps) corners.push_back({r.t, k, r.slope});
   std::stable_sort(corners.begin(), corners.end(),
                    [](const Corner& a, const Corner& b) { return a.t < b.t; });
-  // Per mode: its state x, its input b = sum_k in_k (u_k - u_k(start)) and that input's slope g.
-  std::vector<Cplx> x(nm, 0.0), b(nm, 0.0), g(nm, 0.0);
+  // Per mode, as real and imaginary parts in separate arrays (the loops below vectorise): its
+  // state x, its input b = sum_k in_k (u_k - u_k(start)) and that input's slope g.
+  std::vector<double> xr(nm, 0.0), xi(nm, 0.0), br(nm, 0.0), bi(nm, 0.0), gr(nm, 0.0), gi(nm, 0.0);
+  std::vector<std::vector<double>> outr(np, std::vector<double>(nm)), outi = outr;
+  for (size_t p = 0; p < np; ++p)
+    for (size_t i = 0; i < nm; ++i)
+      outr[p][i] = m.output[p][i].real(), outi[p][i] = m.output[p][i].imag();
   std::vector<double> u(nk, 0.0), slope(nk, 0.0);  // u_k - initial, and its slope
   struct Step {
     double h = -1;
-    std::vector<Cplx> e, f1, f2;  // e^{ph}, h phi1(ph), h^2 phi2(ph)
+    std::vector<double> er, ei, f1r, f1i, f2r, f2i;  // e^{ph}, h phi1(ph), h^2 phi2(ph)
     void set(const ReducedModel& m, double step) {
       h = step;
       const size_t n = m.poles.size();
-      e.resize(n), f1.resize(n), f2.resize(n);
+      for (auto* v : {&er, &ei, &f1r, &f1i, &f2r, &f2i}) v->resize(n);
       for (size_t i = 0; i < n; ++i) {
         const Phi f = phi(m.poles[i] * step);
-        e[i] = f.e, f1[i] = step * f.phi1, f2[i] = step * step * f.phi2;
+        const std::complex<double> f1 = step * f.phi1, f2 = step * step * f.phi2;
+        er[i] = f.e.real(), ei[i] = f.e.imag();
+        f1r[i] = f1.real(), f1i[i] = f1.imag(), f2r[i] = f2.real(), f2i[i] = f2.imag();
       }
     }
   };
@@ -511,9 +517,15 @@ void LtiResponses::modal_add(const std::vector<SourceInput>& inputs,
       if (!(std::fabs(h - scratch.h) <= 1e-9 * scratch.h)) scratch.set(m, h);
       st = &scratch;
     }
+    const double *er = st->er.data(), *ei = st->ei.data(), *f1r = st->f1r.data(),
+                 *f1i = st->f1i.data(), *f2r = st->f2r.data(), *f2i = st->f2i.data();
     for (size_t i = 0; i < nm; ++i) {
-      x[i] = st->e[i] * x[i] + st->f1[i] * b[i] + st->f2[i] * g[i];
-      b[i] += g[i] * h;
+      const double nr = er[i] * xr[i] - ei[i] * xi[i] + f1r[i] * br[i] - f1i[i] * bi[i] +
+                        f2r[i] * gr[i] - f2i[i] * gi[i];
+      const double ni = er[i] * xi[i] + ei[i] * xr[i] + f1r[i] * bi[i] + f1i[i] * br[i] +
+                        f2r[i] * gi[i] + f2i[i] * gr[i];
+      xr[i] = nr, xi[i] = ni;
+      br[i] += gr[i] * h, bi[i] += gi[i] * h;
     }
     for (size_t k = 0; k < nk; ++k) u[k] += slope[k] * h;
   };
@@ -528,16 +540,22 @@ void LtiResponses::modal_add(const std::vector<SourceInput>& inputs,
       active = true;
       slope[corners[c].k] += corners[c].slope;
       const auto& in = m.input[corners[c].k];
-      for (size_t i = 0; i < nm; ++i) g[i] += in[i] * corners[c].slope;
+      for (size_t i = 0; i < nm; ++i)
+        gr[i] += in[i].real() * corners[c].slope, gi[i] += in[i].imag() * corners[c].slope;
     }
     advance(tq - tc);
     tc = tq;
     if (!active) continue;
     for (size_t p = 0; p < np; ++p) {
-      Cplx y = 0.0;
-      const auto& o = m.output[p];
-      for (size_t i = 0; i < nm; ++i) y += o[i] * x[i];
-      double d = y.real();
+      const double *orr = outr[p].data(), *oi = outi[p].data();
+      double y0 = 0, y1 = 0;  // two partial sums: a shorter dependency chain
+      size_t i = 0;
+      for (; i + 1 < nm; i += 2) {
+        y0 += orr[i] * xr[i] - oi[i] * xi[i];
+        y1 += orr[i + 1] * xr[i + 1] - oi[i + 1] * xi[i + 1];
+      }
+      if (i < nm) y0 += orr[i] * xr[i] - oi[i] * xi[i];
+      double d = y0 + y1;
       for (size_t k = 0; k < nk; ++k) d += m.direct[k][p] * u[k];
       out[p][j] += d;
     }
@@ -635,7 +653,16 @@ Waveform LtiResponses::modal_waveform(const std::vector<SourceInput>& inputs,
             times.size(), dt, 2e3 * worst, 1e3 * grid.interp_tol);
         break;
       }
-      dt *= 0.5;
+      // The error of a smooth response falls as dt^2: go straight to the level that should
+      // meet the tolerance (then tested like any other), skipping the levels on the way; never
+      // finer than max_rows allows.
+      const double target = dt * std::sqrt(0.5 * grid.interp_tol / worst) * 0.9;
+      int halvings = 1;
+      while (halvings < 30 && dt * std::ldexp(1.0, -halvings) > target &&
+             static_cast<double>(times.size()) * std::ldexp(1.0, halvings + 1) <
+                 static_cast<double>(grid.max_rows))
+        ++halvings;
+      dt = std::ldexp(dt, -halvings);
     }
   }
   Waveform w;

@@ -33,7 +33,13 @@ std::complex<double> ReducedModel::transfer(size_t k, size_t p, std::complex<dou
   std::complex<double> h = direct[k][p];
   for (size_t i = 0; i < poles.size(); ++i) {
     const std::complex<double> z = s - poles[i];  // 1 / z as conj(z) / |z|^2: no __divdc3
-    h += output[p][i] * input[k][i] * std::conj(z) / std::norm(z);
+    const std::complex<double> r = output[p][i] * input[k][i];
+    if (!paired[i]) {
+      h += r * std::conj(z) / std::norm(z);
+    } else {  // r / 2 at p and conj(r / 2) at conj(p)
+      const std::complex<double> zc = s - std::conj(poles[i]);
+      h += 0.5 * (r * std::conj(z) / std::norm(z) + std::conj(r) * std::conj(zc) / std::norm(zc));
+    }
   }
   return h;
 }
@@ -84,7 +90,7 @@ StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,
   const int n = circuit.unknown_count();
   const size_t nk = excitations.size(), np = probes.size();
   ReducedModel model;
-  ReducedModelStats& st = model.stats;
+  ReducedModelStats st;  // factorizations and expansion points so far
 
   // G and C as real sparse matrices over unknowns 1..n (index 0 = unknown 1).
   Eigen::SparseMatrix<double> g(n, n), c(n, n);
@@ -133,6 +139,10 @@ StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,
     }
     return Status::Ok();
   };
+  // Pivots from the middle of the band first: the refactorizations below reuse them, and the
+  // ones a 1 kHz matrix would choose (its 1e-12 S ties on floating nodes) fill in badly.
+  if (Status s = ac->factor(std::sqrt(opt.f_min * opt.f_max)); !s.ok()) return s;
+  ++st.factorizations;
   {
     std::vector<double> fs(opt.check_points);
     for (int i = 0; i < opt.check_points; ++i)
@@ -226,22 +236,31 @@ StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,
         continue;
       }
       const Cplx pole = sigma - 1.0 / lambda[i];
+      // A complex pole's conjugate (the next eigenvalue: a real matrix's come in exact pairs,
+      // with conjugate vectors) is carried by it: one mode, output doubled, real part taken.
+      const bool paired =
+          lambda[i].imag() != 0 && i + 1 < q && lambda[i + 1] == std::conj(lambda[i]);
+      const int modes = paired ? 2 : 1;
+      if (paired) ++i;
+      const int at = paired ? i - 1 : i;
       if (pole.real() > 0 && pole.real() * opt.horizon >= 1e-3) {
         // Dropped; the check below sees what that costs (a pole with weight fails it).
         double weight = 0;
         for (size_t k = 0; k < nk; ++k)
           for (size_t p = 0; p < np; ++p)
             weight =
-                std::max(weight, std::abs(cw(p, i) * d(i, k) / lambda[i] / pole) / scale[k][p]);
-        ++mod.stats.dropped;
+                std::max(weight, std::abs(cw(p, at) * d(at, k) / lambda[at] / pole) / scale[k][p]);
+        mod.stats.dropped += modes;
         mod.stats.dropped_weight = std::max(mod.stats.dropped_weight, weight);
         continue;
       }
       mod.poles.push_back(pole);
-      for (size_t k = 0; k < nk; ++k) mod.input[k].push_back(d(i, k) / lambda[i]);
-      for (size_t p = 0; p < np; ++p) mod.output[p].push_back(cw(p, i));
+      mod.paired.push_back(paired);
+      mod.stats.poles += modes;
+      for (size_t k = 0; k < nk; ++k) mod.input[k].push_back(d(at, k) / lambda[at]);
+      for (size_t p = 0; p < np; ++p)
+        mod.output[p].push_back(static_cast<double>(modes) * cw(p, at));
     }
-    mod.stats.poles = static_cast<int>(mod.poles.size());
     double worst = 0, worst_f = 0;
     for (size_t f = 0; f < freqs.size(); ++f) {
       const Cplx s(0.0, 2 * std::numbers::pi * freqs[f]);
@@ -258,6 +277,8 @@ StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,
   };
 
   std::vector<double> used;
+  std::vector<std::pair<double, double>> open;  // check intervals not yet refined
+  for (size_t i = 0; i + 1 < freqs.size(); ++i) open.push_back({freqs[i], freqs[i + 1]});
   for (double f : {opt.f_min, opt.f_max / 10}) {
     StatusOr<bool> added = expand_at(f);
     if (!added) return added.status();
@@ -266,25 +287,34 @@ StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,
   while (true) {
     if (Status s = build(); !s.ok()) return s;
     if (model.stats.error <= opt.tol) {
-      // Refinement: the check grid's geometric midpoints must pass too (a resonance can hide
-      // between check points); those that do not join the grid and the search goes on.
-      std::vector<double> sorted = freqs, mids;
-      std::sort(sorted.begin(), sorted.end());
-      for (size_t i = 0; i + 1 < sorted.size(); ++i)
-        if (sorted[i + 1] > sorted[i] * (1 + 1e-9))
-          mids.push_back(std::sqrt(sorted[i] * sorted[i + 1]));
+      // Refinement, as adaptive quadrature refines: every open interval of the check grid
+      // (at first all of them) is tested at its geometric midpoint, where a resonance could
+      // hide. An interval whose midpoint passes is closed; one whose midpoint fails leaves its
+      // two halves open, the midpoint joins the grid and the search goes on.
+      std::vector<std::pair<double, double>> next;
+      std::vector<double> mids;
+      for (const auto& [lo, hi] : open)
+        if (hi > lo * (1 + 1e-9)) mids.push_back(std::sqrt(lo * hi));
       if (freqs.size() + mids.size() > static_cast<size_t>(opt.max_check_points)) break;
       const size_t before = freqs.size();
       if (Status s = add_checks(mids); !s.ok()) return s;
       double worst = 0, worst_f = 0;
-      for (size_t f = before; f < freqs.size(); ++f) {
+      for (size_t f = before, j = 0; f < freqs.size(); ++f, ++j) {
         const Cplx sj(0.0, 2 * std::numbers::pi * freqs[f]);
+        double e = 0;
         for (size_t k = 0; k < nk; ++k)
-          for (size_t p = 0; p < np; ++p) {
-            const double e = std::abs(model.transfer(k, p, sj) - exact[f][k][p]) / scale[k][p];
-            if (!(e <= worst)) worst = e, worst_f = freqs[f];
-          }
+          for (size_t p = 0; p < np; ++p)
+            e = std::max(e, std::abs(model.transfer(k, p, sj) - exact[f][k][p]) / scale[k][p]);
+        if (e > opt.tol) {
+          const auto it = std::find_if(open.begin(), open.end(), [&](const auto& iv) {
+            return iv.first < freqs[f] && freqs[f] < iv.second;
+          });
+          next.push_back({it->first, freqs[f]});
+          next.push_back({freqs[f], it->second});
+        }
+        if (!(e <= worst)) worst = e, worst_f = freqs[f];
       }
+      open = std::move(next);
       if (worst <= opt.tol) break;
       model.stats.error = worst;
       model.stats.error_frequency = worst_f;

@@ -21,9 +21,11 @@
 //    is max |H_r - H| over the peak |H| of that source and probe (DC gain included). Expansion
 //    points are added greedily at the check frequency with the largest error (the next-worst
 //    when its vectors are already in the basis) until the error is at most `tol`. Then the
-//    grid is refined: the model must also pass at the geometric midpoints of the check points
-//    (a resonance can hide between them); if it does not, they join the grid and the search
-//    goes on, up to max_check_points.
+//    grid is refined as adaptive quadrature does: the model must also pass at the geometric
+//    midpoint of every check interval (a resonance can hide between check points); an interval
+//    whose midpoint fails joins the grid as two halves, tested again at their own midpoints
+//    once the search has fixed the model there (up to max_check_points). Accepted: every check
+//    point passes and every interval's midpoint passed.
 // 4. A pole in the right half plane is a projection artefact (the circuits here are passive). It
 //    is kept when it is so slow that it cannot grow over `horizon` (Re p horizon < 1e-3), and
 //    dropped otherwise, before the check: a model that needed it fails the check there, and the
@@ -73,10 +75,14 @@ struct ReducedModelStats {
   int check_points = 0;        // frequencies checked, refinement included
 };
 
+// A complex pole stands for itself and its conjugate (`paired`): its output is doubled, so that
+// in the time domain a mode's share of a probe is always Re(out_pi x_i), x_i' = p_i x_i + in_ki
+// u_k.
 struct ReducedModel {
   std::vector<std::complex<double>> poles;                // [i], 1/s
+  std::vector<bool> paired;                               // [i]: carries conj(p_i) too
   std::vector<std::vector<std::complex<double>>> input;   // [k][i]: in_ki
-  std::vector<std::vector<std::complex<double>>> output;  // [p][i]: out_pi
+  std::vector<std::vector<std::complex<double>>> output;  // [p][i]: out_pi (doubled if paired)
   std::vector<std::vector<double>> direct;                // [k][p]: D_kp
   ReducedModelStats stats;
 
