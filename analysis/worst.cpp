@@ -629,32 +629,41 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
       std::array<bool, kMetrics> wanted{};
       for (int m = 0; m < kMetrics; ++m)
         wanted[m] = std::find(cands[m].begin(), cands[m].end(), ci) != cands[m].end();
-      // Rank every history by its predicted key per metric; keep the `verify` lowest.
+      // Rank every history by its predicted key per metric; keep the `verify` lowest. Per
+      // previous pattern, every gap at once: a term reads the previous byte's wave at
+      // term.sample - pre + frame + g, so over the gap grid it is one strided sweep of that wave.
       std::array<std::vector<std::tuple<double, size_t, long>>, kMetrics> top;
+      const size_t ng = gaps.size();
+      std::vector<double> key(kMetrics * ng), y(ng);
       for (size_t k = 0; k < previous.size(); ++k) {
-        const std::vector<float>& w = prev_wave[k];
-        for (long g : gaps) {
-          ++dw.ranked;
-          std::array<double, kMetrics> key;
-          key.fill(kInf);
-          const long off = -pre + g + frame;
-          for (const Linear& l : lin) {
-            if (!wanted[l.metric]) continue;
-            double y = l.key0;
-            for (const Term& term : l.terms) {
-              const long i = term.sample + off;
-              if (i >= 0 && i < reach) y += term.coef * w[static_cast<size_t>(i)];
-            }
-            key[l.metric] = std::min(key[l.metric], y);
+        const float* w = prev_wave[k].data();
+        std::fill(key.begin(), key.end(), kInf);
+        for (const Linear& l : lin) {
+          if (!wanted[l.metric]) continue;
+          std::fill(y.begin(), y.end(), l.key0);
+          for (const Term& term : l.terms) {
+            // Gap indices whose read falls inside the wave: 0 <= base + gaps[j] < reach.
+            const long base = term.sample - pre + frame;
+            const long j0 = std::max(0L, (-base - gap_min + gap_step - 1) / gap_step);
+            const long j1 =
+                std::min(static_cast<long>(ng), (reach - base - gap_min + gap_step - 1) / gap_step);
+            const long first = base + gap_min;
+            for (long j = j0; j < j1; ++j) y[j] += term.coef * w[first + j * gap_step];
           }
-          for (int m = 0; m < kMetrics; ++m) {
-            if (!wanted[m]) continue;
-            auto& tm = top[m];
-            if (static_cast<int>(tm.size()) < opt.verify || key[m] < std::get<0>(tm.back())) {
-              if (static_cast<int>(tm.size()) >= opt.verify) tm.pop_back();
-              tm.insert(std::upper_bound(tm.begin(), tm.end(), std::tuple{key[m], k, g}),
-                        {key[m], k, g});
-            }
+          double* km = key.data() + static_cast<size_t>(l.metric) * ng;
+          for (size_t j = 0; j < ng; ++j) km[j] = std::min(km[j], y[j]);
+        }
+        dw.ranked += static_cast<long>(ng);
+        for (int m = 0; m < kMetrics; ++m) {
+          if (!wanted[m]) continue;
+          auto& tm = top[m];
+          const double* km = key.data() + static_cast<size_t>(m) * ng;
+          for (size_t j = 0; j < ng; ++j) {
+            if (static_cast<int>(tm.size()) >= opt.verify && !(km[j] < std::get<0>(tm.back())))
+              continue;
+            if (static_cast<int>(tm.size()) >= opt.verify) tm.pop_back();
+            const std::tuple<double, size_t, long> entry{km[j], k, gaps[j]};
+            tm.insert(std::upper_bound(tm.begin(), tm.end(), entry), entry);
           }
         }
       }

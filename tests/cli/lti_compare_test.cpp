@@ -57,9 +57,10 @@ Deviation compare(const Netlist& netlist, const std::string& path, double tstop)
   Deviation d{testing::max_abs_difference(lti->wave, 0, *ng, 0),
               testing::max_abs_difference(transient->wave, 0, *ng, 0)};
   std::printf(
-      "%s: max |dev| from ngspice tight: LTI %.3f mV (%ld march steps, %ld rows), "
+      "%s: max |dev| from ngspice tight: LTI %.3f mV (%s: order %d, %ld march steps; %ld rows), "
       "transient %.3f mV\n",
-      path.c_str(), d.lti * 1e3, lti->lti.steps, lti->grid.rows, d.transient * 1e3);
+      path.c_str(), d.lti * 1e3, lti->lti.method.c_str(), lti->lti.model.order, lti->lti.steps,
+      lti->grid.rows, d.transient * 1e3);
   ::testing::Test::RecordProperty("lti_mV", std::to_string(d.lti * 1e3));
   return d;
 }
