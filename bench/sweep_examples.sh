@@ -6,6 +6,8 @@
 # PNGs) and points per minute; the summed run time of the points over the wall time shows how well
 # the cores were used. Set MPI_NP=N to run under `mpirun -np N` on this machine instead
 # (ISOLINK_MPI builds; rank 0 only hands out points, so N = cores + 1).
+# ENGINES="auto transient" runs each sweep once per `--engine` (back to back, one row each; the
+# default is auto alone).
 # Prints a Markdown table (for bench/README.md); the outputs stay in $OUT (default a temp folder).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -24,12 +26,15 @@ fi
 
 echo "| sweep | points | pass / fail / error | wall s | points/min | point s (mean) | cores busy |"
 echo "|---|---|---|---|---|---|---|"
+read -r -a engines <<<"${ENGINES:-auto}"
 for f in "${sweeps[@]}"; do
+ for engine in "${engines[@]}"; do
   name=$(basename "$f" .yaml)
-  dir="$OUT/$name"
+  ((${#engines[@]} > 1)) && name="$name ($engine)"
+  dir="$OUT/$(basename "$f" .yaml)-$engine"
   rm -rf "$dir"
   s=$(date +%s%N)
-  "${launch[@]}" "$ISOLINK" sweep "$f" -o "$dir" -q "${jobs_arg[@]}" >/dev/null 2>&1 || true
+  "${launch[@]}" "$ISOLINK" sweep "$f" -o "$dir" -q --engine "$engine" "${jobs_arg[@]}" >/dev/null 2>&1 || true
   e=$(date +%s%N)
   awk -F, -v name="$name" -v ns=$((e - s)) '
     NR == 1 { for (i = 1; i <= NF; i++) { if ($i == "verdict") v = i; if ($i == "seconds") t = i }; next }
@@ -39,6 +44,7 @@ for f in "${sweeps[@]}"; do
       printf "| %s | %d | %d / %d / %d | %.1f | %.1f | %.2f | %.2f |\n", name, n, c["pass"],
              c["fail"], c["error"], wall, n / wall * 60, sum / n, sum / wall
     }' "$dir/results.csv"
+ done
 done
 echo
 echo "outputs: $OUT"

@@ -276,6 +276,11 @@ StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,
     return Status::Ok();
   };
 
+  // The basis and its images are three dense n x q arrays: at most kMaxBasisBytes in all (their
+  // capacity, grown by doubling, at most twice that).
+  constexpr double kMaxBasisBytes = 384.0 * (1 << 20);
+  const int max_order = static_cast<int>(
+      std::min<double>(opt.max_order, kMaxBasisBytes / (3.0 * sizeof(double) * n)));
   std::vector<double> used;
   std::vector<std::pair<double, double>> open;  // check intervals not yet refined
   for (size_t i = 0; i + 1 < freqs.size(); ++i) open.push_back({freqs[i], freqs[i + 1]});
@@ -319,7 +324,7 @@ StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,
       model.stats.error = worst;
       model.stats.error_frequency = worst_f;
     }
-    if (static_cast<int>(used.size()) >= opt.max_points || basis.q >= opt.max_order)
+    if (static_cast<int>(used.size()) >= opt.max_points || basis.q >= max_order)
       return Status::Error(fmt::format(
           "reduced model: error {:.2g} at {:.4g} Hz after {} expansion points (order {}), over "
           "the {:.2g} allowed",

@@ -57,9 +57,11 @@ struct ReducedModelOptions {
   int max_check_points = 4096;  // refinement stops here (accepted: spacing 0.4 % by then)
   int moments = 3;              // Krylov vectors per source and expansion point
   int max_points = 40;          // expansion points before giving up
-  int max_order = 1200;         // basis size before giving up
-  double horizon = 0.0;         // s, the longest time the model is evaluated over (step 4); > 0
-  Status validate() const;      // names the field, its value and the rule
+  // Basis size before giving up; lower on large circuits, where the basis (three dense
+  // unknowns x order arrays, grown by doubling) would pass 384 MB (32,000 unknowns: order 524).
+  int max_order = 1200;
+  double horizon = 0.0;     // s, the longest time the model is evaluated over (step 4); > 0
+  Status validate() const;  // names the field, its value and the rule
 };
 
 struct ReducedModelStats {
