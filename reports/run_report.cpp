@@ -197,10 +197,18 @@ std::string run_report_markdown(const link::LinkSpec& spec, const LinkRun& run,
       "|\n|---|---|---|---|---|---|---|\n";
   for (const DirectionRun& d : run.directions) {
     const bool lti = d.sim.engine == analysis::Engine::Lti;
+    const bool reduced = lti && d.sim.lti.method == "reduced model";
+    // The reduced model has no steps: its order stands in that column.
+    const std::string steps = reduced
+                                  ? fmt::format("- (order {})", d.sim.lti.model.order)
+                                  : fmt::format("{}", lti ? d.sim.lti.steps : d.sim.stats.accepted);
+    const std::string rejected =
+        reduced ? "-" : fmt::format("{}", lti ? d.sim.lti.rejected : d.sim.stats.rejected);
     md += fmt::format("| {} | {} | {} | {} | {} | {} | {:.3f} s |\n", d.link.description,
-                      lti ? "LTI (edge responses)" : "transient", d.sim.unknowns,
-                      lti ? d.sim.lti.steps : d.sim.stats.accepted,
-                      lti ? d.sim.lti.rejected : d.sim.stats.rejected,
+                      reduced ? "LTI, reduced model"
+                      : lti   ? "LTI, march"
+                              : "transient",
+                      d.sim.unknowns, steps, rejected,
                       lti ? d.sim.lti.factorizations : d.sim.stats.factorizations, d.sim.seconds);
   }
   for (const DirectionRun& d : run.directions)

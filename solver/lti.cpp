@@ -633,7 +633,8 @@ Waveform LtiResponses::modal_waveform(const std::vector<SourceInput>& inputs,
         all.push_back(times[j]);
         if (j + 1 < times.size()) all.push_back(0.5 * (times[j] + times[j + 1]));
       }
-      std::vector<std::vector<double>> v = evaluate(all, 0.5 * dt);
+      rows = evaluate(all, 0.5 * dt);
+      const std::vector<std::vector<double>>& v = rows;
       double worst = 0.0;
       for (size_t p = 0; p < np; ++p) {
         if (!grid.grid_probes.empty() && (p >= grid.grid_probes.size() || !grid.grid_probes[p]))
@@ -642,9 +643,11 @@ Waveform LtiResponses::modal_waveform(const std::vector<SourceInput>& inputs,
         for (size_t j = 1; j + 1 < all.size(); j += 2)
           worst = std::max(worst, scale * std::fabs(v[p][j] - 0.5 * (v[p][j - 1] + v[p][j + 1])));
       }
-      rows.assign(np, {});
-      for (size_t p = 0; p < np; ++p)
-        for (size_t j = 0; j < all.size(); j += 2) rows[p].push_back(v[p][j]);
+      // The rows are the even entries: compacted in place (no copies of the largest arrays).
+      for (size_t p = 0; p < np; ++p) {
+        for (size_t j = 0; 2 * j < all.size(); ++j) rows[p][j] = rows[p][2 * j];
+        rows[p].resize(times.size());
+      }
       if (worst <= 0.5 * grid.interp_tol) break;
       if (2 * static_cast<long>(times.size()) - 1 > grid.max_rows) {
         gi.warning = fmt::format(
@@ -666,7 +669,7 @@ Waveform LtiResponses::modal_waveform(const std::vector<SourceInput>& inputs,
     }
   }
   Waveform w;
-  w.time = times;
+  w.time = std::move(times);
   for (size_t p = 0; p < np; ++p) w.add_column(labels_[p], std::move(rows[p]));
   gi.rows = static_cast<long>(w.time.size());
   gi.step = dt;
