@@ -190,6 +190,21 @@ StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,
   // Builds the pole-residue model from the current basis and measures its error.
   auto build = [&]() -> Status {
     const int q = basis.q;
+    if (q == 0) {  // nothing reaches the probes (no source drives anything): H = 0
+      ReducedModel mod;
+      mod.direct.assign(nk, std::vector<double>(np, 0.0));
+      mod.input.assign(nk, {});
+      mod.output.assign(np, {});
+      mod.stats = st;
+      double worst = 0;
+      for (size_t f = 0; f < freqs.size(); ++f)
+        for (size_t k = 0; k < nk; ++k)
+          for (size_t p = 0; p < np; ++p)
+            worst = std::max(worst, std::abs(exact[f][k][p]) / scale[k][p]);
+      mod.stats.error = worst;
+      model = std::move(mod);
+      return Status::Ok();
+    }
     const auto v = basis.v.leftCols(q);
     const Eigen::MatrixXd gr = v.transpose() * basis.gv.leftCols(q);
     const Eigen::MatrixXd cr = v.transpose() * basis.cv.leftCols(q);
