@@ -634,30 +634,30 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
       // term.sample - pre + frame + g, so over the gap grid it is one strided sweep of that wave.
       std::array<std::vector<std::tuple<double, size_t, long>>, kMetrics> top;
       const size_t ng = gaps.size();
-      std::vector<double> key(kMetrics * ng), y(ng);
+      std::vector<double> keys(kMetrics * ng), y(ng);
       for (size_t k = 0; k < previous.size(); ++k) {
         const float* w = prev_wave[k].data();
-        std::fill(key.begin(), key.end(), kInf);
+        std::fill(keys.begin(), keys.end(), kInf);
         for (const Linear& l : lin) {
           if (!wanted[l.metric]) continue;
           std::fill(y.begin(), y.end(), l.key0);
           for (const Term& term : l.terms) {
-            // Gap indices whose read falls inside the wave: 0 <= base + gaps[j] < reach.
-            const long base = term.sample - pre + frame;
-            const long j0 = std::max(0L, (-base - gap_min + gap_step - 1) / gap_step);
+            // Gap indices whose read falls inside the wave: 0 <= at + gaps[j] < reach.
+            const long at = term.sample - pre + frame;
+            const long j0 = std::max(0L, (-at - gap_min + gap_step - 1) / gap_step);
             const long j1 =
-                std::min(static_cast<long>(ng), (reach - base - gap_min + gap_step - 1) / gap_step);
-            const long first = base + gap_min;
+                std::min(static_cast<long>(ng), (reach - at - gap_min + gap_step - 1) / gap_step);
+            const long first = at + gap_min;
             for (long j = j0; j < j1; ++j) y[j] += term.coef * w[first + j * gap_step];
           }
-          double* km = key.data() + static_cast<size_t>(l.metric) * ng;
+          double* km = keys.data() + static_cast<size_t>(l.metric) * ng;
           for (size_t j = 0; j < ng; ++j) km[j] = std::min(km[j], y[j]);
         }
         dw.ranked += static_cast<long>(ng);
         for (int m = 0; m < kMetrics; ++m) {
           if (!wanted[m]) continue;
           auto& tm = top[m];
-          const double* km = key.data() + static_cast<size_t>(m) * ng;
+          const double* km = keys.data() + static_cast<size_t>(m) * ng;
           for (size_t j = 0; j < ng; ++j) {
             if (static_cast<int>(tm.size()) >= opt.verify && !(km[j] < std::get<0>(tm.back())))
               continue;
