@@ -342,20 +342,28 @@ StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::Par
     return Status::Ok();
   };
 
-  if (opt.edge_engine == WorstOptions::EdgeEngine::Auto) {
-    // The reduced model in closed form: one model, sampled on longer records until settled.
+  // The link driven by one 0 -> +1 edge at `lead`, held for `span`, and its circuit and probe.
+  auto edge_link = [&](double span) {
     traffic::Drive drive;
     drive.encoding = opt.expand.stimulus.encoding;
-    drive.segments = {{0.0, lead, 0}, {lead, lead + opt.max_span, +1}};
+    drive.segments = {{0.0, lead, 0}, {lead, lead + span, +1}};
     link::ExpandOptions ex = opt.expand;
     ex.drive = drive;
-    StatusOr<link::ExpandedLink> link = link::expand_link(spec, parts, d, ex);
-    if (!link) return link.status();
-    Circuit circuit;
-    for (const Card& card : link->netlist.cards)
+    return link::expand_link(spec, parts, d, ex);
+  };
+  auto edge_circuit = [](const link::ExpandedLink& link, Circuit& circuit) -> StatusOr<Probe> {
+    for (const Card& card : link.netlist.cards)
       if (Status s = circuit.add(card); !s.ok()) return s;
     if (Status s = circuit.finalize(); !s.ok()) return s;
-    StatusOr<Probe> probe = parse_probe(circuit, "v(rxp,rxn)");
+    return parse_probe(circuit, "v(rxp,rxn)");
+  };
+
+  if (opt.edge_engine == WorstOptions::EdgeEngine::Auto) {
+    // The reduced model in closed form: one model, sampled on longer records until settled.
+    StatusOr<link::ExpandedLink> link = edge_link(opt.max_span);
+    if (!link) return link.status();
+    Circuit circuit;
+    StatusOr<Probe> probe = edge_circuit(*link, circuit);
     if (!probe) return probe.status();
     for (const auto& e : circuit.elements()) e->bind_time(opt.dt, lead + opt.max_span);
     LtiOptions lo;
@@ -391,18 +399,10 @@ StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::Par
   }
 
   for (double span = 40e-6;; span *= 2) {
-    traffic::Drive drive;
-    drive.encoding = opt.expand.stimulus.encoding;
-    drive.segments = {{0.0, lead, 0}, {lead, lead + span, +1}};
-    link::ExpandOptions ex = opt.expand;
-    ex.drive = drive;
-    StatusOr<link::ExpandedLink> link = link::expand_link(spec, parts, d, ex);
+    StatusOr<link::ExpandedLink> link = edge_link(span);
     if (!link) return link.status();
     Circuit circuit;
-    for (const Card& card : link->netlist.cards)
-      if (Status s = circuit.add(card); !s.ok()) return s;
-    if (Status s = circuit.finalize(); !s.ok()) return s;
-    StatusOr<Probe> probe = parse_probe(circuit, "v(rxp,rxn)");
+    StatusOr<Probe> probe = edge_circuit(*link, circuit);
     if (!probe) return probe.status();
     TransientOptions to;
     to.tstep = opt.dt;
