@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <tuple>
 #include <utility>
 
 #include "netlists/traffic/command.h"
@@ -39,18 +40,59 @@ ByteFrame pattern_frame(int pattern) {
   return {static_cast<uint8_t>(pattern & 0xFF), (pattern >> 8) & 1};
 }
 
-// The level changes of one byte frame starting at sample `start`: (sample, dL).
-void frame_edges(const ByteFrame& f, const traffic::EncodingOptions& enc, long start, long half,
+// The level changes of half-bit levels h starting at sample `start`: (sample, dL). Linear in h
+// (the line idles at 0 before and after), so it also gives the edges of a difference of levels.
+void level_edges(const std::vector<int>& h, long start, long half,
                  std::vector<std::pair<long, int>>& out) {
-  traffic::EncodingOptions e = enc;
-  e.error_bit = f.error_bit;
-  const std::vector<int> h = traffic::byte_half_bits(f.byte, e);
   int prev = 0;
   for (size_t k = 0; k <= h.size(); ++k) {
     const int level = k < h.size() ? h[k] : 0;
     if (level != prev) out.push_back({start + static_cast<long>(k) * half, level - prev});
     prev = level;
   }
+}
+
+std::vector<int> pattern_levels(int pattern, const traffic::EncodingOptions& enc) {
+  traffic::EncodingOptions e = enc;
+  e.error_bit = (pattern >> 8) & 1;
+  return traffic::byte_half_bits(static_cast<uint8_t>(pattern & 0xFF), e);
+}
+
+// The level changes of one byte frame starting at sample `start`: (sample, dL).
+void frame_edges(const ByteFrame& f, const traffic::EncodingOptions& enc, long start, long half,
+                 std::vector<std::pair<long, int>>& out) {
+  level_edges(pattern_levels(f.byte | f.error_bit << 8, enc), start, half, out);
+}
+
+// A byte frame's half-bit levels are affine in its 9 free bits (the 8 data bits and the error
+// bit, bit b of the pattern): h(q) = h(0) + sum_b bit_b(q) (h(2^b) - h(0)). So is the receiver's
+// response to it. Checked here for every pattern, so an encoding that broke it would be refused
+// rather than searched wrongly.
+constexpr int kPatternBits = 9;
+struct PatternBasis {
+  std::vector<int> base;                           // h(0)
+  std::array<std::vector<int>, kPatternBits> bit;  // h(2^b) - h(0)
+};
+
+StatusOr<PatternBasis> pattern_basis(const traffic::EncodingOptions& enc) {
+  PatternBasis pb;
+  pb.base = pattern_levels(0, enc);
+  for (int b = 0; b < kPatternBits; ++b) {
+    pb.bit[b] = pattern_levels(1 << b, enc);
+    if (pb.bit[b].size() != pb.base.size())
+      return Status::Error("internal error: byte frames of different lengths");
+    for (size_t k = 0; k < pb.base.size(); ++k) pb.bit[b][k] -= pb.base[k];
+  }
+  for (int q = 0; q < (1 << kPatternBits); ++q) {
+    std::vector<int> h = pb.base;
+    for (int b = 0; b < kPatternBits; ++b)
+      if (q >> b & 1)
+        for (size_t k = 0; k < h.size(); ++k) h[k] += pb.bit[b][k];
+    if (h != pattern_levels(q, enc))
+      return Status::Error(fmt::format(
+          "internal error: byte frame {:#05x} is not affine in its bits (the search needs it)", q));
+  }
+  return pb;
 }
 
 // v[i] += sum dL E(origin + i - n_edge) for i in [0, v.size()): the record of E where it
@@ -586,17 +628,23 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
         }
     }
   } else if (history) {
-    // The previous byte alone, from its start, for every pattern: u at window sample i for gap g
-    // is prev_wave[q][i - pre + g + frame].
+    // The previous byte's response per pattern bit (PatternBasis): u_q at window sample i for
+    // gap g is U[0][i - pre + frame + g] + sum_b bit_b(q) U[1 + b][i - pre + frame + g].
+    StatusOr<PatternBasis> basis = pattern_basis(opt.expand.stimulus.encoding);
+    if (!basis) return basis.status();
     const long reach = frame + gap_max + search.len();
-    std::vector<std::vector<float>> prev_wave(previous.size());
-    for (size_t k = 0; k < previous.size(); ++k) {
-      std::vector<double> v(static_cast<size_t>(reach), 0.0);
+    std::array<std::vector<double>, kPatternBits + 1> U;
+    for (int b = 0; b <= kPatternBits; ++b) {
+      U[b].assign(static_cast<size_t>(reach), 0.0);
       std::vector<std::pair<long, int>> edges;
-      frame_edges(pattern_frame(previous[k]), opt.expand.stimulus.encoding, 0, half, edges);
-      add_edges(e, edges, 0, v);
-      prev_wave[k].assign(v.begin(), v.end());
+      level_edges(b == 0 ? basis->base : basis->bit[b - 1], 0, half, edges);
+      add_edges(e, edges, 0, U[b]);
     }
+    // Every pattern, in order: the ranking below then enumerates the best patterns per gap
+    // instead of trying each (the `previous` index is the pattern itself).
+    bool every_pattern = previous.size() == (1u << kPatternBits);
+    for (size_t k = 0; every_pattern && k < previous.size(); ++k)
+      every_pattern = previous[k] == static_cast<int>(k);
     const double slack_v = 2 * dw.previous_bound;
     const double slack_t = slope_min > 0 ? slack_v / slope_min : 0;
     // Candidates per metric: the target patterns within the slack of the best after idle.
@@ -617,6 +665,9 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
     for (const auto& c : cands) all.insert(all.end(), c.begin(), c.end());
     std::sort(all.begin(), all.end());
     all.erase(std::unique(all.begin(), all.end()), all.end());
+    const size_t ng = gaps.size();
+    constexpr size_t kCols = kPatternBits + 1;
+    std::vector<double> coef;  // per linear model: kCols rows of ng (constant, then per bit)
     for (size_t n = 0; n < all.size(); ++n) {
       const size_t ci = all[n];
       if (opt.progress)
@@ -625,51 +676,117 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
       const std::vector<double> base = search.target_wave(t);
       StatusOr<eye::CheckResult> c = search.check(base, t);
       if (!c) return c.status();
-      const std::vector<Linear> lin = linearize(*c, base, rules, dt);
+      std::vector<Linear> lin = linearize(*c, base, rules, dt);
       std::array<bool, kMetrics> wanted{};
       for (int m = 0; m < kMetrics; ++m)
         wanted[m] = std::find(cands[m].begin(), cands[m].end(), ci) != cands[m].end();
-      // Rank every history by its predicted key per metric; keep the `verify` lowest. Per
-      // previous pattern, every gap at once: a term reads the previous byte's wave at
-      // term.sample - pre + frame + g, so over the gap grid it is one strided sweep of that wave.
-      std::array<std::vector<std::tuple<double, size_t, long>>, kMetrics> top;
-      const size_t ng = gaps.size();
-      std::vector<double> keys(kMetrics * ng), y(ng);
-      for (size_t k = 0; k < previous.size(); ++k) {
-        const float* w = prev_wave[k].data();
-        std::fill(keys.begin(), keys.end(), kInf);
-        for (const Linear& l : lin) {
-          if (!wanted[l.metric]) continue;
-          std::fill(y.begin(), y.end(), l.key0);
-          for (const Term& term : l.terms) {
-            // Gap indices whose read falls inside the wave: 0 <= at + gaps[j] < reach.
-            const long at = term.sample - pre + frame;
-            const long j0 = std::max(0L, (-at - gap_min + gap_step - 1) / gap_step);
-            const long j1 =
-                std::min(static_cast<long>(ng), (reach - at - gap_min + gap_step - 1) / gap_step);
-            const long first = at + gap_min;
-            for (long j = j0; j < j1; ++j) y[j] += term.coef * w[first + j * gap_step];
-          }
-          double* km = keys.data() + static_cast<size_t>(l.metric) * ng;
-          for (size_t j = 0; j < ng; ++j) km[j] = std::min(km[j], y[j]);
-        }
-        dw.ranked += static_cast<long>(ng);
-        for (int m = 0; m < kMetrics; ++m) {
-          if (!wanted[m]) continue;
-          auto& tm = top[m];
-          const double* km = keys.data() + static_cast<size_t>(m) * ng;
-          for (size_t j = 0; j < ng; ++j) {
-            if (static_cast<int>(tm.size()) >= opt.verify && !(km[j] < std::get<0>(tm.back())))
-              continue;
-            if (static_cast<int>(tm.size()) >= opt.verify) tm.pop_back();
-            const std::tuple<double, size_t, long> entry{km[j], k, gaps[j]};
-            tm.insert(std::upper_bound(tm.begin(), tm.end(), entry), entry);
+      lin.erase(std::remove_if(lin.begin(), lin.end(),
+                               [&](const Linear& l) { return !wanted[l.metric]; }),
+                lin.end());
+      // Each model's predicted key for previous pattern q at gap j is affine in q's bits:
+      // coef[0][j] + sum_b bit_b(q) coef[1 + b][j]. A term reads u at term.sample - pre + frame
+      // + g, so over the gap grid it is one strided sweep of each basis wave.
+      coef.assign(lin.size() * kCols * ng, 0.0);
+      for (size_t li = 0; li < lin.size(); ++li) {
+        double* cl = coef.data() + li * kCols * ng;
+        std::fill(cl, cl + ng, lin[li].key0);
+        for (const Term& term : lin[li].terms) {
+          // Gap indices whose read falls inside the wave: 0 <= at + gaps[j] < reach.
+          const long at = term.sample - pre + frame;
+          const long j0 = std::max(0L, (-at - gap_min + gap_step - 1) / gap_step);
+          const long j1 =
+              std::min(static_cast<long>(ng), (reach - at - gap_min + gap_step - 1) / gap_step);
+          const long first = at + gap_min;
+          for (size_t b = 0; b < kCols; ++b) {
+            const double* w = U[b].data() + first;
+            double* y = cl + b * ng;
+            for (long j = j0; j < j1; ++j) y[j] += term.coef * w[j * gap_step];
           }
         }
       }
+      auto key_of = [&](size_t li, int q, size_t j) {
+        const double* cl = coef.data() + li * kCols * ng;
+        double y = cl[j];
+        for (size_t b = 0; b < kPatternBits; ++b)
+          if (q >> b & 1) y += cl[(b + 1) * ng + j];
+        return y;
+      };
+      // The `verify` lowest histories (key, previous index, gap index), in order.
+      using Entry = std::tuple<double, size_t, size_t>;
+      auto offer = [&](std::vector<Entry>& top, const Entry& en) {
+        if (static_cast<int>(top.size()) >= opt.verify) {
+          if (!(en < top.back())) return;
+          top.pop_back();
+        }
+        top.insert(std::upper_bound(top.begin(), top.end(), en), en);
+      };
+      // A metric's key is the lowest of its models', so each of its `verify` lowest histories is
+      // among the `verify` lowest of the model that gives its key (fewer than `verify` histories
+      // are below it there): the union of the models' lowest, each re-keyed by every model of the
+      // metric, holds the metric's lowest. Per model and gap, with every pattern allowed, the
+      // lowest key sets the bits whose coefficient is negative, and the next lowest flip the bits
+      // with the smallest |coefficient|: the r-th lowest flips only bits among the r smallest
+      // (each flip adds |coefficient|), so the subsets of the `verify` smallest hold them all.
+      std::array<std::vector<Entry>, kMetrics> top;
+      std::vector<Entry> model_top, pool;
+      const size_t r = std::min<size_t>(static_cast<size_t>(opt.verify), kPatternBits);
+      for (int m = 0; m < kMetrics; ++m) {
+        if (!wanted[m]) continue;
+        pool.clear();
+        for (size_t li = 0; li < lin.size(); ++li) {
+          if (lin[li].metric != m) continue;
+          model_top.clear();
+          const double* cl = coef.data() + li * kCols * ng;
+          for (size_t j = 0; j < ng; ++j) {
+            if (!every_pattern) {
+              for (size_t k = 0; k < previous.size(); ++k)
+                offer(model_top, {key_of(li, previous[k], j), k, j});
+              continue;
+            }
+            double lowest = cl[j];
+            int q = 0;
+            std::array<std::pair<double, int>, kPatternBits> mag;
+            for (int b = 0; b < kPatternBits; ++b) {
+              const double w = cl[(b + 1) * ng + j];
+              if (w < 0) lowest += w, q |= 1 << b;
+              mag[b] = {std::abs(w), b};
+            }
+            if (static_cast<int>(model_top.size()) >= opt.verify &&
+                lowest > std::get<0>(model_top.back()))
+              continue;
+            std::partial_sort(mag.begin(), mag.begin() + r, mag.end());
+            for (unsigned mask = 0; mask < (1u << r); ++mask) {
+              double key = lowest;
+              for (size_t i = 0; i < r; ++i)
+                if (mask >> i & 1) key += mag[i].first;
+              if (static_cast<int>(model_top.size()) >= opt.verify &&
+                  key > std::get<0>(model_top.back()))
+                continue;
+              int p = q;
+              for (size_t i = 0; i < r; ++i)
+                if (mask >> i & 1) p ^= 1 << mag[i].second;
+              offer(model_top, {key, static_cast<size_t>(p), j});
+            }
+          }
+          pool.insert(pool.end(), model_top.begin(), model_top.end());
+        }
+        std::sort(pool.begin(), pool.end(), [](const Entry& a, const Entry& b) {
+          return std::tie(std::get<1>(a), std::get<2>(a)) <
+                 std::tie(std::get<1>(b), std::get<2>(b));
+        });
+        for (size_t i = 0; i < pool.size(); ++i) {
+          const size_t k = std::get<1>(pool[i]), j = std::get<2>(pool[i]);
+          if (i > 0 && std::get<1>(pool[i - 1]) == k && std::get<2>(pool[i - 1]) == j) continue;
+          double key = kInf;
+          for (size_t li = 0; li < lin.size(); ++li)
+            if (lin[li].metric == m) key = std::min(key, key_of(li, previous[k], j));
+          offer(top[m], {key, k, j});
+        }
+      }
+      dw.ranked += static_cast<long>(previous.size() * ng);
       std::vector<std::pair<size_t, long>> exact;
       for (const auto& tm : top)
-        for (const auto& [key, k, g] : tm) exact.push_back({k, g});
+        for (const auto& [key, k, j] : tm) exact.push_back({k, gaps[j]});
       std::sort(exact.begin(), exact.end());
       exact.erase(std::unique(exact.begin(), exact.end()), exact.end());
       for (const auto& [k, g] : exact) {

@@ -29,8 +29,10 @@
 //    for each metric (the slack is what the previous byte can change it by: 2 x its bound, in
 //    volts or, divided by the slowest crossing slope, in seconds) are then combined with every
 //    previous byte and gap, ranked by the first-order change each makes to every pulse's metric,
-//    and the best-ranked ones are scored exactly. With `exhaustive`, every combination is scored
-//    (brute force; the tests check the search against it).
+//    and the best-ranked ones are scored exactly. A byte frame is affine in its 9 free bits, so
+//    each predicted change is too: per gap the ranking reads each metric's best previous bytes
+//    off the per-bit coefficients rather than trying all 512. With `exhaustive`, every
+//    combination is scored (brute force; the tests check the search against it).
 #pragma once
 
 #include <cstdint>

@@ -96,6 +96,14 @@ Keys keys_of_traffic(const Traffic& t, double from, double to) {
   return keys_of(*c, f.rules);
 }
 
+std::string traffic_text_for_test(const Traffic& t) {
+  std::string s;
+  for (size_t i = 0; i < t.frames.size(); ++i)
+    s += fmt::format("{:.0f}ns {:02X}{} ", t.gaps[i] * 1e9, t.frames[i].byte,
+                     t.frames[i].error_bit ? "e" : "");
+  return s;
+}
+
 TEST(WorstCase, EdgeResponseSettlesAndSuperposesLikeTheTransient) {
   const Fixture& f = fixture();
   EXPECT_LE(f.edge.drift, f.opt.settle_tol);
@@ -187,6 +195,31 @@ TEST(WorstCase, SearchEqualsBruteForceOnAReducedSet) {
     EXPECT_NEAR(d->metric("edge")->value, bf.edge, 1e-15);
   }
   EXPECT_LT(fast->scored, full->scored / 4) << "the search should score far fewer waveforms";
+}
+
+// With every previous pattern allowed, the ranking enumerates each model's best patterns from
+// its per-bit coefficients instead of trying all 512 (worst.cpp): the same histories must come
+// out as when each pattern is tried in turn (the same 512 listed out of order take that path).
+TEST(WorstCase, RankingByBitsEqualsRankingEachPattern) {
+  const Fixture& f = fixture();
+  WorstOptions opt = f.opt;
+  opt.targets = {0x00, 0x1FF, 0xA5, 0x15A, 0x0F, 0x3C};
+  StatusOr<DirectionWorst> by_bits = worst_case_direction(f.edge, f.rules, opt);
+  ASSERT_TRUE(by_bits.ok()) << by_bits.status().message();
+  for (int p = 511; p >= 0; --p) opt.previous.push_back(p);
+  StatusOr<DirectionWorst> each = worst_case_direction(f.edge, f.rules, opt);
+  ASSERT_TRUE(each.ok()) << each.status().message();
+  EXPECT_EQ(by_bits->scored, each->scored);
+  EXPECT_GT(by_bits->scored, static_cast<long>(opt.targets.size()))
+      << "histories must have been scored, not only the targets after idle";
+  ASSERT_EQ(by_bits->metrics.size(), each->metrics.size());
+  for (size_t m = 0; m < each->metrics.size(); ++m) {
+    const WorstMetric& a = by_bits->metrics[m];
+    const WorstMetric& b = each->metrics[m];
+    SCOPED_TRACE(a.name);
+    EXPECT_EQ(a.value, b.value);
+    EXPECT_EQ(traffic_text_for_test(a.traffic), traffic_text_for_test(b.traffic));
+  }
 }
 
 const DirectionWorst& full_worst() {
