@@ -45,7 +45,27 @@ StatusOr<DirectionRun> run_direction(link::ExpandedLink link, const RunOptions& 
   StatusOr<SimulationResult> sim = simulate_netlist(dr.link.netlist, req);
   if (!sim) return sim.status().with_context(dr.link.description);
   dr.sim = std::move(*sim);
+  if (Status s = score_direction(dr); !s.ok()) return s;
+  return dr;
+}
 
+StatusOr<DirectionRun> run_direction_synthesized(link::ExpandedLink link, const EdgeResponse& e) {
+  DirectionRun dr;
+  dr.link = std::move(link);
+  const auto start = std::chrono::steady_clock::now();
+  const double t_end = dr.link.netlist.tran ? dr.link.netlist.tran->tstop : 0.0;
+  StatusOr<Waveform> w = synthesize_drive(e, dr.link.drive, t_end);
+  if (!w) return w.status().with_context(dr.link.description);
+  dr.sim.wave = std::move(*w);
+  dr.sim.engine = Engine::Lti;
+  dr.sim.engine_note = "v(rxp,rxn) synthesized from the edge response: " + e.engine;
+  dr.sim.seconds =
+      e.seconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (Status s = score_direction(dr); !s.ok()) return s;
+  return dr;
+}
+
+Status score_direction(DirectionRun& dr) {
   StatusOr<eye::Rules> rules = eye::load_rules(dr.link.rules);
   if (!rules) return rules.status();
   dr.rules = *rules;
@@ -80,7 +100,7 @@ StatusOr<DirectionRun> run_direction(link::ExpandedLink link, const RunOptions& 
     dr.tones = std::move(*r);
     dr.pass = dr.pass && dr.tones->pass;
   }
-  return dr;
+  return Status::Ok();
 }
 
 StatusOr<LinkRun> run_link(const link::LinkSpec& spec, const link::PartLibrary& parts,

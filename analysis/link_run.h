@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "analysis/simulate.h"
+#include "analysis/worst.h"
 #include "eye/check.h"
 #include "eye/rules.h"
 #include "netlists/link/expand.h"
@@ -57,6 +58,15 @@ StatusOr<LinkRun> run_link(const link::LinkSpec& spec, const link::PartLibrary& 
 // One expanded direction simulated and scored: run_link's work per direction (packs expand every
 // hop first and simulate each distinct circuit once).
 StatusOr<DirectionRun> run_direction(link::ExpandedLink link, const RunOptions& opt = {});
+
+// One expanded direction scored on v(rxp,rxn) synthesized from its edge response (worst.h,
+// synthesize_drive: exact superposition on the response's 1 ns grid) instead of simulated: the
+// sweep's path when it computes the worst case, whose edge response it shares. The waveform has
+// that one column; an error when a level change of the drive is off the grid.
+StatusOr<DirectionRun> run_direction_synthesized(link::ExpandedLink link, const EdgeResponse& e);
+// Scores dr.sim.wave (column 0, v(rxp,rxn)) with the receiver's rules: dr.rules, data, tones,
+// pass. Used by both of the above.
+Status score_direction(DirectionRun& dr);
 
 // The probes of every direction, resampled onto one uniform axis, columns "down v(rxp,rxn)", ...
 Waveform run_waveforms(const LinkRun& run, double dt);

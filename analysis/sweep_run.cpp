@@ -382,7 +382,39 @@ PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t
       r.seconds = now_seconds() - t0;
       return r;
     }
-    StatusOr<LinkRun> run = run_link(po.point.spec, parts, opt.run);
+    // With the worst case asked for (and no waveform files), each direction's edge response
+    // serves both: the spec traffic's v(rxp,rxn) is its exact superposition (the LTI engine's
+    // answer on the response's 1 ns grid, run_direction_synthesized) instead of a second model
+    // of the link and a finer output grid. Traffic off that grid is simulated as before.
+    const WorstOptions wopt{.expand = opt.run.expand};
+    std::vector<EdgeResponse> edges;
+    StatusOr<LinkRun> run = Status::Error("not run");
+    if (s.worst_outputs && opt.waves_dir.empty() && opt.run.engine != Engine::Transient) {
+      LinkRun lr;
+      lr.pass = true;
+      for (link::Direction d : po.point.spec.stimulus.directions) {
+        StatusOr<link::ExpandedLink> ex =
+            link::expand_link(po.point.spec, parts, d, opt.run.expand);
+        if (!ex) return fail(ex.status().message());
+        StatusOr<DirectionRun> dr = Status::Error("not run");
+        if (on_grid(ex->drive, wopt.dt)) {
+          StatusOr<EdgeResponse> e = edge_response(po.point.spec, parts, d, wopt);
+          if (!e) return fail("worst: " + e.status().message());
+          dr = run_direction_synthesized(std::move(*ex), *e);
+          edges.push_back(std::move(*e));
+        } else {
+          dr = run_direction(std::move(*ex), opt.run);
+        }
+        if (!dr) return fail(dr.status().message());
+        lr.pass = lr.pass && dr->pass;
+        lr.seconds += dr->sim.seconds;
+        lr.directions.push_back(std::move(*dr));
+      }
+      if (edges.size() != lr.directions.size()) edges.clear();
+      run = std::move(lr);
+    } else {
+      run = run_link(po.point.spec, parts, opt.run);
+    }
     if (!run) return fail(run.status().message());
     std::vector<std::string> cells = std::move(r.cells);
     r = score_run(*run);
@@ -395,7 +427,7 @@ PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t
     }
     if (s.worst_outputs) {
       // The default options, as `isolink run` and `isolink worst` use, on the run's expansion.
-      StatusOr<WorstResult> w = worst_case(po.point.spec, parts, {.expand = opt.run.expand});
+      StatusOr<WorstResult> w = worst_case(po.point.spec, parts, wopt, std::move(edges));
       if (!w) return fail("worst: " + w.status().message());
       r.worst = worst_cells(*w);
     }

@@ -527,6 +527,36 @@ Waveform synthesize(const EdgeResponse& e, const Traffic& traffic,
   return w;
 }
 
+StatusOr<Waveform> synthesize_drive(const EdgeResponse& e, const traffic::Drive& drive,
+                                    double t_end) {
+  // The PWL sources start at the first segment's level (the operating point) and hold the
+  // last one: the response of a line idle at the start, and of each level change after.
+  if (!drive.segments.empty() && drive.segments.front().level != 0)
+    return Status::Error("the drive does not start idle: no edge response superposes to it");
+  std::vector<std::pair<long, int>> edges;
+  int level = 0;
+  for (const traffic::DriveSegment& g : drive.segments) {
+    if (g.level == level) continue;
+    if (!on_grid({{g}}, e.dt))
+      return Status::Error(fmt::format(
+          "the drive changes level at {:.6g} us, off the {:g} ns grid of the edge response",
+          g.start * 1e6, e.dt * 1e9));
+    edges.push_back({to_samples(g.start, e.dt), g.level - level});
+    level = g.level;
+  }
+  const long n = std::max(2L, to_samples(t_end, e.dt) + 1);
+  if (n > 100'000'000)
+    return Status::Error(fmt::format("a {:g} us record on a {:g} ns grid is too long to synthesize",
+                                     t_end * 1e6, e.dt * 1e9));
+  std::vector<double> v(static_cast<size_t>(n), e.v_idle);
+  add_edges(e, edges, 0, v);
+  Waveform w;
+  w.time.resize(static_cast<size_t>(n));
+  for (long i = 0; i < n; ++i) w.time[static_cast<size_t>(i)] = static_cast<double>(i) * e.dt;
+  w.add_column("v(rxp,rxn)", std::move(v));
+  return w;
+}
+
 StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::Rules& rules,
                                               const WorstOptions& opt) {
   if (Status s = opt.validate(); !s.ok()) return s;
@@ -836,12 +866,24 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
   return dw;
 }
 
+bool on_grid(const traffic::Drive& drive, double dt) {
+  for (const traffic::DriveSegment& g : drive.segments) {
+    const double n = g.start / dt;
+    if (!(std::abs(n - std::round(n)) <= 1e-6)) return false;
+  }
+  return true;
+}
+
 StatusOr<WorstResult> worst_case(const link::LinkSpec& spec, const link::PartLibrary& parts,
-                                 const WorstOptions& opt) {
+                                 const WorstOptions& opt, std::vector<EdgeResponse> edges) {
   if (Status s = opt.validate(); !s.ok()) return s;
+  if (!edges.empty() && edges.size() != spec.stimulus.directions.size())
+    return Status::Error(fmt::format("internal error: {} edge responses for {} directions",
+                                     edges.size(), spec.stimulus.directions.size()));
   const auto start = std::chrono::steady_clock::now();
   WorstResult out;
-  for (link::Direction d : spec.stimulus.directions) {
+  for (size_t di = 0; di < spec.stimulus.directions.size(); ++di) {
+    const link::Direction d = spec.stimulus.directions[di];
     StatusOr<link::ExpandedLink> ex = link::expand_link(spec, parts, d, opt.expand);
     if (!ex) return ex.status();
     StatusOr<eye::Rules> rules = eye::load_rules(ex->rules);
@@ -851,7 +893,8 @@ StatusOr<WorstResult> worst_case(const link::LinkSpec& spec, const link::PartLib
       dopt.progress = [&](const std::string& what, double fraction) {
         opt.progress(fmt::format("{} {}", link::direction_name(d), what), fraction);
       };
-    StatusOr<EdgeResponse> e = edge_response(spec, parts, d, dopt);
+    StatusOr<EdgeResponse> e =
+        edges.empty() ? edge_response(spec, parts, d, dopt) : std::move(edges[di]);
     if (!e) return e.status();
     StatusOr<DirectionWorst> dw = worst_case_direction(*e, *rules, dopt);
     if (!dw) return dw.status().with_context(ex->description + ", worst case");

@@ -166,9 +166,21 @@ double tail_bound(const EdgeResponse& e, double half_bit, double tau);
 Waveform synthesize(const EdgeResponse& e, const Traffic& traffic,
                     const traffic::EncodingOptions& enc, double t0, double t1);
 
-// The worst case of every direction in spec.stimulus.directions.
+// v(rxp,rxn) of a whole drive (a link's own traffic, link::ExpandedLink::drive) by superposition,
+// on [0, t_end] every e.dt: exact at the samples for the link whose edge response e is. Every
+// level change must fall on the grid (within 1e-6 of a sample); an error names the first that
+// does not.
+StatusOr<Waveform> synthesize_drive(const EdgeResponse& e, const traffic::Drive& drive,
+                                    double t_end);
+
+// Whether every level change of the drive falls on a grid of step dt (within 1e-6 of a step).
+bool on_grid(const traffic::Drive& drive, double dt);
+
+// The worst case of every direction in spec.stimulus.directions; `edges`, when given, are their
+// edge responses (one per direction, in order, from edge_response with the same options).
 StatusOr<WorstResult> worst_case(const link::LinkSpec& spec, const link::PartLibrary& parts,
-                                 const WorstOptions& opt = {});
+                                 const WorstOptions& opt = {},
+                                 std::vector<EdgeResponse> edges = {});
 // One direction, from its edge response (tests build their own).
 StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::Rules& rules,
                                               const WorstOptions& opt);

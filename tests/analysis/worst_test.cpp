@@ -134,6 +134,46 @@ TEST(WorstCase, EdgeResponseSettlesAndSuperposesLikeTheTransient) {
   EXPECT_LT(worst, 2e-3) << "superposition vs transient, max |dv| = " << worst * 1e3 << " mV";
 }
 
+// The sweep's path for the spec traffic (run_direction_synthesized): v(rxp,rxn) superposed from
+// the edge response on its 1 ns grid, scored like the simulated run. Against the LTI engine's own
+// run of the same link (its 1 mV output grid): the same verdict and bytes, every metric within
+// 1 mV and 25 ps (the 1 ns samples can miss a peak by a fraction of a mV).
+TEST(WorstCase, SynthesizedRunMatchesTheSimulatedRun) {
+  const Fixture& f = fixture();
+  link::LinkSpec spec = f.spec;
+  spec.stimulus.frames = {"stack-write reg=0x0100 data=02B778BC", "broadcast-read reg=0x0200 n=2"};
+  StatusOr<link::ExpandedLink> ex =
+      link::expand_link(spec, f.parts, link::Direction::kDown, f.opt.expand);
+  ASSERT_TRUE(ex.ok()) << ex.status().message();
+  ASSERT_TRUE(on_grid(ex->drive, f.edge.dt));
+  StatusOr<DirectionRun> syn = run_direction_synthesized(*ex, f.edge);
+  ASSERT_TRUE(syn.ok()) << syn.status().message();
+  RunOptions ro;
+  ro.engine = Engine::Lti;
+  StatusOr<DirectionRun> sim = run_direction(*ex, ro);
+  ASSERT_TRUE(sim.ok()) << sim.status().message();
+  ASSERT_TRUE(syn->data && sim->data);
+  const eye::CheckResult& a = *syn->data;
+  const eye::CheckResult& b = *sim->data;
+  EXPECT_EQ(a.pass, b.pass);
+  EXPECT_EQ(a.pulses.size(), b.pulses.size());
+  EXPECT_TRUE(a.expect_match);
+  EXPECT_EQ(a.frames.size(), b.frames.size());
+  EXPECT_NEAR(*a.vstart_min(), *b.vstart_min(), 1e-3);
+  EXPECT_NEAR(*a.vend_min(), *b.vend_min(), 1e-3);
+  EXPECT_NEAR(*a.width_min(), *b.width_min(), 25e-12);
+  EXPECT_NEAR(*a.width_max(), *b.width_max(), 25e-12);
+  EXPECT_NEAR(*a.edge_max(), *b.edge_max(), 25e-12);
+  EXPECT_NEAR(syn->sim.wave.time.back(), sim->sim.wave.time.back(), 1e-9);
+  // Off the grid, synthesis is refused rather than snapped.
+  traffic::Drive shifted = ex->drive;
+  for (traffic::DriveSegment& g : shifted.segments) g.start += 0.3e-9, g.end += 0.3e-9;
+  shifted.segments.front().start = 0;
+  EXPECT_FALSE(on_grid(shifted, f.edge.dt));
+  EXPECT_NE(synthesize_drive(f.edge, shifted, 1e-4).status().message().find("off the 1 ns grid"),
+            std::string::npos);
+}
+
 TEST(WorstCase, TailBoundCoversTheResponse) {
   const Fixture& f = fixture();
   const double T = 250e-9;
