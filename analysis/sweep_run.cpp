@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <system_error>
 
@@ -398,7 +399,12 @@ PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t
         if (!ex) return fail(ex.status().message());
         StatusOr<DirectionRun> dr = Status::Error("not run");
         if (on_grid(ex->drive, wopt.dt)) {
-          StatusOr<EdgeResponse> e = edge_response(po.point.spec, parts, d, wopt);
+          // The same circuit as a direction before (a mirror-symmetric link): its response.
+          std::optional<EdgeResponse> same;
+          for (size_t k = 0; edges.size() == lr.directions.size() && k < edges.size() && !same; ++k)
+            if (same_circuit(lr.directions[k].link.netlist, ex->netlist)) same = edges[k];
+          StatusOr<EdgeResponse> e =
+              same ? std::move(*same) : edge_response(po.point.spec, parts, d, wopt);
           if (!e) return fail("worst: " + e.status().message());
           dr = run_direction_synthesized(std::move(*ex), *e);
           edges.push_back(std::move(*e));

@@ -659,16 +659,19 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
     }
   } else if (history) {
     // The previous byte's response per pattern bit (PatternBasis): u_q at window sample i for
-    // gap g is U[0][i - pre + frame + g] + sum_b bit_b(q) U[1 + b][i - pre + frame + g].
+    // gap g is U_0(i - pre + frame + g) + sum_b bit_b(q) U_{1 + b}(i - pre + frame + g).
     StatusOr<PatternBasis> basis = pattern_basis(opt.expand.stimulus.encoding);
     if (!basis) return basis.status();
     const long reach = frame + gap_max + search.len();
-    std::array<std::vector<double>, kPatternBits + 1> U;
-    for (int b = 0; b <= kPatternBits; ++b) {
-      U[b].assign(static_cast<size_t>(reach), 0.0);
+    // Interleaved, U[i * kCols + b]: a read at one sample takes all kCols columns at once.
+    constexpr size_t kCols = kPatternBits + 1;
+    std::vector<double> U(static_cast<size_t>(reach) * kCols);
+    for (size_t b = 0; b < kCols; ++b) {
+      std::vector<double> u(static_cast<size_t>(reach), 0.0);
       std::vector<std::pair<long, int>> edges;
       level_edges(b == 0 ? basis->base : basis->bit[b - 1], 0, half, edges);
-      add_edges(e, edges, 0, U[b]);
+      add_edges(e, edges, 0, u);
+      for (size_t i = 0; i < u.size(); ++i) U[i * kCols + b] = u[i];
     }
     // Every pattern, in order: the ranking below then enumerates the best patterns per gap
     // instead of trying each (the `previous` index is the pattern itself).
@@ -696,7 +699,6 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
     std::sort(all.begin(), all.end());
     all.erase(std::unique(all.begin(), all.end()), all.end());
     const size_t ng = gaps.size();
-    constexpr size_t kCols = kPatternBits + 1;
     std::vector<double> coef;  // per linear model: kCols rows of ng (constant, then per bit)
     for (size_t n = 0; n < all.size(); ++n) {
       const size_t ci = all[n];
@@ -727,10 +729,10 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
           const long j1 =
               std::min(static_cast<long>(ng), (reach - at - gap_min + gap_step - 1) / gap_step);
           const long first = at + gap_min;
-          for (size_t b = 0; b < kCols; ++b) {
-            const double* w = U[b].data() + first;
-            double* y = cl + b * ng;
-            for (long j = j0; j < j1; ++j) y[j] += term.coef * w[j * gap_step];
+          for (long j = j0; j < j1; ++j) {
+            const double* u = U.data() + static_cast<size_t>(first + j * gap_step) * kCols;
+            for (size_t b = 0; b < kCols; ++b)
+              cl[b * ng + static_cast<size_t>(j)] += term.coef * u[b];
           }
         }
       }
@@ -785,18 +787,19 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
                 lowest > std::get<0>(model_top.back()))
               continue;
             std::partial_sort(mag.begin(), mag.begin() + r, mag.end());
-            for (unsigned mask = 0; mask < (1u << r); ++mask) {
-              double key = lowest;
-              for (size_t i = 0; i < r; ++i)
-                if (mask >> i & 1) key += mag[i].first;
-              if (static_cast<int>(model_top.size()) >= opt.verify &&
-                  key > std::get<0>(model_top.back()))
-                continue;
-              int p = q;
-              for (size_t i = 0; i < r; ++i)
-                if (mask >> i & 1) p ^= 1 << mag[i].second;
+            // The subsets in increasing order of their members (mag ascending): a member that
+            // pushes the key past the `verify`-th lowest ends its branch, as all later ones would.
+            auto visit = [&](auto&& self, size_t from, double key, int p) -> void {
               offer(model_top, {key, static_cast<size_t>(p), j});
-            }
+              for (size_t i = from; i < r; ++i) {
+                const double next = key + mag[i].first;
+                if (static_cast<int>(model_top.size()) >= opt.verify &&
+                    next > std::get<0>(model_top.back()))
+                  break;
+                self(self, i + 1, next, p ^ (1 << mag[i].second));
+              }
+            };
+            visit(visit, 0, lowest, q);
           }
           pool.insert(pool.end(), model_top.begin(), model_top.end());
         }
@@ -882,10 +885,30 @@ StatusOr<WorstResult> worst_case(const link::LinkSpec& spec, const link::PartLib
                                      edges.size(), spec.stimulus.directions.size()));
   const auto start = std::chrono::steady_clock::now();
   WorstResult out;
+  std::vector<link::ExpandedLink> expanded;  // per direction done, to find a same circuit
   for (size_t di = 0; di < spec.stimulus.directions.size(); ++di) {
     const link::Direction d = spec.stimulus.directions[di];
     StatusOr<link::ExpandedLink> ex = link::expand_link(spec, parts, d, opt.expand);
     if (!ex) return ex.status();
+    // A mirror-symmetric link (the same parts at both ends) is the same circuit both ways: its
+    // worst case is computed once and reported for each direction.
+    bool reused = false;
+    for (size_t k = 0; k < expanded.size() && !reused; ++k) {
+      if (expanded[k].rules != ex->rules || !same_circuit(expanded[k].netlist, ex->netlist))
+        continue;
+      DirectionWorst dw = out.directions[k];
+      dw.same_as = link::direction_name(dw.direction);
+      dw.seconds = dw.edge.seconds = 0;  // nothing computed for it
+      dw.direction = d;
+      dw.description = ex->description;
+      dw.receiver = ex->receiver;
+      out.directions.push_back(std::move(dw));
+      reused = true;
+    }
+    if (reused) {
+      expanded.push_back(std::move(*ex));
+      continue;
+    }
     StatusOr<eye::Rules> rules = eye::load_rules(ex->rules);
     if (!rules) return rules.status();
     WorstOptions dopt = opt;  // progress says which direction
@@ -904,6 +927,7 @@ StatusOr<WorstResult> worst_case(const link::LinkSpec& spec, const link::PartLib
     dw->edge = std::move(*e);
     out.pass = out.pass && dw->pass;
     out.directions.push_back(std::move(*dw));
+    expanded.push_back(std::move(*ex));
   }
   out.seconds = seconds_since(start);
   return out;
@@ -985,6 +1009,7 @@ nlohmann::ordered_json worst_json(const WorstResult& r) {
     dj["scored"] = d.scored;
     dj["ranked"] = d.ranked;
     dj["seconds"] = d.seconds;
+    if (!d.same_as.empty()) dj["same_circuit_as"] = d.same_as;
     dj["edge_response"] = {
         {"engine", d.edge.engine},          {"span_us", d.edge.span * 1e6},
         {"settle_mV", d.edge.settle * 1e3}, {"half_bit_residue_uV", d.edge.drift * 1e6},
@@ -1050,6 +1075,11 @@ std::string worst_markdown(const WorstResult& r) {
         d.memory * 1e6, d.gap_min * 1e6, d.previous_bound * 1e3, d.older_bound * 1e3, d.scored,
         d.ranked, d.seconds + d.edge.seconds, d.edge.engine);
     if (!d.edge.engine_note.empty()) md += "Edge response: " + d.edge.engine_note + ".\n\n";
+    if (!d.same_as.empty())
+      md += fmt::format(
+          "The link is the same circuit as {} (the same parts at both ends): its "
+          "result, computed once.\n\n",
+          d.same_as);
     for (const std::string& why : d.reasons) md += "- " + why + "\n";
     if (!d.reasons.empty()) md += "\n";
     md += "Replay any row in `isolink run` with its stimulus block:\n\n```yaml\n";

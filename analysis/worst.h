@@ -143,6 +143,9 @@ struct DirectionWorst {
   long scored = 0;            // waveforms scored with the eye checker
   long ranked = 0;            // histories ranked by first-order change
   double seconds = 0;
+  // The direction whose result this is when the link is the same circuit both ways (the same
+  // parts at both ends): computed once. Empty when computed for this direction.
+  std::string same_as;
   std::vector<WorstMetric> metrics;  // vstart, vend, width_min, width_max, edge
   bool pass = true;                  // every scored waveform passes and every margin >= 0
   std::vector<std::string> reasons;  // why not (the first failing traffic per reason)

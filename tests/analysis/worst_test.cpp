@@ -378,6 +378,46 @@ TEST(WorstCase, ReducedModelEdgeResponseMatchesTheTransient) {
   EXPECT_LT(dev, 0.2e-3);
 }
 
+// The same parts at both ends make the same circuit both ways: worst_case computes it once and
+// says so (same_as); different ends are computed each way, and their results differ.
+TEST(WorstCase, MirrorSymmetricLinkIsComputedOnce) {
+  const Fixture& f = fixture();
+  link::LinkSpec spec = f.spec;
+  spec.stimulus.directions = {link::Direction::kDown, link::Direction::kUp};
+  WorstOptions opt = f.opt;
+  opt.targets = {0x00, 0x1FF, 0xA5};
+  StatusOr<WorstResult> sym = worst_case(spec, f.parts, opt);
+  ASSERT_TRUE(sym.ok()) << sym.status().message();
+  ASSERT_EQ(sym->directions.size(), 2u);
+  EXPECT_EQ(sym->directions[0].same_as, "");
+  EXPECT_EQ(sym->directions[1].same_as, "down");
+  EXPECT_EQ(sym->directions[1].direction, link::Direction::kUp);
+  EXPECT_EQ(sym->directions[1].description.rfind("up:", 0), 0u);
+  // The copy is what the up direction computes on its own.
+  spec.stimulus.directions = {link::Direction::kUp};
+  StatusOr<WorstResult> up = worst_case(spec, f.parts, opt);
+  ASSERT_TRUE(up.ok()) << up.status().message();
+  ASSERT_EQ(up->directions[0].metrics.size(), sym->directions[1].metrics.size());
+  for (size_t m = 0; m < up->directions[0].metrics.size(); ++m)
+    EXPECT_EQ(up->directions[0].metrics[m].value, sym->directions[1].metrics[m].value);
+
+  // A capacitor-isolated receiving end: not the same circuit up and down.
+  StatusOr<link::LinkSpec> asym = link::read_link_spec_text(
+      R"(name: worst-asym
+tx: {device: bq7961x, isolation: {type: transformer, part: HMU1228NL}}
+rx: {device: bq7961x, isolation: {type: cap}}
+cable: {length: 2, material: pp, gauge: 24}
+stimulus: {frames: ["single-read dev=1 reg=0x0215 n=1"], direction: both}
+)",
+      "asym.yaml");
+  ASSERT_TRUE(asym.ok()) << asym.status().message();
+  StatusOr<WorstResult> both = worst_case(*asym, f.parts, opt);
+  ASSERT_TRUE(both.ok()) << both.status().message();
+  ASSERT_EQ(both->directions.size(), 2u);
+  EXPECT_EQ(both->directions[1].same_as, "");
+  EXPECT_NE(both->directions[0].edge.e, both->directions[1].edge.e);
+}
+
 TEST(WorstCase, OptionsAreValidatedUpFront) {
   WorstOptions o;
   o.gap_step = 0;
