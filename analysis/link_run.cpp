@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 
 namespace isolink::analysis {
@@ -108,9 +109,22 @@ StatusOr<LinkRun> run_link(const link::LinkSpec& spec, const link::PartLibrary& 
   LinkRun run;
   const auto start = std::chrono::steady_clock::now();
   run.pass = true;
+  std::vector<std::string> keys;  // link::circuit_key per direction done
   for (link::Direction d : spec.stimulus.directions) {
     StatusOr<link::ExpandedLink> ex = link::expand_link(spec, parts, d, opt.expand);
     if (!ex) return ex.status();
+    keys.push_back(link::circuit_key(*ex));
+    const size_t same =
+        static_cast<size_t>(std::find(keys.begin(), keys.end() - 1, keys.back()) - keys.begin());
+    if (same + 1 < keys.size()) {
+      DirectionRun dr = run.directions[same];
+      dr.same_as = link::direction_name(dr.link.direction);
+      dr.link = std::move(*ex);
+      dr.sim.seconds = 0;  // nothing simulated for it
+      run.pass = run.pass && dr.pass;
+      run.directions.push_back(std::move(dr));
+      continue;
+    }
     StatusOr<DirectionRun> dr = run_direction(std::move(*ex), opt);
     if (!dr) return dr.status();
     run.pass = run.pass && dr->pass;

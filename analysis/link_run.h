@@ -34,6 +34,9 @@ struct DirectionRun {
   std::optional<eye::CheckResult> data;   // the data frames' check (when any were sent)
   std::optional<eye::CheckResult> tones;  // the tones' check (when any were sent)
   bool pass = false;
+  // The direction whose simulation this is, when both are the same circuit and traffic
+  // (link::circuit_key: the same parts at both ends): simulated once. Empty when simulated.
+  std::string same_as;
 };
 
 struct LinkRun {

@@ -11,10 +11,8 @@
 #include <mutex>
 
 #include "analysis/sweep_run.h"
-#include "base/hex.h"
 #include "netlists/link/cable.h"
 #include "netlists/link/expand.h"
-#include "netlists/spice_writer.h"
 #include "netlists/traffic/command.h"
 
 namespace isolink::analysis {
@@ -25,16 +23,6 @@ std::vector<int> range(int a, int b, int step) {  // a, a + step, ... through b
   std::vector<int> out;
   for (int k = a; step > 0 ? k <= b : k >= b; k += step) out.push_back(k);
   return out;
-}
-
-// The dedupe key of an expanded direction: its circuit and traffic as SPICE text (the title names
-// the spec and is left out), the receiver's rules and the bytes it must decode.
-std::string circuit_key(const link::ExpandedLink& x) {
-  Netlist n = x.netlist;
-  n.title.clear();
-  std::string key = write_spice(n);
-  key += "\n* rules " + x.rules + "\n* expect " + to_hex(x.expected) + "\n";
-  return key;
 }
 
 // Whether a hop's traffic asks for responses (reads), so that it carries both directions.
@@ -174,7 +162,7 @@ StatusOr<PackResult> run_pack(const PackSpec& pack, const link::PartLibrary& par
       ++out.expansions;
       // A symmetric hop's up direction is the same circuit as its down (node names follow the
       // roles), so it dedupes too.
-      const std::string key = circuit_key(*ex);
+      const std::string key = link::circuit_key(*ex);
       auto [it, added] = by_key.emplace(key, static_cast<int>(distinct.size()));
       if (added) distinct.push_back({*ex, &h.spec, d, Status::Error("not run"), Status::Error("")});
       hr.runs.push_back(it->second);

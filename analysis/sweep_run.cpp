@@ -402,7 +402,7 @@ PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t
           // The same circuit as a direction before (a mirror-symmetric link): its response.
           std::optional<EdgeResponse> same;
           for (size_t k = 0; edges.size() == lr.directions.size() && k < edges.size() && !same; ++k)
-            if (same_circuit(lr.directions[k].link.netlist, ex->netlist)) same = edges[k];
+            if (link::circuit_key(lr.directions[k].link) == link::circuit_key(*ex)) same = edges[k];
           StatusOr<EdgeResponse> e =
               same ? std::move(*same) : edge_response(po.point.spec, parts, d, wopt);
           if (!e) return fail("worst: " + e.status().message());

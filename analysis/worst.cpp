@@ -885,7 +885,7 @@ StatusOr<WorstResult> worst_case(const link::LinkSpec& spec, const link::PartLib
                                      edges.size(), spec.stimulus.directions.size()));
   const auto start = std::chrono::steady_clock::now();
   WorstResult out;
-  std::vector<link::ExpandedLink> expanded;  // per direction done, to find a same circuit
+  std::vector<std::string> keys;  // link::circuit_key per direction done
   for (size_t di = 0; di < spec.stimulus.directions.size(); ++di) {
     const link::Direction d = spec.stimulus.directions[di];
     StatusOr<link::ExpandedLink> ex = link::expand_link(spec, parts, d, opt.expand);
@@ -893,9 +893,9 @@ StatusOr<WorstResult> worst_case(const link::LinkSpec& spec, const link::PartLib
     // A mirror-symmetric link (the same parts at both ends) is the same circuit both ways: its
     // worst case is computed once and reported for each direction.
     bool reused = false;
-    for (size_t k = 0; k < expanded.size() && !reused; ++k) {
-      if (expanded[k].rules != ex->rules || !same_circuit(expanded[k].netlist, ex->netlist))
-        continue;
+    keys.push_back(link::circuit_key(*ex));
+    for (size_t k = 0; k + 1 < keys.size() && !reused; ++k) {
+      if (keys[k] != keys.back()) continue;
       DirectionWorst dw = out.directions[k];
       dw.same_as = link::direction_name(dw.direction);
       dw.seconds = dw.edge.seconds = 0;  // nothing computed for it
@@ -905,10 +905,7 @@ StatusOr<WorstResult> worst_case(const link::LinkSpec& spec, const link::PartLib
       out.directions.push_back(std::move(dw));
       reused = true;
     }
-    if (reused) {
-      expanded.push_back(std::move(*ex));
-      continue;
-    }
+    if (reused) continue;
     StatusOr<eye::Rules> rules = eye::load_rules(ex->rules);
     if (!rules) return rules.status();
     WorstOptions dopt = opt;  // progress says which direction
@@ -927,7 +924,6 @@ StatusOr<WorstResult> worst_case(const link::LinkSpec& spec, const link::PartLib
     dw->edge = std::move(*e);
     out.pass = out.pass && dw->pass;
     out.directions.push_back(std::move(*dw));
-    expanded.push_back(std::move(*ex));
   }
   out.seconds = seconds_since(start);
   return out;

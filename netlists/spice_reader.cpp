@@ -1056,45 +1056,4 @@ StatusOr<Netlist> read_spice_text(const std::string& text, const std::string& na
   return read(SourceFile::FromText(name, text));
 }
 
-namespace {
-
-bool same_arg(const CardArg& a, const CardArg& b) {
-  return a.kind == b.kind && a.number == b.number && a.word == b.word && a.call == b.call;
-}
-
-bool same_card(const Card& a, const Card& b) {
-  if (a.letter != b.letter || a.name != b.name || a.nodes != b.nodes || a.refs != b.refs ||
-      a.args.size() != b.args.size() || a.params.size() != b.params.size())
-    return false;
-  for (size_t i = 0; i < a.args.size(); ++i)
-    if (!same_arg(a.args[i], b.args[i])) return false;
-  for (size_t i = 0; i < a.params.size(); ++i)
-    if (a.params[i].first != b.params[i].first || !same_arg(a.params[i].second, b.params[i].second))
-      return false;
-  return true;
-}
-
-}  // namespace
-
-bool same_circuit(const Netlist& a, const Netlist& b) {
-  if (a.cards.size() != b.cards.size() || a.options.size() != b.options.size() ||
-      a.initial_voltages.size() != b.initial_voltages.size() ||
-      a.tran.has_value() != b.tran.has_value())
-    return false;
-  if (a.tran && (a.tran->tstep != b.tran->tstep || a.tran->tstop != b.tran->tstop ||
-                 a.tran->tstart != b.tran->tstart || a.tran->tmax != b.tran->tmax ||
-                 a.tran->uic != b.tran->uic))
-    return false;
-  for (size_t i = 0; i < a.cards.size(); ++i)
-    if (!same_card(a.cards[i], b.cards[i])) return false;
-  for (size_t i = 0; i < a.options.size(); ++i)
-    if (a.options[i].key != b.options[i].key || !same_arg(a.options[i].value, b.options[i].value))
-      return false;
-  for (size_t i = 0; i < a.initial_voltages.size(); ++i)
-    if (a.initial_voltages[i].node != b.initial_voltages[i].node ||
-        a.initial_voltages[i].value != b.initial_voltages[i].value)
-      return false;
-  return true;
-}
-
 }  // namespace isolink

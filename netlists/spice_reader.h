@@ -52,12 +52,6 @@ struct Netlist {
   std::vector<std::string> warnings;  // formatted diagnostics ("file:line:col: warning: ...")
 };
 
-// Whether two netlists describe the same circuit and analysis: the same cards (kind, name, nodes,
-// references, values, in order), .tran, .options and .ic. Titles, source locations and warnings
-// do not count. Two directions of a mirror-symmetric link expand to the same circuit, and the
-// link-level analyses then compute it once.
-bool same_circuit(const Netlist& a, const Netlist& b);
-
 // Reads a netlist file; .include paths are relative to the including file.
 StatusOr<Netlist> read_spice_file(const std::string& path);
 // Reads netlist text; `name` is used in diagnostics and .include paths are relative to the

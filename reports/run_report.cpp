@@ -120,6 +120,7 @@ nlohmann::ordered_json run_report_json(const link::LinkSpec& spec, const LinkRun
     } else if (!d.sim.engine_note.empty()) {
       solver["engine_note"] = d.sim.engine_note;
     }
+    if (!d.same_as.empty()) solver["same_circuit_as"] = d.same_as;
     ordered_json j{{"direction", link::direction_name(d.link.direction)},
                    {"transmitter", d.link.transmitter},
                    {"receiver", d.link.receiver},
@@ -212,7 +213,12 @@ std::string run_report_markdown(const link::LinkSpec& spec, const LinkRun& run,
                       lti ? d.sim.lti.factorizations : d.sim.stats.factorizations, d.sim.seconds);
   }
   for (const DirectionRun& d : run.directions)
-    if (d.sim.engine == analysis::Engine::Lti && d.sim.lti.method == "reduced model")
+    if (!d.same_as.empty())
+      md += fmt::format(
+          "\n{}: the same circuit and traffic as {} (the same parts at both ends): its waveform, "
+          "simulated once.\n",
+          d.link.description, d.same_as);
+    else if (d.sim.engine == analysis::Engine::Lti && d.sim.lti.method == "reduced model")
       md += fmt::format(
           "\n{}: waveform by the LTI engine from a reduced model (order {}, {} poles, {} "
           "expansion points; its transfer within {:.1e} of the peak of the exact AC solution at "

@@ -2,9 +2,11 @@
 
 #include <fmt/format.h>
 
+#include "base/hex.h"
 #include "netlists/link/board.h"
 #include "netlists/link/cable.h"
 #include "netlists/link/cards.h"
+#include "netlists/spice_writer.h"
 
 namespace isolink::link {
 
@@ -239,6 +241,14 @@ StatusOr<ExpandedLink> expand_link(const LinkSpec& spec, const PartLibrary& part
   }
   if (spec.sim.reltol) out.netlist.options.push_back(option("reltol", *spec.sim.reltol));
   return out;
+}
+
+std::string circuit_key(const ExpandedLink& x) {
+  Netlist n = x.netlist;
+  n.title.clear();
+  std::string key = write_spice(n);
+  key += "\n* rules " + x.rules + "\n* expect " + to_hex(x.expected) + "\n";
+  return key;
 }
 
 }  // namespace isolink::link

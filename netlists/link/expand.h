@@ -68,4 +68,11 @@ struct ExpandedLink {
 StatusOr<ExpandedLink> expand_link(const LinkSpec& spec, const PartLibrary& parts, Direction d,
                                    const ExpandOptions& opt = {});
 
+// What makes two expanded directions the same analysis: the circuit and traffic as SPICE text
+// (the title, which names the spec, left out), the receiver's rules and the bytes it must decode.
+// A mirror-symmetric link (the same parts at both ends) has the same key both ways, as do the
+// identical hops of a pack (node names follow the roles): the link-level analyses compute one
+// result per key.
+std::string circuit_key(const ExpandedLink& x);
+
 }  // namespace isolink::link

@@ -108,28 +108,6 @@ TEST(SpiceReader, ElementsAndTitle) {
   EXPECT_FALSE(n.tran);
 }
 
-// same_circuit: cards, values, .tran and .options count; titles, layout and comments do not.
-TEST(SpiceReader, SameCircuitIgnoresTitleAndLayoutOnly) {
-  const std::string base = "* one\nR1 a b 1k\nC1 b 0 10n\nV1 a 0 PWL(0 0 1u 5)\n.tran 1n 10u\n";
-  StatusOr<Netlist> a = read_spice_text(base, "a.cir");
-  StatusOr<Netlist> b = read_spice_text(
-      "* another title\n\n* a comment\nR1   a b   1000\nC1 b 0 10e-9\nV1 a 0 PWL(0 0 1u 5)\n"
-      ".tran 1n 10u\n",
-      "b.cir");
-  ASSERT_TRUE(a.ok() && b.ok());
-  EXPECT_TRUE(same_circuit(*a, *b));
-  for (const std::string& other :
-       {std::string("* one\nR1 a b 1.1k\nC1 b 0 10n\nV1 a 0 PWL(0 0 1u 5)\n.tran 1n 10u\n"),
-        std::string("* one\nR1 a c 1k\nC1 b 0 10n\nV1 a 0 PWL(0 0 1u 5)\n.tran 1n 10u\n"),
-        std::string("* one\nR1 a b 1k\nC1 b 0 10n\nV1 a 0 PWL(0 0 2u 5)\n.tran 1n 10u\n"),
-        std::string("* one\nR1 a b 1k\nC1 b 0 10n\nV1 a 0 PWL(0 0 1u 5)\n.tran 1n 20u\n"),
-        base + ".options reltol=1e-4\n", base + "R2 b 0 1meg\n"}) {
-    StatusOr<Netlist> c = read_spice_text(other, "c.cir");
-    ASSERT_TRUE(c.ok()) << c.status().message();
-    EXPECT_FALSE(same_circuit(*a, *c)) << other;
-  }
-}
-
 TEST(SpiceReader, SourceValues) {
   Netlist n = read_ok(
       "sources\n"
