@@ -192,12 +192,29 @@ class Search {
   long pre() const { return pre_; }
   long len() const { return len_; }
 
+  // Builds the target's per-bit windows (PatternBasis); an error when the encoding breaks it.
+  Status init() {
+    StatusOr<PatternBasis> basis = pattern_basis(enc_);
+    if (!basis) return basis.status();
+    for (int b = 0; b <= kPatternBits; ++b) {
+      std::vector<double>& w = target_basis_[static_cast<size_t>(b)];
+      w.assign(static_cast<size_t>(len_), b == 0 ? e_.v_idle : 0.0);
+      std::vector<std::pair<long, int>> edges;
+      level_edges(b == 0 ? basis->base : basis->bit[static_cast<size_t>(b - 1)], pre_, half_,
+                  edges);
+      add_edges(e_, edges, 0, w);
+    }
+    return Status::Ok();
+  }
+
   // The target frame's own waveform (history idle) on the window; target starts at sample pre_.
   std::vector<double> target_wave(int pattern) const {
-    std::vector<double> v(static_cast<size_t>(len_), e_.v_idle);
-    std::vector<std::pair<long, int>> edges;
-    frame_edges(pattern_frame(pattern), enc_, pre_, half_, edges);
-    add_edges(e_, edges, 0, v);
+    std::vector<double> v = target_basis_[0];
+    for (int b = 0; b < kPatternBits; ++b) {
+      if (!(pattern >> b & 1)) continue;
+      const std::vector<double>& w = target_basis_[static_cast<size_t>(b + 1)];
+      for (size_t i = 0; i < v.size(); ++i) v[i] += w[i];
+    }
     return v;
   }
   // Adds the previous byte ending `gap` samples before the target's start.
@@ -229,6 +246,7 @@ class Search {
   traffic::EncodingOptions enc_;
   long half_ = 0, frame_ = 0, pre_ = 0, post_ = 0, len_ = 0;
   std::vector<double> t_;
+  std::array<std::vector<double>, kPatternBits + 1> target_basis_;  // v_idle + base, then bits
 };
 
 // Slope dv/dt at time a of sampled v (window times i * dt).
@@ -564,6 +582,7 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
   DirectionWorst dw;
   dw.rules = rules;
   Search search(e, rules, opt);
+  if (Status s = search.init(); !s.ok()) return s;
   const long half = search.half(), frame = search.frame(), pre = search.pre();
   const double dt = e.dt;
   const double byte_duration = static_cast<double>(frame) * dt;
@@ -699,7 +718,7 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
     std::sort(all.begin(), all.end());
     all.erase(std::unique(all.begin(), all.end()), all.end());
     const size_t ng = gaps.size();
-    std::vector<double> coef;  // per linear model: kCols rows of ng (constant, then per bit)
+    std::vector<double> coef;  // per linear model, per gap: kCols (constant, then per bit)
     for (size_t n = 0; n < all.size(); ++n) {
       const size_t ci = all[n];
       if (opt.progress)
@@ -716,12 +735,12 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
                                [&](const Linear& l) { return !wanted[l.metric]; }),
                 lin.end());
       // Each model's predicted key for previous pattern q at gap j is affine in q's bits:
-      // coef[0][j] + sum_b bit_b(q) coef[1 + b][j]. A term reads u at term.sample - pre + frame
-      // + g, so over the gap grid it is one strided sweep of each basis wave.
+      // c(j, 0) + sum_b bit_b(q) c(j, 1 + b), stored per model as [j][kCols]. A term reads u at
+      // term.sample - pre + frame + g, so over the gap grid it is one strided sweep of U.
       coef.assign(lin.size() * kCols * ng, 0.0);
       for (size_t li = 0; li < lin.size(); ++li) {
         double* cl = coef.data() + li * kCols * ng;
-        std::fill(cl, cl + ng, lin[li].key0);
+        for (size_t j = 0; j < ng; ++j) cl[j * kCols] = lin[li].key0;
         for (const Term& term : lin[li].terms) {
           // Gap indices whose read falls inside the wave: 0 <= at + gaps[j] < reach.
           const long at = term.sample - pre + frame;
@@ -732,88 +751,84 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
           for (long j = j0; j < j1; ++j) {
             const double* u = U.data() + static_cast<size_t>(first + j * gap_step) * kCols;
             for (size_t b = 0; b < kCols; ++b)
-              cl[b * ng + static_cast<size_t>(j)] += term.coef * u[b];
+              cl[static_cast<size_t>(j) * kCols + b] += term.coef * u[b];
           }
         }
       }
       auto key_of = [&](size_t li, int q, size_t j) {
         const double* cl = coef.data() + li * kCols * ng;
-        double y = cl[j];
+        double y = cl[j * kCols];
         for (size_t b = 0; b < kPatternBits; ++b)
-          if (q >> b & 1) y += cl[(b + 1) * ng + j];
+          if (q >> b & 1) y += cl[j * kCols + b + 1];
         return y;
       };
-      // The `verify` lowest histories (key, previous index, gap index), in order.
+      // Per metric, the `verify` lowest distinct histories (key, previous index, gap index), in
+      // order. A metric's key is the lowest of its models', so offering every model's values and
+      // keeping each history once, at its lowest, gives the metric's lowest histories; a value
+      // above the `verify`-th kept cannot enter (the kept one only gets lower).
       using Entry = std::tuple<double, size_t, size_t>;
-      auto offer = [&](std::vector<Entry>& top, const Entry& en) {
-        if (static_cast<int>(top.size()) >= opt.verify) {
-          if (!(en < top.back())) return;
-          top.pop_back();
-        }
-        top.insert(std::upper_bound(top.begin(), top.end(), en), en);
-      };
-      // A metric's key is the lowest of its models', so each of its `verify` lowest histories is
-      // among the `verify` lowest of the model that gives its key (fewer than `verify` histories
-      // are below it there): the union of the models' lowest, each re-keyed by every model of the
-      // metric, holds the metric's lowest. Per model and gap, with every pattern allowed, the
-      // lowest key sets the bits whose coefficient is negative, and the next lowest flip the bits
-      // with the smallest |coefficient|: the r-th lowest flips only bits among the r smallest
-      // (each flip adds |coefficient|), so the subsets of the `verify` smallest hold them all.
       std::array<std::vector<Entry>, kMetrics> top;
-      std::vector<Entry> model_top, pool;
-      const size_t r = std::min<size_t>(static_cast<size_t>(opt.verify), kPatternBits);
-      for (int m = 0; m < kMetrics; ++m) {
-        if (!wanted[m]) continue;
-        pool.clear();
-        for (size_t li = 0; li < lin.size(); ++li) {
-          if (lin[li].metric != m) continue;
-          model_top.clear();
-          const double* cl = coef.data() + li * kCols * ng;
-          for (size_t j = 0; j < ng; ++j) {
-            if (!every_pattern) {
-              for (size_t k = 0; k < previous.size(); ++k)
-                offer(model_top, {key_of(li, previous[k], j), k, j});
-              continue;
-            }
-            double lowest = cl[j];
-            int q = 0;
-            std::array<std::pair<double, int>, kPatternBits> mag;
-            for (int b = 0; b < kPatternBits; ++b) {
-              const double w = cl[(b + 1) * ng + j];
-              if (w < 0) lowest += w, q |= 1 << b;
-              mag[b] = {std::abs(w), b};
-            }
-            if (static_cast<int>(model_top.size()) >= opt.verify &&
-                lowest > std::get<0>(model_top.back()))
-              continue;
-            std::partial_sort(mag.begin(), mag.begin() + r, mag.end());
-            // The subsets in increasing order of their members (mag ascending): a member that
-            // pushes the key past the `verify`-th lowest ends its branch, as all later ones would.
-            auto visit = [&](auto&& self, size_t from, double key, int p) -> void {
-              offer(model_top, {key, static_cast<size_t>(p), j});
-              for (size_t i = from; i < r; ++i) {
-                const double next = key + mag[i].first;
-                if (static_cast<int>(model_top.size()) >= opt.verify &&
-                    next > std::get<0>(model_top.back()))
-                  break;
-                self(self, i + 1, next, p ^ (1 << mag[i].second));
-              }
-            };
-            visit(visit, 0, lowest, q);
-          }
-          pool.insert(pool.end(), model_top.begin(), model_top.end());
+      auto full = [&](const std::vector<Entry>& list) {
+        return static_cast<int>(list.size()) >= opt.verify;
+      };
+      auto offer = [&](std::vector<Entry>& list, const Entry& en) {
+        for (auto it = list.begin(); it != list.end(); ++it) {
+          if (std::get<1>(*it) != std::get<1>(en) || std::get<2>(*it) != std::get<2>(en)) continue;
+          if (!(en < *it)) return;  // the same history, already as low
+          list.erase(it);
+          break;
         }
-        std::sort(pool.begin(), pool.end(), [](const Entry& a, const Entry& b) {
-          return std::tie(std::get<1>(a), std::get<2>(a)) <
-                 std::tie(std::get<1>(b), std::get<2>(b));
-        });
-        for (size_t i = 0; i < pool.size(); ++i) {
-          const size_t k = std::get<1>(pool[i]), j = std::get<2>(pool[i]);
-          if (i > 0 && std::get<1>(pool[i - 1]) == k && std::get<2>(pool[i - 1]) == j) continue;
-          double key = kInf;
-          for (size_t li = 0; li < lin.size(); ++li)
-            if (lin[li].metric == m) key = std::min(key, key_of(li, previous[k], j));
-          offer(top[m], {key, k, j});
+        if (full(list)) {
+          if (!(en < list.back())) return;
+          list.pop_back();
+        }
+        list.insert(std::upper_bound(list.begin(), list.end(), en), en);
+      };
+      // Per model and gap, with every pattern allowed: the lowest key sets the bits whose
+      // coefficient is negative, and the next lowest flip the bits with the smallest
+      // |coefficient|; the r-th lowest flips only bits among the r smallest (each flip adds its
+      // |coefficient|), so the subsets of the `verify` smallest hold them all.
+      const size_t r = std::min<size_t>(static_cast<size_t>(opt.verify), kPatternBits);
+      for (size_t li = 0; li < lin.size(); ++li) {
+        std::vector<Entry>& tm = top[static_cast<size_t>(lin[li].metric)];
+        const double* cl = coef.data() + li * kCols * ng;
+        for (size_t j = 0; j < ng; ++j) {
+          if (!every_pattern) {
+            for (size_t k = 0; k < previous.size(); ++k)
+              offer(tm, {key_of(li, previous[k], j), k, j});
+            continue;
+          }
+          double lowest = cl[j * kCols];
+          int q = 0;
+          std::array<std::pair<double, int>, kPatternBits> mag;
+          for (int b = 0; b < kPatternBits; ++b) {
+            const double w = cl[j * kCols + static_cast<size_t>(b) + 1];
+            if (w < 0) lowest += w, q |= 1 << b;
+            mag[b] = {std::abs(w), b};
+          }
+          if (full(tm)) {
+            const double worst_kept = std::get<0>(tm.back());
+            if (lowest > worst_kept) continue;
+            // Only the best pattern itself can enter when one flip already costs too much.
+            double flip = kInf;
+            for (const auto& m2 : mag) flip = std::min(flip, m2.first);
+            if (lowest + flip > worst_kept) {
+              offer(tm, {lowest, static_cast<size_t>(q), j});
+              continue;
+            }
+          }
+          std::partial_sort(mag.begin(), mag.begin() + r, mag.end());
+          // The subsets in increasing order of their members (mag ascending): a member that
+          // pushes the key past the `verify`-th lowest ends its branch, as all later ones would.
+          auto visit = [&](auto&& self, size_t from, double key, int p) -> void {
+            offer(tm, {key, static_cast<size_t>(p), j});
+            for (size_t i = from; i < r; ++i) {
+              const double next = key + mag[i].first;
+              if (full(tm) && next > std::get<0>(tm.back())) break;
+              self(self, i + 1, next, p ^ (1 << mag[i].second));
+            }
+          };
+          visit(visit, 0, lowest, q);
         }
       }
       dw.ranked += static_cast<long>(previous.size() * ng);
@@ -822,12 +837,20 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
         for (const auto& [key, k, j] : tm) exact.push_back({k, gaps[j]});
       std::sort(exact.begin(), exact.end());
       exact.erase(std::unique(exact.begin(), exact.end()), exact.end());
+      std::vector<double> v(base.size());
       for (const auto& [k, g] : exact) {
-        std::vector<double> v = base;
-        search.add_previous(v, previous[k], g);
+        // base + u_q over the window, from the basis (the same sums add_previous makes).
+        const int q = previous[k];
+        for (size_t i = 0; i < v.size(); ++i) {
+          const double* u = U.data() + (static_cast<long>(i) - pre + frame + g) * kCols;
+          double sum = base[i] + u[0];
+          for (int b = 0; b < kPatternBits; ++b)
+            if (q >> b & 1) sum += u[b + 1];
+          v[i] = sum;
+        }
         StatusOr<Score> sc = search.score(v, t);
         if (!sc) return sc.status();
-        consider(*sc, t, previous[k], g);
+        consider(*sc, t, q, g);
       }
     }
   }
