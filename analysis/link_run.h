@@ -58,6 +58,16 @@ const std::vector<std::string>& run_probes();
 
 StatusOr<LinkRun> run_link(const link::LinkSpec& spec, const link::PartLibrary& parts,
                            const RunOptions& opt = {});
+// run_link for a caller that computes the worst case as well (the sweep): each direction's edge
+// response (edge_response with `wopt`) also gives its traffic's v(rxp,rxn), by exact
+// superposition on the response's 1 ns grid (run_direction_synthesized), instead of a second
+// model of the link and a finer output grid. A direction whose drive is off that grid is
+// simulated (run_direction). `edges` receives one response per direction, for worst_case, or
+// none when a direction was simulated. A direction with the same circuit key as one before
+// (link::circuit_key) takes its response and result (same_as).
+StatusOr<LinkRun> run_link_from_edges(const link::LinkSpec& spec, const link::PartLibrary& parts,
+                                      const RunOptions& opt, const WorstOptions& wopt,
+                                      std::vector<EdgeResponse>& edges);
 // One expanded direction simulated and scored: run_link's work per direction (packs expand every
 // hop first and simulate each distinct circuit once).
 StatusOr<DirectionRun> run_direction(link::ExpandedLink link, const RunOptions& opt = {});

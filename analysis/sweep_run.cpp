@@ -15,7 +15,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <optional>
 #include <sstream>
 #include <system_error>
 
@@ -384,43 +383,13 @@ PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t
       return r;
     }
     // With the worst case asked for (and no waveform files), each direction's edge response
-    // serves both: the spec traffic's v(rxp,rxn) is its exact superposition (the LTI engine's
-    // answer on the response's 1 ns grid, run_direction_synthesized) instead of a second model
-    // of the link and a finer output grid. Traffic off that grid is simulated as before.
+    // serves both (run_link_from_edges).
     const WorstOptions wopt{.expand = opt.run.expand};
     std::vector<EdgeResponse> edges;
-    StatusOr<LinkRun> run = Status::Error("not run");
-    if (s.worst_outputs && opt.waves_dir.empty() && opt.run.engine != Engine::Transient) {
-      LinkRun lr;
-      lr.pass = true;
-      for (link::Direction d : po.point.spec.stimulus.directions) {
-        StatusOr<link::ExpandedLink> ex =
-            link::expand_link(po.point.spec, parts, d, opt.run.expand);
-        if (!ex) return fail(ex.status().message());
-        StatusOr<DirectionRun> dr = Status::Error("not run");
-        if (on_grid(ex->drive, wopt.dt)) {
-          // The same circuit as a direction before (a mirror-symmetric link): its response.
-          std::optional<EdgeResponse> same;
-          for (size_t k = 0; edges.size() == lr.directions.size() && k < edges.size() && !same; ++k)
-            if (link::circuit_key(lr.directions[k].link) == link::circuit_key(*ex)) same = edges[k];
-          StatusOr<EdgeResponse> e =
-              same ? std::move(*same) : edge_response(po.point.spec, parts, d, wopt);
-          if (!e) return fail("worst: " + e.status().message());
-          dr = run_direction_synthesized(std::move(*ex), *e);
-          edges.push_back(std::move(*e));
-        } else {
-          dr = run_direction(std::move(*ex), opt.run);
-        }
-        if (!dr) return fail(dr.status().message());
-        lr.pass = lr.pass && dr->pass;
-        lr.seconds += dr->sim.seconds;
-        lr.directions.push_back(std::move(*dr));
-      }
-      if (edges.size() != lr.directions.size()) edges.clear();
-      run = std::move(lr);
-    } else {
-      run = run_link(po.point.spec, parts, opt.run);
-    }
+    StatusOr<LinkRun> run =
+        s.worst_outputs && opt.waves_dir.empty() && opt.run.engine != Engine::Transient
+            ? run_link_from_edges(po.point.spec, parts, opt.run, wopt, edges)
+            : run_link(po.point.spec, parts, opt.run);
     if (!run) return fail(run.status().message());
     std::vector<std::string> cells = std::move(r.cells);
     r = score_run(*run);

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 #include "netlists/link/link_spec.h"
 
@@ -44,6 +45,24 @@ TEST(LinkRun, MirrorSymmetricDirectionIsSimulatedOnce) {
   EXPECT_EQ(up->directions[0].sim.wave.columns[0], both->directions[1].sim.wave.columns[0]);
   EXPECT_EQ(*up->directions[0].data->vstart_min(), *both->directions[1].data->vstart_min());
   EXPECT_EQ(up->pass, both->directions[1].pass);
+
+  // The sweep's path: one edge response per direction (the second the first's), the traffic
+  // superposed from it, within 1 mV of the simulated run's VSTART.
+  std::vector<EdgeResponse> edges;
+  StatusOr<LinkRun> from_edges =
+      run_link_from_edges(spec_of(xfmr, "both"), *parts, {}, WorstOptions{}, edges);
+  ASSERT_TRUE(from_edges.ok()) << from_edges.status().message();
+  ASSERT_EQ(edges.size(), 2u);
+  EXPECT_EQ(edges[0].e, edges[1].e);
+  ASSERT_EQ(from_edges->directions.size(), 2u);
+  EXPECT_EQ(from_edges->directions[1].same_as, "down");
+  for (size_t k = 0; k < 2; ++k) {
+    ASSERT_TRUE(from_edges->directions[k].data);
+    EXPECT_NE(from_edges->directions[k].sim.engine_note.find("synthesized"), std::string::npos);
+    EXPECT_NEAR(*from_edges->directions[k].data->vstart_min(),
+                *both->directions[k].data->vstart_min(), 1e-3);
+    EXPECT_EQ(from_edges->directions[k].pass, both->directions[k].pass);
+  }
 
   StatusOr<LinkRun> asym = run_link(spec_of("{type: cap}", "both"), *parts);
   ASSERT_TRUE(asym.ok()) << asym.status().message();
