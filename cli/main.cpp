@@ -1,10 +1,17 @@
 // isolink: signal-integrity analyzer for BMS daisy-chain links.
 #include <CLI/CLI.hpp>
+#include <malloc.h>
 #include <cstdio>
 
 #include "cli/commands.h"
 
 int main(int argc, char** argv) {
+  // Every sweep point, edge response and model allocates and frees the same large arrays (MBs):
+  // keep them in the heap (up to 32 MB each, 512 MB of free memory before trimming) rather than
+  // unmapped and faulted in again each time. Measured 2026-12-01: a worst-case sweep runs 17 %
+  // faster (bench/README.md). Peak memory is unchanged; only freed memory is kept for reuse.
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);
+  mallopt(M_TRIM_THRESHOLD, 512 << 20);
   CLI::App app{"isolink: signal integrity of BMS daisy-chain links (BQ7961x, BQ79600, BQ79606A)"};
   app.require_subcommand(1);
   int exit_code = 0;
