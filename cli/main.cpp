@@ -1,6 +1,7 @@
 // isolink: signal-integrity analyzer for BMS daisy-chain links.
-#include <CLI/CLI.hpp>
 #include <malloc.h>
+
+#include <CLI/CLI.hpp>
 #include <cstdio>
 
 #include "cli/commands.h"
