@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 
 namespace isolink::analysis {
 
@@ -104,8 +105,15 @@ Status score_direction(DirectionRun& dr) {
   return Status::Ok();
 }
 
-StatusOr<LinkRun> run_link(const link::LinkSpec& spec, const link::PartLibrary& parts,
-                           const RunOptions& opt) {
+namespace {
+
+// The directions of spec.stimulus.directions, each expanded and run by `one`; a direction with the
+// same circuit key as one before (link::circuit_key) gets a copy of that result (same_as) and
+// `copied(index of the original)` instead.
+StatusOr<LinkRun> run_each_direction(
+    const link::LinkSpec& spec, const link::PartLibrary& parts, const RunOptions& opt,
+    const std::function<StatusOr<DirectionRun>(link::ExpandedLink, link::Direction)>& one,
+    const std::function<void(size_t)>& copied) {
   LinkRun run;
   const auto start = std::chrono::steady_clock::now();
   run.pass = true;
@@ -116,17 +124,17 @@ StatusOr<LinkRun> run_link(const link::LinkSpec& spec, const link::PartLibrary& 
     keys.push_back(link::circuit_key(*ex));
     const size_t same =
         static_cast<size_t>(std::find(keys.begin(), keys.end() - 1, keys.back()) - keys.begin());
+    StatusOr<DirectionRun> dr = Status::Error("not run");
     if (same + 1 < keys.size()) {
-      DirectionRun dr = run.directions[same];
-      dr.same_as = link::direction_name(dr.link.direction);
-      dr.link = std::move(*ex);
-      dr.sim.seconds = 0;  // nothing simulated for it
-      run.pass = run.pass && dr.pass;
-      run.directions.push_back(std::move(dr));
-      continue;
+      dr = run.directions[same];
+      dr->same_as = link::direction_name(dr->link.direction);
+      dr->link = std::move(*ex);
+      dr->sim.seconds = 0;  // nothing computed for it
+      copied(same);
+    } else {
+      dr = one(std::move(*ex), d);
+      if (!dr) return dr.status();
     }
-    StatusOr<DirectionRun> dr = run_direction(std::move(*ex), opt);
-    if (!dr) return dr.status();
     run.pass = run.pass && dr->pass;
     run.directions.push_back(std::move(*dr));
   }
@@ -134,45 +142,39 @@ StatusOr<LinkRun> run_link(const link::LinkSpec& spec, const link::PartLibrary& 
   return run;
 }
 
+}  // namespace
+
+StatusOr<LinkRun> run_link(const link::LinkSpec& spec, const link::PartLibrary& parts,
+                           const RunOptions& opt) {
+  return run_each_direction(
+      spec, parts, opt,
+      [&](link::ExpandedLink ex, link::Direction) { return run_direction(std::move(ex), opt); },
+      [](size_t) {});
+}
+
 StatusOr<LinkRun> run_link_from_edges(const link::LinkSpec& spec, const link::PartLibrary& parts,
                                       const RunOptions& opt, const WorstOptions& wopt,
                                       std::vector<EdgeResponse>& edges) {
-  LinkRun run;
-  const auto start = std::chrono::steady_clock::now();
-  run.pass = true;
   edges.clear();
-  std::vector<std::string> keys;  // link::circuit_key per direction done
-  for (link::Direction d : spec.stimulus.directions) {
-    StatusOr<link::ExpandedLink> ex = link::expand_link(spec, parts, d, opt.expand);
-    if (!ex) return ex.status();
-    keys.push_back(link::circuit_key(*ex));
-    const size_t same =
-        static_cast<size_t>(std::find(keys.begin(), keys.end() - 1, keys.back()) - keys.begin());
-    if (same + 1 < keys.size()) {
-      DirectionRun dr = run.directions[same];
-      dr.same_as = link::direction_name(dr.link.direction);
-      dr.link = std::move(*ex);
-      dr.sim.seconds = 0;  // nothing computed for it
-      if (edges.size() > same) edges.push_back(edges[same]);
-      run.pass = run.pass && dr.pass;
-      run.directions.push_back(std::move(dr));
-      continue;
-    }
-    StatusOr<DirectionRun> dr = Status::Error("not run");
-    if (on_grid(ex->drive, wopt.dt) && edges.size() == run.directions.size()) {
-      StatusOr<EdgeResponse> e = edge_response(spec, parts, d, wopt);
-      if (!e) return e.status().with_context("worst case");
-      dr = run_direction_synthesized(std::move(*ex), *e);
-      edges.push_back(std::move(*e));
-    } else {
-      dr = run_direction(std::move(*ex), opt);
-    }
-    if (!dr) return dr.status();
-    run.pass = run.pass && dr->pass;
-    run.directions.push_back(std::move(*dr));
-  }
-  if (edges.size() != run.directions.size()) edges.clear();
-  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  size_t done =
+      0;  // directions run so far (edges has one per direction while all were synthesized)
+  StatusOr<LinkRun> run = run_each_direction(
+      spec, parts, opt,
+      [&](link::ExpandedLink ex, link::Direction d) -> StatusOr<DirectionRun> {
+        const bool all_synthesized = edges.size() == done++;
+        if (!on_grid(ex.drive, wopt.dt) || !all_synthesized)
+          return run_direction(std::move(ex), opt);
+        StatusOr<EdgeResponse> e = edge_response(spec, parts, d, wopt);
+        if (!e) return e.status().with_context("worst case");
+        StatusOr<DirectionRun> dr = run_direction_synthesized(std::move(ex), *e);
+        edges.push_back(std::move(*e));
+        return dr;
+      },
+      [&](size_t same) {
+        if (edges.size() == done && same < edges.size()) edges.push_back(edges[same]);
+        ++done;
+      });
+  if (run && edges.size() != run->directions.size()) edges.clear();
   return run;
 }
 

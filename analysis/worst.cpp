@@ -35,6 +35,12 @@ long to_samples(double t, double dt) {
   return std::lround(t / dt);
 }
 
+// Whether time t falls on a grid of step dt (within 1e-6 of a step).
+bool on_sample(double t, double dt) {
+  const double n = t / dt;
+  return std::abs(n - std::round(n)) <= 1e-6;
+}
+
 // A byte pattern: byte | error_bit << 8.
 ByteFrame pattern_frame(int pattern) {
   return {static_cast<uint8_t>(pattern & 0xFF), (pattern >> 8) & 1};
@@ -187,6 +193,7 @@ class Search {
     for (long i = 0; i < len_; ++i) t_[static_cast<size_t>(i)] = static_cast<double>(i) * e.dt;
   }
 
+  const PatternBasis& basis() const { return basis_; }
   long half() const { return half_; }
   long frame() const { return frame_; }
   long pre() const { return pre_; }
@@ -196,6 +203,7 @@ class Search {
   Status init() {
     StatusOr<PatternBasis> basis = pattern_basis(enc_);
     if (!basis) return basis.status();
+    basis_ = *basis;
     for (int b = 0; b <= kPatternBits; ++b) {
       std::vector<double>& w = target_basis_[static_cast<size_t>(b)];
       w.assign(static_cast<size_t>(len_), b == 0 ? e_.v_idle : 0.0);
@@ -246,6 +254,7 @@ class Search {
   traffic::EncodingOptions enc_;
   long half_ = 0, frame_ = 0, pre_ = 0, post_ = 0, len_ = 0;
   std::vector<double> t_;
+  PatternBasis basis_;
   std::array<std::vector<double>, kPatternBits + 1> target_basis_;  // v_idle + base, then bits
 };
 
@@ -555,7 +564,7 @@ StatusOr<Waveform> synthesize_drive(const EdgeResponse& e, const traffic::Drive&
   int level = 0;
   for (const traffic::DriveSegment& g : drive.segments) {
     if (g.level == level) continue;
-    if (!on_grid({{g}}, e.dt))
+    if (!on_sample(g.start, e.dt))
       return Status::Error(fmt::format(
           "the drive changes level at {:.6g} us, off the {:g} ns grid of the edge response",
           g.start * 1e6, e.dt * 1e9));
@@ -679,8 +688,7 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
   } else if (history) {
     // The previous byte's response per pattern bit (PatternBasis): u_q at window sample i for
     // gap g is U_0(i - pre + frame + g) + sum_b bit_b(q) U_{1 + b}(i - pre + frame + g).
-    StatusOr<PatternBasis> basis = pattern_basis(opt.expand.stimulus.encoding);
-    if (!basis) return basis.status();
+    const PatternBasis& basis = search.basis();
     const long reach = frame + gap_max + search.len();
     // Interleaved, U[i * kCols + b]: a read at one sample takes all kCols columns at once.
     constexpr size_t kCols = kPatternBits + 1;
@@ -688,7 +696,7 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
     for (size_t b = 0; b < kCols; ++b) {
       std::vector<double> u(static_cast<size_t>(reach), 0.0);
       std::vector<std::pair<long, int>> edges;
-      level_edges(b == 0 ? basis->base : basis->bit[b - 1], 0, half, edges);
+      level_edges(b == 0 ? basis.base : basis.bit[b - 1], 0, half, edges);
       add_edges(e, edges, 0, u);
       for (size_t i = 0; i < u.size(); ++i) U[i * kCols + b] = u[i];
     }
@@ -893,10 +901,8 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
 }
 
 bool on_grid(const traffic::Drive& drive, double dt) {
-  for (const traffic::DriveSegment& g : drive.segments) {
-    const double n = g.start / dt;
-    if (!(std::abs(n - std::round(n)) <= 1e-6)) return false;
-  }
+  for (const traffic::DriveSegment& g : drive.segments)
+    if (!on_sample(g.start, dt)) return false;
   return true;
 }
 
