@@ -5,7 +5,10 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <mutex>
 #include <numbers>
+#include <string>
 
 #include "netlists/link/cards.h"
 
@@ -335,8 +338,10 @@ cd CableModel::target_z0_diff(double f) const {
   return std::sqrt(target_series_impedance_diff(f) / target_shunt_admittance_diff(f));
 }
 
-StatusOr<CableModel> cable_model(const CableSpec& spec) {
-  if (Status s = spec.validate(); !s.ok()) return s;
+namespace {
+
+// cable_model without the cache: everything but `length` is per metre.
+StatusOr<CableModel> compute_cable_model(const CableSpec& spec) {
   CableModel m;
   m.length = spec.length;
   m.material = spec.material;
@@ -432,6 +437,42 @@ StatusOr<CableModel> cable_model(const CableSpec& spec) {
   }
 
   if (m.skin_effect && m.r_dc > 0) m.skin = fit_skin(m);
+  return m;
+}
+
+// What the per-metre model depends on: every field but the length and the ladder's layout
+// (segments, loss_stride), exactly (hex floats).
+std::string per_metre_key(const CableSpec& spec) {
+  auto opt = [](const std::optional<double>& x) { return x ? fmt::format("{:a}", *x) : "-"; };
+  return fmt::format("{}|{}|{:a}|{}|{}|{}|{}|{}|{}|{}", spec.material, spec.gauge, spec.temperature,
+                     opt(spec.r), opt(spec.l), opt(spec.c), opt(spec.g), opt(spec.chassis_c),
+                     spec.skin_effect, spec.dielectric_loss);
+}
+
+}  // namespace
+
+StatusOr<CableModel> cable_model(const CableSpec& spec) {
+  if (Status s = spec.validate(); !s.ok()) return s;
+  // The ladder fits (a few ms) do not depend on the length, and a length sweep expands the same
+  // cable several times per point (the edge response, both directions, the worst case): the
+  // per-metre models are kept, at most kKept of them, shared by the threads.
+  constexpr size_t kKept = 64;
+  static std::mutex mutex;
+  static std::map<std::string, CableModel> kept;
+  const std::string key = per_metre_key(spec);
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (auto it = kept.find(key); it != kept.end()) {
+      CableModel m = it->second;
+      m.length = spec.length;
+      return m;
+    }
+  }
+  StatusOr<CableModel> m = compute_cable_model(spec);
+  if (!m) return m;
+  std::lock_guard<std::mutex> lock(mutex);
+  if (kept.size() >= kKept) kept.clear();
+  kept.emplace(key, *m);
   return m;
 }
 

@@ -119,6 +119,46 @@ TEST(Cable, PresetsFollowTheFormulas) {
   EXPECT_NEAR(std::real(e->shunt_admittance_diff(1e6)), 1e-6, 0.03e-6);
 }
 
+// cable_model keeps the per-metre models it has fitted (a length sweep expands one cable many
+// times): a second length takes the kept one with its own length, and a spec that differs in any
+// other field is fitted anew.
+TEST(Cable, KeptModelsServeOtherLengthsOnly) {
+  CableSpec base;
+  base.length = 3;
+  auto a = cable_model(base);
+  ASSERT_TRUE(a.ok());
+  base.length = 17;
+  auto b = cable_model(base);
+  ASSERT_TRUE(b.ok());
+  EXPECT_EQ(a->length, 3);
+  EXPECT_EQ(b->length, 17);
+  EXPECT_EQ(a->r_dc, b->r_dc);
+  ASSERT_EQ(a->skin.size(), b->skin.size());
+  for (size_t i = 0; i < a->skin.size(); ++i) EXPECT_EQ(a->skin[i].r, b->skin[i].r);
+  // Each field the model depends on, changed alone after the base was kept: a different model.
+  auto differs = [&](const char* what, auto change) {
+    SCOPED_TRACE(what);
+    CableSpec s = base;
+    change(s);
+    auto m = cable_model(s);
+    ASSERT_TRUE(m.ok()) << m.status().message();
+    const bool same = m->r_dc == b->r_dc && m->l_diff == b->l_diff && m->c_pn == b->c_pn &&
+                      m->c_g == b->c_g && m->tan_delta_eff == b->tan_delta_eff &&
+                      m->skin.size() == b->skin.size() && m->er == b->er;
+    EXPECT_FALSE(same);
+  };
+  differs("material", [](CableSpec& s) { s.material = "pvc"; });
+  differs("gauge", [](CableSpec& s) { s.gauge = 26; });
+  differs("temperature", [](CableSpec& s) { s.temperature = 60; });
+  differs("r", [](CableSpec& s) { s.r = 0.05; });
+  differs("l", [](CableSpec& s) { s.l = 0.6e-6; });
+  differs("c", [](CableSpec& s) { s.c = 50e-12; });
+  differs("g", [](CableSpec& s) { s.g = 1e-6; });
+  differs("chassis_c", [](CableSpec& s) { s.chassis_c = 20e-12; });
+  differs("skin_effect", [](CableSpec& s) { s.skin_effect = false; });
+  differs("dielectric_loss", [](CableSpec& s) { s.dielectric_loss = false; });
+}
+
 TEST(Cable, ValidationNamesTheField) {
   CableSpec s;
   s.length = -1;
