@@ -529,16 +529,107 @@ void LtiResponses::modal_add(const std::vector<SourceInput>& inputs,
     }
     for (size_t k = 0; k < nk; ++k) u[k] += slope[k] * h;
   };
+  // Tail: past the last corner, with every source's slope back to zero (up to rounding), each
+  // mode's input b is constant. A mode that decays within what is left of the record (|Re p|
+  // times the span left above 1) is written x = x_ss + d, x_ss = -b / p its steady state, and
+  // d just decays by e^{p h}: its share of a probe is the constant Re(out x_ss) plus Re(out d),
+  // and once max_p |out_pi d_i| is below kTailTol of that probe's scale it leaves the loop for
+  // good (|e^{p h}| < 1). Slower modes keep the exact update. A long record after the last edge
+  // (the worst-case search's edge response: 160,000 samples) then costs the slow modes alone.
+  constexpr double kTailTol = 1e-13;
+  std::vector<double> slope_scale(nk, 0.0);  // largest |slope| a source has had
+  bool tail = false;
+  std::vector<size_t> slow, fast;  // mode indices in the tail; fast ones are dropped when decayed
+  std::vector<double> dr, di;      // per fast mode: d = x - x_ss
+  std::vector<double> tail_const;  // per probe: what the modes settle to, and the direct term
+  std::vector<double> tail_scale;  // per probe: |tail_const| + sum |out d| at the tail's start
+  auto enter_tail = [&](double left) {
+    for (size_t k = 0; k < nk; ++k)
+      if (std::fabs(slope[k]) > 1e-12 * slope_scale[k]) return;
+    tail_const.assign(np, 0.0);
+    tail_scale.assign(np, 0.0);
+    for (size_t p = 0; p < np; ++p)
+      for (size_t k = 0; k < nk; ++k) tail_const[p] += m.direct[k][p] * u[k];
+    for (size_t i = 0; i < nm; ++i) {
+      const std::complex<double> pole = m.poles[i];
+      if (!(-pole.real() * left > 1.0)) {
+        slow.push_back(i);
+        continue;
+      }
+      const std::complex<double> xss = -std::complex<double>(br[i], bi[i]) / pole;
+      fast.push_back(i);
+      dr.push_back(xr[i] - xss.real());
+      di.push_back(xi[i] - xss.imag());
+      for (size_t p = 0; p < np; ++p) {
+        tail_const[p] += outr[p][i] * xss.real() - outi[p][i] * xss.imag();
+        tail_scale[p] += std::abs(m.output[p][i]) * std::hypot(dr.back(), di.back());
+      }
+    }
+    for (size_t p = 0; p < np; ++p) tail_scale[p] += std::fabs(tail_const[p]);
+    tail = true;
+  };
+  // One tail step of h: the slow modes' exact update, the fast ones' decay.
+  auto tail_step = [&](double h) {
+    if (!(h > 0)) return;
+    const Step* st = &uniform;
+    if (!(std::fabs(h - uniform.h) <= 1e-9 * uniform.h)) {
+      if (!(std::fabs(h - scratch.h) <= 1e-9 * scratch.h)) scratch.set(m, h);
+      st = &scratch;
+    }
+    for (size_t i : slow) {
+      const double nr =
+          st->er[i] * xr[i] - st->ei[i] * xi[i] + st->f1r[i] * br[i] - st->f1i[i] * bi[i];
+      const double ni =
+          st->er[i] * xi[i] + st->ei[i] * xr[i] + st->f1r[i] * bi[i] + st->f1i[i] * br[i];
+      xr[i] = nr, xi[i] = ni;
+    }
+    for (size_t f = 0; f < fast.size(); ++f) {
+      const size_t i = fast[f];
+      const double nr = st->er[i] * dr[f] - st->ei[i] * di[f];
+      const double ni = st->er[i] * di[f] + st->ei[i] * dr[f];
+      dr[f] = nr, di[f] = ni;
+    }
+  };
+  // Drops the fast modes whose share of every probe has decayed below kTailTol of its scale.
+  auto prune = [&]() {
+    size_t kept = 0;
+    for (size_t f = 0; f < fast.size(); ++f) {
+      const size_t i = fast[f];
+      const double d = std::hypot(dr[f], di[f]);
+      bool live = false;
+      for (size_t p = 0; p < np && !live; ++p)
+        live = std::abs(m.output[p][i]) * d > kTailTol * tail_scale[p];
+      if (!live) continue;
+      fast[kept] = i, dr[kept] = dr[f], di[kept] = di[f];
+      ++kept;
+    }
+    fast.resize(kept), dr.resize(kept), di.resize(kept);
+  };
   double tc = times.empty() ? 0.0 : times[0];
   if (!corners.empty()) tc = std::min(tc, corners[0].t);
   size_t c = 0;
   for (size_t j = 0; j < times.size(); ++j) {
     const double tq = times[j];
+    if (tail) {
+      tail_step(tq - tc);
+      tc = tq;
+      if (j % 64 == 0) prune();
+      for (size_t p = 0; p < np; ++p) {
+        double d = tail_const[p];
+        for (size_t i : slow) d += outr[p][i] * xr[i] - outi[p][i] * xi[i];
+        for (size_t f = 0; f < fast.size(); ++f)
+          d += outr[p][fast[f]] * dr[f] - outi[p][fast[f]] * di[f];
+        out[p][j] += d;
+      }
+      continue;
+    }
     for (; c < corners.size() && corners[c].t <= tq; ++c) {
       advance(corners[c].t - tc);
       tc = corners[c].t;
       active = true;
       slope[corners[c].k] += corners[c].slope;
+      slope_scale[corners[c].k] = std::max(
+          {slope_scale[corners[c].k], std::fabs(corners[c].slope), std::fabs(slope[corners[c].k])});
       const auto& in = m.input[corners[c].k];
       for (size_t i = 0; i < nm; ++i)
         gr[i] += in[i].real() * corners[c].slope, gi[i] += in[i].imag() * corners[c].slope;
@@ -546,6 +637,7 @@ void LtiResponses::modal_add(const std::vector<SourceInput>& inputs,
     advance(tq - tc);
     tc = tq;
     if (!active) continue;
+    if (c == corners.size() && j + 1 < times.size()) enter_tail(times.back() - tc);
     for (size_t p = 0; p < np; ++p) {
       const double *orr = outr[p].data(), *oi = outi[p].data();
       double y0 = 0, y1 = 0;  // two partial sums: a shorter dependency chain
