@@ -797,6 +797,7 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
       // |coefficient|; the r-th lowest flips only bits among the r smallest (each flip adds its
       // |coefficient|), so the subsets of the `verify` smallest hold them all.
       const size_t r = std::min<size_t>(static_cast<size_t>(opt.verify), kPatternBits);
+      std::array<std::pair<double, int>, kPatternBits> mag;  // |coefficient|, bit
       for (size_t li = 0; li < lin.size(); ++li) {
         std::vector<Entry>& tm = top[static_cast<size_t>(lin[li].metric)];
         const double* cl = coef.data() + li * kCols * ng;
@@ -808,7 +809,6 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
           }
           double lowest = cl[j * kCols];
           int q = 0;
-          std::array<std::pair<double, int>, kPatternBits> mag;
           for (int b = 0; b < kPatternBits; ++b) {
             const double w = cl[j * kCols + static_cast<size_t>(b) + 1];
             if (w < 0) lowest += w, q |= 1 << b;
