@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -204,25 +205,39 @@ class Search {
     StatusOr<PatternBasis> basis = pattern_basis(enc_);
     if (!basis) return basis.status();
     basis_ = *basis;
+    std::array<std::vector<double>, kPatternBits + 1> columns;  // v_idle + base, then per bit
     for (int b = 0; b <= kPatternBits; ++b) {
-      std::vector<double>& w = target_basis_[static_cast<size_t>(b)];
+      std::vector<double>& w = columns[static_cast<size_t>(b)];
       w.assign(static_cast<size_t>(len_), b == 0 ? e_.v_idle : 0.0);
       std::vector<std::pair<long, int>> edges;
       level_edges(b == 0 ? basis->base : basis->bit[static_cast<size_t>(b - 1)], pre_, half_,
                   edges);
       add_edges(e_, edges, 0, w);
     }
+    // The sums of the columns over every subset of the low and of the high bits: a pattern's
+    // wave is then two additions (512 of them in the idle-target stage).
+    for (int part = 0; part < 2; ++part) {
+      const int first = part == 0 ? 0 : kLowBits,
+                count = part == 0 ? kLowBits : kPatternBits - kLowBits;
+      std::vector<std::vector<double>>& sums = subset_sums_[static_cast<size_t>(part)];
+      sums.assign(size_t{1} << count, std::vector<double>(static_cast<size_t>(len_), 0.0));
+      if (part == 0) sums[0] = columns[0];
+      for (size_t s = 1; s < sums.size(); ++s) {
+        const int low = std::countr_zero(s);  // s = (s without its lowest bit) + that bit
+        const std::vector<double>& rest = sums[s & (s - 1)];
+        const std::vector<double>& w = columns[static_cast<size_t>(first + low + 1)];
+        for (size_t i = 0; i < w.size(); ++i) sums[s][i] = rest[i] + w[i];
+      }
+    }
     return Status::Ok();
   }
 
   // The target frame's own waveform (history idle) on the window; target starts at sample pre_.
   std::vector<double> target_wave(int pattern) const {
-    std::vector<double> v = target_basis_[0];
-    for (int b = 0; b < kPatternBits; ++b) {
-      if (!(pattern >> b & 1)) continue;
-      const std::vector<double>& w = target_basis_[static_cast<size_t>(b + 1)];
-      for (size_t i = 0; i < v.size(); ++i) v[i] += w[i];
-    }
+    const std::vector<double>& a = subset_sums_[0][static_cast<size_t>(pattern & kLowMask)];
+    const std::vector<double>& b = subset_sums_[1][static_cast<size_t>(pattern >> kLowBits)];
+    std::vector<double> v(a.size());
+    for (size_t i = 0; i < v.size(); ++i) v[i] = a[i] + b[i];
     return v;
   }
   // Adds the previous byte ending `gap` samples before the target's start.
@@ -255,7 +270,9 @@ class Search {
   long half_ = 0, frame_ = 0, pre_ = 0, post_ = 0, len_ = 0;
   std::vector<double> t_;
   PatternBasis basis_;
-  std::array<std::vector<double>, kPatternBits + 1> target_basis_;  // v_idle + base, then bits
+  static constexpr int kLowBits = 5, kLowMask = (1 << kLowBits) - 1;
+  // [0][s]: v_idle + base + the bit columns of low-bit subset s; [1][s]: those of high-bit s.
+  std::array<std::vector<std::vector<double>>, 2> subset_sums_;
 };
 
 // Slope dv/dt at time a of sampled v (window times i * dt).
@@ -438,6 +455,7 @@ StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::Par
     LtiOptions lo;
     lo.method = LtiOptions::Method::Reduced;
     lo.horizon = lead + opt.max_span;
+    lo.reduced.start_points = opt.model_start_points;
     if (opt.progress) opt.progress("edge response, reduced model", 0.0);
     StatusOr<LtiResponses> lti = LtiResponses::compute(circuit, {*probe}, lo);
     if (lti) {
@@ -461,6 +479,7 @@ StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::Par
           "reduced model (order {}, {} poles, {} expansion points, AC error {:.1e} of peak up to "
           "3 GHz), sampled on a {:g} ns grid",
           m.order, m.poles, m.expansion_points, m.error, opt.dt * 1e9);
+      out.expansion_points = m.points;
       out.seconds = seconds_since(start);
       return out;
     }
@@ -692,9 +711,12 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
     const long reach = frame + gap_max + search.len();
     // Interleaved, U[i * kCols + b]: a read at one sample takes all kCols columns at once.
     constexpr size_t kCols = kPatternBits + 1;
+    // The columns themselves too (Ucol[b][i]): an exact wave adds only its pattern's set bits.
     std::vector<double> U(static_cast<size_t>(reach) * kCols);
+    std::array<std::vector<double>, kCols> Ucol;
     for (size_t b = 0; b < kCols; ++b) {
-      std::vector<double> u(static_cast<size_t>(reach), 0.0);
+      std::vector<double>& u = Ucol[b];
+      u.assign(static_cast<size_t>(reach), 0.0);
       std::vector<std::pair<long, int>> edges;
       level_edges(b == 0 ? basis.base : basis.bit[b - 1], 0, half, edges);
       add_edges(e, edges, 0, u);
@@ -849,12 +871,13 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
       for (const auto& [k, g] : exact) {
         // base + u_q over the window, from the basis (the same sums add_previous makes).
         const int q = previous[k];
-        for (size_t i = 0; i < v.size(); ++i) {
-          const double* u = U.data() + (static_cast<long>(i) - pre + frame + g) * kCols;
-          double sum = base[i] + u[0];
-          for (int b = 0; b < kPatternBits; ++b)
-            if (q >> b & 1) sum += u[b + 1];
-          v[i] = sum;
+        const size_t off = static_cast<size_t>(frame + g - pre);  // window sample 0 in U
+        const double* u0 = Ucol[0].data() + off;
+        for (size_t i = 0; i < v.size(); ++i) v[i] = base[i] + u0[i];
+        for (int b = 0; b < kPatternBits; ++b) {
+          if (!(q >> b & 1)) continue;
+          const double* ub = Ucol[static_cast<size_t>(b) + 1].data() + off;
+          for (size_t i = 0; i < v.size(); ++i) v[i] += ub[i];
         }
         StatusOr<Score> sc = search.score(v, t);
         if (!sc) return sc.status();

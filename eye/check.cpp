@@ -111,9 +111,12 @@ namespace {
 // Not inlined: inlined, its accumulator became the caller's `peak`, whose address fmt takes, and
 // the loop stored it to memory at every sample (17 % of the worst-case search's time).
 [[gnu::noinline]] double largest_magnitude(std::span<const double> v) {
-  double peak = 0;
-  for (double x : v) peak = std::max(peak, std::abs(x));
-  return peak;
+  double peak[4] = {0, 0, 0, 0};  // four running maxima: no chain of dependent comparisons
+  size_t i = 0;
+  for (; i + 4 <= v.size(); i += 4)
+    for (size_t k = 0; k < 4; ++k) peak[k] = std::max(peak[k], std::abs(v[i + k]));
+  for (; i < v.size(); ++i) peak[0] = std::max(peak[0], std::abs(v[i]));
+  return std::max(std::max(peak[0], peak[1]), std::max(peak[2], peak[3]));
 }
 }  // namespace
 
@@ -146,7 +149,6 @@ StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const d
   r.t_end = t.back();
 
   Segmentation seg = segment(t, v, segment_params(rules));
-  r.pulses = measure_pulses(t, v, seg, rules);
   if (!rules.tone) {
     // Item 4a: when a run's half bits make whole frames up to its second-last pulse, its last
     // pulse is the line's kickback after the postamble (AC coupling swinging back past the
@@ -156,12 +158,12 @@ StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const d
     std::vector<size_t> tails;
     for (const FrameSpan& fs : seg.frames) {
       size_t acc = 0;
-      for (size_t p = fs.first; p < fs.last; ++p) acc += r.pulses[p].half_bits;
+      for (size_t p = fs.first; p < fs.last; ++p) acc += pulse_half_bits(seg, p, rules);
       if (fs.last > fs.first && acc % frame_len == 0) tails.push_back(fs.last);
     }
     for (auto it = tails.rbegin(); it != tails.rend(); ++it) drop_frame_tail(&seg, *it);
-    if (!tails.empty()) r.pulses = measure_pulses(t, v, seg, rules);
   }
+  r.pulses = measure_pulses(t, v, seg, rules);
   r.ringing = seg.ringing;
   r.idle = find_idle_undershoots(t, v, seg, rules);
   const FrameFormat& fmt_ = r.frame_format;

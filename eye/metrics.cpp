@@ -31,10 +31,37 @@ SegmentParams segment_params(const Rules& r) {
   return SegmentParams{r.vth, r.merge_gap, r.min_pulse, r.transition_gap};
 }
 
+namespace {
+// Item 5: a pulse's width (to the next pulse's start when joined to it) and its class k.
+double pulse_width(const Segmentation& seg, size_t i) {
+  const PulseSpan& ps = seg.pulses[i];
+  return seg.joined_next[i] ? seg.pulses[i + 1].a - ps.a : ps.b - ps.a;
+}
+int pulse_class(double width, const Rules& r) {
+  // A pulse far longer than a frame (a DC level, a 10 s pulse in the wrong units) carries at most
+  // kMaxHalfBits half bits for decoding: memory stays linear in samples, not in pulse length.
+  return static_cast<int>(std::lround(std::min(width / r.pulse_time, 1e9)));
+}
+
+// max over j in [lo, hi) of s v[j], at least `floor` (four running maxima: no chain of
+// dependent comparisons through the samples).
+double signed_max(std::span<const double> v, size_t lo, size_t hi, int s, double floor) {
+  double m[4] = {floor, floor, floor, floor};
+  size_t j = lo;
+  for (; j + 4 <= hi; j += 4)
+    for (int k = 0; k < 4; ++k) m[k] = std::max(m[k], s * v[j + static_cast<size_t>(k)]);
+  for (; j < hi; ++j) m[0] = std::max(m[0], s * v[j]);
+  return std::max(std::max(m[0], m[1]), std::max(m[2], m[3]));
+}
+}  // namespace
+
+int pulse_half_bits(const Segmentation& seg, size_t i, const Rules& r) {
+  return std::clamp(pulse_class(pulse_width(seg, i), r), 1, kMaxHalfBits);
+}
+
 std::vector<PulseMetrics> measure_pulses(std::span<const double> t, std::span<const double> v,
                                          const Segmentation& seg, const Rules& r) {
   std::vector<PulseMetrics> out(seg.pulses.size());
-  const double T = r.pulse_time;
   for (size_t i = 0; i < seg.pulses.size(); ++i) {
     const PulseSpan& ps = seg.pulses[i];
     PulseMetrics& m = out[i];
@@ -49,10 +76,8 @@ std::vector<PulseMetrics> measure_pulses(std::span<const double> t, std::span<co
     m.idle = !joined;
 
     // Item 5-6: width and class.
-    const double width = joined ? seg.pulses[i + 1].a - ps.a : ps.b - ps.a;
-    // A pulse far longer than a frame (a DC level, a 10 s pulse in the wrong units) carries at most
-    // kMaxHalfBits half bits for decoding: memory stays linear in samples, not in pulse length.
-    m.k = static_cast<int>(std::lround(std::min(width / T, 1e9)));
+    const double width = pulse_width(seg, i);
+    m.k = pulse_class(width, r);
     m.half_bits = std::clamp(m.k, 1, kMaxHalfBits);
     if (!m.truncated) m.width.value = width;
     if (joined && !m.truncated) {
@@ -106,9 +131,12 @@ std::vector<PulseMetrics> measure_pulses(std::span<const double> t, std::span<co
 
     // Item 8: VSTART, VEND.
     const double mid = 0.5 * (ps.a + ps.b);
-    double vstart = r.vth;  // s*v at a
-    size_t j = ps.ia;
-    for (; j < ps.ib && t[j] <= mid; ++j) vstart = std::max(vstart, s * v[j]);
+    // s*v is vth at a; the samples from a up to mid, then mid itself (interpolated).
+    const size_t j = static_cast<size_t>(
+        std::upper_bound(t.begin() + static_cast<std::ptrdiff_t>(ps.ia),
+                         t.begin() + static_cast<std::ptrdiff_t>(std::max(ps.ia, ps.ib)), mid) -
+        t.begin());
+    double vstart = signed_max(v, ps.ia, j, s, r.vth);
     vstart = std::max(vstart, s * interp(t, v, ps.ia > 0 ? ps.ia - 1 : 0, j + 1, mid));
     const double vend =
         s * interp(t, v, ps.ia > 0 ? ps.ia - 1 : 0, ps.ib + 1, ps.b - r.vend_offset);

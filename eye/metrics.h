@@ -80,6 +80,8 @@ struct WorstMargin {
 };
 
 SegmentParams segment_params(const Rules& r);
+// Item 5: the half bits pulse i of seg carries for decoding (PulseMetrics::half_bits).
+int pulse_half_bits(const Segmentation& seg, size_t i, const Rules& r);
 // Items 5-9 for every pulse of seg.
 std::vector<PulseMetrics> measure_pulses(std::span<const double> t, std::span<const double> v,
                                          const Segmentation& seg, const Rules& r);

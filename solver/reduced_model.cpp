@@ -26,6 +26,8 @@ Status ReducedModelOptions::validate() const {
   if (max_points < 1) return bad("max_points", max_points, "must be positive");
   if (max_order < 1) return bad("max_order", max_order, "must be positive");
   if (!(horizon > 0) || !std::isfinite(horizon)) return bad("horizon", horizon, "must be positive");
+  for (double f : start_points)
+    if (!(f >= f_min && f <= f_max)) return bad("start_points", f, "must lie in f_min..f_max");
   return Status::Ok();
 }
 
@@ -184,6 +186,7 @@ StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,
       }
     }
     ++st.expansion_points;
+    st.points.push_back(f);
     return added;
   };
 
@@ -198,6 +201,22 @@ StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,
         if (!(x <= e)) e = x;  // a NaN sticks: such a model never passes
       }
     return e;
+  };
+
+  // Gr = V'GV and Cr = V'CV, grown by the rows and columns of the vectors added since the last
+  // build (the basis only grows, and its earlier vectors do not change).
+  Eigen::MatrixXd gr, cr;
+  auto project = [&]() {
+    const int q = basis.q, q0 = static_cast<int>(gr.rows());
+    if (q == q0) return;
+    gr.conservativeResize(q, q);
+    cr.conservativeResize(q, q);
+    const auto v = basis.v.leftCols(q);
+    const auto added = basis.v.middleCols(q0, q - q0);
+    gr.rightCols(q - q0) = v.transpose() * basis.gv.middleCols(q0, q - q0);
+    cr.rightCols(q - q0) = v.transpose() * basis.cv.middleCols(q0, q - q0);
+    gr.bottomLeftCorner(q - q0, q0) = added.transpose() * basis.gv.leftCols(q0);
+    cr.bottomLeftCorner(q - q0, q0) = added.transpose() * basis.cv.leftCols(q0);
   };
 
   // Builds the pole-residue model from the current basis and measures its error.
@@ -223,8 +242,7 @@ StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,
       return Status::Ok();
     }
     const auto v = basis.v.leftCols(q);
-    const Eigen::MatrixXd gr = v.transpose() * basis.gv.leftCols(q);
-    const Eigen::MatrixXd cr = v.transpose() * basis.cv.leftCols(q);
+    project();
     Eigen::MatrixXd br(q, nk), lr(np, q);
     for (size_t k = 0; k < nk; ++k) {
       Eigen::VectorXd e(n);
@@ -300,7 +318,10 @@ StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,
   std::vector<double> used;
   std::vector<std::pair<double, double>> open;  // check intervals not yet refined
   for (size_t i = 0; i + 1 < freqs.size(); ++i) open.push_back({freqs[i], freqs[i + 1]});
-  for (double f : {opt.f_min, opt.f_max / 10}) {
+  std::vector<double> first{opt.f_min, opt.f_max / 10};
+  for (double f : opt.start_points)
+    if (std::find(first.begin(), first.end(), f) == first.end()) first.push_back(f);
+  for (double f : first) {
     StatusOr<bool> added = expand_at(f);
     if (!added) return added.status();
     used.push_back(f);
@@ -369,6 +390,7 @@ StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,
   model.stats.factorizations = st.factorizations;
   model.stats.check_points = static_cast<int>(freqs.size());
   model.stats.expansion_points = st.expansion_points;
+  model.stats.points = st.points;
   return model;
 }
 
