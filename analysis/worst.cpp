@@ -722,6 +722,11 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
       add_edges(e, edges, 0, u);
       for (size_t i = 0; i < u.size(); ++i) U[i * kCols + b] = u[i];
     }
+    // reach_of[i] = sum_b |U_b(i)|: no previous byte moves v at U's sample i by more.
+    std::vector<double> reach_of(static_cast<size_t>(reach), 0.0);
+    for (size_t b = 0; b < kCols; ++b)
+      for (size_t i = 0; i < reach_of.size(); ++i) reach_of[i] += std::abs(Ucol[b][i]);
+
     // Every pattern, in order: the ranking below then enumerates the best patterns per gap
     // instead of trying each (the `previous` index is the pattern itself).
     bool every_pattern = previous.size() == (1u << kPatternBits);
@@ -748,7 +753,7 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
     std::sort(all.begin(), all.end());
     all.erase(std::unique(all.begin(), all.end()), all.end());
     const size_t ng = gaps.size();
-    std::vector<double> coef;  // per linear model, per gap: kCols (constant, then per bit)
+    std::vector<double> coef;  // one model's, per gap: kCols (constant, then per bit)
     for (size_t n = 0; n < all.size(); ++n) {
       const size_t ci = all[n];
       if (opt.progress)
@@ -764,38 +769,15 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
       lin.erase(std::remove_if(lin.begin(), lin.end(),
                                [&](const Linear& l) { return !wanted[l.metric]; }),
                 lin.end());
-      // Each model's predicted key for previous pattern q at gap j is affine in q's bits:
-      // c(j, 0) + sum_b bit_b(q) c(j, 1 + b), stored per model as [j][kCols]. A term reads u at
-      // term.sample - pre + frame + g, so over the gap grid it is one strided sweep of U.
-      coef.assign(lin.size() * kCols * ng, 0.0);
-      for (size_t li = 0; li < lin.size(); ++li) {
-        double* cl = coef.data() + li * kCols * ng;
-        for (size_t j = 0; j < ng; ++j) cl[j * kCols] = lin[li].key0;
-        for (const Term& term : lin[li].terms) {
-          // Gap indices whose read falls inside the wave: 0 <= at + gaps[j] < reach.
-          const long at = term.sample - pre + frame;
-          const long j0 = std::max(0L, (-at - gap_min + gap_step - 1) / gap_step);
-          const long j1 =
-              std::min(static_cast<long>(ng), (reach - at - gap_min + gap_step - 1) / gap_step);
-          const long first = at + gap_min;
-          for (long j = j0; j < j1; ++j) {
-            const double* u = U.data() + static_cast<size_t>(first + j * gap_step) * kCols;
-            for (size_t b = 0; b < kCols; ++b)
-              cl[static_cast<size_t>(j) * kCols + b] += term.coef * u[b];
-          }
-        }
-      }
-      auto key_of = [&](size_t li, int q, size_t j) {
-        const double* cl = coef.data() + li * kCols * ng;
-        double y = cl[j * kCols];
-        for (size_t b = 0; b < kPatternBits; ++b)
-          if (q >> b & 1) y += cl[j * kCols + b + 1];
-        return y;
-      };
+      // Models in order of their key after idle, so that each metric's list below fills with
+      // low keys first and models that cannot reach it are skipped (bound below).
+      std::stable_sort(lin.begin(), lin.end(),
+                       [](const Linear& a, const Linear& b) { return a.key0 < b.key0; });
       // Per metric, the `verify` lowest distinct histories (key, previous index, gap index), in
       // order. A metric's key is the lowest of its models', so offering every model's values and
       // keeping each history once, at its lowest, gives the metric's lowest histories; a value
-      // above the `verify`-th kept cannot enter (the kept one only gets lower).
+      // above the `verify`-th kept cannot enter (the kept one only gets lower). What is kept does
+      // not depend on the order of the offers.
       using Entry = std::tuple<double, size_t, size_t>;
       std::array<std::vector<Entry>, kMetrics> top;
       auto full = [&](const std::vector<Entry>& list) {
@@ -814,19 +796,58 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
         }
         list.insert(std::upper_bound(list.begin(), list.end(), en), en);
       };
+      // A term reads u at term.sample - pre + frame + g: the gap indices whose read falls
+      // inside the wave (0 <= at + gaps[j] < reach) are [j0, j1).
+      auto gap_range = [&](const Term& term) {
+        const long at = term.sample - pre + frame;
+        const long j0 = std::max(0L, (-at - gap_min + gap_step - 1) / gap_step);
+        const long j1 =
+            std::min(static_cast<long>(ng), (reach - at - gap_min + gap_step - 1) / gap_step);
+        return std::tuple<long, long, long>{at + gap_min, j0, j1};
+      };
       // Per model and gap, with every pattern allowed: the lowest key sets the bits whose
       // coefficient is negative, and the next lowest flip the bits with the smallest
       // |coefficient|; the r-th lowest flips only bits among the r smallest (each flip adds its
       // |coefficient|), so the subsets of the `verify` smallest hold them all.
       const size_t r = std::min<size_t>(static_cast<size_t>(opt.verify), kPatternBits);
       std::array<std::pair<double, int>, kPatternBits> mag;  // |coefficient|, bit
-      for (size_t li = 0; li < lin.size(); ++li) {
-        std::vector<Entry>& tm = top[static_cast<size_t>(lin[li].metric)];
-        const double* cl = coef.data() + li * kCols * ng;
+      for (const Linear& model : lin) {
+        std::vector<Entry>& tm = top[static_cast<size_t>(model.metric)];
+        // No history moves the key below key0 - sum |coef| max_g reach(at + g): a model whose
+        // bound is above the list's last, once full, cannot enter it.
+        if (full(tm)) {
+          double drop = 0;
+          for (const Term& term : model.terms) {
+            const auto [first, j0, j1] = gap_range(term);
+            double most = 0;
+            for (long j = j0; j < j1; ++j)
+              most = std::max(most, reach_of[static_cast<size_t>(first + j * gap_step)]);
+            drop += std::abs(term.coef) * most;
+          }
+          if (model.key0 - drop > std::get<0>(tm.back())) continue;
+        }
+        // The model's predicted key for previous pattern q at gap j is affine in q's bits:
+        // c(j, 0) + sum_b bit_b(q) c(j, 1 + b), stored as cl[j * kCols + ...]; over the gap
+        // grid each term is one strided sweep of U.
+        coef.assign(kCols * ng, 0.0);
+        double* cl = coef.data();
+        for (size_t j = 0; j < ng; ++j) cl[j * kCols] = model.key0;
+        for (const Term& term : model.terms) {
+          const auto [first, j0, j1] = gap_range(term);
+          for (long j = j0; j < j1; ++j) {
+            const double* u = U.data() + static_cast<size_t>(first + j * gap_step) * kCols;
+            for (size_t b = 0; b < kCols; ++b)
+              cl[static_cast<size_t>(j) * kCols + b] += term.coef * u[b];
+          }
+        }
         for (size_t j = 0; j < ng; ++j) {
           if (!every_pattern) {
-            for (size_t k = 0; k < previous.size(); ++k)
-              offer(tm, {key_of(li, previous[k], j), k, j});
+            for (size_t k = 0; k < previous.size(); ++k) {
+              double y = cl[j * kCols];
+              for (size_t b = 0; b < kPatternBits; ++b)
+                if (previous[k] >> b & 1) y += cl[j * kCols + b + 1];
+              offer(tm, {y, k, j});
+            }
             continue;
           }
           double lowest = cl[j * kCols];
