@@ -469,7 +469,6 @@ StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::Par
     LtiOptions lo;
     lo.method = LtiOptions::Method::Reduced;
     lo.horizon = lead + opt.max_span;
-    lo.reduced.start_points = opt.model_start_points;
     if (opt.progress) opt.progress("edge response, reduced model", 0.0);
     StatusOr<LtiResponses> lti = LtiResponses::compute(circuit, {*probe}, lo);
     if (lti) {
@@ -493,7 +492,6 @@ StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::Par
           "reduced model (order {}, {} poles, {} expansion points, AC error {:.1e} of peak up to "
           "3 GHz), sampled on a {:g} ns grid",
           m.order, m.poles, m.expansion_points, m.error, opt.dt * 1e9);
-      out.expansion_points = m.points;
       out.seconds = seconds_since(start);
       return out;
     }
@@ -723,23 +721,19 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
     // gap g is U_0(i - pre + frame + g) + sum_b bit_b(q) U_{1 + b}(i - pre + frame + g).
     const PatternBasis& basis = search.basis();
     const long reach = frame + gap_max + search.len();
-    // Interleaved, U[i * kCols + b]: a read at one sample takes all kCols columns at once.
     constexpr size_t kCols = kPatternBits + 1;
-    // The columns themselves too (Ucol[b][i]): an exact wave adds only its pattern's set bits.
-    std::vector<double> U(static_cast<size_t>(reach) * kCols);
-    std::array<std::vector<double>, kCols> Ucol;
+    std::array<std::vector<double>, kCols> U;  // U[b][i]: the column of bit b - 1 (0: the base)
     for (size_t b = 0; b < kCols; ++b) {
-      std::vector<double>& u = Ucol[b];
+      std::vector<double>& u = U[b];
       u.assign(static_cast<size_t>(reach), 0.0);
       std::vector<std::pair<long, int>> edges;
       level_edges(b == 0 ? basis.base : basis.bit[b - 1], 0, half, edges);
       add_edges(e, edges, 0, u);
-      for (size_t i = 0; i < u.size(); ++i) U[i * kCols + b] = u[i];
     }
     // reach_of[i] = sum_b |U_b(i)|: no previous byte moves v at U's sample i by more.
     std::vector<double> reach_of(static_cast<size_t>(reach), 0.0);
     for (size_t b = 0; b < kCols; ++b)
-      for (size_t i = 0; i < reach_of.size(); ++i) reach_of[i] += std::abs(Ucol[b][i]);
+      for (size_t i = 0; i < reach_of.size(); ++i) reach_of[i] += std::abs(U[b][i]);
 
     // Every pattern, in order: the ranking below then enumerates the best patterns per gap
     // instead of trying each (the `previous` index is the pattern itself).
@@ -848,10 +842,10 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
         for (size_t j = 0; j < ng; ++j) cl[j * kCols] = model.key0;
         for (const Term& term : model.terms) {
           const auto [first, j0, j1] = gap_range(term);
-          for (long j = j0; j < j1; ++j) {
-            const double* u = U.data() + static_cast<size_t>(first + j * gap_step) * kCols;
-            for (size_t b = 0; b < kCols; ++b)
-              cl[static_cast<size_t>(j) * kCols + b] += term.coef * u[b];
+          for (size_t b = 0; b < kCols; ++b) {
+            const double* u = U[b].data() + first;
+            for (long j = j0; j < j1; ++j)
+              cl[static_cast<size_t>(j) * kCols + b] += term.coef * u[j * gap_step];
           }
         }
         for (size_t j = 0; j < ng; ++j) {
@@ -907,11 +901,11 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
         // base + u_q over the window, from the basis (the same sums add_previous makes).
         const int q = previous[k];
         const size_t off = static_cast<size_t>(frame + g - pre);  // window sample 0 in U
-        const double* u0 = Ucol[0].data() + off;
+        const double* u0 = U[0].data() + off;
         for (size_t i = 0; i < v.size(); ++i) v[i] = base[i] + u0[i];
         for (int b = 0; b < kPatternBits; ++b) {
           if (!(q >> b & 1)) continue;
-          const double* ub = Ucol[static_cast<size_t>(b) + 1].data() + off;
+          const double* ub = U[static_cast<size_t>(b) + 1].data() + off;
           for (size_t i = 0; i < v.size(); ++i) v[i] += ub[i];
         }
         StatusOr<Score> sc = search.score(v, t);

@@ -63,8 +63,7 @@ struct EdgeResponse {
   double drift = 0;         // max |E(t) - E(t - T)| over the last 10 %: a half bit's residue (V)
   std::string engine;       // what produced it ("reduced model, order 119 ...", "transient ...")
   std::string engine_note;  // edge_engine auto: why the reduced model was not used
-  std::vector<double> expansion_points;  // Hz, the reduced model's (empty: the transient ran)
-  double seconds = 0;                    // wall time
+  double seconds = 0;       // wall time
   // e at n samples after the corner: 0 before the record, e.back() after it.
   double at(long n) const {
     const long i = n + pre;
@@ -84,10 +83,6 @@ struct WorstOptions {
   // back to the transient when the model does not pass; `transient` always runs the transient.
   enum class EdgeEngine { Auto, Transient };
   EdgeEngine edge_engine = EdgeEngine::Auto;
-  // Hz: the reduced model's first expansion points (ReducedModelOptions::start_points), from a
-  // similar link's EdgeResponse::expansion_points: a sweep passes its first point's. The
-  // model's check is the same with or without them.
-  std::vector<double> model_start_points;
   double reltol = 1e-6;       // transient tolerance of the edge response
   double settle_tol = 20e-6;  // V: settled when a half bit's response stays below this
   double max_memory = 20e-6;  // s: longest memory searched; B there is reported as the bound

@@ -85,23 +85,6 @@ void BM_EdgeResponse(benchmark::State& state) {
 }
 BENCHMARK(BM_EdgeResponse)->Unit(benchmark::kMillisecond);
 
-// The same at 12.5 m, its reduced model started from the 12 m one's expansion points (what a
-// sweep's points do with their first point's).
-void BM_EdgeResponseStartedFromNeighbour(benchmark::State& state) {
-  const Fixture& f = fixture();
-  link::LinkSpec spec = f.spec;
-  spec.cable.length = 12.5;
-  analysis::WorstOptions wopt = f.wopt;
-  wopt.model_start_points = f.edge.expansion_points;
-  for (auto _ : state) {
-    StatusOr<analysis::EdgeResponse> e =
-        analysis::edge_response(spec, f.parts, link::Direction::kDown, wopt);
-    if (!e) die(e.status());
-    state.counters["points"] = static_cast<double>(e->expansion_points.size());
-  }
-}
-BENCHMARK(BM_EdgeResponseStartedFromNeighbour)->Unit(benchmark::kMillisecond);
-
 void BM_WorstSearch(benchmark::State& state) {
   const Fixture& f = fixture();
   for (auto _ : state) {

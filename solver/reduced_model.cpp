@@ -26,8 +26,6 @@ Status ReducedModelOptions::validate() const {
   if (max_points < 1) return bad("max_points", max_points, "must be positive");
   if (max_order < 1) return bad("max_order", max_order, "must be positive");
   if (!(horizon > 0) || !std::isfinite(horizon)) return bad("horizon", horizon, "must be positive");
-  for (double f : start_points)
-    if (!(f >= f_min && f <= f_max)) return bad("start_points", f, "must lie in f_min..f_max");
   return Status::Ok();
 }
 
@@ -186,7 +184,6 @@ StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,
       }
     }
     ++st.expansion_points;
-    st.points.push_back(f);
     return added;
   };
 
@@ -318,10 +315,7 @@ StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,
   std::vector<double> used;
   std::vector<std::pair<double, double>> open;  // check intervals not yet refined
   for (size_t i = 0; i + 1 < freqs.size(); ++i) open.push_back({freqs[i], freqs[i + 1]});
-  std::vector<double> first{opt.f_min, opt.f_max / 10};
-  for (double f : opt.start_points)
-    if (std::find(first.begin(), first.end(), f) == first.end()) first.push_back(f);
-  for (double f : first) {
+  for (double f : {opt.f_min, opt.f_max / 10}) {
     StatusOr<bool> added = expand_at(f);
     if (!added) return added.status();
     used.push_back(f);
@@ -390,7 +384,6 @@ StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,
   model.stats.factorizations = st.factorizations;
   model.stats.check_points = static_cast<int>(freqs.size());
   model.stats.expansion_points = st.expansion_points;
-  model.stats.points = st.points;
   return model;
 }
 

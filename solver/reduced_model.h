@@ -60,11 +60,7 @@ struct ReducedModelOptions {
   // Basis size before giving up; lower on large circuits, where the basis (three dense
   // unknowns x order arrays, grown by doubling) would pass 384 MB (32,000 unknowns: order 524).
   int max_order = 1200;
-  double horizon = 0.0;  // s, the longest time the model is evaluated over (step 4); > 0
-  // Hz: expansion points to take before the greedy search, besides f_min and f_max / 10: a
-  // similar circuit's (ReducedModelStats::points, e.g. the previous point of a sweep), so that
-  // the search starts near where it ends. The check is the same; each must lie in the band.
-  std::vector<double> start_points;
+  double horizon = 0.0;     // s, the longest time the model is evaluated over (step 4); > 0
   Status validate() const;  // names the field, its value and the rule
 };
 
@@ -75,7 +71,6 @@ struct ReducedModelStats {
   int dropped = 0;            // right-half-plane poles dropped (step 4)
   double dropped_weight = 0;  // the largest of their weights |out in / p| over the peak
   int expansion_points = 0;
-  std::vector<double> points;  // Hz, the expansion points, in the order taken
   double error = 0.0;          // the check's error (relative)
   double error_frequency = 0;  // Hz, where it is largest
   int factorizations = 0;      // complex sparse LUs (expansion points and check)

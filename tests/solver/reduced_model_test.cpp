@@ -23,7 +23,7 @@ struct Ladder {
   Circuit circuit;
   std::vector<Probe> probes;
 };
-std::unique_ptr<Ladder> ladder(double cap = 20e-12) {
+std::unique_ptr<Ladder> ladder() {
   auto b = std::make_unique<Ladder>();
   std::vector<Card> cards{card("v1", {"in", "0"}, {call("pwl", {0, 0, 1e-9, 1})}),
                           card("rs", {"in", "n0"}, {num(100)})};
@@ -32,7 +32,7 @@ std::unique_ptr<Ladder> ladder(double cap = 20e-12) {
                       z = "n" + std::to_string(i + 1);
     cards.push_back(card("r" + std::to_string(i), {a, m}, {num(0.2)}));
     cards.push_back(card("l" + std::to_string(i), {m, z}, {num(50e-9)}));
-    cards.push_back(card("c" + std::to_string(i), {z, "0"}, {num(cap)}));
+    cards.push_back(card("c" + std::to_string(i), {z, "0"}, {num(20e-12)}));
   }
   cards.push_back(card("rl", {"n40", "0"}, {num(100)}));
   EXPECT_EQ(build(b->circuit, cards), "");
@@ -44,13 +44,11 @@ std::unique_ptr<Ladder> ladder(double cap = 20e-12) {
   return b;
 }
 
-LtiResponses responses(const Ladder& b, LtiOptions::Method method, int max_points = 40,
-                       std::vector<double> start_points = {}) {
+LtiResponses responses(const Ladder& b, LtiOptions::Method method, int max_points = 40) {
   LtiOptions opt;
   opt.horizon = 2e-6;
   opt.method = method;
   opt.reduced.max_points = max_points;
-  opt.reduced.start_points = std::move(start_points);
   auto r = LtiResponses::compute(b.circuit, b.probes, opt);
   EXPECT_TRUE(r.ok()) << r.status().message();
   return std::move(*r);
@@ -118,40 +116,6 @@ TEST(ReducedModel, StepResponseMatchesTheMarch) {
     }
   EXPECT_GT(peak, 0.4);
   EXPECT_LT(worst, 1e-4);  // V per V of step
-}
-
-// A sweep's next point starts its model from the previous point's expansion points: the same
-// check is met, the given points are taken first (after f_min and f_max / 10), and the step
-// response is the one the model of that circuit built from scratch gives.
-TEST(ReducedModel, StartedFromAnotherModelsPointsMeetsTheSameCheck) {
-  auto first = ladder(20e-12);
-  LtiResponses a = responses(*first, LtiOptions::Method::Reduced);
-  const std::vector<double>& points = a.stats().model.points;
-  ASSERT_EQ(static_cast<int>(points.size()), a.stats().model.expansion_points);
-  EXPECT_EQ(points[0], 1e3);
-  EXPECT_EQ(points[1], 3e8);
-  auto next = ladder(22e-12);
-  LtiResponses scratch = responses(*next, LtiOptions::Method::Reduced);
-  LtiResponses started = responses(*next, LtiOptions::Method::Reduced, 40, points);
-  const ReducedModelStats& st = started.stats().model;
-  EXPECT_LE(st.error, 2e-5);
-  ASSERT_GE(st.points.size(), points.size());
-  for (size_t i = 0; i < points.size(); ++i) EXPECT_EQ(st.points[i], points[i]);
-  double worst = 0;
-  for (double t = 0.1e-9; t < 1.5e-6; t += 0.37e-9)
-    for (size_t p = 0; p < 2; ++p)
-      worst = std::max(worst,
-                       std::fabs(started.step_response(0, p, t) - scratch.step_response(0, p, t)));
-  EXPECT_LT(worst, 1e-4);  // each is within 1e-4 of the march (StepResponseMatchesTheMarch)
-  // A point outside the band is refused, by name.
-  LtiOptions bad;
-  bad.horizon = 2e-6;
-  bad.method = LtiOptions::Method::Reduced;
-  bad.reduced.start_points = {5e9};
-  auto r = LtiResponses::compute(next->circuit, next->probes, bad);
-  ASSERT_FALSE(r.ok());
-  EXPECT_NE(r.status().message().find("start_points = 5e+09"), std::string::npos)
-      << r.status().message();
 }
 
 // A model that cannot meet its check within max_points: `reduced` reports it, `auto` marches.
