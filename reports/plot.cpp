@@ -194,6 +194,14 @@ const ImagePlugin& image_plugin() {
   return plugin;
 }
 
+}  // namespace
+
+void load_image_plugin() {
+  image_plugin();
+}
+
+namespace {
+
 struct Box {
   bool defined = false;
   int xbegin = 0, xend = 0, ybegin = 0, yend = 0;

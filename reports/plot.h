@@ -128,6 +128,11 @@ struct ColumnRange {
   bool valid = false;
 };
 
+// Loads the image plug-in now rather than on the first Canvas::create (OpenImageIO and its
+// libraries: about 0.3 s of relocations); thread-safe, and a create waits for a load under way.
+// `isolink sweep` loads it on a low-priority thread while its points run.
+void load_image_plugin();
+
 class Canvas {
  public:
   // A width x height RGB image filled with background, with the DejaVu fonts located.
