@@ -111,12 +111,7 @@ namespace {
 // Not inlined: inlined, its accumulator became the caller's `peak`, whose address fmt takes, and
 // the loop stored it to memory at every sample (17 % of the worst-case search's time).
 [[gnu::noinline]] double largest_magnitude(std::span<const double> v) {
-  double peak[4] = {0, 0, 0, 0};  // four running maxima: no chain of dependent comparisons
-  size_t i = 0;
-  for (; i + 4 <= v.size(); i += 4)
-    for (size_t k = 0; k < 4; ++k) peak[k] = std::max(peak[k], std::abs(v[i + k]));
-  for (; i < v.size(); ++i) peak[0] = std::max(peak[0], std::abs(v[i]));
-  return std::max(std::max(peak[0], peak[1]), std::max(peak[2], peak[3]));
+  return running_max(v, 0, v.size(), 0.0, [](double x) { return std::abs(x); });
 }
 }  // namespace
 

@@ -42,17 +42,6 @@ int pulse_class(double width, const Rules& r) {
   // kMaxHalfBits half bits for decoding: memory stays linear in samples, not in pulse length.
   return static_cast<int>(std::lround(std::min(width / r.pulse_time, 1e9)));
 }
-
-// max over j in [lo, hi) of s v[j], at least `floor` (four running maxima: no chain of
-// dependent comparisons through the samples).
-double signed_max(std::span<const double> v, size_t lo, size_t hi, int s, double floor) {
-  double m[4] = {floor, floor, floor, floor};
-  size_t j = lo;
-  for (; j + 4 <= hi; j += 4)
-    for (int k = 0; k < 4; ++k) m[k] = std::max(m[k], s * v[j + static_cast<size_t>(k)]);
-  for (; j < hi; ++j) m[0] = std::max(m[0], s * v[j]);
-  return std::max(std::max(m[0], m[1]), std::max(m[2], m[3]));
-}
 }  // namespace
 
 int pulse_half_bits(const Segmentation& seg, size_t i, const Rules& r) {
@@ -136,7 +125,7 @@ std::vector<PulseMetrics> measure_pulses(std::span<const double> t, std::span<co
         std::upper_bound(t.begin() + static_cast<std::ptrdiff_t>(ps.ia),
                          t.begin() + static_cast<std::ptrdiff_t>(std::max(ps.ia, ps.ib)), mid) -
         t.begin());
-    double vstart = signed_max(v, ps.ia, j, s, r.vth);
+    double vstart = running_max(v, ps.ia, j, r.vth, [s](double x) { return s * x; });
     vstart = std::max(vstart, s * interp(t, v, ps.ia > 0 ? ps.ia - 1 : 0, j + 1, mid));
     const double vend =
         s * interp(t, v, ps.ia > 0 ? ps.ia - 1 : 0, ps.ib + 1, ps.b - r.vend_offset);

@@ -9,6 +9,7 @@
 // Margins are distances to the limit, positive = inside; NaN where a metric does not apply.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -80,6 +81,17 @@ struct WorstMargin {
 };
 
 SegmentParams segment_params(const Rules& r);
+// The largest f(v[j]) over j in [lo, hi), at least `floor`, with four running maxima so that the
+// comparisons do not form one chain through the samples (the eye check's per-sample loops).
+template <class F>
+double running_max(std::span<const double> v, size_t lo, size_t hi, double floor, F f) {
+  double m[4] = {floor, floor, floor, floor};
+  size_t j = lo;
+  for (; j + 4 <= hi; j += 4)
+    for (size_t k = 0; k < 4; ++k) m[k] = std::max(m[k], f(v[j + k]));
+  for (; j < hi; ++j) m[0] = std::max(m[0], f(v[j]));
+  return std::max(std::max(m[0], m[1]), std::max(m[2], m[3]));
+}
 // Item 5: the half bits pulse i of seg carries for decoding (PulseMetrics::half_bits).
 int pulse_half_bits(const Segmentation& seg, size_t i, const Rules& r);
 // Items 5-9 for every pulse of seg.

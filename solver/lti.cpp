@@ -507,16 +507,17 @@ void LtiResponses::modal_add(const std::vector<SourceInput>& inputs,
   Step uniform, scratch;
   if (uniform_dt > 0) uniform.set(m, uniform_dt);
   bool active = false;  // a corner has passed: before it everything is zero
+  // A cached step serves any h within 1e-9 of it: times t0 + i dt differ from i dt by rounding
+  // of t0 (1e-11 relative at 100 us on a 1 ns step); the states are not moved in time by it
+  // (each query restarts from its own time), only the phase e^{ph} is off by |p| 1e-9 h.
+  auto step_for = [&](double h) -> const Step* {
+    if (std::fabs(h - uniform.h) <= 1e-9 * uniform.h) return &uniform;
+    if (!(std::fabs(h - scratch.h) <= 1e-9 * scratch.h)) scratch.set(m, h);
+    return &scratch;
+  };
   auto advance = [&](double h) {
     if (!(h > 0) || !active) return;
-    // A cached step serves any h within 1e-9 of it: times t0 + i dt differ from i dt by rounding
-    // of t0 (1e-11 relative at 100 us on a 1 ns step); the states are not moved in time by it
-    // (each query restarts from its own time), only the phase e^{ph} is off by |p| 1e-9 h.
-    const Step* st = &uniform;
-    if (!(std::fabs(h - uniform.h) <= 1e-9 * uniform.h)) {
-      if (!(std::fabs(h - scratch.h) <= 1e-9 * scratch.h)) scratch.set(m, h);
-      st = &scratch;
-    }
+    const Step* st = step_for(h);
     const double *er = st->er.data(), *ei = st->ei.data(), *f1r = st->f1r.data(),
                  *f1i = st->f1i.data(), *f2r = st->f2r.data(), *f2i = st->f2i.data();
     for (size_t i = 0; i < nm; ++i) {
@@ -571,11 +572,7 @@ void LtiResponses::modal_add(const std::vector<SourceInput>& inputs,
   // One tail step of h: the slow modes' exact update, the fast ones' decay.
   auto tail_step = [&](double h) {
     if (!(h > 0)) return;
-    const Step* st = &uniform;
-    if (!(std::fabs(h - uniform.h) <= 1e-9 * uniform.h)) {
-      if (!(std::fabs(h - scratch.h) <= 1e-9 * scratch.h)) scratch.set(m, h);
-      st = &scratch;
-    }
+    const Step* st = step_for(h);
     for (size_t i : slow) {
       const double nr =
           st->er[i] * xr[i] - st->ei[i] * xi[i] + st->f1r[i] * br[i] - st->f1i[i] * bi[i];
