@@ -107,6 +107,7 @@ StatusOr<SweepOutcome> run_sweep_mpi(const SweepSpec& s, const link::PartLibrary
   }
   ResultLog& L = **log;
   const std::vector<size_t> todo_list = L.todo();
+  if (opt.on_pool_ready) opt.on_pool_ready();  // rank 0 runs no point: no pool of its own
   std::deque<size_t> todo(todo_list.begin(), todo_list.end());
   const RowShape shape = row_shape(s);
   int active = world.size - 1;

@@ -843,6 +843,8 @@ StatusOr<SweepOutcome> run_sweep(const SweepSpec& s, const link::PartLibrary& pa
   const std::vector<size_t> todo = L.todo();
   const int threads = opt.jobs > 0 ? opt.jobs : tbb::this_task_arena::max_concurrency();
   tbb::task_arena arena(threads);
+  arena.initialize();  // loads oneTBB's allocator and thread-pool libraries
+  if (opt.on_pool_ready) opt.on_pool_ready();
   arena.execute([&] {
     // One task per point (grain 1): points take seconds, so scheduling costs nothing, and a
     // thread only ever holds the point it is running.

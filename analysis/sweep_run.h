@@ -202,6 +202,11 @@ struct SweepOptions {
       render_plots;
   bool quiet = false;  // no progress
   PointOptions point;  // waves_dir is filled in from keep_waves
+  // Called once, when the thread pool is up and before the first point: the moment to start
+  // background work (cli/ loads the charts' image plug-in there). Not before: the pool's first
+  // start loads libraries, and a dlopen on another thread would hold it up for as long as its
+  // own loading takes (0.3-0.6 s of OpenImageIO's plug-ins, with both cores waiting).
+  std::function<void()> on_pool_ready;
 };
 
 struct SweepOutcome {

@@ -118,14 +118,17 @@ int run_sweep_command(const SweepArgs& a) {
                  mpi ? fmt::format(", {} MPI ranks", ranks).c_str() : "", opt.out_dir.c_str());
   }
   // The charts' image plug-in is loaded while the points run, on a thread at the lowest
-  // priority: it takes the time the points leave a core idle (start-up, the last points) instead
-  // of 0.3 s after them (a fifth of a 4 s sweep's fixed cost). The charts wait for it if needed.
+  // priority: it takes the time the points leave a core idle (the last points) instead of 0.3 s
+  // after them (a fifth of a 4 s sweep's fixed cost). It starts once the sweep's thread pool is
+  // up (on_pool_ready), and the charts wait for it if needed.
   std::jthread plugin_loader;  // joined when the command returns
   if (opt.plots && rank == 0)
-    plugin_loader = std::jthread([] {
-      setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 19);  // this thread only (Linux)
-      reports::load_image_plugin();
-    });
+    opt.on_pool_ready = [&plugin_loader] {
+      plugin_loader = std::jthread([] {
+        setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 19);  // this thread only (Linux)
+        reports::load_image_plugin();
+      });
+    };
   StatusOr<sweep::SweepOutcome> out = Status::Error("not run");
 #ifdef ISOLINK_HAVE_MPI
   if (mpi)
