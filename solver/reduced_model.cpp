@@ -24,6 +24,7 @@ Status ReducedModelOptions::validate() const {
     return bad("max_check_points", max_check_points, "must be at least check_points");
   if (moments < 1 || moments > 20) return bad("moments", moments, "must be in 1..20");
   if (max_points < 1) return bad("max_points", max_points, "must be positive");
+  if (batch < 1) return bad("batch", batch, "must be positive");
   if (max_order < 1) return bad("max_order", max_order, "must be positive");
   if (!(horizon > 0) || !std::isfinite(horizon)) return bad("horizon", horizon, "must be positive");
   return Status::Ok();
@@ -220,6 +221,7 @@ StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,
   auto build = [&]() -> Status {
     const int q = basis.q;
     ReducedModel mod;
+    ++st.steps;
     mod.direct.assign(nk, std::vector<double>(np, 0.0));
     mod.input.assign(nk, {});
     mod.output.assign(np, {});
@@ -357,15 +359,29 @@ StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,
           "the {:.2g} allowed",
           model.stats.error, model.stats.error_frequency, used.size(), basis.q, opt.tol));
     // Check frequencies by the error there, worst first; the first one whose vectors are new.
+    // Then, up to `batch` points in all, the next-worst local maxima of the error over the grid
+    // (other resonances): one build per step instead of one per point.
     std::vector<std::pair<double, double>> ranked;  // (error, f)
+    std::vector<std::pair<double, double>> by_f;    // (f, error), by frequency
     for (size_t f = 0; f < freqs.size(); ++f) {
       const double e = error_at(model, f);
+      by_f.emplace_back(freqs[f], e);
       if (e > opt.tol) ranked.emplace_back(e, freqs[f]);
     }
     std::sort(ranked.rbegin(), ranked.rend());
+    std::sort(by_f.begin(), by_f.end());
+    std::vector<std::pair<double, double>> peaks;  // (error, f): local maxima over tol
+    for (size_t i = 0; i < by_f.size(); ++i) {
+      const double e = by_f[i].second;
+      if (e > opt.tol && !(i > 0 && by_f[i - 1].second > e) &&
+          !(i + 1 < by_f.size() && by_f[i + 1].second > e))
+        peaks.emplace_back(e, by_f[i].first);
+    }
+    std::sort(peaks.rbegin(), peaks.rend());
+    auto is_used = [&](double f) { return std::find(used.begin(), used.end(), f) != used.end(); };
     bool grew = false;
     for (const auto& [e, f] : ranked) {
-      if (std::find(used.begin(), used.end(), f) != used.end()) continue;
+      if (is_used(f)) continue;
       StatusOr<bool> added = expand_at(f);
       if (!added) return added.status();
       used.push_back(f);
@@ -374,6 +390,15 @@ StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,
         break;
       }
       if (static_cast<int>(used.size()) >= opt.max_points) break;
+    }
+    for (int taken = 1; taken < opt.batch && grew;) {
+      const auto next = std::find_if(peaks.begin(), peaks.end(),
+                                     [&](const auto& pk) { return !is_used(pk.second); });
+      if (next == peaks.end() || static_cast<int>(used.size()) >= opt.max_points) break;
+      StatusOr<bool> added = expand_at(next->second);
+      if (!added) return added.status();
+      used.push_back(next->second);
+      ++taken;
     }
     if (!grew)
       return Status::Error(fmt::format(
@@ -384,6 +409,7 @@ StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,
   model.stats.factorizations = st.factorizations;
   model.stats.check_points = static_cast<int>(freqs.size());
   model.stats.expansion_points = st.expansion_points;
+  model.stats.steps = st.steps;
   return model;
 }
 
