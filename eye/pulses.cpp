@@ -24,7 +24,8 @@ std::vector<Excursion> find_excursions(std::span<const double> t, std::span<cons
   if (n == 0) return out;
   int state = 0;
   Excursion cur;
-  for (size_t i = 0; i < n; ++i) {
+  // One sample of the state machine: a change of state closes or opens an excursion.
+  auto step = [&](size_t i) {
     const double x = v[i];
     const int st = x >= vth ? 1 : (x <= -vth ? -1 : 0);
     if (st != state) {
@@ -51,6 +52,38 @@ std::vector<Excursion> find_excursions(std::span<const double> t, std::span<cons
       cur.peak = state * x;
       cur.peak_t = t[i];
     }
+  };
+  // Most samples stay in the state of the one before (a pulse's top, the idle line): blocks of
+  // kBlock that do are taken whole, without a branch per sample; the block holding a change of
+  // state, and the tail, go sample by sample. The same excursions, peaks and peak times.
+  constexpr size_t kBlock = 8;
+  size_t i = 0;
+  while (i < n) {
+    if (state == 0) {
+      while (i + kBlock <= n) {
+        bool quiet = true;
+        for (size_t k = 0; k < kBlock; ++k) quiet &= v[i + k] < vth && v[i + k] > -vth;
+        if (!quiet) break;
+        i += kBlock;
+      }
+    } else {
+      const double s = state;
+      while (i + kBlock <= n) {
+        bool inside = true;
+        double most = s * v[i];
+        for (size_t k = 0; k < kBlock; ++k) {
+          inside &= s * v[i + k] >= vth;
+          most = std::max(most, s * v[i + k]);
+        }
+        if (!inside) break;
+        if (most > cur.peak)  // the first sample above the peak so far, as one by one
+          for (size_t k = 0; k < kBlock; ++k)
+            if (s * v[i + k] > cur.peak) cur.peak = s * v[i + k], cur.peak_t = t[i + k];
+        i += kBlock;
+      }
+    }
+    const size_t end = std::min(n, i + kBlock);
+    for (; i < end; ++i) step(i);
   }
   if (state != 0) {
     cur.b = t[n - 1];

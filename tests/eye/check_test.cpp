@@ -1,9 +1,11 @@
 #include "eye/check.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -98,6 +100,33 @@ TEST(Check, BadSamplesAreErrors) {
   r = check_samples(t, v, bad);
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.status().message().find("vth = -1"), std::string::npos) << r.status().message();
+}
+
+// A bad sample is found and named wherever it is: in the first samples, inside the blocks the
+// check takes without a branch per sample (every lane), and in the tail after the last block.
+TEST(Check, BadSamplesAreNamedWhereverTheyAre) {
+  const size_t n = 1003;
+  for (size_t at : {size_t{0}, size_t{1}, size_t{2}, size_t{3}, size_t{4}, size_t{5}, size_t{8},
+                    size_t{500}, size_t{501}, size_t{502}, size_t{503}, size_t{998}, size_t{1000},
+                    size_t{1001}, size_t{1002}}) {
+    for (int kind = 0; kind < 4; ++kind) {
+      std::vector<double> t(n), v(n, 0.0);
+      for (size_t i = 0; i < n; ++i) t[i] = static_cast<double>(i) * ns;
+      std::string want = fmt::format("sample {} is not a finite number", at);
+      if (kind == 0) v[at] = std::numeric_limits<double>::quiet_NaN();
+      if (kind == 1) v[at] = -std::numeric_limits<double>::infinity();
+      if (kind == 2) t[at] = std::numeric_limits<double>::infinity();
+      if (kind == 3) {
+        if (at == 0) continue;
+        t[at] = t[at - 1];  // time stands still
+        want = fmt::format("time does not increase at sample {} ", at);
+      }
+      StatusOr<CheckResult> r = check_samples(t, v, rules());
+      ASSERT_FALSE(r.ok()) << "sample " << at << " kind " << kind;
+      EXPECT_NE(r.status().message().find(want), std::string::npos)
+          << r.status().message() << " (kind " << kind << ")";
+    }
+  }
 }
 
 TEST(Check, RecordCutMidFrameIsTruncatedAndInconclusive) {

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include "synth.h"
 
 namespace isolink::eye {
@@ -44,6 +46,55 @@ TEST(Excursions, OpenAtTheRecordEnds) {
   EXPECT_DOUBLE_EQ(ex[0].a, 0.0);
   EXPECT_TRUE(ex[1].open_end);
   EXPECT_DOUBLE_EQ(ex[1].b, 3 * ns);
+}
+
+// Against the definition, sample by sample, on waveforms with long runs on either side of the
+// threshold (what find_excursions takes in blocks), ties for the peak and runs of every length
+// from 1: sample i lies in an excursion of sign s exactly when s v[i] >= vth; each excursion is
+// the whole run [ia, ib); its peak is the run's largest s v, at the first sample that has it.
+TEST(Excursions, EveryRunOfSamplesPastTheThresholdIsOneExcursion) {
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 200; ++trial) {
+    std::vector<double> t, v;
+    const double vth = 1.2;
+    while (v.size() < 300) {
+      const int level = static_cast<int>(rng() % 3) - 1;  // a run below, inside or above
+      const size_t len = 1 + rng() % (trial % 2 ? 40 : 9);
+      for (size_t k = 0; k < len; ++k) {
+        double x = level * (vth + (rng() % 4) * 0.5);  // on the threshold, or 0.5-1.5 V past
+        if (level == 0) x = (static_cast<double>(rng() % 5) - 2) * 0.5;  // -1.0 .. 1.0
+        v.push_back(x);
+        t.push_back(static_cast<double>(t.size()) * ns);
+      }
+    }
+    const std::vector<Excursion> ex = find_excursions(t, v, vth);
+    std::vector<int> sign_at(v.size(), 0);
+    size_t next = 0;
+    for (const Excursion& e : ex) {
+      ASSERT_TRUE(e.sign == 1 || e.sign == -1);
+      ASSERT_LT(e.ia, e.ib);
+      EXPECT_GE(e.ia, next);  // in order, not overlapping
+      next = e.ib;
+      double peak = -1;
+      size_t at = 0;
+      for (size_t i = e.ia; i < e.ib; ++i) {
+        sign_at[i] = e.sign;
+        if (e.sign * v[i] > peak) peak = e.sign * v[i], at = i;
+      }
+      EXPECT_EQ(e.peak, peak) << "trial " << trial;
+      EXPECT_EQ(e.peak_t, t[at]) << "trial " << trial;
+      EXPECT_EQ(e.open_start, e.ia == 0);
+      EXPECT_EQ(e.open_end, e.ib == v.size());
+      if (e.ia > 0) {  // the crossing between the sample before and the first inside
+        EXPECT_NEAR(e.a, t[e.ia - 1] + (e.sign * vth - v[e.ia - 1]) / (v[e.ia] - v[e.ia - 1]) * ns,
+                    1e-18);
+      }
+    }
+    for (size_t i = 0; i < v.size(); ++i) {
+      const int want = v[i] >= vth ? 1 : (v[i] <= -vth ? -1 : 0);
+      ASSERT_EQ(sign_at[i], want) << "trial " << trial << " sample " << i;
+    }
+  }
 }
 
 TEST(Segment, SameSignExcursionsLessThan100nsApartMergeWithADip) {
