@@ -3,9 +3,9 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
+#include <experimental/simd>
 #include <filesystem>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -113,28 +113,31 @@ namespace {
 // Not inlined: inlined, its accumulator became the caller's `peak`, whose address fmt takes, and
 // the loop stored it to memory at every sample (17 % of the worst-case search's time).
 [[gnu::noinline]] double largest_magnitude(std::span<const double> v) {
-  return running_max(v, 0, v.size(), 0.0, [](double x) { return std::abs(x); });
+  return running_max(v, 0, v.size(), 0.0, [](auto x) {
+    using std::abs;
+    return abs(x);
+  });
 }
 
 // Where to start checking the samples one by one (a number not finite, time not increasing):
-// past all but the last few when, taken in four lanes without a branch per sample, every
-// x * 0 sums to 0 (an infinity or a NaN makes it NaN) and every time step is positive; 0 when
-// something is wrong somewhere, so that the one-by-one check finds and names it.
+// past all but the last few when, a SIMD register of samples at a time, every x * 0 sums to 0
+// (an infinity or a NaN makes it NaN) and every time step is positive; 0 when something is wrong
+// somewhere, so that the one-by-one check finds and names it.
 size_t first_unordered(std::span<const double> t, std::span<const double> v) {
-  constexpr size_t kLanes = 4;
+  namespace stdx = std::experimental;
+  using V = stdx::native_simd<double>;
   const size_t n = std::min(t.size(), v.size());
   if (n == 0) return 0;
-  std::array<double, kLanes> probe{}, step;
-  step.fill(std::numeric_limits<double>::infinity());
+  V probe = 0.0, step = std::numeric_limits<double>::infinity();
   size_t i = 1;
-  for (; i + kLanes <= n; i += kLanes)
-    for (size_t k = 0; k < kLanes; ++k) {
-      probe[k] += t[i + k] * 0.0 + v[i + k] * 0.0;
-      const double d = t[i + k] - t[i + k - 1];
-      step[k] = d < step[k] ? d : step[k];
-    }
-  bool ok = t[0] * 0.0 + v[0] * 0.0 == 0.0;
-  for (size_t k = 0; k < kLanes; ++k) ok = ok && probe[k] == 0.0 && step[k] > 0.0;
+  for (; i + V::size() <= n; i += V::size()) {
+    const V ti(t.data() + i, stdx::element_aligned),
+        before(t.data() + i - 1, stdx::element_aligned), vi(v.data() + i, stdx::element_aligned);
+    probe += ti * 0.0 + vi * 0.0;
+    step = stdx::min(step, ti - before);
+  }
+  const bool ok =
+      t[0] * 0.0 + v[0] * 0.0 == 0.0 && stdx::all_of(probe == 0.0) && stdx::all_of(step > 0.0);
   return ok ? i : 0;
 }
 }  // namespace

@@ -125,7 +125,7 @@ std::vector<PulseMetrics> measure_pulses(std::span<const double> t, std::span<co
         std::upper_bound(t.begin() + static_cast<std::ptrdiff_t>(ps.ia),
                          t.begin() + static_cast<std::ptrdiff_t>(std::max(ps.ia, ps.ib)), mid) -
         t.begin());
-    double vstart = running_max(v, ps.ia, j, r.vth, [s](double x) { return s * x; });
+    double vstart = running_max(v, ps.ia, j, r.vth, [s](auto x) { return s * x; });
     vstart = std::max(vstart, s * interp(t, v, ps.ia > 0 ? ps.ia - 1 : 0, j + 1, mid));
     const double vend =
         s * interp(t, v, ps.ia > 0 ? ps.ia - 1 : 0, ps.ib + 1, ps.b - r.vend_offset);

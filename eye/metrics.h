@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <experimental/simd>
 #include <limits>
 #include <span>
 #include <string>
@@ -81,16 +82,20 @@ struct WorstMargin {
 };
 
 SegmentParams segment_params(const Rules& r);
-// The largest f(v[j]) over j in [lo, hi), at least `floor`, with four running maxima so that the
-// comparisons do not form one chain through the samples (the eye check's per-sample loops).
+// The largest f(v[j]) over j in [lo, hi), at least `floor`, taken a SIMD register of samples at
+// a time (std::experimental::simd): the eye check's per-sample loops. f maps a double and a
+// register alike (written with auto and operators, or abs found by lookup).
 template <class F>
 double running_max(std::span<const double> v, size_t lo, size_t hi, double floor, F f) {
-  double m[4] = {floor, floor, floor, floor};
+  namespace stdx = std::experimental;
+  using V = stdx::native_simd<double>;
+  V m = floor;
   size_t j = lo;
-  for (; j + 4 <= hi; j += 4)
-    for (size_t k = 0; k < 4; ++k) m[k] = std::max(m[k], f(v[j + k]));
-  for (; j < hi; ++j) m[0] = std::max(m[0], f(v[j]));
-  return std::max(std::max(m[0], m[1]), std::max(m[2], m[3]));
+  for (; j + V::size() <= hi; j += V::size())
+    m = stdx::max(m, f(V(v.data() + j, stdx::element_aligned)));
+  double out = stdx::hmax(m);
+  for (; j < hi; ++j) out = std::max(out, f(v[j]));
+  return out;
 }
 // Item 5: the half bits pulse i of seg carries for decoding (PulseMetrics::half_bits).
 int pulse_half_bits(const Segmentation& seg, size_t i, const Rules& r);
