@@ -178,6 +178,18 @@ StatusOr<LinkRun> run_link_from_edges(const link::LinkSpec& spec, const link::Pa
   return run;
 }
 
+std::vector<int> same_circuits(const LinkRun& run) {
+  std::vector<int> same(run.directions.size(), -1);
+  for (size_t d = 0; d < run.directions.size(); ++d) {
+    if (run.directions[d].same_as.empty()) continue;
+    for (size_t k = 0; k < d && same[d] < 0; ++k)
+      if (run.directions[k].same_as.empty() &&
+          link::direction_name(run.directions[k].link.direction) == run.directions[d].same_as)
+        same[d] = static_cast<int>(k);
+  }
+  return same;
+}
+
 Waveform run_waveforms(const LinkRun& run, double dt) {
   Waveform out;
   std::vector<Waveform> parts;

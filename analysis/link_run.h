@@ -68,6 +68,9 @@ StatusOr<LinkRun> run_link(const link::LinkSpec& spec, const link::PartLibrary& 
 StatusOr<LinkRun> run_link_from_edges(const link::LinkSpec& spec, const link::PartLibrary& parts,
                                       const RunOptions& opt, const WorstOptions& wopt,
                                       std::vector<EdgeResponse>& edges);
+// Per direction of `run`, the index of the earlier direction it is the same circuit as (its
+// same_as), or -1: what worst_case needs to skip its own circuit keys.
+std::vector<int> same_circuits(const LinkRun& run);
 // One expanded direction simulated and scored: run_link's work per direction (packs expand every
 // hop first and simulate each distinct circuit once).
 StatusOr<DirectionRun> run_direction(link::ExpandedLink link, const RunOptions& opt = {});

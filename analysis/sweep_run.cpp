@@ -402,7 +402,8 @@ PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t
     }
     if (s.worst_outputs) {
       // The default options, as `isolink run` and `isolink worst` use, on the run's expansion.
-      StatusOr<WorstResult> w = worst_case(po.point.spec, parts, wopt, std::move(edges));
+      StatusOr<WorstResult> w =
+          worst_case(po.point.spec, parts, wopt, std::move(edges), same_circuits(*run));
       if (!w) return fail("worst: " + w.status().message());
       r.worst = worst_cells(*w);
     }

@@ -959,11 +959,20 @@ bool on_grid(const traffic::Drive& drive, double dt) {
 }
 
 StatusOr<WorstResult> worst_case(const link::LinkSpec& spec, const link::PartLibrary& parts,
-                                 const WorstOptions& opt, std::vector<EdgeResponse> edges) {
+                                 const WorstOptions& opt, std::vector<EdgeResponse> edges,
+                                 std::vector<int> same) {
   if (Status s = opt.validate(); !s.ok()) return s;
-  if (!edges.empty() && edges.size() != spec.stimulus.directions.size())
-    return Status::Error(fmt::format("internal error: {} edge responses for {} directions",
-                                     edges.size(), spec.stimulus.directions.size()));
+  const size_t nd = spec.stimulus.directions.size();
+  if (!edges.empty() && edges.size() != nd)
+    return Status::Error(
+        fmt::format("internal error: {} edge responses for {} directions", edges.size(), nd));
+  if (!same.empty() && same.size() != nd)
+    return Status::Error(
+        fmt::format("internal error: {} circuit matches for {} directions", same.size(), nd));
+  for (size_t di = 0; di < same.size(); ++di)
+    if (same[di] >= static_cast<int>(di))
+      return Status::Error(fmt::format(
+          "internal error: direction {} is matched with a later one ({})", di, same[di]));
   const auto start = std::chrono::steady_clock::now();
   WorstResult out;
   std::vector<std::string> keys;  // link::circuit_key per direction done
@@ -974,9 +983,9 @@ StatusOr<WorstResult> worst_case(const link::LinkSpec& spec, const link::PartLib
     // A mirror-symmetric link (the same parts at both ends) is the same circuit both ways: its
     // worst case is computed once and reported for each direction.
     bool reused = false;
-    keys.push_back(link::circuit_key(*ex));
-    for (size_t k = 0; k + 1 < keys.size() && !reused; ++k) {
-      if (keys[k] != keys.back()) continue;
+    if (same.empty()) keys.push_back(link::circuit_key(*ex));
+    for (size_t k = 0; k < di && !reused; ++k) {
+      if (same.empty() ? keys[k] != keys.back() : same[di] != static_cast<int>(k)) continue;
       DirectionWorst dw = out.directions[k];
       dw.same_as = link::direction_name(dw.direction);
       dw.seconds = dw.edge.seconds = 0;  // nothing computed for it

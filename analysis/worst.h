@@ -181,9 +181,12 @@ bool on_grid(const traffic::Drive& drive, double dt);
 
 // The worst case of every direction in spec.stimulus.directions; `edges`, when given, are their
 // edge responses (one per direction, in order, from edge_response with the same options).
+// `same`, when given, says per direction which earlier direction is the same circuit (its index,
+// or -1), as a run of the same spec found it (same_circuits of link_run.h); otherwise each
+// direction's link::circuit_key is compared here.
 StatusOr<WorstResult> worst_case(const link::LinkSpec& spec, const link::PartLibrary& parts,
-                                 const WorstOptions& opt = {},
-                                 std::vector<EdgeResponse> edges = {});
+                                 const WorstOptions& opt = {}, std::vector<EdgeResponse> edges = {},
+                                 std::vector<int> same = {});
 // One direction, from its edge response (tests build their own).
 StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::Rules& rules,
                                               const WorstOptions& opt);

@@ -39,6 +39,7 @@ TEST(LinkRun, MirrorSymmetricDirectionIsSimulatedOnce) {
   EXPECT_EQ(both->directions[1].same_as, "down");
   EXPECT_EQ(both->directions[1].link.direction, link::Direction::kUp);
   EXPECT_EQ(both->directions[1].link.description.rfind("up:", 0), 0u);
+  EXPECT_EQ(same_circuits(*both), (std::vector<int>{-1, 0}));
   StatusOr<LinkRun> up = run_link(spec_of(xfmr, "up"), *parts);
   ASSERT_TRUE(up.ok()) << up.status().message();
   ASSERT_TRUE(up->directions[0].data && both->directions[1].data);
@@ -68,6 +69,7 @@ TEST(LinkRun, MirrorSymmetricDirectionIsSimulatedOnce) {
   ASSERT_TRUE(asym.ok()) << asym.status().message();
   ASSERT_EQ(asym->directions.size(), 2u);
   EXPECT_EQ(asym->directions[1].same_as, "");
+  EXPECT_EQ(same_circuits(*asym), (std::vector<int>{-1, -1}));
   EXPECT_NE(asym->directions[0].sim.wave.columns[0], asym->directions[1].sim.wave.columns[0]);
 }
 

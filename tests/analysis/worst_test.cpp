@@ -393,6 +393,22 @@ TEST(WorstCase, MirrorSymmetricLinkIsComputedOnce) {
   EXPECT_EQ(sym->directions[1].same_as, "down");
   EXPECT_EQ(sym->directions[1].direction, link::Direction::kUp);
   EXPECT_EQ(sym->directions[1].description.rfind("up:", 0), 0u);
+  // The match given by the caller (a run's same_circuits) instead of found here: the same result;
+  // told that the directions differ, each is computed; a match with a later direction is refused.
+  StatusOr<WorstResult> told = worst_case(spec, f.parts, opt, {}, {-1, 0});
+  ASSERT_TRUE(told.ok()) << told.status().message();
+  EXPECT_EQ(told->directions[1].same_as, "down");
+  StatusOr<WorstResult> apart = worst_case(spec, f.parts, opt, {}, {-1, -1});
+  ASSERT_TRUE(apart.ok()) << apart.status().message();
+  EXPECT_EQ(apart->directions[1].same_as, "");
+  EXPECT_GT(apart->directions[1].scored, 0);
+  for (size_t m = 0; m < sym->directions[1].metrics.size(); ++m) {
+    EXPECT_EQ(told->directions[1].metrics[m].value, sym->directions[1].metrics[m].value);
+    EXPECT_EQ(apart->directions[1].metrics[m].value, sym->directions[1].metrics[m].value);
+  }
+  StatusOr<WorstResult> ahead = worst_case(spec, f.parts, opt, {}, {1, -1});
+  ASSERT_FALSE(ahead.ok());
+  EXPECT_NE(ahead.status().message().find("matched with a later one"), std::string::npos);
   // The copy is what the up direction computes on its own.
   spec.stimulus.directions = {link::Direction::kUp};
   StatusOr<WorstResult> up = worst_case(spec, f.parts, opt);
