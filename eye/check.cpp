@@ -185,7 +185,7 @@ StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const d
     }
     for (auto it = tails.rbegin(); it != tails.rend(); ++it) drop_frame_tail(&seg, *it);
   }
-  r.pulses = measure_pulses(t, v, seg, rules);
+  r.pulses = measure_pulses(t, v, seg, rules, opt.warning_texts);
   r.ringing = seg.ringing;
   r.idle = find_idle_undershoots(t, v, seg, rules);
   const FrameFormat& fmt_ = r.frame_format;

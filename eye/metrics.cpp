@@ -49,7 +49,8 @@ int pulse_half_bits(const Segmentation& seg, size_t i, const Rules& r) {
 }
 
 std::vector<PulseMetrics> measure_pulses(std::span<const double> t, std::span<const double> v,
-                                         const Segmentation& seg, const Rules& r) {
+                                         const Segmentation& seg, const Rules& r,
+                                         bool warning_texts) {
   std::vector<PulseMetrics> out(seg.pulses.size());
   for (size_t i = 0; i < seg.pulses.size(); ++i) {
     const PulseSpan& ps = seg.pulses[i];
@@ -114,7 +115,8 @@ std::vector<PulseMetrics> measure_pulses(std::span<const double> t, std::span<co
     }
 
     if (m.truncated) {
-      m.warnings.push_back("truncated: cut by the start or end of the record, not judged");
+      if (warning_texts)
+        m.warnings.push_back("truncated: cut by the start or end of the record, not judged");
       continue;
     }
 
@@ -154,7 +156,7 @@ std::vector<PulseMetrics> measure_pulses(std::span<const double> t, std::span<co
     m.droop.value = vstart - vend;
     m.droop.limit = r.droop_max;
     m.droop.margin = r.droop_max - m.droop.value;
-    if (m.droop.margin < 0)
+    if (m.droop.margin < 0 && warning_texts)
       m.warnings.push_back(
           fmt::format("droop: {:.3f} V > {:.2f} V (VSTART {:.3f} V, VEND {:.3f} V)", m.droop.value,
                       r.droop_max, vstart, vend));

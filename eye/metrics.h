@@ -100,8 +100,10 @@ double running_max(std::span<const double> v, size_t lo, size_t hi, double floor
 // Item 5: the half bits pulse i of seg carries for decoding (PulseMetrics::half_bits).
 int pulse_half_bits(const Segmentation& seg, size_t i, const Rules& r);
 // Items 5-9 for every pulse of seg.
+// warning_texts false: PulseMetrics::warnings left empty (CheckOptions::warning_texts).
 std::vector<PulseMetrics> measure_pulses(std::span<const double> t, std::span<const double> v,
-                                         const Segmentation& seg, const Rules& r);
+                                         const Segmentation& seg, const Rules& r,
+                                         bool warning_texts = true);
 // Item 10, after every frame.
 std::vector<IdleUndershoot> find_idle_undershoots(std::span<const double> t,
                                                   std::span<const double> v,

@@ -234,6 +234,20 @@ TEST(Metrics, ExponentialDroopWarning) {
   EXPECT_EQ(m.warnings[0].rfind("droop:", 0), 0u);
   EXPECT_TRUE(m.fails.empty());
   EXPECT_TRUE(r.pass);
+  // Without warning texts: the same numbers and verdict, no text.
+  StatusOr<Rules> rules = load_rules("bq7961x");
+  ASSERT_TRUE(rules.ok());
+  CheckOptions quiet;
+  quiet.warning_texts = false;
+  const Waveform w = render(t);
+  StatusOr<CheckResult> q = check_waveform(w, *rules, quiet);
+  ASSERT_TRUE(q.ok()) << q.status().message();
+  ASSERT_EQ(q->pulses.size(), r.pulses.size());
+  EXPECT_TRUE(q->pulses[4].warnings.empty());
+  EXPECT_EQ(q->pulses[4].droop.value, m.droop.value);
+  EXPECT_EQ(q->pulses[4].droop.margin, m.droop.margin);
+  EXPECT_EQ(q->pulses[4].vend.value, m.vend.value);
+  EXPECT_EQ(q->pass, r.pass);
 }
 
 // A 40 ns dip to 1.0 V inside the ++ double pulse: still one pulse, and it fails.
