@@ -15,6 +15,10 @@ void filter(const Waveform& w, const std::vector<std::pair<double, double>>& win
             std::vector<double>& t, std::vector<double>& v) {
   t.clear(), v.clear();
   const std::vector<double>& col = w.columns[0];
+  if (windows.empty()) {  // data without tones: every sample kept, none for the tone check
+    if (!inside) t = w.time, v = col;
+    return;
+  }
   for (size_t i = 0; i < w.time.size(); ++i) {
     bool in = false;
     for (const auto& [a, b] : windows)
