@@ -7,6 +7,7 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <experimental/simd>
 #include <limits>
 #include <tuple>
 #include <utility>
@@ -902,12 +903,24 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
         // base + u_q over the window, from the basis (the same sums add_previous makes).
         const int q = previous[k];
         const size_t off = static_cast<size_t>(frame + g - pre);  // window sample 0 in U
-        const double* u0 = U[0].data() + off;
-        for (size_t i = 0; i < v.size(); ++i) v[i] = base[i] + u0[i];
-        for (int b = 0; b < kPatternBits; ++b) {
-          if (!(q >> b & 1)) continue;
-          const double* ub = U[static_cast<size_t>(b) + 1].data() + off;
-          for (size_t i = 0; i < v.size(); ++i) v[i] += ub[i];
+        // One pass, a SIMD register of samples at a time, summing the base and set bits'
+        // columns in registers: a pass per column stalled on its stores (13 % of the search).
+        std::array<const double*, kCols> cols;
+        size_t nc = 0;
+        for (size_t b = 0; b < kCols; ++b)
+          if (b == 0 || (q >> (b - 1) & 1)) cols[nc++] = U[b].data() + off;
+        namespace stdx = std::experimental;
+        using V = stdx::native_simd<double>;
+        size_t i = 0;
+        for (; i + V::size() <= v.size(); i += V::size()) {
+          V sum(base.data() + i, stdx::element_aligned);
+          for (size_t col = 0; col < nc; ++col) sum += V(cols[col] + i, stdx::element_aligned);
+          sum.copy_to(v.data() + i, stdx::element_aligned);
+        }
+        for (; i < v.size(); ++i) {
+          double sum = base[i];
+          for (size_t col = 0; col < nc; ++col) sum += cols[col][i];
+          v[i] = sum;
         }
         StatusOr<Score> sc = search.score(v, t);
         if (!sc) return sc.status();
