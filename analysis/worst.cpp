@@ -249,11 +249,16 @@ class Search {
 
   // The target frame's own waveform (history idle) on the window; target starts at sample pre_.
   std::vector<double> target_wave(int pattern) const {
+    std::vector<double> v;
+    target_wave(pattern, v);
+    return v;
+  }
+  // The same into v (its storage reused: the idle-target stage's 512 waves).
+  void target_wave(int pattern, std::vector<double>& v) const {
     const std::vector<double>& a = subset_sums_[0][static_cast<size_t>(pattern & kLowMask)];
     const std::vector<double>& b = subset_sums_[1][static_cast<size_t>(pattern >> kLowBits)];
-    std::vector<double> v(a.size());
+    v.resize(a.size());
     for (size_t i = 0; i < v.size(); ++i) v[i] = a[i] + b[i];
-    return v;
   }
   // Adds the previous byte ending `gap` samples before the target's start.
   void add_previous(std::vector<double>& v, int pattern, long gap) const {
@@ -681,10 +686,12 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
 
   // Stage 1: every target pattern after idle.
   std::vector<Score> idle_scores(targets.size());
+  std::vector<double> wave;
   for (size_t i = 0; i < targets.size(); ++i) {
     if (opt.progress && i % 64 == 0)
       opt.progress("search, idle targets", static_cast<double>(i) / targets.size());
-    StatusOr<Score> sc = search.score(search.target_wave(targets[i]), targets[i]);
+    search.target_wave(targets[i], wave);
+    StatusOr<Score> sc = search.score(wave, targets[i]);
     if (!sc) return sc.status();
     idle_scores[i] = *sc;
     consider(*sc, targets[i], -1, 0);

@@ -3,7 +3,9 @@
 #include <fmt/format.h>
 #include <klu.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "solver/mna.h"
@@ -83,6 +85,24 @@ Status AcAnalysis::add_excitation(const std::string& source, std::complex<double
   return Status::Ok();
 }
 
+namespace {
+
+// klu_z_rcond's estimate, min |U_kk| / max |U_kk| (0 for a zero or NaN pivot), from squared
+// magnitudes: it used hypot per pivot, 1.4 ms of a 12 m link's 266 refactorizations.
+double pivot_ratio(const klu_numeric* numeric, int n) {
+  const double* u = static_cast<const double*>(numeric->Udiag);  // interleaved re, im
+  double lo = std::numeric_limits<double>::infinity(), hi = 0;
+  for (int k = 0; k < n; ++k) {
+    const double m2 = u[2 * k] * u[2 * k] + u[2 * k + 1] * u[2 * k + 1];
+    if (!(m2 > 0) || !std::isfinite(m2)) return 0;
+    lo = std::min(lo, m2);
+    hi = std::max(hi, m2);
+  }
+  return n > 0 ? std::sqrt(lo / hi) : 0;
+}
+
+}  // namespace
+
 Status AcAnalysis::factor(double frequency) {
   Impl& m = *impl_;
   if (!(frequency >= 0) || !std::isfinite(frequency))
@@ -97,10 +117,7 @@ Status AcAnalysis::factor(double frequency) {
   bool ok = false;
   if (m.numeric) {
     ok = klu_z_refactor(ap, ai, m.a.data(), m.symbolic, m.numeric, &m.common) == 1;
-    if (ok) {
-      klu_z_rcond(m.symbolic, m.numeric, &m.common);
-      ok = m.common.rcond > 1e-13;
-    }
+    ok = ok && pivot_ratio(m.numeric, m.pattern.size()) > 1e-13;
     if (!ok) klu_z_free_numeric(&m.numeric, &m.common);
   }
   if (!ok) {
