@@ -38,25 +38,25 @@ int render_text(float* mask, int w, int h, int x, int y, const char* text, int s
 int encode_png(int w, int h, const unsigned char* rgb,
                void (*sink)(void* ctx, const unsigned char* data, size_t n), void* ctx, char* err,
                size_t errlen) {
-  OIIO::ImageBuf img(OIIO::ImageSpec(w, h, 3, OIIO::TypeDesc::UINT8));
-  img.set_pixels(OIIO::ROI(0, w, 0, h, 0, 1, 0, 3), OIIO::TypeDesc::UINT8, rgb);
-  std::vector<unsigned char> bytes;
-  OIIO::Filesystem::IOVecOutput proxy(bytes);
-  std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create("image.png", &proxy);
   // zlib level 3 with no row filter (PNG_FILTER_NONE): the charts' flat colours and thin lines
   // compress about as well unfiltered, 3-5 times faster than the default (level 6, adaptive
   // filters). Measured on a sweep chart (1800 x 1100): 54 -> 11 ms, 53 -> 95 kB; on an eye
   // diagram: 169 -> 44 ms, 721 -> 624 kB.
-  OIIO::ImageSpec spec = img.spec();
+  OIIO::ImageSpec spec(w, h, 3, OIIO::TypeDesc::UINT8);
   spec.attribute("png:compressionLevel", 3);
   spec.attribute("png:filter", 8);
-  if (out && out->open("image.png", spec) && img.write(out.get()) && out->close()) {
+  std::vector<unsigned char> bytes;
+  OIIO::Filesystem::IOVecOutput proxy(bytes);
+  std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create("image.png", &proxy);
+  // Straight from the caller's pixels: an ImageBuf in between copied them pixel by pixel through
+  // its iterators (40 ms of a sweep chart's 150).
+  if (out && out->open("image.png", spec) && out->write_image(OIIO::TypeDesc::UINT8, rgb) &&
+      out->close()) {
     out.reset();
     sink(ctx, bytes.data(), bytes.size());
     return 0;
   }
   std::string msg = out ? out->geterror() : std::string();
-  if (msg.empty()) msg = img.geterror();
   if (msg.empty()) msg = OIIO::geterror();
   if (errlen > 0) {
     const size_t n = std::min(msg.size(), errlen - 1);
