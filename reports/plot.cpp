@@ -129,8 +129,10 @@ Rect PlotArea::data_rect(double x0, double x1, double y0, double y1) const {
 
 namespace {
 
+// Rounded half away from zero as std::lround, whose libm call was a third of a chart's drawing
+// time (the value is non-negative, and its sum with 0.5 exact in double).
 uint8_t to_byte(float v) {
-  return static_cast<uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
+  return static_cast<uint8_t>(static_cast<double>(std::clamp(v, 0.0f, 1.0f) * 255.0f) + 0.5);
 }
 
 Rect intersect(const Rect& a, const Rect& b) {
