@@ -1003,20 +1003,24 @@ StatusOr<WorstResult> worst_case(const link::LinkSpec& spec, const link::PartLib
     if (!ex) return ex.status();
     // A mirror-symmetric link (the same parts at both ends) is the same circuit both ways: its
     // worst case is computed once and reported for each direction.
-    bool reused = false;
-    if (same.empty()) keys.push_back(link::circuit_key(*ex));
-    for (size_t k = 0; k < di && !reused; ++k) {
-      if (same.empty() ? keys[k] != keys.back() : same[di] != static_cast<int>(k)) continue;
-      DirectionWorst dw = out.directions[k];
+    // The earlier direction this one is the same circuit as: the caller's match, or the first
+    // with the same circuit key.
+    int match = same.empty() ? -1 : same[di];
+    if (same.empty()) {
+      keys.push_back(link::circuit_key(*ex));
+      const auto it = std::find(keys.begin(), keys.end() - 1, keys.back());
+      if (it != keys.end() - 1) match = static_cast<int>(it - keys.begin());
+    }
+    if (match >= 0) {
+      DirectionWorst dw = out.directions[static_cast<size_t>(match)];
       dw.same_as = link::direction_name(dw.direction);
       dw.seconds = dw.edge.seconds = 0;  // nothing computed for it
       dw.direction = d;
       dw.description = ex->description;
       dw.receiver = ex->receiver;
       out.directions.push_back(std::move(dw));
-      reused = true;
+      continue;
     }
-    if (reused) continue;
     StatusOr<eye::Rules> rules = eye::load_rules(ex->rules);
     if (!rules) return rules.status();
     WorstOptions dopt = opt;  // progress says which direction
