@@ -61,12 +61,48 @@ void DriveBuilder::push(double start, double end, int level) {
   t_ = end;
 }
 
+double DriveBuilder::next_idle() const {
+  const double automatic = any_item_ ? timing_.frame_gap : timing_.lead;
+  return (gap_ >= 0 ? gap_ : automatic) + pending_idle_;
+}
+
+Status DriveBuilder::set_max_duration(double seconds) {
+  if (!(seconds > 0.0)) {
+    return Status::Error(
+        fmt::format("maximum duration {} s is invalid: it must be a positive time", seconds));
+  }
+  max_duration_ = seconds;
+  return Status::Ok();
+}
+
+Status DriveBuilder::set_max_segments(size_t count) {
+  if (count == 0) return Status::Error("maximum segment count 0 is invalid: it must be >= 1");
+  max_segments_ = static_cast<double>(count);
+  return Status::Ok();
+}
+
+Status DriveBuilder::check_room(double length, double segments) const {
+  const double end = t_ + next_idle() + length;
+  if (!(end <= max_duration_)) {
+    return Status::Error(
+        fmt::format("the traffic would last {:g} s by the end of this item; the limit is {:g} s",
+                    end, max_duration_));
+  }
+  // + 1: the idle before the item.
+  const double count = static_cast<double>(drive_.segments.size()) + 1 + segments;
+  if (!(count <= max_segments_)) {
+    return Status::Error(
+        fmt::format("the traffic would have up to {:.0f} level segments by the end of this item; "
+                    "the limit is {:.0f}",
+                    count, max_segments_));
+  }
+  return Status::Ok();
+}
+
 Status DriveBuilder::begin_item() {
   Status s = validate(timing_);
   if (!s.ok()) return s;
-  const double automatic = any_item_ ? timing_.frame_gap : timing_.lead;
-  const double idle = (gap_ >= 0 ? gap_ : automatic) + pending_idle_;
-  push(t_, t_ + idle, 0);
+  push(t_, t_ + next_idle(), 0);
   pending_idle_ = 0;
   gap_ = -1;
   any_item_ = true;
@@ -81,6 +117,12 @@ Status DriveBuilder::add_frame(const std::vector<uint8_t>& bytes, std::string la
   EncodingOptions enc = enc_;
   if (error_bit >= 0) enc.error_bit = error_bit;
   Status s = validate(enc);
+  if (!s.ok()) return s;
+  s = validate(timing_);
+  if (!s.ok()) return s;
+  const double n = static_cast<double>(bytes.size());
+  s = check_room(n * byte_duration(enc) + (n - 1) * timing_.byte_gap,
+                 n * byte_half_bit_count(enc) + (n - 1));
   if (!s.ok()) return s;
   s = begin_item();
   if (!s.ok()) return s;
@@ -106,6 +148,10 @@ Status DriveBuilder::add_frame(const std::vector<uint8_t>& bytes, std::string la
 
 Status DriveBuilder::add_tone(Tone tone, const ToneOptions& opt) {
   Status s = validate(opt);
+  if (!s.ok()) return s;
+  s = validate(timing_);
+  if (!s.ok()) return s;
+  s = check_room(tone_duration(opt), 2.0 * opt.couplets);
   if (!s.ok()) return s;
   s = begin_item();
   if (!s.ok()) return s;

@@ -22,6 +22,7 @@
 //   tail 5 us idle after the last item: covers tblank (4 us) for the undershoot check.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -97,10 +98,22 @@ class DriveBuilder {
   // The idle time before the next item is `seconds` exactly instead of the automatic lead /
   // frame_gap (any add_idle still adds to it): traffic with given gaps (a worst case's replay).
   Status set_gap(double seconds);
+  // Refuses, before building it, any item that would end after `seconds` of traffic (the error
+  // names both times): a script's memory stays bounded however many bytes or couplets it asks
+  // for. The default is no limit.
+  Status set_max_duration(double seconds);
+  // The same for the number of level segments (tones of very short pulses are many segments in
+  // little time). The default is no limit.
+  Status set_max_segments(size_t count);
   // Adds the tail and returns the drive; the builder is left empty.
   Drive finish();
 
  private:
+  // The idle before the next item (the automatic lead / frame_gap or set_gap's, plus add_idle's).
+  double next_idle() const;
+  // Ok, or the error for an item of `length` seconds and at most `segments` segments that would
+  // end past max_duration_ or max_segments_.
+  Status check_room(double length, double segments) const;
   Status begin_item();
   void push(double start, double end, int level);
 
@@ -111,6 +124,8 @@ class DriveBuilder {
   double pending_idle_ = 0;
   double gap_ = -1;  // set_gap's value for the next item, -1 = automatic
   bool any_item_ = false;
+  double max_duration_ = HUGE_VAL;
+  double max_segments_ = HUGE_VAL;
 };
 
 // Line voltages for a level: P = vdd/2 * (1 + level), N = vdd/2 * (1 - level).

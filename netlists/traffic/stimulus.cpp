@@ -164,6 +164,10 @@ Status add_item(DriveBuilder& b, std::string_view item, const StimulusOptions& o
 
 StatusOr<Drive> build_drive(std::string_view script, const StimulusOptions& opt) {
   DriveBuilder b(opt.encoding, opt.timing);
+  // Each item is refused before it is built if it would end past the limit ('pattern prbs15
+  // bytes=999999' twice built 2 x 20 M segments, 1 GB and 20 s, before the check below).
+  if (Status s = b.set_max_duration(kMaxDriveSeconds); !s.ok()) return s;
+  if (Status s = b.set_max_segments(kMaxDriveSegments); !s.ok()) return s;
   size_t index = 0;
   size_t pos = 0;
   while (pos <= script.size()) {

@@ -17,6 +17,7 @@
 // Times take SPICE suffixes with an optional trailing "s": 250n, 250ns, 1u, 1us, 2.5e-7, 20us.
 #pragma once
 
+#include <cstddef>
 #include <string_view>
 
 #include "base/status.h"
@@ -28,6 +29,9 @@ namespace isolink::traffic {
 
 // The longest traffic build_drive accepts, in seconds of simulated time.
 inline constexpr double kMaxDriveSeconds = 1.0;
+// The most level segments build_drive builds: 1 s of back-to-back bytes at the 250 ns half bit is
+// 2.6 M; tones of very short pulses would be many more in that time.
+inline constexpr size_t kMaxDriveSegments = 4'000'000;
 
 struct StimulusOptions {
   EncodingOptions encoding;  // byte frame format

@@ -253,5 +253,36 @@ TEST(Pwl, EdgeMustFitInsideTheShortestSegment) {
   EXPECT_TRUE(pwl_sources(d, opt).ok());
 }
 
+// With a 1 ms limit: 97 bytes end at 1 us + 97 x 6.5 us + 96 x 3.8 us = 996.3 us and fit; 98
+// would end at 1006.6 us and are refused, and nothing of them is built. A second 250-couplet wake
+// tone (500 us) after a first would end at 1 + 500 + 12 + 500 = 1013 us.
+TEST(DriveBuilder, ItemsPastTheMaximumDurationAreRefusedUnbuilt) {
+  DriveBuilder b;
+  ASSERT_TRUE(b.set_max_duration(1e-3).ok());
+  Status s = b.add_frame(std::vector<uint8_t>(98, 0x00));
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("would last 0.0010066 s by the end of this item; the limit is "
+                             "0.001 s"),
+            std::string::npos)
+      << s.message();
+  ASSERT_TRUE(b.add_frame(std::vector<uint8_t>(97, 0x00)).ok());
+  Drive d = b.finish();
+  ASSERT_EQ(d.frames.size(), 1u);
+  EXPECT_NEAR(d.frames[0].end, 996.3e-6, 1e-12);
+
+  ASSERT_TRUE(b.set_max_duration(1e-3).ok());
+  ToneOptions tone;
+  tone.couplets = 250;
+  ASSERT_TRUE(b.add_tone(Tone::kWake, tone).ok());
+  s = b.add_tone(Tone::kWake, tone);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("would last 0.001013 s"), std::string::npos) << s.message();
+  d = b.finish();
+  ASSERT_EQ(d.frames.size(), 1u);
+  EXPECT_NEAR(d.frames[0].end, 501e-6, 1e-12);
+  EXPECT_FALSE(b.set_max_duration(0).ok());
+  EXPECT_FALSE(b.set_max_duration(std::nan("")).ok());
+}
+
 }  // namespace
 }  // namespace isolink::traffic

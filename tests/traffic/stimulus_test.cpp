@@ -126,5 +126,38 @@ TEST(Stimulus, GapSetsTheIdleBeforeTheNextItemExactly) {
             std::string::npos);
 }
 
+// An item that would take the traffic past kMaxDriveSeconds is refused before it is built: one
+// 'pattern prbs15 bytes=999999' is 1 us lead + 999,999 x 6.5 us frames + 999,998 x 3.8 us gaps =
+// 10.2999869 s (20 M segments, 0.5 GB, were built before the end-of-script check saw that).
+TEST(Stimulus, ItemPastTheLimitIsRefusedBeforeItIsBuilt) {
+  StatusOr<Drive> d = build_drive("wake; pattern prbs15 bytes=999999; pattern all256 bytes=999999");
+  ASSERT_FALSE(d.ok());
+  const std::string& m = d.status().message();
+  EXPECT_NE(m.find("item 2 (pattern prbs15 bytes=999999): the traffic would last 10.3 s by the "
+                   "end of this item; the limit is 1 s"),
+            std::string::npos)
+      << m;
+  // A pattern that fits (97,000 bytes: 0.999 s) still builds, and idle still counts at the end.
+  d = build_drive("pattern alt bytes=97000");
+  ASSERT_TRUE(d.ok()) << d.status().message();
+  EXPECT_NEAR(d->duration(), 1e-6 + 97000 * 6.5e-6 + 96999 * 3.8e-6 + 5e-6, 1e-9);
+  d = build_drive("pattern alt bytes=97000; idle 10m");
+  ASSERT_FALSE(d.ok());
+  EXPECT_NE(d.status().message().find("the traffic lasts 1.0091 s; the limit is 1 s"),
+            std::string::npos)
+      << d.status().message();
+  // Tones of 100,000 couplets of 1 ns pulses last 0.2 ms each but are 200,000 segments (and one
+  // idle before each): the 20th would end at 20 x 200,001 = 4,000,020 segments.
+  std::string tones;
+  for (int i = 0; i < 21; ++i) tones += "tone wake couplets=100000 pulse=1n;";
+  d = build_drive(tones);
+  ASSERT_FALSE(d.ok());
+  EXPECT_NE(d.status().message().find("item 20 (tone wake couplets=100000 pulse=1n): the traffic "
+                                      "would have up to 4000020 level segments by the end of "
+                                      "this item; the limit is 4000000"),
+            std::string::npos)
+      << d.status().message();
+}
+
 }  // namespace
 }  // namespace isolink::traffic
