@@ -9,6 +9,7 @@
 #include <charconv>
 #include <cmath>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string_view>
 
@@ -186,26 +187,33 @@ Status check_duplicate_keys(const YamlDoc& doc, const YAML::Node& node) {
   return Status::Ok();
 }
 
-// Records where a document's first node starts (no node: an empty document).
-class FirstNode : public YAML::EventHandler {
+// Records where a document's first node starts (no node: an empty document), and the first alias
+// of a map or list in it.
+class DocumentScan : public YAML::EventHandler {
  public:
   std::optional<YAML::Mark> mark;
+  std::optional<YAML::Mark> collection_alias;
   void OnDocumentStart(const YAML::Mark&) override {}
   void OnDocumentEnd() override {}
   void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
-  void OnAlias(const YAML::Mark& m, YAML::anchor_t) override { note(m); }
+  void OnAlias(const YAML::Mark& m, YAML::anchor_t anchor) override {
+    note(m);
+    if (!collection_alias && collections_.count(anchor) > 0) collection_alias = m;
+  }
   void OnScalar(const YAML::Mark& m, const std::string&, YAML::anchor_t,
                 const std::string&) override {
     note(m);
   }
-  void OnSequenceStart(const YAML::Mark& m, const std::string&, YAML::anchor_t,
+  void OnSequenceStart(const YAML::Mark& m, const std::string&, YAML::anchor_t anchor,
                        YAML::EmitterStyle::value) override {
     note(m);
+    if (anchor != YAML::NullAnchor) collections_.insert(anchor);
   }
   void OnSequenceEnd() override {}
-  void OnMapStart(const YAML::Mark& m, const std::string&, YAML::anchor_t,
+  void OnMapStart(const YAML::Mark& m, const std::string&, YAML::anchor_t anchor,
                   YAML::EmitterStyle::value) override {
     note(m);
+    if (anchor != YAML::NullAnchor) collections_.insert(anchor);
   }
   void OnMapEnd() override {}
 
@@ -213,19 +221,28 @@ class FirstNode : public YAML::EventHandler {
   void note(const YAML::Mark& m) {
     if (!mark) mark = m;
   }
+  std::set<YAML::anchor_t> collections_;  // anchors of maps and lists
 };
 
-// Where a second document with content starts, if there is one. Not YAML::LoadAll: in yaml-cpp
-// 0.7 (Debian 12) it never returns on some malformed text ("," alone), adding a null document per
-// turn until memory runs out (jbeder/yaml-cpp#1040, fixed upstream by #1319 after 0.7; found by
-// tests/fuzz). At most two documents are read here.
-std::optional<YAML::Mark> second_document(const std::string& text) {
+struct TextScan {
+  std::optional<YAML::Mark> second_document;   // where a second document with content starts
+  std::optional<YAML::Mark> collection_alias;  // the first alias of a map or list
+};
+
+// The events of the first document, and whether a second one has content. Not YAML::LoadAll: in
+// yaml-cpp 0.7 (Debian 12) it never returns on some malformed text ("," alone), adding a null
+// document per turn until memory runs out (jbeder/yaml-cpp#1040, fixed upstream by #1319 after
+// 0.7; found by tests/fuzz). At most two documents are read here.
+TextScan scan_text(const std::string& text) {
   std::istringstream in(text);
   YAML::Parser parser(in);
-  FirstNode first, second;
-  if (!parser.HandleNextDocument(first)) return std::nullopt;
-  if (!parser.HandleNextDocument(second)) return std::nullopt;
-  return second.mark;
+  DocumentScan first, second;
+  TextScan out;
+  if (!parser.HandleNextDocument(first)) return out;
+  out.collection_alias = first.collection_alias;
+  if (!parser.HandleNextDocument(second)) return out;
+  out.second_document = second.mark;
+  return out;
 }
 
 }  // namespace
@@ -248,7 +265,24 @@ StatusOr<YamlDoc> YamlDoc::from_text(const std::string& text, const std::string&
     return Status::Error(
         fmt::format("{}: error: a NUL byte at offset {} (is this a text file?)", name, nul));
   try {
-    if (const std::optional<YAML::Mark> m = second_document(text))
+    const TextScan scan = scan_text(text);
+    // An alias of a map or list shares the node: one inside its own anchor is a cycle, and
+    // nested ones multiply ("billion laughs": 30 lines, 2^30 nodes to walk). Aliases of single
+    // values stay allowed.
+    if (const std::optional<YAML::Mark>& m = scan.collection_alias) {
+      const size_t from = static_cast<size_t>(m->pos);
+      size_t end = from + 1;
+      while (end < text.size() && end - from < 64 &&
+             !std::isspace(static_cast<unsigned char>(text[end])) &&
+             std::string_view(",]}").find(text[end]) == std::string_view::npos)
+        ++end;
+      return error_at(SourceLoc{doc.file_, m->line + 1, m->column + 1},
+                      fmt::format("'{}' is an alias of a map or list: isolink does not share "
+                                  "maps or lists between places; write it out where it is "
+                                  "used (aliases of single values are allowed)",
+                                  text.substr(from, end - from)));
+    }
+    if (const std::optional<YAML::Mark>& m = scan.second_document)
       return error_at(SourceLoc{doc.file_, m->line + 1, m->column + 1},
                       "a second YAML document ('---') in the file: isolink reads one "
                       "document per file; remove it or move it to its own file");

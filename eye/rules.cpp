@@ -338,7 +338,8 @@ StatusOr<Rules> load_rules(const std::string& name_or_path) {
     if (r) parsed.emplace(name_or_path, *r);
     return r;
   }
-  if (!std::filesystem::exists(name_or_path)) {
+  std::error_code ec;  // a name too long for a path is "no such rule set", not an exception
+  if (!std::filesystem::exists(name_or_path, ec)) {
     std::string names;
     for (const auto& n : builtin_rule_names()) names += (names.empty() ? "" : ", ") + n;
     return Status::Error(

@@ -338,12 +338,15 @@ class Reader {
     if (include_stack_.size() >= kMaxIncludeDepth)
       return error_at(
           where, fmt::format("includes nest deeper than the limit of {} files", kMaxIncludeDepth));
-    if (fs::is_directory(p))
+    // The error_code forms: a name past NAME_MAX or PATH_MAX gets its reason below, not an
+    // exception (found by tests/fuzz).
+    std::error_code ec;
+    if (fs::is_directory(p, ec))
       return error_at(where, std::string(section ? "library file '" : "include file '") + name +
                                  "' is a folder ('" + p.string() + "')");
     auto text = read_input_file(p.string());
     if (!text) {
-      if (!fs::exists(p))
+      if (!fs::exists(p, ec) && !ec)  // with ec set (a name too long), the reader's reason
         return error_at(where, std::string(section ? "cannot open library file '"
                                                    : "cannot open include file '") +
                                    name + "' (looked for '" + p.string() + "')");

@@ -124,5 +124,35 @@ TEST(YamlDoc, MissingFileIsAnError) {
             std::string::npos);
 }
 
+// An alias of a map or list inside its own anchor made the key check recurse until the stack
+// overflowed (tests/fuzz), and nested aliases multiply the nodes to walk; both are refused where
+// the alias is. Aliases of single values still read as the value.
+TEST(YamlDoc, AliasOfAMapOrListIsRefusedWhereItIs) {
+  auto cyclic = YamlDoc::from_text("name: x\nloop: &self {a: 1, b: *self}\n", "cyc.yaml");
+  ASSERT_FALSE(cyclic.ok());
+  EXPECT_NE(
+      cyclic.status().message().find("cyc.yaml:2:23: error: '*self' is an alias of a map or list"),
+      std::string::npos)
+      << cyclic.status().message();
+  // The fuzzer's input: the root map's anchor used inside it.
+  auto fuzz = YamlDoc::from_text("&.0\nix: &.:\nd: 6.0\niz &.ix: *.0\n.0c", "fuzz.yaml");
+  ASSERT_FALSE(fuzz.ok());
+  EXPECT_NE(fuzz.status().message().find("'*.0' is an alias of a map or list"), std::string::npos)
+      << fuzz.status().message();
+  // 30 levels of doubling: 2^30 nodes if walked.
+  std::string laughs = "l0: &l0 [x, x]\n";
+  for (int i = 1; i < 30; ++i)
+    laughs += "l" + std::to_string(i) + ": &l" + std::to_string(i) + " [*l" +
+              std::to_string(i - 1) + ", *l" + std::to_string(i - 1) + "]\n";
+  auto big = YamlDoc::from_text(laughs, "laughs.yaml");
+  ASSERT_FALSE(big.ok());
+  EXPECT_NE(big.status().message().find("laughs.yaml:2:10: error: '*l0' is an alias"),
+            std::string::npos)
+      << big.status().message();
+  auto scalar = YamlDoc::from_text("r: &r 100\ns: *r\n", "ok.yaml");
+  ASSERT_TRUE(scalar.ok()) << scalar.status().message();
+  EXPECT_EQ(scalar->root()["s"].Scalar(), "100");
+}
+
 }  // namespace
 }  // namespace isolink::config

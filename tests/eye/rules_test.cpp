@@ -150,6 +150,11 @@ TEST(Rules, LoadsAUserFileFromDisk) {
   ASSERT_FALSE(missing.ok());
   EXPECT_NE(msg(missing).find("no_such_rules: error: no such rule set"), std::string::npos);
   EXPECT_NE(msg(missing).find("(bq79600, bq7961x, tone)"), std::string::npos);
+  // A name longer than NAME_MAX: std::filesystem::exists threw out of load_rules before.
+  const std::string long_name(300, 'r');
+  StatusOr<Rules> too_long = load_rules(long_name);
+  ASSERT_FALSE(too_long.ok());
+  EXPECT_NE(msg(too_long).find(long_name + ": error: no such rule set"), std::string::npos);
 }
 
 struct BadCase {

@@ -307,6 +307,18 @@ TEST_F(TempDir, MissingIncludeShowsChain) {
   EXPECT_EQ(d.notes[0], " (included from " + top + ":3:10)");
 }
 
+// A file name longer than NAME_MAX (255 bytes) made std::filesystem throw out of the reader
+// (tests/fuzz); it is an error at the .include with the system's reason.
+TEST(SpiceReader, IncludeNameTooLongIsAnError) {
+  const std::string name(300, 'q');
+  auto n = read_spice_text("title\nR1 a 0 1\n.inc " + name + "\n", "long.cir");
+  ASSERT_FALSE(n);
+  EXPECT_NE(n.status().message().find("long.cir:3:6: error: include file '" + name +
+                                      "': cannot open the file: File name too long"),
+            std::string::npos)
+      << n.status().message();
+}
+
 TEST_F(TempDir, RecursiveInclude) {
   const std::string top = write("top.cir", "top\n.include a.cir\n");
   write("a.cir", "R1 a 0 1\n.include b.cir\n");
