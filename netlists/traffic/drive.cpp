@@ -99,14 +99,11 @@ Status DriveBuilder::check_room(double length, double segments) const {
   return Status::Ok();
 }
 
-Status DriveBuilder::begin_item() {
-  Status s = validate(timing_);
-  if (!s.ok()) return s;
+void DriveBuilder::begin_item() {
   push(t_, t_ + next_idle(), 0);
   pending_idle_ = 0;
   gap_ = -1;
   any_item_ = true;
-  return Status::Ok();
 }
 
 Status DriveBuilder::add_frame(const std::vector<uint8_t>& bytes, std::string label,
@@ -124,8 +121,7 @@ Status DriveBuilder::add_frame(const std::vector<uint8_t>& bytes, std::string la
   s = check_room(n * byte_duration(enc) + (n - 1) * timing_.byte_gap,
                  n * byte_half_bit_count(enc) + (n - 1));
   if (!s.ok()) return s;
-  s = begin_item();
-  if (!s.ok()) return s;
+  begin_item();
   DriveFrame f;
   f.kind = FrameKind::kData;
   f.label = std::move(label);
@@ -153,8 +149,7 @@ Status DriveBuilder::add_tone(Tone tone, const ToneOptions& opt) {
   if (!s.ok()) return s;
   s = check_room(tone_duration(opt), 2.0 * opt.couplets);
   if (!s.ok()) return s;
-  s = begin_item();
-  if (!s.ok()) return s;
+  begin_item();
   DriveFrame f;
   f.kind = FrameKind::kTone;
   f.label = std::string(tone_name(tone));

@@ -114,7 +114,8 @@ class DriveBuilder {
   // Ok, or the error for an item of `length` seconds and at most `segments` segments that would
   // end past max_duration_ or max_segments_.
   Status check_room(double length, double segments) const;
-  Status begin_item();
+  // The idle before an item (callers have validated timing_ and checked the room).
+  void begin_item();
   void push(double start, double end, int level);
 
   EncodingOptions enc_;
