@@ -2,13 +2,16 @@
 
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <poll.h>
 #include <signal.h>
 #include <stdio.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <system_error>
@@ -45,24 +48,75 @@ size_t human_mib(size_t bytes) {
 
 // --- input -----------------------------------------------------------------------------------
 
-StatusOr<std::string> read_input_file(const std::string& path, size_t max_bytes) {
+namespace {
+
+// What a path that is not a regular file is, in words.
+const char* kind_of(const struct stat& st) {
+  if (S_ISCHR(st.st_mode)) return "a character device";
+  if (S_ISBLK(st.st_mode)) return "a block device";
+  if (S_ISFIFO(st.st_mode)) return "a FIFO or pipe";
+  if (S_ISSOCK(st.st_mode)) return "a socket";
+  return "not a regular file";
+}
+
+// Waits until fd has input, an end, or the deadline passes (false: it passed).
+bool wait_readable(int fd, std::chrono::steady_clock::time_point deadline) {
+  for (;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0) return false;
+    struct pollfd p {};
+    p.fd = fd;
+    p.events = POLLIN;
+    const int n = ::poll(&p, 1, static_cast<int>(std::min<long long>(left.count(), 1 << 30)));
+    if (n > 0) return true;
+    if (n < 0 && errno != EINTR) return true;  // let read() report it
+  }
+}
+
+}  // namespace
+
+StatusOr<std::string> read_input_file(const std::string& path, size_t max_bytes,
+                                      double max_seconds) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0)
     return Status::Error(
         fmt::format("{}: error: cannot open the file: {}", path, errno_text(errno)));
   if (S_ISDIR(st.st_mode))
     return Status::Error(fmt::format("{}: error: this is a folder, not a file", path));
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  const bool regular = S_ISREG(st.st_mode);
+  // Not a regular file (a device, a FIFO, a pipe): opened without waiting for a writer, and read
+  // under a deadline as well as the size limit, so that neither /dev/zero nor a pipe that never
+  // ends holds isolink.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | (regular ? 0 : O_NONBLOCK));
   if (fd < 0)
     return Status::Error(
         fmt::format("{}: error: cannot open the file: {}", path, errno_text(errno)));
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(std::clamp(max_seconds, 0.0, 1e6)));
+  const std::string limits = max_bytes >= (size_t{1} << 20)
+                                 ? fmt::format("{} MiB", human_mib(max_bytes))
+                                 : fmt::format("{} byte", max_bytes);
+  auto not_regular = [&] {
+    return regular ? std::string()
+                   : fmt::format(
+                         " ({}, not a regular file: read for at most {:g} s and {}; save "
+                         "its content to a file)",
+                         kind_of(st), max_seconds, limits);
+  };
   std::string text;
-  if (S_ISREG(st.st_mode) && static_cast<unsigned long long>(st.st_size) <= max_bytes)
+  if (regular && static_cast<unsigned long long>(st.st_size) <= max_bytes)
     text.reserve(static_cast<size_t>(st.st_size));
   char chunk[1 << 16];
   for (;;) {
+    if (!regular && !wait_readable(fd, deadline)) {
+      ::close(fd);
+      return Status::Error(fmt::format("{}: error: no end of input after {:g} s{}", path,
+                                       max_seconds, not_regular()));
+    }
     const ssize_t n = ::read(fd, chunk, sizeof chunk);
-    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
     if (n < 0) {
       const int err = errno;
       ::close(fd);
@@ -73,9 +127,9 @@ StatusOr<std::string> read_input_file(const std::string& path, size_t max_bytes)
     if (text.size() + static_cast<size_t>(n) > max_bytes) {
       ::close(fd);
       return Status::Error(
-          fmt::format("{}: error: the file is larger than the {} limit for an input file", path,
-                      max_bytes >= (size_t{1} << 20) ? fmt::format("{} MiB", human_mib(max_bytes))
-                                                     : fmt::format("{} byte", max_bytes)));
+          fmt::format("{}: error: the file is larger than the {} limit for an "
+                      "input file{}",
+                      path, limits, not_regular()));
     }
     text.append(chunk, static_cast<size_t>(n));
   }

@@ -34,10 +34,17 @@ namespace isolink {
 // /dev/zero given as a netlist ends here rather than in std::bad_alloc).
 inline constexpr size_t kMaxInputFileBytes = size_t{64} << 20;  // 64 MiB
 
+// A path that is not a regular file (a character device such as /dev/zero, a FIFO, a pipe) is
+// also read under this deadline: input with no end after it is refused.
+inline constexpr double kMaxInputWaitSeconds = 10;
+
 // The whole file, or "PATH: error: ..." when it cannot be opened, is a folder, or is larger than
-// max_bytes (the message states the limit).
+// max_bytes (the message states the limit); a path that is not a regular file is opened without
+// waiting for a writer and refused when its input has not ended after max_seconds (the message
+// names what it is and both limits).
 StatusOr<std::string> read_input_file(const std::string& path,
-                                      size_t max_bytes = kMaxInputFileBytes);
+                                      size_t max_bytes = kMaxInputFileBytes,
+                                      double max_seconds = kMaxInputWaitSeconds);
 
 class OutputFile {
  public:

@@ -13,15 +13,12 @@
 #include "base/csv.h"
 #include "base/file_io.h"
 #include "base/hex.h"
+#include "eye/verdict.h"
 
 namespace isolink::eye {
 namespace {
 
 using json = nlohmann::ordered_json;
-
-// Levels over this many thresholds (120 V for the 1.2 V data threshold) are no daisy-chain
-// signal: the units are wrong (mV read as V), so the record gets no verdict of pass.
-constexpr double kImplausible = 100;
 
 json num(double x) {
   return std::isnan(x) ? json(nullptr) : json(x);
@@ -293,44 +290,39 @@ StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const d
 
   r.worst = worst_margins(r.pulses);
 
-  // Item 11: the verdict. Failures measured on the link come first; then what keeps the record
-  // from showing that the link works (no verdict of pass without it).
-  std::vector<std::string> open;  // reasons for "inconclusive"
+  // Item 11: the verdict (eye/verdict.h): failures measured on the link, then what keeps the
+  // record from showing that the link works (no verdict of pass without it).
   const double peak = largest_magnitude(v);
-  if (peak > kImplausible * rules.vth)
-    open.push_back(fmt::format("levels up to {:.4g} V: no daisy-chain signal as read", peak));
-  if (r.pulses.empty())
-    open.push_back(
-        fmt::format("no pulses: nothing stays past +/-{:g} V for {:g} ns (largest |v| {:.4g} V)",
-                    rules.vth, ns(rules.min_pulse), peak));
+  VerdictFacts facts;
+  facts.peak = peak;
+  facts.decodes = rules.tone || structural > 0;
+  facts.runs = seg.frames.size();
   if (size_t nf = r.failing())
-    r.reasons.push_back(fmt::format("{} of {} pulses fail", nf, r.pulses.size()));
+    facts.failures.push_back(fmt::format("{} of {} pulses fail", nf, r.pulses.size()));
   for (size_t i = 0; i < r.frames.size(); ++i)
     if (r.frames[i].fails())
-      r.reasons.push_back(fmt::format("frame {} at {:.4f} us does not decode: {} ({})", i,
-                                      r.frames[i].start * 1e6, r.frames[i].fault,
-                                      r.frames[i].detail));
-  if (!rules.tone && !r.pulses.empty() && structural == 0)
-    open.push_back(fmt::format("no frame decodes: {} pulses in {} runs, none forms a byte",
-                               r.pulses.size(), seg.frames.size()));
+      facts.failures.push_back(fmt::format("frame {} at {:.4f} us does not decode: {} ({})", i,
+                                           r.frames[i].start * 1e6, r.frames[i].fault,
+                                           r.frames[i].detail));
+  if (!r.expect_match)
+    facts.failures.push_back("decoded bytes differ from the expected: " + r.expect_detail);
   size_t cut = 0;
   for (const PulseMetrics& p : r.pulses) cut += p.truncated ? 1 : 0;
   if (cut > 0)
-    open.push_back(fmt::format(
+    facts.open.push_back(fmt::format(
         "the record cuts {} pulse{} (first: {}): {} not judged", cut, cut == 1 ? "" : "s",
         place(*std::find_if(r.pulses.begin(), r.pulses.end(),
                             [](const PulseMetrics& p) { return p.truncated; })),
         cut == 1 ? "it is" : "they are"));
-  if (!r.expect_match)
-    r.reasons.push_back("decoded bytes differ from the expected: " + r.expect_detail);
+  const Verdict verdict = decide_verdict(r.pulses, rules, facts);
 
   // Hints: the samples look like the wrong units, the wrong column or swapped P and N.
   const bool decoded_nothing = !rules.tone && structural == 0;
-  if (peak > kImplausible * rules.vth)
+  if (peak > kImplausibleVth * rules.vth)
     r.hints.push_back(fmt::format(
         "|v| reaches {:.4g} V, over {:g}x the {:g} V threshold: a column in mV read as volts? "
         "(a units row such as \"s,mV\" under the names sets the scale)",
-        peak, kImplausible, rules.vth));
+        peak, kImplausibleVth, rules.vth));
   else if (r.pulses.empty() && peak > 0 && peak < rules.vth / 100)
     r.hints.push_back(fmt::format(
         "|v| stays under {:.4g} V, 1/100 of the threshold: the wrong column (an idle channel, a "
@@ -360,13 +352,9 @@ StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const d
           inverted, inverted == 1 ? "" : "s", inverted == 1 ? "s" : ""));
   }
 
-  // A record with no pulses, or none that forms a byte, shows nothing about the link (an
-  // unrelated capture, the wrong column): inconclusive whatever its pulses measure. Otherwise a
-  // measured failure fails, and a record that cuts a pulse cannot pass.
-  const bool nothing = r.pulses.empty() || decoded_nothing || peak > kImplausible * rules.vth;
-  r.inconclusive = nothing || (r.reasons.empty() && !open.empty());
-  r.reasons.insert(r.reasons.end(), open.begin(), open.end());
-  r.pass = r.reasons.empty();
+  r.reasons = verdict.reasons;
+  r.pass = verdict.kind == VerdictKind::kPass;
+  r.inconclusive = verdict.kind == VerdictKind::kInconclusive;
   return r;
 }
 

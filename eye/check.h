@@ -58,7 +58,7 @@ struct CheckResult {
   bool tone = false;                           // tone rules: nothing is decoded
   FrameFormat frame_format;                    // decoding options in effect
   bool pass = false;                           // the verdict
-  bool inconclusive = false;                   // no verdict: nothing decodes, or a pulse is cut
+  bool inconclusive = false;                   // no verdict (eye/verdict.h says when)
   std::vector<std::string> reasons;            // why it fails / is inconclusive (empty on pass)
   std::vector<std::string> hints;              // what to check when the data look misread
   size_t samples = 0;                          // samples in the waveform
@@ -82,11 +82,12 @@ struct CheckResult {
   const char* verdict() const { return pass ? "pass" : inconclusive ? "inconclusive" : "fail"; }
 };
 
-// Checks time/value samples (t strictly increasing) against rules. The verdict is never pass when
-// the record cannot show the link works: no pulses, no frame whose structure decodes (data rules),
-// or a pulse cut by the record's start or end. With no failure measured such a record is
-// "inconclusive" (pass = false, inconclusive = true), with hints when the samples look like the
-// wrong units (levels 1000x off, pulses far from the half bit) or swapped P and N.
+// Checks time/value samples (t strictly increasing) against rules. The verdict is formed by
+// eye/verdict.h's decide_verdict (one rule for every path): fail when the record shows the link
+// (a frame forms a byte, or a daisy-chain run) and something measured fails; "inconclusive"
+// (pass = false, inconclusive = true) when it cannot show the link (no pulses, levels 100x off,
+// nothing decoded and no daisy-chain run of failing pulses) or nothing fails but a pulse is cut;
+// hints follow when the samples look like the wrong units, the wrong column or swapped P and N.
 StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const double> v,
                                     const Rules& rules, const CheckOptions& opt = {});
 // Checks column `column` of w.

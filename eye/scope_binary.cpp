@@ -829,11 +829,17 @@ std::string hex4(const unsigned char* b, size_t n) {
 }  // namespace
 
 std::optional<std::string> binary_kind(const std::string& path) {
-  const std::string ext = ext_of(path);
   File f(std::fopen(path.c_str(), "rb"));
   unsigned char b[64] = {};
   const size_t n = f ? std::fread(b, 1, sizeof b, f.get()) : 0;
-  const std::string_view s(reinterpret_cast<const char*>(b), n);
+  return binary_kind_of(path, std::string_view(reinterpret_cast<const char*>(b), n));
+}
+
+std::optional<std::string> binary_kind_of(const std::string& path, std::string_view head) {
+  const std::string ext = ext_of(path);
+  const std::string_view s = head.substr(0, 64);
+  const size_t n = s.size();
+  const auto* b = reinterpret_cast<const unsigned char*>(s.data());
   if (ext == "isf" || s.rfind(":WFMP", 0) == 0 || s.rfind(":WFMO", 0) == 0) return "tektronix isf";
   if (n >= 12 && s.rfind("AG", 0) == 0) return "keysight bin";
   if (n >= 12 && s.rfind("RG01", 0) == 0) return "rigol bin";

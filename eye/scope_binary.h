@@ -38,6 +38,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "base/status.h"
@@ -55,6 +56,8 @@ struct BinaryTrace {
 // that is refused ("wfm", "binary (.bin)", "binary (.trc)"), from the extension and the first
 // bytes; nullopt for text.
 std::optional<std::string> binary_kind(const std::string& path);
+// The same from the file's name and its first bytes (at least 64 when the file has them).
+std::optional<std::string> binary_kind_of(const std::string& path, std::string_view head);
 StatusOr<std::vector<BinaryTrace>> read_binary(const std::string& path);
 
 }  // namespace isolink::eye

@@ -282,6 +282,82 @@ std::string canonical_channel(std::string_view name) {
   return "";
 }
 
+namespace {
+
+// The fields after the key of the first preamble row (lines [0, end)) whose first field is `key`
+// (ignoring case and a trailing '=' with blanks, as in Rigol's "Attenuation = "), and its 0-based
+// line; nullopt when there is none.
+std::optional<std::pair<size_t, std::vector<std::string>>> preamble_row(
+    const std::vector<std::string>& head, size_t end, std::string_view key) {
+  std::vector<std::string_view> f;
+  for (size_t i = 0; i < end && i < head.size(); ++i) {
+    split_fields(head[i], ',', &f);
+    if (f.size() < 2) continue;
+    std::string_view k = unquote(f[0]);
+    while (!k.empty() && (k.back() == '=' || k.back() == ' ')) k.remove_suffix(1);
+    if (lower(k) != lower(key)) continue;
+    std::vector<std::string> values;
+    for (size_t j = 1; j < f.size(); ++j) values.emplace_back(unquote(f[j]));
+    return std::pair{i, std::move(values)};
+  }
+  return std::nullopt;
+}
+
+// "10", "10X", "10x" -> 10.
+std::optional<double> probe_factor(std::string v) {
+  while (!v.empty() && (v.back() == 'X' || v.back() == 'x')) v.pop_back();
+  return number_of(&v);
+}
+
+// Rigol DS1052E CSV: a `"Channel Data","CH 1","CH 2"` row names the value columns (whose header
+// only says "Voltage (V)"), and `"Attenuation = ",10,1` gives each channel's probe factor with
+// `"Scale (V/DIV) = ",0.1,2` its scale before the probe. The scope writes probe-tip volts (its
+// 8-bit counts, 25 a division, times Scale x Attenuation / 25: the real export in
+// tests/eye/data/real steps by 0.04 V on CH 1 at 0.1 V/div and 10X), so the values are read as
+// they are; check_probe_step refuses a channel whose values step by the scale without the probe
+// factor (the reader measures the step over the whole record).
+Status rigol_channel_rows(const std::vector<std::string>& head, size_t pre_end, ScopeLayout* l,
+                          const std::string& source) {
+  const auto names = preamble_row(head, pre_end, "Channel Data");
+  if (!names) return Status::Ok();
+  std::vector<size_t> values;  // the value columns, in order
+  for (size_t k = 0; k < l->columns.size(); ++k)
+    if (!l->columns[k].time_like && !l->columns[k].meta) values.push_back(k);
+  const int line = static_cast<int>(names->first) + 1;
+  if (names->second.size() != values.size())
+    return Status::Error(fmt::format(
+        "{}:{}: error: the \"Channel Data\" row names {} channel{} but the data rows hold {} "
+        "value column{}: the file contradicts itself",
+        source, line, names->second.size(), names->second.size() == 1 ? "" : "s", values.size(),
+        values.size() == 1 ? "" : "s"));
+  for (size_t i = 0; i < values.size(); ++i) {
+    ScopeColumn& c = l->columns[values[i]];
+    c.name = names->second[i];
+    c.channel = canonical_channel(c.name);
+  }
+  const auto att = preamble_row(head, pre_end, "Attenuation");
+  if (!att) return Status::Ok();
+  const auto scale = preamble_row(head, pre_end, "Scale (V/DIV)");
+  l->probe_line = static_cast<int>(att->first) + 1;
+  for (size_t i = 0; i < values.size(); ++i) {
+    ScopeColumn& c = l->columns[values[i]];
+    const std::optional<double> a =
+        i < att->second.size() ? probe_factor(att->second[i]) : std::nullopt;
+    if (!a || !(*a > 0))
+      return Status::Error(
+          fmt::format("{}:{}: error: no probe factor for {} in the "
+                      "\"Attenuation\" row: expected a number such as 10 or 10X",
+                      source, l->probe_line, c.name));
+    c.probe_factor = *a;
+    const std::optional<double> sc =
+        scale && i < scale->second.size() ? number_of(&scale->second[i]) : std::nullopt;
+    if (sc && *sc > 0) c.volts_per_div = *sc;
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
 const std::string* ScopeLayout::find(std::string_view key) const {
   const std::string k = lower(key);
   for (const auto& [key_, value] : preamble)
@@ -490,6 +566,7 @@ StatusOr<ScopeLayout> detect_layout(
     const size_t pre_end = names_at ? *names_at : (l.units_line ? l.units_line - 1 : d);
     key_values(head, pre_end, l.decimal_comma, &l.preamble);
     finish_columns(names, units.empty() ? nullptr : &units, l.data_fields);
+    if (Status st = rigol_channel_rows(head, pre_end, &l, source); !st.ok()) return st;
     l.name = !names.empty() ? (units.empty() ? "header" : "header + units row")
                             : (!units.empty() ? "units row" : "no header");
     // Rigol X,CH1,Start,Increment with the values under Start and Increment.
@@ -568,6 +645,30 @@ StatusOr<ScopeLayout> detect_layout(
                  "its header file NAME.csv or NAME.bin beside it)");
   }
   return l;
+}
+
+StatusOr<std::string> check_probe_step(const ScopeLayout& l, const ScopeColumn& c, double step,
+                                       const std::string& source) {
+  if (c.probe_factor <= 0) return std::string();
+  const double q = c.volts_per_div * c.probe_factor / 25;  // the 8-bit step at the probe tip
+  auto multiple_of = [&](double unit) {
+    return unit > 0 && step > 0 && std::abs(step / unit - std::round(step / unit)) < 0.01;
+  };
+  if (q > 0 && c.probe_factor != 1 && step < 0.5 * q && multiple_of(q / c.probe_factor))
+    return Status::Error(fmt::format(
+        "{}:{}: error: {}: Attenuation {:g}X, so its values should step by {:g} V ({:g} V/div x "
+        "{:g} / 25), but they step by {:g} V, the scale without the probe: the file contradicts "
+        "its data (volts at the scope's input, not at the probe tip?), so which volts it holds "
+        "cannot be told; export it again from the scope",
+        source, l.probe_line, c.name, c.probe_factor, q, c.volts_per_div, c.probe_factor, step));
+  return fmt::format(
+      "{}: probe attenuation {:g}X (line {}): the values are probe-tip volts as "
+      "written{}",
+      c.name, c.probe_factor, l.probe_line,
+      q > 0 && multiple_of(q) ? fmt::format(" (the smallest step between values, {:g} V, is a "
+                                            "multiple of {:g} V = {:g} V/div x {:g} / 25)",
+                                            step, q, c.volts_per_div, c.probe_factor)
+                              : "");
 }
 
 std::optional<size_t> first_channel(const ScopeLayout& l) {

@@ -43,12 +43,14 @@ std::optional<Unit> parse_unit(std::string_view token);
 std::string canonical_channel(std::string_view name);
 
 struct ScopeColumn {
-  std::string name;        // as in the header; "column K" when there is none
-  std::string channel;     // canonical channel, "" when none
-  Unit unit;               // from a units row, from the name ("Time (s)") or from the preamble
-  size_t field = 0;        // 0-based field in a data row
-  bool time_like = false;  // a time or sample-number column (never P or N)
-  bool meta = false;       // Rigol Start/Increment: not a signal
+  std::string name;          // as in the header; "column K" when there is none
+  std::string channel;       // canonical channel, "" when none
+  Unit unit;                 // from a units row, from the name ("Time (s)") or from the preamble
+  size_t field = 0;          // 0-based field in a data row
+  bool time_like = false;    // a time or sample-number column (never P or N)
+  bool meta = false;         // Rigol Start/Increment: not a signal
+  double probe_factor = 0;   // Rigol DS1052E "Attenuation" row (10 for 10X); 0 when none
+  double volts_per_div = 0;  // its "Scale (V/DIV)" row, before the probe; 0 when none
 };
 
 struct ScopeLayout {
@@ -66,7 +68,8 @@ struct ScopeLayout {
   double t0 = 0, dt = 0;
   std::string time_from;                                      // how time is obtained, in words
   std::vector<std::pair<std::string, std::string>> preamble;  // key, value as read
-  const std::string* find(std::string_view key) const;        // preamble value, case-insensitive
+  int probe_line = 0;  // 1-based line of the "Attenuation" row; 0 when none
+  const std::string* find(std::string_view key) const;  // preamble value, case-insensitive
 };
 
 // head: the file's first lines (BOM and line ends removed), head[0] being line first_line.
@@ -85,6 +88,12 @@ struct ColumnPick {
 };
 StatusOr<ColumnPick> pick_column(const ScopeLayout& l, const std::string& ref, const char* flag,
                                  const std::string& source);
+// A column with a probe factor (ScopeColumn::probe_factor > 0): step is the smallest change
+// between consecutive values over the record (0 when it never changes). Refused ("FILE:LINE:
+// error: ...", the Attenuation row's line) when the values step by the scale without the probe,
+// which contradicts the row; otherwise a note for the read block, "" when there is no factor.
+StatusOr<std::string> check_probe_step(const ScopeLayout& l, const ScopeColumn& c, double step,
+                                       const std::string& source);
 // The first signal column (not time, not Start/Increment).
 std::optional<size_t> first_channel(const ScopeLayout& l);
 

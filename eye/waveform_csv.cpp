@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "base/file_io.h"
 #include "eye/csv_lines.h"
 #include "eye/scope_binary.h"
 #include "eye/scope_formats.h"
@@ -214,6 +215,12 @@ StatusOr<OneFile> read_one(LineReader& in, const std::string& source, const std:
   std::string footer_text;
   size_t row = 0;
   Status bad = Status::Ok();
+  struct ValueStep {
+    double prev = 0, min = 0;
+  };
+  std::vector<ValueStep> steps(picked.size());
+  const bool probed = std::any_of(picked.begin(), picked.end(),
+                                  [&](size_t k) { return l.columns[k].probe_factor > 0; });
   auto take = [&](std::string_view text, int number) -> bool {
     if (trim_cell(text).empty()) return true;
     split_fields(text, l.delim, &f);
@@ -271,6 +278,12 @@ StatusOr<OneFile> read_one(LineReader& in, const std::string& source, const std:
     for (size_t i = 0; i < vfield.size(); ++i) {
       if (!get(vfield[i], i, &x)) return false;
       v += vscale[i] * x;
+      if (probed) {  // the smallest step between values, for check_probe_step
+        ValueStep& s = steps[i];
+        const double d = std::abs(x - s.prev);
+        if (row > 0 && d > 0 && (s.min == 0 || d < s.min)) s.min = d;
+        s.prev = x;
+      }
     }
     if (!out.t.empty() && !(t > out.t.back())) {
       bad = err(number, fmt::format("time {:g} is not after {:g} on line {}: time must increase "
@@ -293,6 +306,11 @@ StatusOr<OneFile> read_one(LineReader& in, const std::string& source, const std:
   if (out.t.size() < 2)
     return err(l.data_line,
                fmt::format("fewer than two samples in the data from line {}", l.data_line));
+  for (size_t i = 0; i < picked.size() && probed; ++i) {
+    StatusOr<std::string> note = check_probe_step(l, l.columns[picked[i]], steps[i].min, source);
+    if (!note) return note.status();
+    if (!note->empty()) notes.push_back(*note);
+  }
 
   // What was read.
   if (info) {
@@ -412,6 +430,22 @@ StatusOr<OneFile> read_binary_one(const std::string& path, const std::string& ki
 
 StatusOr<OneFile> read_path(const std::string& path, const std::string& time_ref,
                             const std::vector<Term>& terms, CaptureInfo* info) {
+  std::error_code ec;
+  const std::filesystem::file_status st = std::filesystem::status(path, ec);
+  if (!ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st) &&
+      !std::filesystem::is_directory(st)) {
+    // A device, a FIFO or a pipe: read whole under read_input_file's size and time limits
+    // (/dev/zero, a pipe that never ends), then parsed as text.
+    StatusOr<std::string> text = read_input_file(path);
+    if (!text) return text.status();
+    if (std::optional<std::string> kind = binary_kind_of(path, *text))
+      return Status::Error(fmt::format(
+          "{}: error: a {} capture from a device or pipe: binary captures are read from a regular "
+          "file (their headers are checked against its length); save it to a file first",
+          path, *kind));
+    LineReader in(*text);
+    return read_one(in, path, time_ref, terms, "", {}, info);
+  }
   if (std::optional<std::string> kind = binary_kind(path)) {
     if (!time_ref.empty())
       return Status::Error(

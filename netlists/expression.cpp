@@ -48,8 +48,13 @@ const Function kFunctions[] = {
 class Parser {
  public:
   Parser(std::string_view s, const ParamLookup& lookup, const OffsetLoc& where,
-         const FunctionLookup& functions, int depth)
-      : s_(s), lookup_(lookup), where_(where), functions_(functions), depth_(depth) {}
+         const FunctionLookup& functions, int depth, bool single_equals = false)
+      : s_(s),
+        lookup_(lookup),
+        where_(where),
+        functions_(functions),
+        depth_(depth),
+        single_equals_(single_equals) {}
 
   StatusOr<double> run() {
     double v = 0;
@@ -135,9 +140,15 @@ class Parser {
       if (pos_ >= s_.size()) return true;
       const char c = s_[pos_];
       const bool eq_next = pos_ + 1 < s_.size() && s_[pos_ + 1] == '=';
-      int op = 0;  // 1 ==, 2 !=, 3 <, 4 >, 5 <=, 6 >=
+      int op = 0;  // 1 ==, 2 !=, 3 <, 4 >, 5 <=, 6 >=, 7 = (in a condition)
       if (c == '=' && eq_next)
         op = 1;
+      else if (c == '=' && !single_equals_)
+        return fail(pos_,
+                    "'=' in an expression: equality is '==' (a single '=' means equality only in "
+                    "a .if / .elseif condition)");
+      else if (c == '=')
+        op = 7;  // '=' as equality, as ngspice reads it in a condition
       else if (c == '!' && eq_next)
         op = 2;
       else if (c == '<')
@@ -146,12 +157,13 @@ class Parser {
         op = eq_next ? 6 : 4;
       else
         return true;
-      pos_ += (op == 3 || op == 4) ? 1 : 2;
+      pos_ += (op == 3 || op == 4 || op == 7) ? 1 : 2;
       double r = 0;
       if (!sum(r)) return false;
       bool t = false;
       switch (op) {
         case 1:
+        case 7:
           t = v == r;
           break;
         case 2:
@@ -376,6 +388,7 @@ class Parser {
   const FunctionLookup& functions_;
   std::size_t pos_ = 0;
   int depth_ = 0;
+  bool single_equals_ = false;  // '=' is equality (a .if / .elseif condition)
   Status status_;
   static constexpr int kMaxDepth = 200;
 };
@@ -383,8 +396,9 @@ class Parser {
 }  // namespace
 
 StatusOr<double> evaluate_expression(std::string_view text, const ParamLookup& lookup,
-                                     const OffsetLoc& where, const FunctionLookup& functions) {
-  return Parser(text, lookup, where, functions, 0).run();
+                                     const OffsetLoc& where, const FunctionLookup& functions,
+                                     bool condition) {
+  return Parser(text, lookup, where, functions, 0, condition).run();
 }
 
 }  // namespace isolink::spice

@@ -9,7 +9,7 @@
 //   expr    := or ('?' expr ':' expr)?                 ternary, as ngspice
 //   or      := and ('||' and)*                         logical values: 0 false, else true -> 1/0
 //   and     := compare ('&&' compare)*
-//   compare := sum (('==' | '!=' | '<' | '>' | '<=' | '>=') sum)*
+//   compare := sum (('==' | '!=' | '<' | '>' | '<=' | '>=') sum)*    ('=' too in a condition)
 //   sum     := term (('+' | '-') term)*
 //   term    := unary (('*' | '/') unary)*
 //   unary   := ('-' | '+' | '!') unary | power
@@ -50,9 +50,12 @@ using FunctionLookup = std::function<const UserFunction*(const std::string& name
 
 // Errors: syntax (unexpected character, unbalanced parentheses, missing operand), undefined
 // parameter, unknown function or wrong argument count, division by zero, non-finite result;
-// each at the offending character.
+// each at the offending character. A single '=' is an error ("equality is '=='"), except with
+// `condition` (a .if / .elseif condition), where it is equality as ngspice reads it:
+// `.elseif (select2 = 2)`; in the bodies of .func functions it stays an error.
 StatusOr<double> evaluate_expression(std::string_view text, const ParamLookup& lookup,
                                      const OffsetLoc& where,
-                                     const FunctionLookup& functions = nullptr);
+                                     const FunctionLookup& functions = nullptr,
+                                     bool condition = false);
 
 }  // namespace isolink::spice

@@ -107,10 +107,12 @@ struct Scope {
 };
 
 // Expression text evaluated in a scope (its parameters and .func functions).
-StatusOr<double> eval_in(const Scope& scope, std::string_view text, const spice::OffsetLoc& where) {
+// condition: a .if / .elseif condition, where a single '=' is equality (as in ngspice).
+StatusOr<double> eval_in(const Scope& scope, std::string_view text, const spice::OffsetLoc& where,
+                         bool condition = false) {
   return spice::evaluate_expression(
       text, [&](const std::string& name) { return scope.find(name); }, where,
-      [&](const std::string& name) { return scope.find_func(name); });
+      [&](const std::string& name) { return scope.find_func(name); }, condition);
 }
 
 // Element letters isolink refuses, with the feature's name and what to do instead.
@@ -519,8 +521,9 @@ class Reader {
     auto condition = [&](const Line& l) -> StatusOr<bool> {
       if (l.toks.size() < 2) return error_at(l.end(), "expected a condition after " + l.key());
       const std::size_t from = l.toks[1].offset;
-      auto v = eval_in(scope, std::string_view(l.ll.text).substr(from),
-                       [&](std::size_t o) { return l.ll.loc(from + o); });
+      auto v = eval_in(
+          scope, std::string_view(l.ll.text).substr(from),
+          [&](std::size_t o) { return l.ll.loc(from + o); }, true);
       if (!v) return v.status();
       return *v != 0.0;
     };

@@ -99,3 +99,26 @@ def test_bad_samples_raise():
         isolink.check([0, 1, 2], [0, 1])
     with pytest.raises(isolink.Error, match="one-dimensional"):
         isolink.check(np.zeros((2, 2)), np.zeros((2, 2)))
+
+
+def test_failing_daisy_chain_pulses_fail_though_nothing_decodes(exe, tmp_path):
+    """eye/README.md "Verdict": pulses with the daisy-chain's timing that fail their rules are a
+    failed link even when no frame decodes; the same pulses meeting the rules are inconclusive.
+    Here P and N are swapped (the signs flipped: nothing decodes). At 0.6 A = 1.5 V every pulse
+    fails VSTART (1.6 V): fail, as `isolink check` says on the same samples. At A: inconclusive."""
+    t, v, s = frame_wave(0x5A)
+    r = isolink.check(t, -0.6 * v)
+    assert r["verdict"] == "fail" and r["pass"] is False
+    assert r["decoded"]["bytes"] == ""
+    runs = 1 + sum(1 for i in range(1, len(s)) if s[i] != s[i - 1])
+    assert r["summary"]["pulses"] == r["summary"]["failing"] == runs
+    assert any("have the daisy-chain's timing" in x and x.endswith("a failed link")
+               for x in r["reasons"]), r["reasons"]
+    path = tmp_path / "swapped.csv"
+    np.savetxt(path, np.column_stack([t, -0.6 * v]), delimiter=",", header="time,v", comments="",
+               fmt="%.12g")
+    out, _ = cli(exe, "check", path, "--json", expect_rc=1)
+    assert json.loads(out)["verdict"] == "fail"
+    r = isolink.check(t, -v)
+    assert r["verdict"] == "inconclusive"
+    assert any("meet the rules: P and N swapped" in x for x in r["reasons"]), r["reasons"]

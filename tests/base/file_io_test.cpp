@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -56,6 +57,57 @@ std::vector<std::string> names_in(const std::string& dir) {
 }
 
 using Names = std::vector<std::string>;
+
+// Input that is not a regular file is read under a size and a time limit (issue 30: `isolink
+// check /dev/zero` never ended): a device that never ends stops at the size, a FIFO whose writer
+// never writes (or never opens it) stops at the deadline, and a FIFO that ends is read whole.
+TEST(InputFile, DeviceWithoutEndStopsAtTheSizeLimit) {
+  StatusOr<std::string> t = read_input_file("/dev/zero", 1024);
+  ASSERT_FALSE(t.ok());
+  EXPECT_EQ(t.status().message(),
+            "/dev/zero: error: the file is larger than the 1024 byte limit for an input file (a "
+            "character device, not a regular file: read for at most 10 s and 1024 byte; save its "
+            "content to a file)");
+}
+
+TEST(InputFile, FifoWithoutEndStopsAtTheDeadline) {
+  const std::string dir = test_dir(), path = dir + "/pipe";
+  ASSERT_EQ(::mkfifo(path.c_str(), 0600), 0);
+  // no writer at all: the open does not wait for one, the read stops at the deadline
+  auto start = std::chrono::steady_clock::now();
+  StatusOr<std::string> t = read_input_file(path, kMaxInputFileBytes, 0.3);
+  double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_FALSE(t.ok());
+  EXPECT_EQ(t.status().message(),
+            path +
+                ": error: no end of input after 0.3 s (a FIFO or pipe, not a regular file: "
+                "read for at most 0.3 s and 64 MiB; save its content to a file)");
+  EXPECT_GE(took, 0.3);
+  EXPECT_LT(took, 5.0);
+  // a writer that writes a line and holds the pipe open: the same
+  const int w = ::open(path.c_str(), O_RDWR);  // RDWR: does not wait for a reader
+  ASSERT_GE(w, 0);
+  ASSERT_EQ(::write(w, "a,b\n", 4), 4);
+  start = std::chrono::steady_clock::now();
+  t = read_input_file(path, kMaxInputFileBytes, 0.3);
+  took = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ::close(w);
+  ASSERT_FALSE(t.ok());
+  EXPECT_NE(t.status().message().find("no end of input after 0.3 s"), std::string::npos);
+  EXPECT_LT(took, 5.0);
+}
+
+TEST(InputFile, FifoThatEndsIsReadWhole) {
+  const std::string dir = test_dir(), path = dir + "/pipe";
+  ASSERT_EQ(::mkfifo(path.c_str(), 0600), 0);
+  std::thread writer([&] {
+    std::ofstream(path, std::ios::binary) << "time,v\n0,1\n";  // opens once the reader has
+  });
+  StatusOr<std::string> t = read_input_file(path, kMaxInputFileBytes, 10);
+  writer.join();
+  ASSERT_TRUE(t.ok()) << t.status().message();
+  EXPECT_EQ(*t, "time,v\n0,1\n");
+}
 
 TEST(OutputFile, NewFileHasTheTextAndNothingElseIsLeft) {
   const std::string dir = test_dir();

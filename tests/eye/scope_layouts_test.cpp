@@ -4,8 +4,11 @@
 // example exports show it. Then the hazards: units, swapped columns, truncated pulses, a flat
 // record, long pulses. Binary captures are in scope_binary_test.cpp.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "scope_fixture.h"
@@ -206,6 +209,87 @@ TEST_F(Layout, RigolDs1052eQuotedPreambleAndTrailingCommas) {
   EXPECT_EQ(info.columns[1].unit, "(V)");
 }
 
+// The DS1052E's full preamble, keys and order as the scope writes them (the real export
+// tests/eye/data/real/DS1052E.csv, from RigolWFM tests/files/wfm/DS1052E.csv; SOURCES.md): the
+// "Channel Data" row names the channels over a header that says only "Voltage (V)", and the
+// "Attenuation" row gives each probe's factor. The values are probe-tip volts, in steps of the
+// 8-bit count: Scale (V/DIV) x Attenuation / 25. `step_p` / `step_n` quantize P and N.
+std::string ds1052e_text(const std::string& attenuation, double step_p, double step_n) {
+  std::string s = "\"Number of Data points =\"," + std::to_string(record().samples()) +
+                  ",\n\"Time Scale (s/DIV) =\",2E-6,\n\"Time Delay (s) =\",0,\n"
+                  "\"Sampling Frequency (Hz)=\",500000000,\n\"Trigger Mode = \",0,\n"
+                  "\"Trigger Source = \",1,\n\"Channel Data\",\"CH 1\",\"CH 2\"\n"
+                  "\"Attenuation = \"," +
+                  attenuation +
+                  "\n\"Pos (V) = \",0,0\n\"PosOrig (V) = \",0,0\n"
+                  "\"Scale (V/DIV) = \",0.2,0.2\n\"ScaleOrig (V) = \",0.2,0.2\n"
+                  "\"Minimum (V) = \",1.52,1.52\n\"Maximum (V) = \",3.52,3.52\n"
+                  "\"Inverted = \",\"NO\",\"NO\"\n\"Time (s)\",\"Voltage (V)\",\"Voltage (V)\"\n";
+  s += rows([&](size_t, double t, double p, double n) {
+    return num(t) + "," + num(step_p * std::round(p / step_p)) + "," +
+           num(step_n * std::round(n / step_n));
+  });
+  return s + ",,\n";
+}
+
+TEST_F(Layout, RigolDs1052eChannelDataRowNamesTheChannels) {
+  // 10X probes at 0.2 V/div: 0.08 V steps; P - N keeps its 2 V levels (25 steps)
+  const std::string f = write("DS1052E.csv", ds1052e_text("10,10", 0.08, 0.08));
+  CsvColumns c;
+  c.p = "CH 1";
+  c.n = "CH 2";
+  CaptureInfo info;
+  expect_pass({f}, c, &info, 1e-6);
+  ASSERT_EQ(info.columns.size(), 3u);
+  EXPECT_EQ(info.columns[1].name, "CH 1");
+  EXPECT_EQ(info.columns[1].channel, "CH1");
+  EXPECT_EQ(info.columns[1].index, 2u);
+  EXPECT_EQ(info.columns[2].name, "CH 2");
+  EXPECT_EQ(info.columns[2].index, 3u);
+  // the record's edges move a leg 0.16 V a sample: its smallest step, 2 x 0.08 V
+  const std::string note =
+      "CH 1: probe attenuation 10X (line 8): the values are probe-tip volts as written (the "
+      "smallest step between values, 0.16 V, is a multiple of 0.08 V = 0.2 V/div x 10 / 25)";
+  EXPECT_NE(std::find(info.notes.begin(), info.notes.end(), note), info.notes.end())
+      << fmt::format("{}", fmt::join(info.notes, "\n"));
+  // the channel names as the other layouts take them
+  c.p = "CH1";
+  c.n = "2";
+  expect_pass({f}, c, nullptr, 1e-6);
+  // "1X" / "10X" as written by other firmware: CH 1 at 1X steps by 0.008 V
+  CaptureInfo info2;
+  c.p = "CH 1";
+  c.n = "CH 2";
+  expect_pass({write("DS1052E_x.csv", ds1052e_text("\"1X\",\"10X\"", 0.008, 0.08))}, c, &info2,
+              0.03);
+  EXPECT_EQ(info2.notes.size(), 2u) << fmt::format("{}", fmt::join(info2.notes, "\n"));
+}
+
+TEST_F(Layout, RigolDs1052eAttenuationContradictingTheDataIsRefused) {
+  // the row says 10X, but CH 2 steps by 0.008 V = 0.2 V/div / 25: volts at the scope's input
+  const std::string f = write("DS1052E.csv", ds1052e_text("10,10", 0.08, 0.008));
+  CsvColumns c;
+  c.p = "CH 1";
+  c.n = "CH 2";
+  StatusOr<Waveform> w = read_capture({f}, c);
+  ASSERT_FALSE(w.ok());
+  EXPECT_EQ(w.status().message(),
+            f + ":8: error: CH 2: Attenuation 10X, so its values should step by 0.08 V (0.2 V/div "
+                "x 10 / 25), but they step by 0.008 V, the scale without the probe: the file "
+                "contradicts its data (volts at the scope's input, not at the probe tip?), so "
+                "which volts it holds cannot be told; export it again from the scope");
+  // a "Channel Data" row naming fewer channels than the data hold
+  std::string text = ds1052e_text("10,10", 0.08, 0.08);
+  const std::string row = "\"Channel Data\",\"CH 1\",\"CH 2\"";
+  text.replace(text.find(row), row.size(), "\"Channel Data\",\"CH 1\"");
+  w = read_capture({write("DS1052E_2.csv", text)}, c);
+  ASSERT_FALSE(w.ok());
+  EXPECT_NE(w.status().message().find("DS1052E_2.csv:7: error: the \"Channel Data\" row names 1 "
+                                      "channel but the data rows hold 2 value columns"),
+            std::string::npos)
+      << w.status().message();
+}
+
 TEST_F(Layout, RohdeSchwarzRtbOneChannelPerFile) {
   auto rtb = [](const char* name, bool p) {
     return std::string("in s,") + name + "\n" + rows([&](size_t, double t, double pv, double nv) {
@@ -324,6 +408,8 @@ TEST(RealCsvExports, ReadAsTheFilesPrintThemAndNeverPass) {
       // Rigol DS1052E: quoted preamble, "Time (s)","Voltage (V)","Voltage (V)", a ",," last line
       {"DS1052E.csv", {}, "header", 8192, 0.0, 2e-9, 1.72, -0.04},
       {"DS1052E.csv", diff("#3"), "header", 8192, 0.0, 2e-9, 9.92, 4.96},
+      // the same by the names of its "Channel Data" row: CH 1 at 10X, CH 2 at 1X
+      {"DS1052E.csv", diff("CH 2"), "header", 8192, 0.0, 2e-9, 9.92, 4.96},
       // R&S RTP: values only; the XML header rs_rtp_01.bin beside it gives XStart -2.5 ms and
       // Resolution 1.25 us (RigolWFM tests/test_rohde_schwarz.py: times[0] = -0.0025)
       {"rs_rtp_01.Wfm.csv", {}, "no header", 4000, -0.0025, 1.25e-6, -0.031620555, 1.027668},
@@ -344,6 +430,22 @@ TEST(RealCsvExports, ReadAsTheFilesPrintThemAndNeverPass) {
     EXPECT_FALSE(r->pass);
     EXPECT_TRUE(r->inconclusive) << summary_text(*r);
   }
+  // DS1052E.csv's Attenuation row (10, 1) holds: CH 1 steps by 0.1 V/div x 10 / 25 = 0.04 V
+  CsvColumns pn;
+  pn.p = "CH 1";
+  pn.n = "CH 2";
+  CaptureInfo info;
+  StatusOr<Waveform> w = read_capture({real("DS1052E.csv")}, pn, &info);
+  ASSERT_TRUE(w.ok()) << w.status().message();
+  EXPECT_NEAR(w->columns[0].front(), 1.72 - 9.92, 1e-9);
+  const std::string want[] = {
+      "CH 1: probe attenuation 10X (line 8): the values are probe-tip volts as written (the "
+      "smallest step between values, 0.04 V, is a multiple of 0.04 V = 0.1 V/div x 10 / 25)",
+      "CH 2: probe attenuation 1X (line 8): the values are probe-tip volts as written (the "
+      "smallest step between values, 0.08 V, is a multiple of 0.08 V = 2 V/div x 1 / 25)"};
+  for (const std::string& n : want)
+    EXPECT_NE(std::find(info.notes.begin(), info.notes.end(), n), info.notes.end())
+        << fmt::format("{}", fmt::join(info.notes, "\n"));
 }
 
 // ---- hazards ----

@@ -133,6 +133,13 @@ TEST_F(ExpressionTest, Errors) {
   EXPECT_EQ(error("1+max(1)").rfind("e.cir:1:11: error: max() takes 2 arguments, got 1", 0), 0u);
   EXPECT_EQ(error("sqrt(-1)").rfind("e.cir:1:9: error: sqrt() result is not a finite", 0), 0u);
   EXPECT_EQ(error("2*1.2.3").rfind("e.cir:1:11: error: malformed number '1.2.3'", 0), 0u);
+  // a single '=' is equality only in a .if / .elseif condition: here it is named at its column
+  EXPECT_EQ(error("(a = 2)").rfind("e.cir:1:12: error: '=' in an expression: equality is '==' "
+                                   "(a single '=' means equality only in a .if / .elseif "
+                                   "condition)",
+                                   0),
+            0u)
+      << error("(a = 2)");
   EXPECT_EQ(error("2 $ 3").rfind("e.cir:1:11: error: unexpected '$'", 0), 0u);
   EXPECT_EQ(error("").rfind("e.cir:1:9: error: empty expression", 0), 0u);
   // Deep nesting is an error, not a stack overflow.

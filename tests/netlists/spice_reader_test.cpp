@@ -682,6 +682,26 @@ TEST(SpiceReaderDialect, IfElseifElseTakesOneBranch) {
             std::string::npos);
 }
 
+// ngspice reads a single '=' in a .if / .elseif condition as equality (`.elseif (select2 = 2)`
+// in its examples; tests/cli/data/wild/dialect_if_single_equals.cir compares the branch taken
+// with ngspice's); elsewhere a single '=' stays an error that says what to write.
+TEST(SpiceReaderDialect, SingleEqualsIsEqualityInConditionsOnly) {
+  const std::string body =
+      ".if (select2 = 1)\nR1 a 0 1\n.elseif (select2 = 2)\nR2 a 0 2\n.else\nR3 a 0 3\n.endif\n";
+  for (int sel : {1, 2, 3}) {
+    Netlist n = read_ok("t\n.param select2=" + std::to_string(sel) + "\n" + body);
+    ASSERT_EQ(n.cards.size(), 1u) << "select2=" << sel;
+    EXPECT_EQ(n.cards[0].name, "r" + std::to_string(sel)) << "select2=" << sel;
+  }
+  // '=' binds as '==' does: below '+', above '&&'
+  Netlist n = read_ok("t\n.param a=1 b=2\n.if (a + 1 = b && b = 2)\nR1 x 0 1\n.endif\n");
+  EXPECT_EQ(n.cards.size(), 1u);
+  const Diag d = read_error("t\n.param a=1\nR1 x 0 {a = 1}\n");
+  EXPECT_EQ(d.head,
+            "t.cir:3:11: error: '=' in an expression: equality is '==' (a single '=' means "
+            "equality only in a .if / .elseif condition)");
+}
+
 TEST(SpiceReaderDialect, FuncAndOperatorsInParams) {
   Netlist n = read_ok(
       "t\n.func par(a,b) {a*b/(a+b)}\n.func twice(x) = 2*x\n"
