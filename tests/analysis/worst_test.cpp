@@ -342,8 +342,7 @@ TEST(WorstCase, ReproduceBlocksShowTheWorstValueInTheTransient) {
     std::vector<std::string> keys;
     for (const auto& [key, value] : rep.items()) keys.push_back(key);
     EXPECT_EQ(keys, (std::vector<std::string>{"frames", "gaps", "direction"}));
-    const std::string text =
-        head + "stimulus: " + rep.dump() + "\nsim: {reltol: 1e-5}\n";
+    const std::string text = head + "stimulus: " + rep.dump() + "\nsim: {reltol: 1e-5}\n";
     SCOPED_TRACE(m.name + ": " + text);
     StatusOr<link::LinkSpec> spec = link::read_link_spec_text(text, "reproduce.yaml");
     ASSERT_TRUE(spec.ok()) << spec.status().message();
