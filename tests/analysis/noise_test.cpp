@@ -150,7 +150,7 @@ TEST(NoiseConversion, BalancedRcConvertsNothing) {
   StatusOr<std::vector<ConversionPoint>> pts = conversion_sweep(rc_cards(1e3, 1e-9), req);
   ASSERT_TRUE(pts.ok()) << pts.status().message();
   for (const ConversionPoint& p : *pts) {
-    EXPECT_EQ(p.dm_worst, std::abs(p.vp - p.vn));
+    EXPECT_NEAR(p.dm_worst, std::abs(p.vp - p.vn), 1e-12 * std::abs(p.vp - p.vn));
     EXPECT_LT(std::abs(p.vp - p.vn), 1e-15);
   }
 }
@@ -234,7 +234,7 @@ TEST(NoiseLink, ConversionAgreesWithNgspiceAc) {
     StatusOr<Waveform> ng =
         testing::run_ngspice(deck, {"mag(v(rxp)-v(rxn))", "mag(v(rxp)-v(grx))"}, dir);
     ASSERT_TRUE(ng.ok()) << ng.status().message();
-    ASSERT_GT(ng->samples(), 30u);
+    ASSERT_GT(ng->samples(), 25u);  // 1-400 MHz (BCI) or 100 kHz-400 MHz, 10 per decade
     ConversionRequest req;
     req.sources = nc->sources;
     req.ref = nc->rx_ground;
@@ -432,7 +432,9 @@ TEST(NoiseStatistics, NeverBelowTheCornerSeededAndVerdictOnChoosesTheFigure) {
   ASSERT_GT(a.contributors.size(), 4u);
   sum = 0;
   for (size_t i = 0; i < a.contributors.size(); ++i) {
-    if (i > 0) EXPECT_GE(a.contributors[i - 1].share, a.contributors[i].share);
+    if (i > 0) {
+      EXPECT_GE(a.contributors[i - 1].share, a.contributors[i].share);
+    }
     sum += a.contributors[i].share;
   }
   EXPECT_NEAR(sum, 1.0, 1e-12);
@@ -446,6 +448,10 @@ TEST(NoiseStatistics, NeverBelowTheCornerSeededAndVerdictOnChoosesTheFigure) {
 // parts. Capacitor-only has the lowest immunity over most of the band; capacitor + choke and
 // transformer are far better.
 // DISABLED: the model does not reproduce TI's ranking yet (issue 16 left open on this point).
+// Since issue 30 (1-400 MHz, worst corner, down; analysis/README.md "Installation assumptions"):
+// cap 21.3 mA at 9.2 MHz, cap + choke 14.2 mA at 1.0 MHz, transformer 39.7 mA at 14.3 MHz; the
+// choke's place turns on its loss (choke_loss: 300 gives 58.4 mA), which no data sheet pins down.
+// The history below is from the 100 kHz-400 MHz band:
 // Measured (100 mA AM, worst corner, down, 38 points 100 kHz-400 MHz): cap-only is lowest at 17
 // of 38 points; median gain over cap-only: cap + choke 0.5 dB, transformer 16.2 dB; immunity
 // min: cap 21.2 mA at 8.9 MHz, cap + choke 17.3 mA at 0.94 MHz, transformer 38.5 mA at 14 MHz.
