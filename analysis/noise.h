@@ -27,6 +27,7 @@
 #pragma once
 
 #include <complex>
+#include <cstdint>
 #include <nlohmann/json_fwd.hpp>
 #include <optional>
 #include <span>
@@ -99,14 +100,41 @@ struct TimeDomainCheck {
   std::vector<std::string> failures;  // first reason per failing phase
 };
 
+// Monte Carlo over the tolerances: `samples` boards, each part uniform within its tolerance
+// (independently), on the same linearised response as the worst corner. A board's immunity is its
+// minimum over the band; `immunity_min` is the level that 99 % of the boards reach (the
+// (samples - ceil(0.99 samples) + 1)-th lowest), at that board's weakest frequency.
+struct StatisticalImmunity {
+  int samples = 0;
+  double percentile = 1;  // %: immunity_min is this percentile of the boards' minima
+  uint64_t seed = 0;
+  double immunity_min = 0;
+  double immunity_min_freq = 0;
+  double median = 0;  // the median board's minimum, for scale
+  bool pass = false;  // level <= immunity_min
+};
+
+// A toleranced part's share of the worst-corner differential voltage beyond the nominal:
+// |Re(e^-j theta S_i)| / sum_j |Re(e^-j theta S_j)| at the worst corner's angle theta (exact for
+// the linearised corner, whose |V| is Re(e^-j theta V0) + that sum). Shares add up to 1.
+struct Contributor {
+  std::string element;  // the group's name ("crxisop", "cable chassis C, P")
+  std::string kind;     // its noise.tolerance key
+  double share = 0;
+};
+
 struct NoiseDirection {
   link::Direction direction = link::Direction::kDown;
   std::string description;  // "down: bq79600 -> bq7961x"
   NoiseBudget budget;
   std::vector<NoisePoint> points;
-  double immunity_min = 0;
-  double immunity_min_freq = 0;
-  bool pass = false;  // level <= immunity_min
+  double immunity_min = 0;       // worst corner, over the band
+  double immunity_min_freq = 0;  // its frequency
+  bool pass_corner = false;      // level <= immunity_min
+  StatisticalImmunity statistical;
+  bool pass = false;  // the verdict: pass_corner, or statistical.pass (noise.verdict_on)
+  // At immunity_min_freq, sorted by share, largest first.
+  std::vector<Contributor> contributors;
   TimeDomainCheck time_domain;
   int unknowns = 0;
   std::vector<std::string> tolerances;  // "name +/-10 %" per toleranced group
@@ -143,9 +171,26 @@ struct ConversionPoint {
   double freq_hz = 0;
   std::complex<double> vp, vn;  // V(p) - V(ref), V(n) - V(ref), nominal, per unit source
   double dm_worst = 0;          // max |vp - vn| over the tolerance box (linearised)
+  double dm_theta = 0;          // the angle of dm's worst corner (WorstCorner::theta)
   double cm_worst = 0;          // max |(vp + vn) / 2|
   double pin_worst = 0;         // max of max |vp|, max |vn|
+  // d vp, d vn per group moved by its full +tolerance (adjoint), in the groups' order.
+  std::vector<std::complex<double>> sp, sn;
 };
+
+// max |h0 + sum s_i d_i| over d_i in [-1, 1] (a linear complex function's worst corner): the
+// maximum over theta of Re(e^-j theta h0) + sum |Re(e^-j theta s_i)|, and that theta.
+struct WorstCorner {
+  double value = 0;
+  double theta = 0;
+};
+WorstCorner worst_corner(std::complex<double> h0, const std::vector<std::complex<double>>& s);
+
+// The shares of the groups in the worst corner at angle theta (Contributor), sorted descending;
+// empty when no group moves the response.
+std::vector<Contributor> contributors_at(const std::vector<ToleranceGroup>& groups,
+                                         const std::vector<std::complex<double>>& s_dm,
+                                         double theta);
 struct ConversionRequest {
   std::vector<std::pair<std::string, double>> sources;  // driven together, with amplitudes
   std::string p = "rxp", n = "rxn", ref = "0";          // the pins and their reference node
@@ -159,9 +204,18 @@ StatusOr<std::vector<ConversionPoint>> conversion_sweep(const std::vector<Card>&
                                                         int* factorizations = nullptr,
                                                         int* unknowns = nullptr);
 
+// The Monte Carlo of StatisticalImmunity on a conversion sweep (its sp / sn per group): ns.samples
+// boards, each group uniform in [-1, 1] of its tolerance, drawn from `seed` (splitmix64, serial:
+// the same on every machine and thread count); a board's immunity at f is min(budget /
+// (|vp - vn| peak), pin_room / (max(|vp|, |vn|) peak)), its figure the minimum over the sweep.
+StatisticalImmunity monte_carlo_immunity(const std::vector<ConversionPoint>& conv, size_t groups,
+                                         const link::NoiseSpec& ns, uint64_t seed, double budget,
+                                         double pin_room, double peak);
+
 // ISO 11452-4 CW: sqrt(2) (RMS level); AM 80 %: 1.8 sqrt(2).
 double noise_peak_factor(const link::NoiseSpec& n);
-// The analysis frequencies: f_start..f_stop, points_per_decade log-spaced, both ends included.
+// The analysis frequencies: noise.band (f_start..f_stop), points_per_decade log-spaced, both ends
+// included.
 std::vector<double> noise_frequencies(const link::NoiseSpec& n);
 
 // The circuit of one direction with its grounds apart and the injection source(s) (DC 0): what
@@ -200,8 +254,14 @@ StatusOr<NoiseRun> run_noise(const link::LinkSpec& spec, const link::PartLibrary
 nlohmann::ordered_json noise_json(const NoiseResult& r);
 // The report.md section ("## Noise immunity ...").
 std::string noise_markdown(const NoiseResult& r);
+// The immunity the verdict uses (noise.verdict_on): the worst corner's or the statistical one.
+struct VerdictImmunity {
+  double value = 0;
+  double freq_hz = 0;
+};
+VerdictImmunity verdict_immunity(const NoiseDirection& d, const link::NoiseSpec& n);
 // Worst immunity over the directions in dB relative to the level (20 log10(immunity / level)),
-// for sweeps: > 0 passes.
+// for sweeps: > 0 passes. The immunity the verdict uses (noise.verdict_on).
 double noise_immunity_min_db(const NoiseResult& r);
 
 }  // namespace isolink::analysis

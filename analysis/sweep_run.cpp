@@ -310,9 +310,10 @@ PointResult::Noise noise_cells(const NoiseResult& r) {
   n.immunity_min_db = noise_immunity_min_db(r);
   for (const NoiseDirection& d : r.directions) {
     const size_t k = d.direction == link::Direction::kDown ? 0 : 1;
-    n.immunity_min[k] = d.immunity_min;
-    n.immunity_min_db_dir[k] = 20 * std::log10(std::max(d.immunity_min / r.spec.level, 1e-20));
-    n.freq_hz[k] = d.immunity_min_freq;
+    const VerdictImmunity v = verdict_immunity(d, r.spec);
+    n.immunity_min[k] = v.value;
+    n.immunity_min_db_dir[k] = 20 * std::log10(std::max(v.value / r.spec.level, 1e-20));
+    n.freq_hz[k] = v.freq_hz;
   }
   return n;
 }

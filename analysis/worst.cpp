@@ -1057,8 +1057,10 @@ link::StimulusSpec reproduce_spec(const WorstMetric& m, link::Direction d) {
 
 namespace {
 
+// A gap as `stimulus.gaps` reads it (microseconds, 10 digits: the reader's value equals the
+// searched one to well under a picosecond).
 std::string time_text(double s) {
-  return fmt::format("{:.6g}u", s * 1e6);
+  return fmt::format("{:.10g}u", s * 1e6);
 }
 
 std::string unit_of(const std::string& metric) {
@@ -1096,6 +1098,13 @@ std::string reproduce_stimulus(const WorstMetric& m, link::Direction d) {
   }
   return fmt::format("stimulus: {{frames: [{}], gaps: [{}], direction: {}}}", frames, gaps,
                      link::direction_name(d));
+}
+
+nlohmann::ordered_json reproduce_json(const WorstMetric& m, link::Direction d) {
+  const link::StimulusSpec st = reproduce_spec(m, d);
+  nlohmann::ordered_json gaps = nlohmann::ordered_json::array();
+  for (double g : st.gaps) gaps.push_back(time_text(g));
+  return {{"frames", st.frames}, {"gaps", gaps}, {"direction", link::direction_name(d)}};
 }
 
 nlohmann::ordered_json worst_json(const WorstResult& r) {
@@ -1148,10 +1157,8 @@ nlohmann::ordered_json worst_json(const WorstResult& r) {
                      {"sign", m.pulse_sign > 0 ? "+" : "-"},
                      {"role", m.role}};
       const link::StimulusSpec st = reproduce_spec(m, d.direction);
-      mj["reproduce"] = {{"frames", st.frames},
-                         {"gaps_us", gaps},
-                         {"direction", link::direction_name(d.direction)},
-                         {"stimulus", reproduce_stimulus(m, d.direction)}};
+      mj["reproduce"] = reproduce_json(m, d.direction);
+      mj["reproduce_yaml"] = reproduce_stimulus(m, d.direction);
       w[m.name] = mj;
     }
     dj["worst"] = w;

@@ -193,6 +193,9 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
 
 // The stimulus block that replays a metric's traffic in `isolink run` (YAML flow map).
 std::string reproduce_stimulus(const WorstMetric& m, link::Direction d);
+// The same block as JSON, exactly the keys `stimulus:` takes (frames, gaps as times with their
+// unit, "3.85u", direction): `spec["stimulus"] = reproduce` replays it. worst_json's `reproduce`.
+nlohmann::ordered_json reproduce_json(const WorstMetric& m, link::Direction d);
 // The traffic as a StimulusSpec (frames "raw HH nocrc [err]", gaps, the direction).
 link::StimulusSpec reproduce_spec(const WorstMetric& m, link::Direction d);
 

@@ -74,12 +74,23 @@ int run_noise(const NoiseArgs& a) {
   if (a.json) {
     std::puts(analysis::noise_json(*noise).dump(2).c_str());
   } else {
-    for (const analysis::NoiseDirection& d : noise->directions)
-      std::printf("%s  %s: immunity %s at %s (test level %s)\n", d.pass ? "pass" : "FAIL",
-                  d.description.c_str(),
-                  link::format_si(d.immunity_min, noise->spec.level_unit()).c_str(),
-                  link::format_si(d.immunity_min_freq, "Hz").c_str(),
-                  link::format_si(noise->spec.level, noise->spec.level_unit()).c_str());
+    const char* unit = noise->spec.level_unit();
+    for (const analysis::NoiseDirection& d : noise->directions) {
+      const bool stat = noise->spec.verdict_on == "statistical";
+      std::printf(
+          "%s  %s: immunity %s at %s worst corner%s, %s at %s for 99 %% of boards%s (test level "
+          "%s)\n",
+          d.pass ? "pass" : "FAIL", d.description.c_str(),
+          link::format_si(d.immunity_min, unit).c_str(),
+          link::format_si(d.immunity_min_freq, "Hz").c_str(), stat ? "" : " (verdict)",
+          link::format_si(d.statistical.immunity_min, unit).c_str(),
+          link::format_si(d.statistical.immunity_min_freq, "Hz").c_str(), stat ? " (verdict)" : "",
+          link::format_si(noise->spec.level, unit).c_str());
+      if (!d.contributors.empty())
+        std::printf("      top contributor at %s: %s %.0f %%\n",
+                    link::format_si(d.immunity_min_freq, "Hz").c_str(),
+                    d.contributors[0].element.c_str(), d.contributors[0].share * 100);
+    }
     std::printf("report: %s/report.md\n", dir.c_str());
   }
   return noise->pass ? 0 : 1;

@@ -60,7 +60,16 @@ StatusOr<ChokeModel> choke_for(const IsolationSpec& iso, const std::string& numb
   if (part->kind != PartKind::Choke)
     return at(iso.loc,
               fmt::format("{}.isolation.chokes: '{}' is not a common-mode choke", where, number));
-  return part->choke;
+  ChokeModel m = part->choke;
+  if (iso.choke_loss == "none") m.loss_r = 0;
+  if (iso.choke_loss == "resistance") m.loss_r = iso.choke_loss_r;
+  return m;
+}
+
+// The cable-side caps per line (CBYPASS2): the spec's, else 100 pF with a transformer.
+double cable_side_c_of(const IsolationSpec& iso) {
+  if (iso.cable_side_c >= 0) return iso.cable_side_c;
+  return iso.type.rfind("transformer", 0) == 0 ? 100e-12 : 0.0;
 }
 
 // One end's board and isolation between its device pins (pin_p/pin_n) and its cable connector
@@ -123,9 +132,9 @@ StatusOr<std::pair<std::string, std::string>> add_end(std::vector<Card>& cards, 
     }
   }
   // CBYPASS2: 100 pF per line on the cable side of a transformer (TI's transformer figure).
-  double cable_side_c = iso.cable_side_c;
-  if (cable_side_c < 0) cable_side_c = type.rfind("transformer", 0) == 0 ? 100e-12 : 0.0;
-  if (cable_side_c > 0) {
+  // Returning to the chassis, add_connector_caps adds them after the board is regrounded.
+  const double cable_side_c = cable_side_c_of(iso);
+  if (cable_side_c > 0 && iso.cable_side_return == "board") {
     *bom += "; " + format_si(cable_side_c, "F") + " per line on the cable side";
     cards.push_back(make_card('c', "c" + side + "cabp", {p, "0"}, {number_arg(cable_side_c)}));
     cards.push_back(make_card('c', "c" + side + "cabn", {n, "0"}, {number_arg(cable_side_c)}));
@@ -170,9 +179,23 @@ void add_connector_caps(std::vector<Card>& cards, const EndSpec& end, const std:
     cards.push_back(make_card('c', "c" + side + "yp", {p, "0"}, {number_arg(end.y_cap)}));
     cards.push_back(make_card('c', "c" + side + "yn", {n, "0"}, {number_arg(end.y_cap)}));
   }
-  if (ground != "0")
+  const double cable_side_c = cable_side_c_of(end.isolation);
+  if (cable_side_c > 0 && end.isolation.cable_side_return == "chassis") {
+    *bom += "; " + format_si(cable_side_c, "F") + " per line on the cable side, to the chassis";
+    cards.push_back(make_card('c', "c" + side + "cabp", {p, "0"}, {number_arg(cable_side_c)}));
+    cards.push_back(make_card('c', "c" + side + "cabn", {n, "0"}, {number_arg(cable_side_c)}));
+  }
+  if (ground == "0") return;
+  cards.push_back(
+      make_card('c', "c" + side + "chassis", {ground, "0"}, {number_arg(end.chassis_c)}));
+  if (end.chassis_r > 0) {
+    // The bond: a strap or screw, R in series with its L.
+    const std::string mid = end.chassis_l > 0 ? ground + "_bond" : "0";
     cards.push_back(
-        make_card('c', "c" + side + "chassis", {ground, "0"}, {number_arg(end.chassis_c)}));
+        make_card('r', "r" + side + "bond", {ground, mid}, {number_arg(end.chassis_r)}));
+    if (end.chassis_l > 0)
+      cards.push_back(make_card('l', "l" + side + "bond", {mid, "0"}, {number_arg(end.chassis_l)}));
+  }
 }
 
 NetlistOption option(const std::string& key, double v) {

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include "netlists/traffic/stimulus.h"
 
 namespace isolink::link {
@@ -66,6 +68,22 @@ Status read_isolation(const YamlDoc& doc, const YAML::Node& node, const std::str
           {"cable_side_c",
            read_quantity(doc, Unit::kFarad, Rule::kNonNegative, &iso->cable_side_c)},
           {"esd", read_quantity(doc, Unit::kFarad, Rule::kNonNegative, &iso->esd)},
+          {"cable_side_return", read_choice(doc, {"board", "chassis"}, &iso->cable_side_return)},
+          {"choke_loss",
+           [&](const YAML::Node& n, const std::string& p) -> Status {
+             if (n.IsScalar() && (n.Scalar() == "fitted" || n.Scalar() == "none")) {
+               iso->choke_loss = n.Scalar();
+               return Status::Ok();
+             }
+             double r = 0;
+             if (!n.IsScalar() || !config::parse_quantity(n.Scalar(), Unit::kOhm, &r) || !(r > 0) ||
+                 !std::isfinite(r))
+               return doc.error(n, fmt::format("key '{}' = {}: expected fitted, none or a "
+                                               "resistance > 0 across each winding (200, 1k)",
+                                               p, config::node_text(n)));
+             iso->choke_loss = "resistance", iso->choke_loss_r = r;
+             return Status::Ok();
+           }},
       });
   if (!s.ok()) return s;
   if (node.IsMap() && node["chokes"] && iso->chokes.empty())
@@ -76,11 +94,11 @@ Status read_isolation(const YamlDoc& doc, const YAML::Node& node, const std::str
     return doc.error(node["chokes"], fmt::format("key '{}.chokes': one or two chokes, found {}",
                                                  path, iso->chokes.size()));
   const bool has_chokes = iso->type == "capchoke" || iso->type == "transformer_choke";
-  if (!has_chokes && node.IsMap() && node["chokes"])
-    return doc.error(node["chokes"],
-                     fmt::format("key '{}.chokes': type {} has no chokes (use capchoke or "
-                                 "transformer_choke)",
-                                 path, iso->type));
+  for (const char* k : {"chokes", "choke_loss"})
+    if (!has_chokes && node.IsMap() && node[k])
+      return doc.error(node[k], fmt::format("key '{}.{}': type {} has no chokes (use capchoke or "
+                                            "transformer_choke)",
+                                            path, k, iso->type));
   // Every key that has no effect is an error: the isolation cap exists only in cap and capchoke.
   const bool has_cap = iso->type == "cap" || iso->type == "capchoke";
   if (!has_cap && node.IsMap() && node["cap"])
@@ -89,6 +107,12 @@ Status read_isolation(const YamlDoc& doc, const YAML::Node& node, const std::str
                                  "{})",
                                  path, iso->type));
   const bool has_xfmr = iso->type == "transformer" || iso->type == "transformer_choke";
+  if (node.IsMap() && node["cable_side_return"] && !(iso->cable_side_c > 0) &&
+      !(has_xfmr && iso->cable_side_c < 0))
+    return doc.error(node["cable_side_return"],
+                     fmt::format("key '{}.cable_side_return': there are no cable-side caps (type "
+                                 "{}, cable_side_c {})",
+                                 path, iso->type, iso->cable_side_c < 0 ? "not given" : "0"));
   if (!has_xfmr && node.IsMap())
     for (const char* k : {"part", "inductance", "leakage", "dcr", "winding_c", "centre_tap_c"})
       if (node[k])
@@ -100,7 +124,7 @@ Status read_isolation(const YamlDoc& doc, const YAML::Node& node, const std::str
 Status read_end(const YamlDoc& doc, const YAML::Node& node, const std::string& path, EndSpec* end) {
   end->loc = doc.loc(node);
   std::vector<std::string> devices = device_names();
-  return read_map(
+  Status s = read_map(
       doc, node, path,
       {
           {"device", read_choice(doc, devices, &end->device)},
@@ -114,7 +138,16 @@ Status read_end(const YamlDoc& doc, const YAML::Node& node, const std::string& p
           {"x_cap", read_quantity(doc, Unit::kFarad, Rule::kNonNegative, &end->x_cap)},
           {"y_cap", read_quantity(doc, Unit::kFarad, Rule::kNonNegative, &end->y_cap)},
           {"chassis_c", read_quantity(doc, Unit::kFarad, Rule::kPositive, &end->chassis_c)},
+          {"chassis_r", read_quantity(doc, Unit::kOhm, Rule::kPositive, &end->chassis_r)},
+          {"chassis_l", read_quantity(doc, Unit::kHenry, Rule::kPositive, &end->chassis_l)},
       });
+  if (!s.ok()) return s;
+  if (node.IsMap() && node["chassis_l"] && !node["chassis_r"])
+    return doc.error(node["chassis_l"],
+                     fmt::format("key '{}.chassis_l': the bond's inductance needs its resistance "
+                                 "'{}.chassis_r' (a strap: chassis_r 1m, chassis_l 20n)",
+                                 path, path));
+  return Status::Ok();
 }
 
 Status read_cable(const YamlDoc& doc, const YAML::Node& node, CableSpec* cable) {
@@ -177,9 +210,37 @@ Status read_stimulus(const YamlDoc& doc, const YAML::Node& node, StimulusSpec* s
   return Status::Ok();
 }
 
+// `noise.band: [f_lo, f_hi]`: two frequencies, lo < hi, inside what the lumped model means.
+Status read_band(const YamlDoc& doc, const YAML::Node& n, const std::string& path,
+                 std::optional<std::pair<double, double>>* band) {
+  constexpr double kLowest = 1e3, kHighest = 1e9;
+  if (!n.IsSequence() || n.size() != 2)
+    return doc.error(n, fmt::format("key '{}': expected [f_lo, f_hi] (e.g. [1meg, 400meg]), "
+                                    "found {}",
+                                    path, config::node_kind(n)));
+  double lo = 0, hi = 0;
+  for (auto [i, out] : {std::pair{0, &lo}, std::pair{1, &hi}}) {
+    const std::string key = fmt::format("{}[{}]", path, i);
+    if (Status s = read_quantity(doc, Unit::kHertz, Rule::kPositive, out)(n[i], key); !s.ok())
+      return s;
+    if (*out < kLowest || *out > kHighest)
+      return doc.error(n[i], fmt::format("key '{}' = {}: must be from 1 kHz to 1 GHz (below, the "
+                                         "floating ties and the cable's bleed resistors set the "
+                                         "answer; above, the boards' traces, which are not "
+                                         "modelled)",
+                                         key, n[i].Scalar()));
+  }
+  if (!(lo < hi))
+    return doc.error(n, fmt::format("key '{}' = [{}, {}]: f_lo must be below f_hi", path,
+                                    n[0].Scalar(), n[1].Scalar()));
+  *band = std::pair{lo, hi};
+  return Status::Ok();
+}
+
 Status read_noise(const YamlDoc& doc, const YAML::Node& node, NoiseSpec* ns) {
   ns->loc = doc.loc(node);
   std::optional<double> level;
+  std::optional<std::pair<double, double>> band;
   NoiseTolerances& t = ns->tolerance;
   Status s = read_map(
       doc, node, "noise",
@@ -194,13 +255,16 @@ Status read_noise(const YamlDoc& doc, const YAML::Node& node, NoiseSpec* ns) {
            }},
           {"position", read_quantity(doc, Unit::kNone, Rule::kNonNegative, &ns->position)},
           {"modulation", read_choice(doc, {"cw", "am"}, &ns->modulation)},
-          {"f_start", read_quantity(doc, Unit::kHertz, Rule::kPositive, &ns->f_start)},
-          {"f_stop", read_quantity(doc, Unit::kHertz, Rule::kPositive, &ns->f_stop)},
+          {"band",
+           [&](const YAML::Node& n, const std::string& p) { return read_band(doc, n, p, &band); }},
           {"points_per_decade", read_int(doc, 1, 200, &ns->points_per_decade)},
           {"pin_limit", read_quantity(doc, Unit::kVolt, Rule::kPositive, &ns->pin_limit)},
           {"calibration_r", read_quantity(doc, Unit::kOhm, Rule::kPositive, &ns->calibration_r)},
           {"clamp_r", read_quantity(doc, Unit::kOhm, Rule::kNonNegative, &ns->clamp_r)},
           {"time_domain", read_bool(doc, &ns->time_domain)},
+          {"samples", read_int(doc, 200, 100000, &ns->samples)},
+          {"seed", read_int(doc, 0, 2147483647, &ns->seed)},
+          {"verdict_on", read_choice(doc, {"corner", "statistical"}, &ns->verdict_on)},
           {"tolerance",
            [&](const YAML::Node& n, const std::string& p) {
              using config::read_percent;
@@ -232,10 +296,11 @@ Status read_noise(const YamlDoc& doc, const YAML::Node& node, NoiseSpec* ns) {
                      fmt::format("key 'noise.position' = {:g}: must be in 0..1 (a fraction of the "
                                  "cable length from the tx end)",
                                  ns->position));
-  if (!(ns->f_stop > ns->f_start))
-    return doc.error(node["f_stop"] ? node["f_stop"] : node,
-                     fmt::format("key 'noise.f_stop' = {:g} Hz: must be above f_start = {:g} Hz",
-                                 ns->f_stop, ns->f_start));
+  if (band) {
+    ns->f_start = band->first, ns->f_stop = band->second;
+  } else if (ns->injection == "ground_shift") {
+    ns->f_start = 100e3;  // ground shift (inverter noise) starts at the switching harmonics
+  }
   return Status::Ok();
 }
 

@@ -9,9 +9,10 @@
 //   part, inductance, leakage, dcr, winding_c, centre_tap_c, cable_side_c, esd}},
 //   cable: {length, material, gauge, temperature, r, l, c, g, segments},
 //   stimulus: {frames, gaps, tones, patterns, script, direction}, sim: {tstep, tmax, method,
-//   reltol}, noise: {injection, level, position, modulation, f_start, f_stop,
-//   points_per_decade, pin_limit, time_domain, tolerance: {...}} (isolink noise; tx / rx also
-//   take x_cap, y_cap, chassis_c and cable chassis_c).
+//   reltol}, noise: {injection, level, position, modulation, band, points_per_decade,
+//   pin_limit, time_domain, samples, seed, verdict_on, tolerance: {...}} (isolink noise; tx / rx
+//   also take x_cap, y_cap, chassis_c, chassis_r, chassis_l, isolation.cable_side_return,
+//   isolation.choke_loss, and cable chassis_c).
 // `tx` is the end that transmits in the down direction (the host / bridge side); `rx` the end
 // that receives it. With direction up (or both) the rx end transmits back to the tx end.
 #pragma once
@@ -38,8 +39,15 @@ struct IsolationSpec {
   std::optional<double> winding_c;     // F
   std::optional<double> centre_tap_c;  // F, cable-side centre tap to ground
   double cable_side_c = -1;            // F per line to ground on the cable side (-1: default)
-  double esd = 0;                      // F per line to ground (ESD part), 0: none
-  SourceLoc loc;                       // the isolation map (or its end)
+  // Where the cable-side caps return when the grounds are kept apart (isolink noise): "board"
+  // (the end's board ground, TI's figure draws a ground symbol) or "chassis".
+  std::string cable_side_return = "board";
+  // The chokes' loss: "fitted" (the part's loss resistor, fitted to its data sheet's CM impedance
+  // at the rated frequency), "none" (lossless), or a resistance across each winding (choke_loss_r).
+  std::string choke_loss = "fitted";
+  double choke_loss_r = 0;  // ohm, when choke_loss is "resistance"
+  double esd = 0;           // F per line to ground (ESD part), 0: none
+  SourceLoc loc;            // the isolation map (or its end)
 };
 
 struct EndSpec {
@@ -52,6 +60,9 @@ struct EndSpec {
   double y_cap = 0;         // F per line to the chassis at the connector (Y caps), 0: none
   double chassis_c = 1e-9;  // F, the board's ground (and its module) to the chassis;
                             // used when the grounds are kept apart (isolink noise)
+  double chassis_r = 0;     // ohm, a DC bond of the board's ground to the chassis (strap,
+                            // screw) in parallel with chassis_c; 0: none (the board floats)
+  double chassis_l = 0;     // H, the bond's inductance, in series with chassis_r
   SourceLoc loc;
 };
 
@@ -93,19 +104,22 @@ struct NoiseTolerances {
 
 // The `noise:` block: what is injected, how hard, over which band (isolink noise).
 struct NoiseSpec {
-  std::string injection = "bci";  // bci | ground_shift | dm
-  double level = 0.1;             // A (bci, dm: RMS of the CW carrier) or V (ground_shift: RMS)
-  double position = 0.5;          // bci, dm: place on the cable, fraction of its length from tx
-  std::string modulation = "am";  // cw | am (ISO 11452-4 AM: 80 % at 1 kHz, peak 1.8 x carrier)
-  double f_start = 100e3;         // Hz
-  double f_stop = 400e6;          // Hz
-  int points_per_decade = 10;     // log-spaced
-  double calibration_r = 100;     // ohm: bci / dm induce level x this in series (ISO 11452-4
-                                  // calibration jig: 50 ohm line, 50 ohm at each end)
-  double clamp_r = 50;            // ohm: the clamp's source impedance in the loop (the
-                                  // generator's 50 ohm through the 1:1 probe)
-  double pin_limit = 20;          // V, receiver pins' common-mode limit (domain.md 2)
-  bool time_domain = true;        // confirm the worst frequency with a transient + the checker
+  std::string injection = "bci";      // bci | ground_shift | dm
+  double level = 0.1;                 // A (bci, dm: RMS of the CW carrier) or V (ground_shift: RMS)
+  double position = 0.5;              // bci, dm: place on the cable, fraction of its length from tx
+  std::string modulation = "am";      // cw | am (ISO 11452-4 AM: 80 % at 1 kHz, peak 1.8 x carrier)
+  double f_start = 1e6;               // Hz, `noise.band` (bci, dm: ISO 11452-4's 1-400 MHz;
+  double f_stop = 400e6;              // Hz   ground_shift: 100 kHz-400 MHz)
+  int points_per_decade = 10;         // log-spaced
+  double calibration_r = 100;         // ohm: bci / dm induce level x this in series (ISO 11452-4
+                                      // calibration jig: 50 ohm line, 50 ohm at each end)
+  double clamp_r = 50;                // ohm: the clamp's source impedance in the loop (the
+                                      // generator's 50 ohm through the 1:1 probe)
+  double pin_limit = 20;              // V, receiver pins' common-mode limit (domain.md 2)
+  bool time_domain = true;            // confirm the worst frequency with a transient + the checker
+  int samples = 200;                  // Monte Carlo boards over the tolerances (uniform in each)
+  int seed = 1;                       // their random seed
+  std::string verdict_on = "corner";  // corner | statistical: which immunity the verdict uses
   NoiseTolerances tolerance;
   SourceLoc loc;
   // "A" or "V".

@@ -3,8 +3,9 @@
 //   (so the driver's edges are amplitude-independent and P/N complementary, as the method needs);
 // - the search equals an independent brute force over a reduced set of bytes and gaps;
 // - random legal traffic (>= 200 byte frames, random commands and gaps) never beats it;
-// - each metric's `reproduce` stimulus, run through the transient engine (`isolink run`'s path),
-//   shows the worst value within 10 mV (1 ns for times).
+// - each metric's `reproduce` object from worst_json, pasted as JSON into a spec's `stimulus:`,
+//   read and run through the transient engine (`isolink run`'s path), shows the worst value
+//   within 10 mV (1 ns for times).
 #include "analysis/worst.h"
 
 #include <fmt/format.h>
@@ -326,18 +327,37 @@ TEST(WorstCase, RandomLegalTrafficNeverBeatsIt) {
   }
 }
 
+// The path a user takes: worst_json's `reproduce` object, written as JSON (a YAML flow map) into
+// the spec's `stimulus:` key, read by the link-spec reader and run (`isolink run`'s run_link).
 TEST(WorstCase, ReproduceBlocksShowTheWorstValueInTheTransient) {
   const Fixture& f = fixture();
   const DirectionWorst& w = full_worst();
+  WorstResult all;
+  all.directions = {w};
+  const nlohmann::ordered_json j = worst_json(all);
+  const std::string base(kLink);
+  const std::string head = base.substr(0, base.find("stimulus:"));
   for (const WorstMetric& m : w.metrics) {
-    link::LinkSpec spec = f.spec;
-    spec.stimulus = reproduce_spec(m, link::Direction::kDown);
-    spec.sim.reltol = 1e-5;
-    StatusOr<LinkRun> run = run_link(spec, f.parts);
+    const nlohmann::ordered_json& rep = j["directions"][0]["worst"][m.name]["reproduce"];
+    std::vector<std::string> keys;
+    for (const auto& [key, value] : rep.items()) keys.push_back(key);
+    EXPECT_EQ(keys, (std::vector<std::string>{"frames", "gaps", "direction"}));
+    const std::string text = head + "stimulus: " + rep.dump() + "\nsim: {reltol: 1e-5}\n";
+    SCOPED_TRACE(m.name + ": " + text);
+    StatusOr<link::LinkSpec> spec = link::read_link_spec_text(text, "reproduce.yaml");
+    ASSERT_TRUE(spec.ok()) << spec.status().message();
+    // The reader's stimulus is the searched traffic: same frames, gaps within 1 fs.
+    const link::StimulusSpec want = reproduce_spec(m, link::Direction::kDown);
+    EXPECT_EQ(spec->stimulus.frames, want.frames);
+    ASSERT_EQ(spec->stimulus.gaps.size(), m.traffic.gaps.size());
+    for (size_t i = 0; i < m.traffic.gaps.size(); ++i)
+      EXPECT_NEAR(spec->stimulus.gaps[i], m.traffic.gaps[i], 1e-15);
+    EXPECT_EQ(spec->stimulus.directions, std::vector<link::Direction>{link::Direction::kDown});
+    StatusOr<LinkRun> run = run_link(*spec, f.parts);
     ASSERT_TRUE(run.ok()) << run.status().message();
+    ASSERT_EQ(run->directions.size(), 1u);
     ASSERT_TRUE(run->directions[0].data.has_value());
     const Keys k = keys_of(*run->directions[0].data, f.rules);
-    SCOPED_TRACE(m.name + ": " + reproduce_stimulus(m, link::Direction::kDown));
     if (m.name == "vstart") {
       EXPECT_NEAR(k.vstart, m.value, 10e-3);
     }
