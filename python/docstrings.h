@@ -38,12 +38,10 @@ Returns:
     "directions": [{"direction", "rules", "check": {"verdict", "reasons", "summary": {...,
     "worst": {"vstart": {"value", "limit", "margin"}, ...}}, "pulses", "decoded"}, "solver",
     ...}], "worst_case" (worst=True)}, plus "pass" (bool) at the top and in each direction, and
-    each direction's waveforms under "wave": {"time": array (s), "v(rxp,rxn)" : array(V),
-                             "v(rxp)", "v(rxn)", "v(txp,txn)"
-}
-on the engine's own time grid.)doc";
+    each direction's waveforms under "wave": {"time": array (s), "v(rxp,rxn)": array (V),
+    "v(rxp)", "v(rxn)", "v(txp,txn)"} on the engine's own time grid.)doc";
 
-    inline constexpr const char* kWorst = R"doc(The worst case over all legal traffic.
+inline constexpr const char* kWorst = R"doc(The worst case over all legal traffic.
 
 As `isolink worst SPEC --json`: lowest VSTART and VEND, narrowest and widest pulse, slowest
 edge per direction, the traffic that causes each and a stimulus block that replays it.
@@ -75,17 +73,15 @@ Returns:
     `isolink noise --json`'s object: {"verdict", "injection", "level", "directions":
     [{"direction", "immunity_min", "immunity_min_freq" (Hz), "points": [...], ...}], ...}.)doc";
 
-inline constexpr const char *kSim = R"doc(Simulate a SPICE netlist (ngspice dialect), as `isolink sim`.
+inline constexpr const char* kSim =
+    R"doc(Simulate a SPICE netlist (ngspice dialect), as `isolink sim`.
 
 Args:
     netlist: a path (str or os.PathLike) or the netlist's text (a str with a line break);
         .include paths in text are taken from the current working directory.
-    probes: signals to record: "v(node)",
-                            "v(a,b)"(V(a) - V(b)),
-                            "i(Vname)" or "i(Lname)".engine
-    : "auto"(LTI where it is the cheaper engine, else transient),
-                            "lti",
-                            "transient".step : a uniform output grid, in seconds(1e-9 or "1n"); None: the LTI engine's grid (linear
+    probes: signals to record: "v(node)", "v(a,b)" (V(a) - V(b)), "i(Vname)" or "i(Lname)".
+    engine: "auto" (LTI where it is the cheaper engine, else transient), "lti", "transient".
+    step: a uniform output grid, in seconds (1e-9 or "1n"); None: the LTI engine's grid (linear
         interpolation within 1 mV) or the transient's own steps.
     tstop, tmax: end time and largest step in seconds, overriding .tran.
     method: "trap" or "gear" (transient), overriding .options method.
@@ -112,7 +108,8 @@ Returns:
     "margin_width_ns", "margin_edge_ns", "decoded_ok", "fail_reason", "seconds", "error", ...
     None for an empty cell, bool for decoded_ok, int for point, float for numbers.)doc";
 
-inline constexpr const char* kPack = R"doc(Simulate a whole daisy chain, as `isolink pack` (nothing written).
+inline constexpr const char* kPack =
+    R"doc(Simulate a whole daisy chain, as `isolink pack` (nothing written).
 
 Every hop (each distinct circuit once), the ring's cable breaks and command timing.
 
@@ -141,7 +138,8 @@ Returns:
     "vend_min", "width_min_ns", ..., "worst": {metric: {"value", "limit", "margin"}}},
     "pulses": [...], "decoded": [...], "pass": bool}.)doc";
 
-inline constexpr const char* kLoadSpec = R"doc(Read a link spec: every key with its default filled in.
+inline constexpr const char* kLoadSpec =
+    R"doc(Read a link spec: every key with its default filled in.
 
 Args:
     spec: a link spec, a path or a dict.

@@ -112,7 +112,7 @@ def every_function():
     print(f"sim: v(out) = {v[-1]:.4f} V at {out['sim']['time'][-1] * 1e9:.0f} ns")
     print(f"sweep: " + ", ".join(f"{r['cable.length']} m {r['verdict']}" for r in out["sweep"]))
     print(f"pack: {out['pack']['verdict']}, weakest hop {out['pack']['weakest_hop']}")
-    print(f"check: {out['check']['verdict']}, decoded {out['check']['decoded']}")
+    print(f"check: {out['check']['verdict']}, decoded {out['check']['decoded']['bytes']}")
     return out
 
 

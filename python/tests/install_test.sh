@@ -5,7 +5,7 @@
 # dict specs and compared with STAGE's bin/isolink (python/README.md, "Installing").
 #   install_test.sh BUILD SITE_DIR NOTEBOOK   (SITE_DIR: ISOLINK_PYTHON_INSTALL_DIR)
 set -euo pipefail
-build=$1 site_rel=$2 notebook=$3
+build=$(realpath "$1") site_rel=$2 notebook=$(realpath "$3")
 stage=$(mktemp -d /tmp/isolink-install-XXXXXX)
 trap 'rm -rf "$stage"' EXIT
 cmake --install "$build" --prefix "$stage" >/dev/null
