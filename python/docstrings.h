@@ -54,9 +54,11 @@ Args:
     parts: extra part-library folders.
 
 Returns:
-    `isolink worst --json`'s object: {"verdict", "directions": [{"direction", "rules",
-    "worst": {"vstart": {"value" (V), "limit", "margin", "traffic", "reproduce"}, "vend",
-    "width_min", "width_max", "edge" (s)}, ...}], ...}.)doc";
+    `isolink worst --json`'s object: {"verdict", "seconds", "directions": [{"direction",
+    "rules", "verdict", "reasons", "memory_us", "edge_response", "worst": {"vstart": {"value",
+    "limit", "margin", "unit" (V; s for the widths and the edge), "bound", "frames",
+    "error_bits", "gaps_us", "pulse", "reproduce" (a stimulus block)}, "vend", "width_min",
+    "width_max", "edge"}, ...}]}.)doc";
 
 inline constexpr const char* kNoise =
     R"doc(Common-mode noise immunity over frequency (BCI, ground shift).
@@ -70,8 +72,10 @@ Args:
     parts: extra part-library folders.
 
 Returns:
-    `isolink noise --json`'s object: {"verdict", "injection", "level", "directions":
-    [{"direction", "immunity_min", "immunity_min_freq" (Hz), "points": [...], ...}], ...}.)doc";
+    `isolink noise --json`'s object: {"verdict", "injection", "level", "level_unit" (A or V),
+    "immunity_min_db" (dB re the level), "directions": [{"direction", "points": [{"freq_hz",
+    "cm_to_dm_db", "pin_cm_v", "dm_v", "immunity", "limited_by", ...}], "immunity_min":
+    {"value", "freq_hz"}, "verdict", "budget", "time_domain", ...}], ...}.)doc";
 
 inline constexpr const char* kSim =
     R"doc(Simulate a SPICE netlist (ngspice dialect), as `isolink sim`.
