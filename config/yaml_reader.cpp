@@ -16,6 +16,7 @@
 #include "base/file_io.h"
 #include "base/si_number.h"
 #include "base/utf8.h"
+#include "config/key_path.h"
 
 namespace isolink::config {
 
@@ -366,6 +367,11 @@ SourceLoc YamlDoc::loc(const YAML::Node& node) const {
     const YAML::Mark m = node.Mark();
     if (m.line >= 0 && !m.is_null()) l.line = m.line + 1, l.col = m.column + 1;
   }
+  // A document built in memory (a Python dict) is located by key path: a "file" of that name,
+  // without lines to show (config/key_path.h).
+  if (l.line > 0 && is_key_path_document(*l.file))
+    if (std::optional<std::string> key = key_path_at(*l.file, l.line, l.col))
+      return SourceLoc{SourceFile::FromText(key->empty() ? l.file->path : *key, ""), 0, 0};
   return l;
 }
 

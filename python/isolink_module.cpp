@@ -1,21 +1,22 @@
 // The isolink Python module (pybind11): a front end beside cli/, over the same library calls.
 //
 //   import isolink
-//   r = isolink.run("netlists/examples/same_pcb.yaml")   # report.json's content, plus waveforms
-//   r["verdict"], r["directions"][0]["check"]["summary"]["worst"], r["directions"][0]["wave"]
-//   m = isolink.check(t, v, rules="bq7961x")             # `isolink check --json`'s object
-//   rows = isolink.sweep("sweep.yaml")                   # results.csv's rows, as dicts
+//   r = isolink.run({"name": "a", "cable": {"length": 12}})   # report.json's content + waveforms
+//   w = isolink.worst("netlists/examples/cap_2m.yaml")         # `isolink worst --json`
+//   m = isolink.check(t, v, rules="bq7961x")                   # `isolink check --json`
 //
-// Every result is the JSON the CLI writes for the same input (report.json, check --json,
-// results.csv), turned into dicts and lists, so a name means the same thing in both front ends.
-// Errors raise isolink.Error (a ValueError) whose text is the CLI's message, file:line:col
-// included. No analysis happens here: each function is the library call its CLI command makes.
+// Every result is the JSON the CLI writes for the same input, built by the same functions
+// (reports::run_report_json, analysis::worst_json, noise_json, reports::pack_report_json,
+// eye::to_json, the sweep's results.csv rows), turned into dicts and lists: a name means the same
+// thing in both front ends and the two cannot drift. Errors raise isolink.Error (a ValueError)
+// whose text is the CLI's message. No analysis happens here: each function reads its input the
+// way its CLI command does, releases the GIL and makes that command's library call.
+#include <fmt/format.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 #include <stdlib.h>
 
-#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -26,10 +27,13 @@
 #include <vector>
 
 #include "analysis/link_run.h"
+#include "analysis/noise.h"
+#include "analysis/pack.h"
 #include "analysis/pack_spec.h"
 #include "analysis/simulate.h"
 #include "analysis/sweep_run.h"
 #include "analysis/sweep_spec.h"
+#include "analysis/worst.h"
 #include "base/csv.h"
 #include "base/hex.h"
 #include "base/status.h"
@@ -38,121 +42,279 @@
 #include "eye/rules.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
+#include "python/convert.h"
+#include "python/docstrings.h"
+#include "reports/pack_report.h"
 #include "reports/run_report.h"
-
-namespace py = pybind11;
 
 namespace isolink::python {
 namespace {
 
-PyObject* g_error = nullptr;  // isolink.Error
-struct ErrorTag {};           // names isolink.Error's type; no C++ exception is translated to it
+struct ErrorTag {};  // names isolink.Error's type; no C++ exception is translated to it
+using Strings = std::vector<std::string>;
 
-[[noreturn]] void raise(const Status& s) {
-  PyErr_SetString(g_error, s.message().c_str());
-  throw py::error_already_set();
+// The readers, from a file or a dict's text (convert.h SpecArg); called without the GIL.
+StatusOr<link::LinkSpec> read_link(const SpecArg& a) {
+  return a.is_file() ? link::read_link_spec_file(a.path)
+                     : link::read_link_spec_text(a.text, a.name);
 }
-template <typename T>
-T take(StatusOr<T> v) {
-  if (!v) raise(v.status());
-  return std::move(*v);
-}
-
-py::object to_python(const nlohmann::ordered_json& j) {
-  switch (j.type()) {
-    case nlohmann::ordered_json::value_t::null:
-      return py::none();
-    case nlohmann::ordered_json::value_t::boolean:
-      return py::bool_(j.get<bool>());
-    case nlohmann::ordered_json::value_t::number_integer:
-      return py::int_(j.get<int64_t>());
-    case nlohmann::ordered_json::value_t::number_unsigned:
-      return py::int_(j.get<uint64_t>());
-    case nlohmann::ordered_json::value_t::number_float:
-      return py::float_(j.get<double>());
-    case nlohmann::ordered_json::value_t::string:
-      return py::str(j.get_ref<const std::string&>());
-    case nlohmann::ordered_json::value_t::array: {
-      py::list l;
-      for (const auto& e : j) l.append(to_python(e));
-      return l;
-    }
-    case nlohmann::ordered_json::value_t::object: {
-      py::dict d;
-      for (const auto& [k, v] : j.items()) d[py::str(k)] = to_python(v);
-      return d;
-    }
-    default:
-      return py::none();  // binary / discarded: never produced by isolink's writers
-  }
+StatusOr<config::YamlDoc> read_doc(const SpecArg& a) {
+  return a.is_file() ? config::YamlDoc::load_file(a.path)
+                     : config::YamlDoc::from_text(a.text, a.name);
 }
 
-py::array_t<double> to_numpy(const std::vector<double>& v) {
-  return py::array_t<double>(static_cast<py::ssize_t>(v.size()), v.data());
+// direction= as the CLI's --direction: overrides the spec's stimulus.direction.
+void check_direction(const std::optional<std::string>& d) {
+  if (d && *d != "down" && *d != "up" && *d != "both")
+    raise(Status::Error("direction: error: '" + *d + "' is none of down, up, both"));
+}
+void set_direction(link::LinkSpec& spec, const std::optional<std::string>& d) {
+  if (d == "down") spec.stimulus.directions = {link::Direction::kDown};
+  if (d == "up") spec.stimulus.directions = {link::Direction::kUp};
+  if (d == "both") spec.stimulus.directions = {link::Direction::kDown, link::Direction::kUp};
 }
 
-// {"time": array, "<probe>": array, ...}: one direction's waveform on the engine's own grid.
-py::dict wave_dict(const Waveform& w) {
-  py::dict d;
-  d["time"] = to_numpy(w.time);
-  for (size_t k = 0; k < w.names.size(); ++k) d[py::str(w.names[k])] = to_numpy(w.columns[k]);
-  return d;
+Strings sim_warnings(const analysis::LinkRun& run) {
+  Strings w;
+  for (const analysis::DirectionRun& d : run.directions)
+    w.insert(w.end(), d.sim.warnings.begin(), d.sim.warnings.end());
+  return w;
 }
 
-StatusOr<analysis::Engine> engine_option(const std::string& engine) {
-  return analysis::parse_engine(engine);
-}
-
-// Solver warnings (floating nodes, ...), each once, as Python warnings: what the CLI prints on
-// stderr.
-void warn(const std::vector<std::string>& seen) {
-  for (const std::string& w : seen)
-    if (PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) < 0) throw py::error_already_set();
-}
-
-// isolink.run: `isolink run SPEC --no-worst`'s report.json as a dict, each direction with its
-// waveforms ("wave") as numpy arrays and its verdict as a bool ("pass").
-py::dict run(const std::string& path, const std::optional<std::string>& direction,
-             const std::string& engine, const std::vector<std::string>& parts_dirs) {
-  if (direction && *direction != "down" && *direction != "up" && *direction != "both")
-    raise(Status::Error("direction: '" + *direction + "' is none of down, up, both"));
+// isolink.run: `isolink run SPEC [--no-worst]`'s report.json, with waveforms and bools.
+py::dict run(const py::object& spec_obj, const std::optional<std::string>& direction,
+             const std::string& engine, bool worst, const Strings& parts_dirs) {
+  check_direction(direction);
+  const SpecArg arg = spec_arg(spec_obj, "spec");
   analysis::RunOptions ro;
-  ro.engine = take(engine_option(engine));
+  ro.engine = take(analysis::parse_engine(engine));
   bool pack = false;
   StatusOr<link::LinkSpec> spec = Status::Error("not read");
   StatusOr<link::PartLibrary> parts = Status::Error("not read");
   StatusOr<analysis::LinkRun> lr = Status::Error("not run");
+  std::optional<StatusOr<analysis::WorstResult>> wr;
   {
     py::gil_scoped_release nogil;  // the work holds no Python object
-    StatusOr<config::YamlDoc> doc = config::YamlDoc::load_file(path);
+    StatusOr<config::YamlDoc> doc = read_doc(arg);
     pack = doc && analysis::is_pack_spec(*doc);
-    if (!pack) spec = link::read_link_spec_file(path);
-    if (spec && direction == "down") spec->stimulus.directions = {link::Direction::kDown};
-    if (spec && direction == "up") spec->stimulus.directions = {link::Direction::kUp};
-    if (spec && direction == "both")
-      spec->stimulus.directions = {link::Direction::kDown, link::Direction::kUp};
+    if (!pack) spec = read_link(arg);
+    if (spec) set_direction(*spec, direction);
     if (spec) parts = link::PartLibrary::load(parts_dirs);
     if (spec && parts) lr = analysis::run_link(*spec, *parts, ro);
+    if (lr && worst) wr = analysis::worst_case(*spec, *parts);
   }
   if (pack)
-    raise(Status::Error(path + ": error: a pack spec (hops:); isolink.run takes a link spec "
-                               "(run a pack with `isolink pack`)"));
+    raise(Status::Error(arg.where() + ": error: a pack spec (hops:); isolink.run takes a link "
+                                      "spec (run a pack with isolink.pack)"));
   if (!spec) raise(spec.status());
   if (!parts) raise(parts.status());
-  if (!lr) raise(lr.status().with_context(path));
-  py::dict out = to_python(reports::run_report_json(*spec, *lr));
+  if (!lr) raise(lr.status().with_context(arg.where()));
+  if (wr && !*wr) raise(wr->status().with_context(arg.where() + ", worst case"));
+  nlohmann::ordered_json j = reports::run_report_json(*spec, *lr);
+  if (wr) j["worst_case"] = analysis::worst_json(**wr);  // as cmd_run.cpp
+  py::dict out = to_python(j);
   out["pass"] = lr->pass;
   py::list dirs = out["directions"];
-  std::vector<std::string> warned;
   for (size_t i = 0; i < lr->directions.size(); ++i) {
-    const analysis::DirectionRun& d = lr->directions[i];
     py::dict dj = dirs[i];
-    dj["pass"] = d.pass;
-    dj["wave"] = wave_dict(d.sim.wave);
-    for (const std::string& w : d.sim.warnings)
-      if (std::find(warned.begin(), warned.end(), w) == warned.end()) warned.push_back(w);
+    dj["pass"] = lr->directions[i].pass;
+    dj["wave"] = wave_dict(lr->directions[i].sim.wave);
   }
-  warn(warned);
+  warn_once(sim_warnings(*lr));
+  return out;
+}
+
+// isolink.worst: `isolink worst SPEC --json`.
+py::object worst(const py::object& spec_obj, const std::optional<std::string>& direction,
+                 const std::string& edge_engine, const Strings& parts_dirs) {
+  check_direction(direction);
+  if (edge_engine != "auto" && edge_engine != "transient")
+    raise(Status::Error("edge_engine: error: '" + edge_engine + "' is none of auto, transient"));
+  const SpecArg arg = spec_arg(spec_obj, "spec");
+  analysis::WorstOptions opt;
+  if (edge_engine == "transient") opt.edge_engine = analysis::WorstOptions::EdgeEngine::Transient;
+  StatusOr<link::LinkSpec> spec = Status::Error("not read");
+  StatusOr<link::PartLibrary> parts = Status::Error("not read");
+  StatusOr<analysis::WorstResult> w = Status::Error("not run");
+  {
+    py::gil_scoped_release nogil;
+    spec = read_link(arg);
+    if (spec) set_direction(*spec, direction);
+    if (spec) parts = link::PartLibrary::load(parts_dirs);
+    if (spec && parts) w = analysis::worst_case(*spec, *parts, opt);
+  }
+  if (!spec) raise(spec.status());
+  if (!parts) raise(parts.status());
+  if (!w) raise(w.status().with_context(arg.where()));
+  return to_python(analysis::worst_json(*w));
+}
+
+// isolink.noise: `isolink noise SPEC --json`.
+py::object noise(const py::object& spec_obj, const Strings& parts_dirs) {
+  const SpecArg arg = spec_arg(spec_obj, "spec");
+  StatusOr<link::LinkSpec> spec = Status::Error("not read");
+  StatusOr<link::PartLibrary> parts = Status::Error("not read");
+  StatusOr<analysis::NoiseRun> nr = Status::Error("not run");
+  {
+    py::gil_scoped_release nogil;
+    spec = read_link(arg);
+    if (spec) parts = link::PartLibrary::load(parts_dirs);
+    if (spec && parts) nr = analysis::run_noise(*spec, *parts);
+  }
+  if (!spec) raise(spec.status());
+  if (!parts) raise(parts.status());
+  if (!nr) raise(nr.status().with_context(arg.where()));
+  py::object out = to_python(analysis::noise_json(nr->noise));
+  warn_once(sim_warnings(nr->run));
+  return out;
+}
+
+// isolink.sim: `isolink sim NETLIST --probe ...`'s columns as numpy arrays.
+py::dict sim(const py::object& netlist, const Strings& probes, const std::string& engine,
+             const py::object& step, const py::object& tstop, const py::object& tmax,
+             const std::optional<std::string>& method, const std::optional<double>& reltol) {
+  if (probes.empty()) raise(Status::Error("probes: error: give at least one probe, e.g. 'v(out)'"));
+  analysis::SimulationRequest req;
+  req.probes = probes;
+  req.engine = take(analysis::parse_engine(engine));
+  const std::optional<double> dt = time_arg(step, "step");
+  req.grid_step = dt.value_or(0.0);
+  req.tstop = time_arg(tstop, "tstop");
+  req.tmax = time_arg(tmax, "tmax");
+  if (method && *method != "trap" && *method != "gear")
+    raise(Status::Error("method: error: '" + *method + "' is none of trap, gear"));
+  if (method)
+    req.method = *method == "trap" ? IntegrationMethod::Trapezoidal : IntegrationMethod::Gear2;
+  if (reltol && !(*reltol >= 1e-9 && *reltol <= 0.1))
+    raise(Status::Error(fmt::format("reltol: error: {:g} is outside 1e-9 to 0.1", *reltol)));
+  req.reltol = reltol;
+  // A str with a line break is the netlist's text; anything else names a file.
+  std::string text;
+  if (py::isinstance<py::str>(netlist)) text = netlist.cast<std::string>();
+  const bool is_text = text.find('\n') != std::string::npos;
+  if (py::isinstance<py::dict>(netlist))
+    raise(Status::Error("netlist: error: expected a path or the netlist's text, got a dict"));
+  const std::string path = is_text ? "" : spec_arg(netlist, "netlist").path;
+  StatusOr<Netlist> n = Status::Error("not read");
+  StatusOr<analysis::SimulationResult> r = Status::Error("not run");
+  {
+    py::gil_scoped_release nogil;
+    n = is_text ? read_spice_text(text, "<netlist>") : read_spice_file(path);
+    if (n) r = analysis::simulate_netlist(*n, req);
+  }
+  if (!n) raise(n.status());
+  if (!r) {
+    const std::string& m = r.status().message();  // as cmd_sim.cpp
+    raise(Status::Error(m.find(": error: ") == std::string::npos ? "sim: error: " + m : m));
+  }
+  warn_once(r->warnings);
+  // With a step, the LTI engine already wrote that grid; the transient's steps are resampled onto
+  // it (as cmd_sim.cpp; simulate_netlist refused a grid of too many rows).
+  return wave_dict(dt && r->engine == analysis::Engine::Transient ? r->wave.resampled(*dt)
+                                                                  : r->wave);
+}
+
+// A results.csv cell as Python: "" -> None, true/false -> bool, a number -> float (the point
+// index -> int), anything else (a variant's name, a reason) -> str.
+py::object cell(const std::string& name, const std::string& text) {
+  if (text.empty()) return py::none();
+  if (text == "true" || text == "false") return py::bool_(text == "true");
+  double x = 0;
+  const char* end = text.data() + text.size();
+  // Decimal numbers only (no hex); "nan" or "inf" would be a variant's name.
+  if (auto [p, ec] = std::from_chars(text.data(), end, x);
+      ec == std::errc() && p == end && std::isfinite(x)) {
+    if (name == "point" || name == "sample") return py::int_(static_cast<int64_t>(x));
+    return py::float_(x);
+  }
+  return py::str(text);
+}
+
+// isolink.sweep: every point's row of results.csv (the same names, units and numbers), as dicts
+// in point order. results.csv and summary.json go to `out` (a temporary folder, removed
+// afterwards, when None).
+py::list sweep(const py::object& sweep_obj, const std::optional<std::string>& out, int jobs,
+               const std::string& engine, const Strings& parts_dirs) {
+  if (jobs < 0)
+    raise(Status::Error("jobs: error: " + std::to_string(jobs) + " is below 0 (0: all cores)"));
+  const SpecArg arg = spec_arg(sweep_obj, "sweep");
+  analysis::sweep::SweepOptions opt;
+  opt.point.run.engine = take(analysis::parse_engine(engine));
+  opt.jobs = jobs;
+  opt.plots = false;  // analysis/ draws nothing; charts are the CLI's (reports/)
+  opt.quiet = true;
+  std::string tmp;
+  if (out) {
+    opt.out_dir = *out;
+  } else {
+    std::string pattern =
+        (std::filesystem::temp_directory_path() / "isolink-sweep-XXXXXX").string();
+    if (!mkdtemp(pattern.data()))
+      raise(Status::Error(pattern + ": error: cannot create a temporary folder"));
+    tmp = opt.out_dir = pattern;
+  }
+  analysis::sweep::SweepSpec s;
+  StatusOr<analysis::sweep::SweepOutcome> r = Status::Error("not run");
+  {
+    py::gil_scoped_release nogil;
+    StatusOr<analysis::sweep::SweepSpec> sp =
+        arg.is_file() ? analysis::sweep::read_sweep_file(arg.path)
+                      : analysis::sweep::read_sweep_text(arg.text, arg.name);
+    StatusOr<link::PartLibrary> p =
+        sp ? link::PartLibrary::load(parts_dirs) : StatusOr<link::PartLibrary>(sp.status());
+    if (p)
+      r = analysis::sweep::run_sweep(*sp, *p, opt);
+    else
+      r = p.status();
+    if (sp) s = std::move(*sp);
+    if (!tmp.empty()) {
+      std::error_code ec;
+      std::filesystem::remove_all(tmp, ec);
+    }
+  }
+  if (!r) raise(r.status());
+  const Strings header = analysis::sweep::results_header(s);
+  py::list rows;
+  for (const analysis::sweep::PointResult& pr : r->results) {
+    std::string line = analysis::sweep::results_row(pr);
+    if (!line.empty() && line.back() == '\n') line.pop_back();
+    const Strings fields = split_csv_line(line);
+    py::dict row;
+    for (size_t k = 0; k < header.size() && k < fields.size(); ++k)
+      row[py::str(header[k])] = cell(header[k], fields[k]);
+    rows.append(std::move(row));
+  }
+  return rows;
+}
+
+// isolink.pack: `isolink pack`'s report.json.
+py::object pack(const py::object& pack_obj, int jobs, bool worst, const Strings& parts_dirs) {
+  if (jobs < 0)
+    raise(Status::Error("jobs: error: " + std::to_string(jobs) + " is below 0 (0: all cores)"));
+  const SpecArg arg = spec_arg(pack_obj, "pack_spec");
+  analysis::PackOptions opt;
+  opt.jobs = jobs;
+  if (worst) opt.worst = analysis::WorstOptions{};
+  StatusOr<analysis::PackSpec> spec = Status::Error("not read");
+  StatusOr<link::PartLibrary> parts = Status::Error("not read");
+  StatusOr<analysis::PackResult> r = Status::Error("not run");
+  {
+    py::gil_scoped_release nogil;
+    spec = arg.is_file() ? analysis::read_pack_spec_file(arg.path)
+                         : analysis::read_pack_spec_text(arg.text, arg.name);
+    if (spec) parts = link::PartLibrary::load(parts_dirs);
+    if (spec && parts) r = analysis::run_pack(*spec, *parts, opt);
+  }
+  if (!spec) raise(spec.status());
+  if (!parts) raise(parts.status());
+  if (!r) raise(r.status().with_context(arg.where()));
+  py::object out = to_python(reports::pack_report_json(*spec, *r));
+  Strings w;
+  for (const analysis::HopResult& h : r->hops) {
+    const Strings hw = sim_warnings(h.run);
+    w.insert(w.end(), hw.begin(), hw.end());
+  }
+  warn_once(w);
   return out;
 }
 
@@ -183,78 +345,14 @@ py::dict check(const py::array_t<double, py::array::c_style | py::array::forceca
 }
 
 // isolink.load_spec: the link spec with every default filled in (report.json's "spec").
-py::dict load_spec(const std::string& path) {
-  return to_python(reports::link_spec_json(take(link::read_link_spec_file(path))));
-}
-
-// A results.csv cell as Python: "" -> None, true/false -> bool, a number -> float (the point
-// index -> int), anything else (a variant's name, a reason) -> str.
-py::object cell(const std::string& name, const std::string& text) {
-  if (text.empty()) return py::none();
-  if (text == "true" || text == "false") return py::bool_(text == "true");
-  double x = 0;
-  const char* end = text.data() + text.size();
-  // Decimal numbers only (no hex); "nan" or "inf" would be a variant's name.
-  if (auto [p, ec] = std::from_chars(text.data(), end, x);
-      ec == std::errc() && p == end && std::isfinite(x)) {
-    if (name == "point" || name == "sample") return py::int_(static_cast<int64_t>(x));
-    return py::float_(x);
-  }
-  return py::str(text);
-}
-
-// isolink.sweep: every point's row of results.csv (the same names, units and numbers), as dicts
-// in point order. results.csv and summary.json go to `out` (a temporary folder, removed
-// afterwards, when None).
-py::list sweep(const std::string& path, const std::optional<std::string>& out, int jobs,
-               const std::string& engine, const std::vector<std::string>& parts_dirs) {
-  if (jobs < 0)
-    raise(Status::Error("jobs: " + std::to_string(jobs) + " is below 0 (0: all cores)"));
-  analysis::sweep::SweepOptions opt;
-  opt.point.run.engine = take(engine_option(engine));
-  opt.jobs = jobs;
-  opt.plots = false;  // analysis/ draws nothing; charts are the CLI's (reports/)
-  opt.quiet = true;
-  std::string tmp;
-  if (out) {
-    opt.out_dir = *out;
-  } else {
-    std::string pattern =
-        (std::filesystem::temp_directory_path() / "isolink-sweep-XXXXXX").string();
-    if (!mkdtemp(pattern.data()))
-      raise(Status::Error(pattern + ": error: cannot create a temporary folder"));
-    tmp = opt.out_dir = pattern;
-  }
-  analysis::sweep::SweepSpec s;
-  StatusOr<analysis::sweep::SweepOutcome> r = Status::Error("not run");
+py::object load_spec(const py::object& spec_obj) {
+  const SpecArg arg = spec_arg(spec_obj, "spec");
+  StatusOr<link::LinkSpec> spec = Status::Error("not read");
   {
     py::gil_scoped_release nogil;
-    StatusOr<analysis::sweep::SweepSpec> sp = analysis::sweep::read_sweep_file(path);
-    StatusOr<link::PartLibrary> p =
-        sp ? link::PartLibrary::load(parts_dirs) : StatusOr<link::PartLibrary>(sp.status());
-    if (p)
-      r = analysis::sweep::run_sweep(*sp, *p, opt);
-    else
-      r = p.status();
-    if (sp) s = std::move(*sp);
-    if (!tmp.empty()) {
-      std::error_code ec;
-      std::filesystem::remove_all(tmp, ec);
-    }
+    spec = read_link(arg);
   }
-  if (!r) raise(r.status());
-  const std::vector<std::string> header = analysis::sweep::results_header(s);
-  py::list rows;
-  for (const analysis::sweep::PointResult& pr : r->results) {
-    std::string line = analysis::sweep::results_row(pr);
-    if (!line.empty() && line.back() == '\n') line.pop_back();
-    const std::vector<std::string> fields = split_csv_line(line);
-    py::dict row;
-    for (size_t k = 0; k < header.size() && k < fields.size(); ++k)
-      row[py::str(header[k])] = cell(header[k], fields[k]);
-    rows.append(std::move(row));
-  }
-  return rows;
+  return to_python(reports::link_spec_json(take(std::move(spec))));
 }
 
 }  // namespace
@@ -262,30 +360,28 @@ py::list sweep(const std::string& path, const std::optional<std::string>& out, i
 
 PYBIND11_MODULE(isolink, m) {
   using namespace isolink::python;
-  m.doc() =
-      "isolink: signal integrity of BMS daisy-chain links (run, check, load_spec, sweep). "
-      "Results are the JSON the isolink CLI writes, as dicts; errors raise isolink.Error with "
-      "the CLI's file:line:col message.";
+  namespace doc = isolink::python::doc;
+  m.doc() = doc::kModule;
   static py::exception<ErrorTag> error(m, "Error", PyExc_ValueError);
-  g_error = error.ptr();
+  set_error_type(error.ptr());
+  const auto no_parts = std::vector<std::string>{};
   m.def("run", &run, py::arg("spec"), py::kw_only(), py::arg("direction") = py::none(),
-        py::arg("engine") = "auto", py::arg("parts") = std::vector<std::string>{},
-        "Simulate a link spec (YAML) with its traffic and score each receiver, as `isolink run "
-        "SPEC --no-worst`: report.json's content as a dict, with 'pass' (bool) at the top and in "
-        "each direction, and each direction's waveforms under 'wave' ({'time': array, "
-        "'v(rxp,rxn)': array, ...}, seconds and volts).");
-  m.def("check", &check, py::arg("t"), py::arg("v"), py::kw_only(), py::arg("rules") = "bq7961x",
-        py::arg("expect") = py::none(),
-        "Score samples v (V) at times t (s, increasing) against a rule set (bq7961x, bq79600, "
-        "tone or a YAML rule file), as `isolink check --json`: its object as a dict, with "
-        "'pass' (bool). expect: the bytes expected, in hex ('80 00 02 15').");
-  m.def("load_spec", &load_spec, py::arg("spec"),
-        "Read a link spec: every key with its default filled in, as report.json's 'spec'.");
+        py::arg("engine") = "auto", py::arg("worst") = false, py::arg("parts") = no_parts,
+        doc::kRun);
+  m.def("worst", &worst, py::arg("spec"), py::kw_only(), py::arg("direction") = py::none(),
+        py::arg("edge_engine") = "auto", py::arg("parts") = no_parts, doc::kWorst);
+  m.def("noise", &noise, py::arg("spec"), py::kw_only(), py::arg("parts") = no_parts, doc::kNoise);
+  m.def("sim", &sim, py::arg("netlist"), py::arg("probes"), py::kw_only(),
+        py::arg("engine") = "auto", py::arg("step") = py::none(), py::arg("tstop") = py::none(),
+        py::arg("tmax") = py::none(), py::arg("method") = py::none(),
+        py::arg("reltol") = py::none(), doc::kSim);
   m.def("sweep", &sweep, py::arg("sweep"), py::kw_only(), py::arg("out") = py::none(),
-        py::arg("jobs") = 0, py::arg("engine") = "auto",
-        py::arg("parts") = std::vector<std::string>{},
-        "Run a sweep file on all cores (jobs: threads, 0 = all) as `isolink sweep --no-plots`: "
-        "one dict per point, in point order, with results.csv's columns and numbers (margins in "
-        "V and ns). results.csv and summary.json are written to out (a temporary folder when "
-        "None, removed afterwards).");
+        py::arg("jobs") = 0, py::arg("engine") = "auto", py::arg("parts") = no_parts, doc::kSweep);
+  m.def("pack", &pack, py::arg("pack_spec"), py::kw_only(), py::arg("jobs") = 0,
+        py::arg("worst") = true, py::arg("parts") = no_parts, doc::kPack);
+  m.def("check", &check, py::arg("t"), py::arg("v"), py::kw_only(), py::arg("rules") = "bq7961x",
+        py::arg("expect") = py::none(), doc::kCheck);
+  m.def("load_spec", &load_spec, py::arg("spec"), doc::kLoadSpec);
+  // compare(capture, spec, fit=[...]): `isolink compare`'s object, once that command exists
+  // (issue 31): a SpecArg for spec, the capture as a path, the command's JSON builder.
 }

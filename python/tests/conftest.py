@@ -10,6 +10,14 @@ import pytest
 HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
 SPEC = HERE / "one_byte.yaml"
+# one_byte.yaml as a dict with the YAML's structure (quantities as numbers or as the YAML's text).
+ONE_BYTE = {
+    "name": "py-one-byte",
+    "tx": {"device": "bq7961x", "isolation": {"type": "cap", "cap": "2.2n"}},
+    "rx": {"device": "bq7961x", "isolation": {"type": "cap", "cap": 2.2e-9}},
+    "cable": {"length": 1, "material": "pp"},
+    "stimulus": {"frames": ["raw 5A nocrc"], "direction": "down"},
+}
 
 
 @pytest.fixture(scope="session")

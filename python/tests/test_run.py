@@ -70,7 +70,7 @@ def test_waveforms_are_numpy_and_match_wave_csv(cli_run, mod_run):
 
 
 def test_direction_and_engine_options():
-    with pytest.raises(isolink.Error, match="direction: 'sideways' is none of down, up, both"):
+    with pytest.raises(isolink.Error, match="direction: error: 'sideways' is none of down, up, both"):
         isolink.run(str(SPEC), direction="sideways")
     with pytest.raises(isolink.Error, match="fast"):
         isolink.run(str(SPEC), engine="fast")
