@@ -13,6 +13,7 @@
 #include "base/csv.h"
 #include "base/file_io.h"
 #include "base/hex.h"
+#include "eye/commands.h"
 
 namespace isolink::eye {
 namespace {
@@ -155,6 +156,9 @@ StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const d
                                        i, t[i], t[i - 1]));
   }
   if (Status s = validate_rules(rules); !s.ok()) return s;
+  if (!(opt.command_idle >= 0) || !std::isfinite(opt.command_idle))
+    return Status::Error(
+        fmt::format("command idle {:g} s is not a finite time >= 0", opt.command_idle));
 
   CheckResult r;
   r.rules = rules.name;
@@ -367,6 +371,9 @@ StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const d
   r.inconclusive = nothing || (r.reasons.empty() && !open.empty());
   r.reasons.insert(r.reasons.end(), open.begin(), open.end());
   r.pass = r.reasons.empty();
+  // The commands the bytes carry: reported beside the verdict, never part of it (a malformed
+  // command on a clean waveform is the firmware's, not the link's).
+  if (opt.commands) r.commands = parse_commands(r, opt.command_idle);
   return r;
 }
 
@@ -490,6 +497,10 @@ json to_json(const CheckResult& r) {
     decoded["mismatch"] = r.expect_detail.empty() ? json(nullptr) : json(r.expect_detail);
   }
   j["decoded"] = std::move(decoded);
+  j["commands"] = commands_json(r.commands);
+  j["commands_omitted"] = r.commands.size() - std::min(r.commands.size(), kMaxJsonPulses);
+  const std::string note = commands_note(r);
+  j["commands_note"] = note.empty() ? json(nullptr) : json(note);
   return j;
 }
 
@@ -505,6 +516,7 @@ std::string summary_text(const CheckResult& r, const std::string& source) {
                      r.rules);
   for (const std::string& why : r.reasons) out += "  " + why + "\n";
   for (const std::string& hint : r.hints) out += "  hint: " + hint + "\n";
+  if (const std::string note = commands_note(r); !note.empty()) out += "  " + note + "\n";
   if (!r.worst.empty()) {
     out += "worst margin per metric:\n";
     for (const WorstMargin& w : r.worst) {
@@ -531,6 +543,7 @@ std::string summary_text(const CheckResult& r, const std::string& source) {
       out += r.expect_match ? "  (as expected)"
                             : "  (expected " + to_hex(*r.expect) + ": " + r.expect_detail + ")";
     out += "\n";
+    out += commands_text(r.commands);
   }
   const size_t kMax = 20;
   std::vector<std::string> fails, warns;
