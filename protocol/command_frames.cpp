@@ -27,6 +27,8 @@ constexpr std::array<KindName, 8> kKinds = {{
 }};
 
 constexpr size_t kCrcBytes = 2;
+// The longest frame: a response of 128 data bytes (init, device, register, data, CRC).
+constexpr size_t kMaxFrameBytes = 1 + 1 + 2 + 128 + kCrcBytes;
 
 // Bytes the init byte announces (0: no request type, length unknown).
 size_t announced_length(uint8_t init) {
@@ -191,7 +193,8 @@ void parse_burst(std::span<const TimedByte> b, size_t lo, size_t hi,
       out.push_back(make_frame(b, p, hi, crc, crc ? FrameFlag::kLength : FrameFlag::kTruncated));
       return;
     }
-    if (!ends_in_valid_crc(b, p, end) && end < hi && ends_in_valid_crc(b, p, hi)) {
+    if (!ends_in_valid_crc(b, p, end) && end < hi && hi - p <= kMaxFrameBytes &&
+        ends_in_valid_crc(b, p, hi)) {
       out.push_back(make_frame(b, p, hi, true, FrameFlag::kLength));
       return;
     }

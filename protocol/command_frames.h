@@ -29,15 +29,14 @@
 //   3. A burst that ends before its frame is complete: "truncated" (the idle or the record's end
 //      cut it), unless the bytes it holds end in a valid CRC of their own: then the host sent a
 //      different count of bytes than its init byte says ("length"). Likewise a frame whose CRC
-//      fails at the announced length, in a burst whose remaining bytes end in a valid CRC, is one
-//      frame of the burst's length with the flag "length".
+//      fails at the announced length, in a burst whose remaining bytes (134 at most, the longest
+//      frame) end in a valid CRC, is one frame of the burst's length with the flag "length".
 //   4. A byte that did not decode (TimedByte::value empty) makes the frame it falls in, and the
 //      rest of its burst, one frame flagged "undecoded": where the next frame starts is unknown.
 //   5. An init byte 0xF0-0xFF (request type 7) has no length: the rest of the burst is one frame
 //      flagged "unknown_init".
 #pragma once
 
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -129,8 +128,7 @@ struct ParsedFrame {
 };
 
 // Splits bytes (in time order) into frames by the rule above and parses each; every input byte
-// lands in exactly one frame. Times are only compared, never required to be finite-checked
-// beyond that: the caller's bytes come from a decoder that refused non-finite samples.
+// lands in exactly one frame, in order. Times are only compared: a NaN idle ends a burst.
 std::vector<ParsedFrame> parse_frames(std::span<const TimedByte> bytes,
                                       const FrameSplitOptions& opt = {});
 

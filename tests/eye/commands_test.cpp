@@ -23,13 +23,15 @@ Rules rules(const char* name = "bq7961x") {
 // The bytes as one ideal waveform, 3.8 us of idle between bytes (a byte every 10.3 us, as the
 // bridge forwards them), amplitude amp, the first byte `lead` into the record.
 CheckResult check_bytes(const std::vector<uint8_t>& bytes, const char* rule_set = "bq7961x",
-                        double amp = 2.0, double lead = 20e-6) {
+                        double amp = 2.0, double lead = 20e-6, const CheckOptions& opt = {}) {
   Waveform w = synth::ideal_frames(bytes, FrameFormat{}, 3.8e-6);
   for (double& x : w.columns[0]) x *= amp / 2.0;
-  for (double& t : w.time) t += lead - 1e-6;  // ideal_frames starts the first byte at 1 us
-  w.time.insert(w.time.begin(), 0.0);         // idle (0 V) from 0
-  w.columns[0].insert(w.columns[0].begin(), 0.0);
-  StatusOr<CheckResult> r = check_waveform(w, rules(rule_set));
+  if (lead > 1e-6) {
+    for (double& t : w.time) t += lead - 1e-6;  // ideal_frames starts the first byte at 1 us
+    w.time.insert(w.time.begin(), 0.0);         // idle (0 V) from 0
+    w.columns[0].insert(w.columns[0].begin(), 0.0);
+  }
+  StatusOr<CheckResult> r = check_waveform(w, rules(rule_set), opt);
   EXPECT_TRUE(r.ok()) << r.status().message();
   return *r;
 }
@@ -100,11 +102,22 @@ TEST(Commands, ACommandAtTheRecordsStartGetsACaveat) {
 TEST(Commands, OnAFailingWaveformTheLinkComesFirst) {
   std::vector<uint8_t> b = kStackWrite;
   b[8] = 0x36;
-  // 1.65 V pulses: short of the bridge's 1.8 V VSTART, the bytes still decode.
-  const CheckResult r = check_bytes(b, "bq79600", 1.65);
+  // Every byte decodes, but they are not the bytes expected: the waveform fails.
+  CheckOptions opt;
+  opt.expect = kStackWrite;
+  CheckResult r = check_bytes(b, "bq7961x", 2.0, 20e-6, opt);
   ASSERT_FALSE(r.pass);
   ASSERT_EQ(r.commands.size(), 1u);
-  EXPECT_EQ(commands_note(r).rfind("command 0 has a bad CRC; the waveform does not pass", 0), 0u)
+  EXPECT_EQ(commands_note(r),
+            "command 0 has a bad CRC; the waveform does not pass the receiver rules either: fix "
+            "the link first, then look at the firmware if the command stays malformed");
+  // 1.65 V pulses: short of the bridge's 1.8 V VSTART, no byte decodes (weak bits).
+  r = check_bytes(b, "bq79600", 1.65);
+  ASSERT_FALSE(r.pass);
+  ASSERT_EQ(r.commands.size(), 1u);
+  EXPECT_EQ(r.commands[0].flags, std::vector<FrameFlag>{FrameFlag::kUndecoded});
+  EXPECT_EQ(commands_note(r).rfind("command 0 holds a byte that did not decode; the waveform", 0),
+            0u)
       << commands_note(r);
 }
 
