@@ -271,6 +271,7 @@ class Search {
     eye::CheckOptions co;
     co.expect = std::vector<uint8_t>{pattern_frame(target).byte};
     co.warning_texts = false;  // the search reads numbers only
+    co.commands = false;
     return eye::check_samples(t_, v, rules_, co);
   }
 

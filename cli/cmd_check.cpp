@@ -11,6 +11,7 @@
 #include "eye/check.h"
 #include "eye/rules.h"
 #include "eye/waveform_csv.h"
+#include "netlists/traffic/stimulus.h"
 #include "protocol/frame.h"
 
 namespace isolink::cli {
@@ -27,6 +28,7 @@ struct CheckArgs {
   std::optional<int> sof_value;
   bool msb_first = false;
   bool lsb_first = false;
+  std::string command_idle;
 };
 
 int fail_input(const std::string& message) {
@@ -42,6 +44,12 @@ int run_check(const CheckArgs& a) {
   if (a.sof_value) opt.sof_value = *a.sof_value;
   if (a.msb_first) opt.bit_order = BitOrder::kMsbFirst;
   if (a.lsb_first) opt.bit_order = BitOrder::kLsbFirst;
+  if (!a.command_idle.empty()) {
+    StatusOr<double> t = traffic::parse_time(a.command_idle);
+    if (!t) return fail_input("--command-idle: error: " + t.status().message());
+    if (*t < 0) return fail_input("--command-idle: error: " + a.command_idle + " is negative");
+    opt.command_idle = *t;
+  }
   if (!a.expect.empty()) {
     StatusOr<std::vector<uint8_t>> e = parse_hex_bytes(a.expect);
     if (!e) return fail_input("--expect: error: " + e.status().message());
@@ -98,6 +106,9 @@ void add_check_command(CLI::App& app, int* exit_code) {
   cmd->add_option("--pulses-csv", args->pulses_csv, "write the per-pulse table to this CSV file");
   cmd->add_option("--expect", args->expect,
                   "bytes expected, e.g. \"80 00 02 15 0B CB 49\": fails on a mismatch");
+  cmd->add_option("--command-idle", args->command_idle,
+                  "an idle longer than this between two bytes ends a command frame (default "
+                  "8us; the bytes of one command come 3.8 us apart)");
   cmd->add_flag_function(
       "--sof,!--no-sof", [args](int64_t count) { args->sof = count > 0; },
       "frames carry (or lack) a start-of-frame bit after the sync pair (default: the rules')");

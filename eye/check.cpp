@@ -14,6 +14,7 @@
 #include "base/file_io.h"
 #include "base/hex.h"
 #include "eye/verdict.h"
+#include "eye/commands.h"
 
 namespace isolink::eye {
 namespace {
@@ -152,6 +153,9 @@ StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const d
                                        i, t[i], t[i - 1]));
   }
   if (Status s = validate_rules(rules); !s.ok()) return s;
+  if (!(opt.command_idle >= 0) || !std::isfinite(opt.command_idle))
+    return Status::Error(
+        fmt::format("command idle {:g} s is not a finite time >= 0", opt.command_idle));
 
   CheckResult r;
   r.rules = rules.name;
@@ -355,6 +359,9 @@ StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const d
   r.reasons = verdict.reasons;
   r.pass = verdict.kind == VerdictKind::kPass;
   r.inconclusive = verdict.kind == VerdictKind::kInconclusive;
+  // The commands the bytes carry: reported beside the verdict, never part of it (a malformed
+  // command on a clean waveform is the firmware's, not the link's).
+  if (opt.commands) r.commands = parse_commands(r, opt.command_idle);
   return r;
 }
 
@@ -478,6 +485,10 @@ json to_json(const CheckResult& r) {
     decoded["mismatch"] = r.expect_detail.empty() ? json(nullptr) : json(r.expect_detail);
   }
   j["decoded"] = std::move(decoded);
+  j["commands"] = commands_json(r.commands);
+  j["commands_omitted"] = r.commands.size() - std::min(r.commands.size(), kMaxJsonPulses);
+  const std::string note = commands_note(r);
+  j["commands_note"] = note.empty() ? json(nullptr) : json(note);
   return j;
 }
 
@@ -493,6 +504,7 @@ std::string summary_text(const CheckResult& r, const std::string& source) {
                      r.rules);
   for (const std::string& why : r.reasons) out += "  " + why + "\n";
   for (const std::string& hint : r.hints) out += "  hint: " + hint + "\n";
+  if (const std::string note = commands_note(r); !note.empty()) out += "  " + note + "\n";
   if (!r.worst.empty()) {
     out += "worst margin per metric:\n";
     for (const WorstMargin& w : r.worst) {
@@ -519,6 +531,7 @@ std::string summary_text(const CheckResult& r, const std::string& source) {
       out += r.expect_match ? "  (as expected)"
                             : "  (expected " + to_hex(*r.expect) + ": " + r.expect_detail + ")";
     out += "\n";
+    out += commands_text(r.commands);
   }
   const size_t kMax = 20;
   std::vector<std::string> fails, warns;

@@ -24,6 +24,7 @@
 #include "eye/metrics.h"
 #include "eye/pulses.h"
 #include "eye/rules.h"
+#include "protocol/command_frames.h"
 #include "protocol/frame.h"
 
 namespace isolink::eye {
@@ -38,6 +39,10 @@ struct CheckOptions {
   // for a search that reads only numbers (the worst case: formatting one droop warning per pulse
   // was 8 % of its time). Failures and the verdict are the same either way.
   bool warning_texts = true;
+  // The decoded bytes are parsed as TI's command and response frames (eye/commands.h); an idle
+  // longer than this between two bytes ends a frame (protocol/command_frames.h, rule 1).
+  double command_idle = FrameSplitOptions{}.max_idle_s;
+  bool commands = true;  // false: not parsed (CheckResult::commands empty), for number searches
 };
 
 // One decoded byte (a frame), or a run of pulses that did not decode.
@@ -72,6 +77,7 @@ struct CheckResult {
   bool expect_match = true;                    // decoded bytes == expected (true when none given)
   std::string expect_detail;                   // first difference, in words
   std::vector<WorstMargin> worst;              // per metric, the smallest margin
+  std::vector<ParsedFrame> commands;           // the frames the bytes carry (none for tones)
 
   size_t failing() const;                    // pulses that fail
   std::optional<double> vstart_min() const;  // over all measured pulses (V)
@@ -95,7 +101,7 @@ StatusOr<CheckResult> check_waveform(const Waveform& w, const Rules& rules,
                                      const CheckOptions& opt = {}, size_t column = 0);
 
 // The JSON object, keys in a fixed order (verdict, reasons, rules, ..., summary, pulses, ringing,
-// idle, decoded).
+// idle, decoded, commands, commands_omitted, commands_note).
 // Pulses (and ringing, idle undershoots) listed in detail are capped at kMaxJsonPulses each;
 // "pulses_omitted" counts the pulses left out (write_pulses_csv has every one).
 inline constexpr size_t kMaxJsonPulses = 10'000;

@@ -3,31 +3,15 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <array>
 #include <cctype>
 #include <optional>
 #include <utility>
 
 #include "base/hex.h"
-#include "netlists/traffic/crc.h"
+#include "protocol/crc16.h"
 
 namespace isolink::traffic {
 namespace {
-
-struct KindName {
-  CommandKind kind;
-  std::string_view name;
-};
-constexpr std::array<KindName, 8> kKinds = {{
-    {CommandKind::kSingleRead, "single-read"},
-    {CommandKind::kSingleWrite, "single-write"},
-    {CommandKind::kStackRead, "stack-read"},
-    {CommandKind::kStackWrite, "stack-write"},
-    {CommandKind::kBroadcastRead, "broadcast-read"},
-    {CommandKind::kBroadcastWrite, "broadcast-write"},
-    {CommandKind::kBroadcastWriteReverse, "broadcast-write-reverse"},
-    {CommandKind::kRaw, "raw"},
-}};
 
 std::string lower(std::string_view s) {
   std::string out(s);
@@ -82,49 +66,6 @@ std::vector<std::string_view> split_ws(std::string_view text) {
     i = j;
   }
   return out;
-}
-
-uint8_t init_byte_base(CommandKind kind) {
-  switch (kind) {
-    case CommandKind::kSingleRead:
-      return 0x80;
-    case CommandKind::kSingleWrite:
-      return 0x90;
-    case CommandKind::kStackRead:
-      return 0xA0;
-    case CommandKind::kStackWrite:
-      return 0xB0;
-    case CommandKind::kBroadcastRead:
-      return 0xC0;
-    case CommandKind::kBroadcastWrite:
-      return 0xD0;
-    case CommandKind::kBroadcastWriteReverse:
-      return 0xE0;
-    case CommandKind::kRaw:
-      return 0x00;
-  }
-  return 0x00;
-}
-
-std::string_view command_keyword(CommandKind kind) {
-  for (const KindName& k : kKinds) {
-    if (k.kind == kind) return k.name;
-  }
-  return "raw";
-}
-
-bool is_read(CommandKind kind) {
-  return kind == CommandKind::kSingleRead || kind == CommandKind::kStackRead ||
-         kind == CommandKind::kBroadcastRead;
-}
-
-bool is_write(CommandKind kind) {
-  return kind == CommandKind::kSingleWrite || kind == CommandKind::kStackWrite ||
-         kind == CommandKind::kBroadcastWrite || kind == CommandKind::kBroadcastWriteReverse;
-}
-
-bool has_device(CommandKind kind) {
-  return kind == CommandKind::kSingleRead || kind == CommandKind::kSingleWrite;
 }
 
 StatusOr<std::vector<uint8_t>> parse_hex_bytes(std::string_view text, std::string_view field) {
@@ -196,11 +137,7 @@ StatusOr<Command> parse_command(std::string_view text) {
   if (tokens.empty()) {
     return Status::Error("empty command: expected e.g. 'stack-write reg=0x0100 data=02B778BC'");
   }
-  const std::string kw = lower(tokens[0]);
-  const KindName* found = nullptr;
-  for (const KindName& k : kKinds) {
-    if (k.name == kw) found = &k;
-  }
+  const std::optional<CommandKind> found = command_kind_of(lower(tokens[0]));
   if (!found) {
     return Status::Error(fmt::format(
         "unknown command '{}': expected single-read, single-write, stack-read, stack-write, "
@@ -208,7 +145,7 @@ StatusOr<Command> parse_command(std::string_view text) {
         tokens[0]));
   }
   Command c;
-  c.kind = found->kind;
+  c.kind = *found;
 
   if (c.kind == CommandKind::kRaw) {
     for (size_t i = 1; i < tokens.size(); ++i) {
@@ -225,7 +162,7 @@ StatusOr<Command> parse_command(std::string_view text) {
     return c;
   }
 
-  const std::string_view name = found->name;
+  const std::string_view name = command_keyword(c.kind);
   std::vector<std::string_view> allowed;
   if (has_device(c.kind)) allowed.push_back("dev");
   allowed.push_back("reg");

@@ -23,19 +23,17 @@
 #include <vector>
 
 #include "base/status.h"
+#include "protocol/command_frames.h"
 
 namespace isolink::traffic {
 
-enum class CommandKind {
-  kSingleRead,
-  kSingleWrite,
-  kStackRead,
-  kStackWrite,
-  kBroadcastRead,
-  kBroadcastWrite,
-  kBroadcastWriteReverse,
-  kRaw,
-};
+// The kinds and their init bytes are protocol/command_frames.h's (shared with the parser).
+using isolink::command_keyword;
+using isolink::CommandKind;
+using isolink::has_device;
+using isolink::init_byte_base;
+using isolink::is_read;
+using isolink::is_write;
 
 struct Command {
   CommandKind kind = CommandKind::kRaw;
@@ -45,14 +43,6 @@ struct Command {
   std::vector<uint8_t> data;  // writes: 1-8 bytes; raw: the bytes as given
   bool crc = true;            // raw only: append the CRC
 };
-
-// Init byte base for the kind: 0x80 single read ... 0xE0 broadcast write reverse; 0 for raw.
-uint8_t init_byte_base(CommandKind kind);
-// The text keyword of the kind, e.g. "stack-write".
-std::string_view command_keyword(CommandKind kind);
-bool is_read(CommandKind kind);
-bool is_write(CommandKind kind);
-bool has_device(CommandKind kind);
 
 // Parses and range-checks one command text.
 StatusOr<Command> parse_command(std::string_view text);

@@ -90,6 +90,38 @@ def test_equals_isolink_check_json_on_wave_csv(exe, cli_run):
     same(got, expected, rel=1e-12)
 
 
+def bytes_wave(data, period=10.3e-6, t0=20e-6):
+    """The bytes as frame_wave draws one, a byte every `period` (3.8 us of idle between the 6.5 us
+    frames, as the bridge forwards a command)."""
+    t = np.round(np.arange(0, round((t0 + len(data) * period + 6e-6) * 1e9) + 1)) * 1e-9
+    v = np.zeros_like(t)
+    for i, b in enumerate(data):
+        _, vb, _ = frame_wave(b, t0=t0 + i * period)
+        v[: len(vb)] += vb
+    return t, v
+
+
+def test_commands_are_parsed_from_the_bytes():
+    # TI's worked example: stack write 02 B7 78 BC to 0x0100, CRC 0A 35 (low byte first).
+    t, v = bytes_wave([0xB3, 0x01, 0x00, 0x02, 0xB7, 0x78, 0xBC, 0x0A, 0x35])
+    r = isolink.check(t, v)
+    assert r["pass"] is True
+    assert len(r["commands"]) == 1
+    c = r["commands"][0]
+    assert (c["kind"], c["register"], c["data"], c["crc"]) == ("stack-write", "0x0100", "02 B7 78 BC", "0A35")
+    assert c["crc_ok"] is True and c["flags"] == [] and c["device"] is None
+    assert c["text"] == "stack write 0x0100 = 02 B7 78 BC, CRC 0A35 ok"
+    assert r["commands_note"] is None
+    # The same bytes with the CRC sent high byte first: the waveform still passes, the command
+    # is the firmware's problem.
+    t, v = bytes_wave([0xB3, 0x01, 0x00, 0x02, 0xB7, 0x78, 0xBC, 0x35, 0x0A])
+    r = isolink.check(t, v)
+    assert r["pass"] is True
+    assert r["commands"][0]["flags"] == ["bad_crc"]
+    assert r["commands"][0]["crc_expected"] == "0A35"
+    assert r["commands_note"].startswith("the waveform meets every receiver rule, but command 0 has a bad CRC")
+
+
 def test_bad_samples_raise():
     t, v, _ = frame_wave(0x5A)
     t[2] = t[1]

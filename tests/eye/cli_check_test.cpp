@@ -80,6 +80,42 @@ TEST_F(CliCheck, PassExitsZeroAndJsonHasTheFieldNames) {
   EXPECT_NEAR(j["summary"]["vstart_min"].get<double>(), 2.0, 1e-6);
 }
 
+// End to end: the cap-2m example link simulated by `isolink run` (TI's stack-write example sent
+// down and up), its wave.csv checked by `isolink check`: the command is listed with a valid CRC,
+// and run's report.json carries the same list.
+TEST_F(CliCheck, CommandsOfASimulatedLink) {
+  const std::string bundle = (dir_ / "bundle").string();
+  ASSERT_EQ(run(std::string("run '") + ISOLINK_EXAMPLES_DIR + "/cap_2m.yaml' -o '" + bundle +
+                "' -q --no-worst --no-images"),
+            0)
+      << err_;
+  for (const char* column : {"down v(rxp,rxn)", "up v(rxp,rxn)"}) {
+    ASSERT_EQ(run("check '" + bundle + "/wave.csv' --diff '" + column + "' --json"), 0) << err_;
+    const nlohmann::json j = nlohmann::json::parse(out_);
+    EXPECT_EQ(j["decoded"]["bytes"], "B3 01 00 02 B7 78 BC 0A 35");
+    ASSERT_EQ(j["commands"].size(), 1u) << column;
+    const nlohmann::json& c = j["commands"][0];
+    EXPECT_EQ(c["kind"], "stack-write");
+    EXPECT_EQ(c["register"], "0x0100");
+    EXPECT_EQ(c["data"], "02 B7 78 BC");
+    EXPECT_EQ(c["crc"], "0A35");
+    EXPECT_EQ(c["crc_ok"], true);
+    EXPECT_TRUE(c["flags"].empty());
+    EXPECT_TRUE(j["commands_note"].is_null());
+    // It spans the nine bytes: eight byte periods of 10.3 us plus the last byte's 6.5 us, within
+    // the link's edges.
+    EXPECT_NEAR(c["end_s"].get<double>() - c["start_s"].get<double>(), 8 * 10.3e-6 + 6.5e-6,
+                100e-9);
+  }
+  ASSERT_EQ(run("check '" + bundle + "/wave.csv' --diff 'down v(rxp,rxn)'"), 0) << err_;
+  EXPECT_NE(out_.find("stack write 0x0100 = 02 B7 78 BC, CRC 0A35 ok"), std::string::npos) << out_;
+  const nlohmann::json report = nlohmann::json::parse(slurp(bundle + "/report.json"));
+  EXPECT_EQ(report["directions"][0]["check"]["commands"][0]["text"],
+            "stack write 0x0100 = 02 B7 78 BC, CRC 0A35 ok");
+  EXPECT_EQ(run("check '" + bundle + "/wave.csv' --command-idle=-1u"), 2);
+  EXPECT_NE(err_.find("--command-idle: error:"), std::string::npos) << err_;
+}
+
 TEST_F(CliCheck, TextSummaryAndPulsesCsv) {
   const std::string csv = write_frames("good.csv", {0x15});
   const std::string table = (dir_ / "pulses.csv").string();

@@ -1,11 +1,11 @@
-#include "netlists/traffic/crc.h"
+#include "protocol/crc16.h"
 
 #include <gtest/gtest.h>
 
 #include <string>
 #include <vector>
 
-namespace isolink::traffic {
+namespace isolink {
 namespace {
 
 TEST(Crc16, CheckValueOf123456789) {
@@ -57,4 +57,4 @@ TEST(Crc16, FrameCheckRejectsCorruption) {
 }
 
 }  // namespace
-}  // namespace isolink::traffic
+}  // namespace isolink

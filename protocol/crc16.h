@@ -13,7 +13,7 @@
 #include <span>
 #include <vector>
 
-namespace isolink::traffic {
+namespace isolink {
 
 // CRC of data (initial value 0xFFFF, reflected polynomial 0xA001).
 uint16_t crc16_ibm(std::span<const uint8_t> data);
@@ -22,4 +22,4 @@ void append_crc16(std::vector<uint8_t>& frame);
 // True when frame (payload followed by its CRC, low byte first) checks; needs at least 3 bytes.
 bool crc16_frame_ok(std::span<const uint8_t> frame);
 
-}  // namespace isolink::traffic
+}  // namespace isolink

@@ -1,6 +1,6 @@
-#include "netlists/traffic/crc.h"
+#include "protocol/crc16.h"
 
-namespace isolink::traffic {
+namespace isolink {
 
 uint16_t crc16_ibm(std::span<const uint8_t> data) {
   uint16_t crc = 0xFFFF;
@@ -25,4 +25,4 @@ bool crc16_frame_ok(std::span<const uint8_t> frame) {
   return frame.size() >= 3 && crc16_ibm(frame) == 0;
 }
 
-}  // namespace isolink::traffic
+}  // namespace isolink
