@@ -99,6 +99,32 @@ Phi phi(std::complex<double> x) {
   return f;
 }
 
+// The shortest linear piece with a slope of any source's waveform up to tstop (its fastest
+// edge), 0 when none moves.
+double shortest_edge(const std::vector<const SourceFunction*>& sources, double tstop) {
+  double shortest = 0.0;
+  for (const SourceFunction* f : sources) {
+    const std::vector<Ramp> ramps = f->ramps(tstop);
+    double slope = 0.0, steepest = 0.0;
+    for (size_t j = 0; j < ramps.size(); ++j) {
+      slope += ramps[j].slope;
+      steepest = std::max(steepest, std::fabs(slope));
+      const double end = j + 1 < ramps.size() ? ramps[j + 1].t : tstop;
+      const double piece = end - ramps[j].t;
+      if (std::fabs(slope) > 1e-9 * steepest && piece > 0 && (shortest == 0 || piece < shortest))
+        shortest = piece;
+    }
+  }
+  return shortest;
+}
+
+// The output grid rule's first level: 20 ns or finer on a link's microseconds, but never more
+// than 65,536 rows to start with, so a run of seconds (an RC of 1 s over 7 s: 350 million rows
+// at 20 ns) starts coarse and is refined only as far as the 1 mV rule asks.
+double coarsest_grid_step(double span) {
+  return std::max(20e-9, span / 65536.0);
+}
+
 }  // namespace
 
 StatusOr<LtiResponses> LtiResponses::compute(const Circuit& circuit,
@@ -151,6 +177,9 @@ StatusOr<LtiResponses> LtiResponses::compute(const Circuit& circuit,
   if (opt.method != LtiOptions::Method::March && nk > 0) {
     ReducedModelOptions ro = opt.reduced;
     ro.horizon = opt.horizon;
+    std::vector<const SourceFunction*> functions;
+    for (const Source& src : r.sources_) functions.push_back(src.function);
+    ro.edge_time = opt.edge_time > 0 ? opt.edge_time : shortest_edge(functions, opt.horizon);
     StatusOr<ReducedModel> model = reduce_circuit(circuit, unit, dc_solutions, probes, ro);
     if (model) {
       r.stats_.method = "reduced model";
@@ -704,7 +733,7 @@ Waveform LtiResponses::modal_waveform(const std::vector<SourceInput>& inputs,
         if (ramp.t > grid.tstart && ramp.t < grid.tstop) corners.push_back(ramp.t);
     std::sort(corners.begin(), corners.end());
     dt = span;
-    while (dt > 20e-9) dt *= 0.5;
+    while (dt > coarsest_grid_step(span)) dt *= 0.5;
     while (true) {
       const std::vector<double> u = uniform(dt);
       times.clear();
@@ -846,7 +875,7 @@ Waveform LtiResponses::waveform(const std::vector<SourceInput>& inputs, const Gr
     rows = rows_at(grid.tstart, dt, count);
   } else {
     dt = span;
-    while (dt > 20e-9) dt *= 0.5;
+    while (dt > coarsest_grid_step(span)) dt *= 0.5;
     count = static_cast<long>(std::llround(span / dt)) + 1;
     if (over_budget(dt)) return Waveform{};
     rows = rows_at(grid.tstart, dt, count);

@@ -63,12 +63,17 @@ struct LtiOptions {
   Method method = Method::Auto;
   ReducedModelOptions reduced;  // its horizon is set from `horizon`
   double horizon = 0.0;         // s, longest lag needed (> 0); the simulated span
-  double step_reltol = 1e-5;    // truncation error per unit time, relative to peak |S|
-  double step_abstol = 1e-7;    // same, absolute (V/V for nodes, A/V for branch currents)
-  double settle_tol = 1e-6;     // V/V (A/V): early stop, see above
-  double first_step = 0.0;      // s; 0 = min(1e-12, horizon * 1e-9)
-  double max_step = 0.0;        // s; 0 = horizon / 64
-  long max_steps = 5'000'000;   // accepted + rejected march steps before giving up
+  // s, the fastest edge the inputs will have: the reduced model's check weights its error by that
+  // edge's spectrum (ReducedModelOptions::edge_time). 0: the shortest linear piece of the
+  // circuit's own sources up to the horizon (none when no source moves). Set it when other
+  // inputs, with faster edges, will be applied (SourceInput).
+  double edge_time = 0.0;
+  double step_reltol = 1e-5;   // truncation error per unit time, relative to peak |S|
+  double step_abstol = 1e-7;   // same, absolute (V/V for nodes, A/V for branch currents)
+  double settle_tol = 1e-6;    // V/V (A/V): early stop, see above
+  double first_step = 0.0;     // s; 0 = min(1e-12, horizon * 1e-9)
+  double max_step = 0.0;       // s; 0 = horizon / 64
+  long max_steps = 5'000'000;  // accepted + rejected march steps before giving up
   // s; 0 = no limit. The march gives up (an error) when the responses have not settled by then:
   // `auto` sets a quarter of the run, since a march over the whole run costs more than the
   // transient (one solve per source and step against one per step).
@@ -137,12 +142,13 @@ class LtiResponses {
     double tstop = 0.0;  // > tstart
     double step = 0.0;   // s, the grid; 0 = chosen by the rule below
     // The rule for step = 0: the largest step (tstop - tstart) / 2^m, m >= the one giving 20 ns or
-    // less, at which every grid probe's value at each cell's midpoint is within interp_tol / 2 of
-    // the linear interpolation of its ends. For a quadratic piece the midpoint is where linear
-    // interpolation errs most; for a single kink inside a cell the worst error is at most twice
-    // the midpoint's, so linear interpolation between rows stays within interp_tol. Cells that
-    // hold a source corner are left out of the test, and every corner inside the span is a row
-    // of its own (so the grid is uniform plus the corners, and a probe on a driven node is exact).
+    // less (or span / 65536 on runs longer than 1.3 ms: the grid is sized from the run), at which
+    // every grid probe's value at each cell's midpoint is within interp_tol / 2 of the linear
+    // interpolation of its ends. For a quadratic piece the midpoint is where linear interpolation
+    // errs most; for a single kink inside a cell the worst error is at most twice the midpoint's,
+    // so linear interpolation between rows stays within interp_tol. Cells that hold a source corner
+    // are left out of the test, and every corner inside the span is a row of its own (so the grid
+    // is uniform plus the corners, and a probe on a driven node is exact).
     double interp_tol = 1e-3;       // V for voltage probes (A/1000 for currents: 1 uA)
     std::vector<bool> grid_probes;  // which probes the rule looks at (empty = all)
     long max_rows = 4'000'000;      // the rule stops refining here (a warning says so)

@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <random>
 
 #include "solver/transient.h"
@@ -379,6 +381,71 @@ TEST(Lti, GridRuleMeetsItsToleranceRightAfterACorner) {
       }
     EXPECT_LT(worst, 1.2e-6) << "rows: " << w.time.size();  // 1 uA target, 20 % for the march
   }
+}
+
+// Slow circuits (issue 28): the output grid is sized from the run, not from nanoseconds. Each
+// circuit's response through the reduced model's grid rule, checked against its closed form at
+// every row and between rows (linear interpolation within the 1 mV rule), with a bounded row
+// count. Lag responses to a ramp input rising over tr from t0.
+double lag_edge(double t, double t0, double tr, double tau) {
+  return (lag_ramp(t - t0, tau) - lag_ramp(t - t0 - tr, tau)) / tr;
+}
+double edge(double t, double t0, double tr) {
+  return std::clamp((t - t0) / tr, 0.0, 1.0);
+}
+void expect_grid_matches(const Built& b, double tstop, size_t probe,
+                         const std::function<double(double)>& exact, double tol, long max_rows,
+                         Method method = Method::Reduced) {
+  LtiResponses lti = responses(b, tstop, method);
+  LtiResponses::GridOptions grid;
+  grid.tstop = tstop;
+  LtiResponses::GridInfo info;
+  const Waveform w = lti.waveform(lti.netlist_inputs(tstop), grid, &info);
+  EXPECT_EQ(info.warning, "");
+  EXPECT_LE(static_cast<long>(w.time.size()), max_rows);
+  double at_rows = 0, between = 0;
+  for (size_t i = 0; i < w.time.size(); ++i) {
+    at_rows = std::max(at_rows, std::fabs(w.columns[probe][i] - exact(w.time[i])));
+    if (i + 1 == w.time.size()) continue;
+    const double t = 0.5 * (w.time[i] + w.time[i + 1]);
+    between = std::max(between,
+                       std::fabs(0.5 * (w.columns[probe][i] + w.columns[probe][i + 1]) - exact(t)));
+  }
+  EXPECT_LT(at_rows, tol) << w.time.size() << " rows";
+  EXPECT_LT(between, 1e-3) << w.time.size() << " rows";  // the grid rule's 1 mV
+}
+
+TEST(LtiSlowCircuits, RcWithOneSecondTimeConstantOverSevenSeconds) {
+  // ngspice's tests/general/rc.cir: 1 ohm, 1 F, PULSE(0 1) (rise = TSTEP = 0.1 s), .tran 0.1 7.
+  // At 20 ns a row this was 350 million rows (21 GB); sized from the run it is 65,537.
+  auto b = make({card("v1", {"1", "0"}, {call("pwl", {0, 0, 0.1, 1})}),
+                 card("r1", {"1", "2"}, {num(1)}), card("c1", {"2", "0"}, {num(1)})},
+                {"v(2)"});
+  expect_grid_matches(
+      *b, 7, 0, [](double t) { return lag_edge(t, 0, 0.1, 1.0); }, 1e-6, 70'000);
+}
+
+TEST(LtiSlowCircuits, RlWithTenMillisecondTimeConstant) {
+  // 10 mH into 1 ohm: the resistor's voltage follows a 1 us edge with tau = 10 ms.
+  auto b = make({card("v1", {"in", "0"}, {call("pwl", {0, 0, 1e-3, 0, 1.001e-3, 1})}),
+                 card("l1", {"in", "x"}, {num(10e-3)}), card("r1", {"x", "0"}, {num(1)})},
+                {"v(x)"});
+  // Auto: the reduced model refuses this circuit (its projection is singular at the mid-band
+  // shift), and the march gives the responses, within its step_reltol (1e-5 of the step per unit
+  // time, 1.5e-5 measured); the grid is the same rule either way.
+  expect_grid_matches(
+      *b, 60e-3, 0, [](double t) { return lag_edge(t, 1e-3, 1e-6, 10e-3); }, 5e-5, 300'000,
+      Method::Auto);
+}
+
+TEST(LtiSlowCircuits, CouplingCapWithTenMegohmBleederIdlingFourMilliseconds) {
+  // 2.2 nF into 10 Mohm (tau 22 ms): a 10 ns edge passes and then droops over 4 ms of idle.
+  auto b = make({card("v1", {"in", "0"}, {call("pwl", {0, 0, 1e-6, 0, 1.01e-6, 1})}),
+                 card("c1", {"in", "x"}, {num(2.2e-9)}), card("r1", {"x", "0"}, {num(10e6)})},
+                {"v(x)"});
+  expect_grid_matches(
+      *b, 4e-3, 0, [](double t) { return edge(t, 1e-6, 10e-9) - lag_edge(t, 1e-6, 10e-9, 22e-3); },
+      1e-6, 70'000);
 }
 
 TEST(Lti, OptionsAreValidatedByName) {
