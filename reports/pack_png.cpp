@@ -101,7 +101,8 @@ PackLayout pack_layout(const PackDiagram& d, const Canvas& c) {
   // The gap between boxes holds the widest label and its frame with room on both sides.
   const int pitch_x = kBoxW + std::max(64, widest + 2 * (kFrame + kClear));
   // Between rows: the labels below one row's line, a turn's stack, the labels above the next's.
-  const int pitch_y = std::max(200, reach_down + reach_up + stack + 2 * (kFrame + kClear));
+  const int down = std::max(reach_down, kBoxH / 2), up = std::max(reach_up, kBoxH / 2);
+  const int pitch_y = std::max(200, down + up + stack + 2 * (kFrame + 2 * kClear));
   for (int k = 0; k < nodes; ++k) {
     const int r = k / per_row, col = r % 2 == 0 ? k % per_row : per_row - 1 - k % per_row;
     const int x = kLeft + col * pitch_x, y = kTop + r * pitch_y;
@@ -132,8 +133,8 @@ PackLayout pack_layout(const PackDiagram& d, const Canvas& c) {
         across = true;
         x = (a.x0 + a.x1) / 2.0;
         // Centred in the band free of both rows' horizontal labels.
-        const int band0 = std::min(a.y0, b.y0) + kBoxH / 2 + reach_down;
-        const int band1 = std::max(a.y0, b.y0) + kBoxH / 2 - reach_up;
+        const int band0 = std::min(a.y0, b.y0) + kBoxH / 2 + down + kFrame + 2 * kClear;
+        const int band1 = std::max(a.y0, b.y0) + kBoxH / 2 - up - kFrame - 2 * kClear;
         y = (band0 + band1) / 2.0 - stack / 2.0;
       }
     } else {

@@ -72,6 +72,7 @@ void shade_frames(Canvas& c, const PlotArea& a, const eye::CheckResult& r, bool 
     const eye::FrameResult& f = r.frames[i];
     if (f.last_pulse >= r.pulses.size()) continue;
     const double t0 = f.start, t1 = r.pulses[f.last_pulse].b;
+    if (t1 < a.x.lo || t0 > a.x.hi) continue;  // outside the plot (a zoom inset)
     const Color fill = f.fails() ? kFrameFailing
                        : tone    ? kFrameTone
                        : f.byte  ? kFrameDecoded
@@ -179,8 +180,8 @@ std::vector<std::string> wrap(const Canvas& c, const std::vector<std::string>& w
   return lines;
 }
 
-// The marked pulse: orange in the plot inside a dashed box, and magnified in the zoom inset below
-// (joined to the box by two lines), with its label above the inset.
+// The marked pulse: orange in the plot inside a dashed orange box, and magnified in the zoom inset
+// below (framed in the same orange), with its label above the inset.
 void draw_marked(Canvas& c, const WavePanelLayout& L, const WavePanel& p, const AxisTicks& yt) {
   const PlotArea& a = L.diff;
   const PlotArea& z = *L.zoom;
@@ -197,9 +198,6 @@ void draw_marked(Canvas& c, const WavePanelLayout& L, const WavePanel& p, const 
   c.line(box.x0, box.y1, box.x1, box.y1, dashed);
   c.line(box.x0, box.y0, box.x0, box.y1, dashed);
   c.line(box.x1, box.y0, box.x1, box.y1, dashed);
-  const LineStyle join{.color = kMark.with_alpha(0.6f), .width = 1.5};
-  c.line(box.x0, box.y1, z.rect.x0, L.zoom_label.y0, join);
-  c.line(box.x1, box.y1, z.rect.x1, L.zoom_label.y0, join);
 
   const UnitScale tu = si_scale(std::max(std::abs(z.x.lo), std::abs(z.x.hi)), "s");
   const AxisTicks zt = make_ticks(z.x, tu, 10);

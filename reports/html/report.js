@@ -1,6 +1,6 @@
 // isolink report.html: draws a run, a sweep or a pack from the JSON block #isolink-data with
 // dygraphs (inlined beside this script). Nothing is fetched: the page opens offline. When every
-// plot has drawn, <body data-ready="1">.
+// plot has drawn, the body gets data-ready="1".
 (function () {
   'use strict';
   const data = JSON.parse(document.getElementById('isolink-data').textContent);
