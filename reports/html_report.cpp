@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 
 #include "reports/sweep_report.h"
 
@@ -135,12 +136,14 @@ std::string base64_of(const std::vector<T>& v) {
   return base64({reinterpret_cast<const uint8_t*>(v.data()), v.size() * sizeof(T)});
 }
 
-// Whether t[i] = t[0] + i dt within 1e-6 of dt for every sample.
+// Whether t[i] = t[0] + i dt within 1e-6 of dt for every sample but the last, which may lie off
+// the grid (a record ends where the simulation stopped; its time is sent as t_last).
 bool uniform_grid(std::span<const double> t, double* dt) {
-  if (t.size() < 2) return false;
-  *dt = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
-  if (!(*dt > 0)) return false;
-  for (size_t i = 0; i < t.size(); ++i)
+  if (t.size() < 3) return false;
+  const size_t n = t.size() - 1;  // the samples on the grid
+  *dt = (t[n - 1] - t.front()) / static_cast<double>(n - 1);
+  if (!(*dt > 0) || !(t[n] > t[n - 1])) return false;
+  for (size_t i = 0; i < n; ++i)
     if (std::abs(t[i] - (t.front() + static_cast<double>(i) * *dt)) > 1e-6 * *dt) return false;
   return true;
 }
@@ -149,6 +152,7 @@ bool uniform_grid(std::span<const double> t, double* dt) {
 
 ordered_json wave_json(const HtmlWave& w, size_t max_samples) {
   const size_t n = std::min(w.time.size(), w.values.size());
+  if (n == 0) return {{"direction", w.direction}, {"samples", 0}, {"kept", 0}};
   const std::span<const double> t = w.time.first(n), v = w.values.first(n);
   const std::vector<size_t> keep = minmax_keep(v, max_samples);
   std::vector<float> vf(keep.size());
@@ -160,9 +164,14 @@ ordered_json wave_json(const HtmlWave& w, size_t max_samples) {
   if (keep.size() == n && uniform_grid(t, &dt)) {
     j["t0"] = t.front();
     j["dt"] = dt;
+    j["t_last"] = t.back();
   } else {
-    std::vector<double> tk(keep.size());
-    for (size_t k = 0; k < keep.size(); ++k) tk[k] = t[keep[k]];
+    // Times as Float32 offsets from the first: 6 ps resolution over 100 us, half the bytes of
+    // Float64.
+    const double t0 = t[keep.front()];
+    std::vector<float> tk(keep.size());
+    for (size_t k = 0; k < keep.size(); ++k) tk[k] = static_cast<float>(t[keep[k]] - t0);
+    j["t0"] = t0;
     j["t"] = base64_of(tk);
   }
   j["v"] = base64_of(vf);
@@ -173,13 +182,28 @@ std::string run_report_html(const ordered_json& report, const ordered_json& extr
                             const std::vector<HtmlWave>& waves, const std::string& eye_png) {
   ordered_json data{{"report", report}, {"extra", extra}};
   ordered_json wj = ordered_json::array();
+  // A wave equal to an earlier one (both directions of a symmetric link) is embedded once.
+  auto same = [&](size_t i) -> std::optional<size_t> {
+    for (size_t k = 0; k < i; ++k)
+      if (std::ranges::equal(waves[k].time, waves[i].time) &&
+          std::ranges::equal(waves[k].values, waves[i].values))
+        return k;
+    return std::nullopt;
+  };
+  size_t distinct = 0;
+  for (size_t i = 0; i < waves.size(); ++i) distinct += same(i) ? 0 : 1;
   // The byte budget shared by the waves; a non-uniform record also pays for its times.
-  const size_t share = kHtmlWaveBytes / std::max<size_t>(waves.size(), 1);
-  for (const HtmlWave& w : waves) {
+  const size_t share = kHtmlWaveBytes / std::max<size_t>(distinct, 1);
+  for (size_t i = 0; i < waves.size(); ++i) {
+    const HtmlWave& w = waves[i];
+    if (const std::optional<size_t> k = same(i)) {
+      wj.push_back({{"direction", w.direction}, {"same_as", *k}});
+      continue;
+    }
     double dt = 0;
     const size_t whole = share * 3 / 16;  // samples a uniform grid may keep whole
     const bool fits = w.time.size() <= whole && uniform_grid(w.time, &dt);
-    wj.push_back(wave_json(w, fits ? whole : share * 3 / 48));
+    wj.push_back(wave_json(w, fits ? whole : share * 3 / 32));
   }
   data["waves"] = std::move(wj);
   data["eye"] = png_data_uri(eye_png);

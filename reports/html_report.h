@@ -47,11 +47,17 @@ struct HtmlWave {
   std::span<const double> time;    // s (not owned)
   std::span<const double> values;  // V (not owned)
 };
-// The base64 bytes a page spends on its waves at most (all directions together): with the rest
-// (the library ~130 kB, report.json, the eye image ~1 MB) a page stays under 8 MB. A uniform grid
-// costs 16/3 bytes a sample (Float32), another 32/3 for Float64 times otherwise; a longer record
-// is reduced by min/max buckets (every excursion kept) and the page says so.
-inline constexpr size_t kHtmlWaveBytes = 5'000'000;
+// The base64 bytes a page spends on its waves at most (all distinct directions together): with the
+// rest (the library ~130 kB, report.json ~150 kB, the eye image ~1 MB) a page stays under 8 MB. A
+// uniform grid costs 16/3 bytes a sample (Float32 values), another 16/3 for Float32 time offsets
+// otherwise; a longer record is reduced by min/max buckets (every excursion kept) and the page
+// says so.
+inline constexpr size_t kHtmlWaveBytes = 6'000'000;
+// A wave as JSON: {direction, samples, kept, t0, and dt, t_last (a uniform grid: times t0 + i dt
+// within 1e-6 of dt, the last sample at t_last) or t (base64 Float32 offsets from t0), v (base64
+// Float32)}. At most max_samples are kept: a longer record is cut into max_samples / 2 buckets and
+// each keeps its lowest and highest sample (in time order). Non-finite values are written as NaN
+// (drawn as gaps).
 nlohmann::ordered_json wave_json(const HtmlWave& w, size_t max_samples);
 // The sample indices a record of n samples keeps at most max_samples of (all when n fits): per
 // bucket the index of the lowest and of the highest value, in time order.
@@ -59,7 +65,8 @@ std::vector<size_t> minmax_keep(std::span<const double> v, size_t max_samples);
 
 // --- pages ---
 
-// A run: report is report.json's object (run_report_json, with "worst_case" when computed),
+// A run (a wave equal to an earlier one is embedded once: {direction, same_as: its index}):
+// report is report.json's object (run_report_json, with "worst_case" when computed),
 // extra: {"bom": {"tx", "rx"}, "cable": text}; waves per direction; eye_png the eye.png file's
 // bytes ("" when not drawn).
 std::string run_report_html(const nlohmann::ordered_json& report,

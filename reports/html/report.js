@@ -92,8 +92,8 @@
     const v = decode(wave.v, Float32Array);
     const n = v.length;
     let t;
-    if (wave.t) t = decode(wave.t, Float64Array);
-    else { t = new Float64Array(n); for (let i = 0; i < n; ++i) t[i] = wave.t0 + i * wave.dt; }
+    if (wave.t) { const off = decode(wave.t, Float32Array); t = new Float64Array(n); for (let i = 0; i < n; ++i) t[i] = wave.t0 + off[i]; }
+    else { t = new Float64Array(n); for (let i = 0; i < n; ++i) t[i] = wave.t0 + i * wave.dt; t[n - 1] = wave.t_last; }
     const pulses = (check && check.pulses) || [];
     const frames = (check && check.decoded && check.decoded.frames) || [];
     const failing = pulses.filter(p => p.fails && p.fails.length);
@@ -274,8 +274,10 @@
         why.append(el('p', {text: 'Worst case, ' + d.direction + ':'}), el('ul', {cls: 'reasons'}, d.reasons.slice(0, 10).map(t => el('li', {text: t}))));
 
     const waves = section('Received waveforms', 'waves');
-    (data.waves || []).forEach((w, i) => {
+    (data.waves || []).forEach((w0, i) => {
       const d = r.directions[i] || {};
+      // Both directions of a symmetric link: the samples are embedded once.
+      const w = w0.same_as != null ? Object.assign({}, data.waves[w0.same_as], {direction: w0.direction}) : w0;
       const box = el('div', {cls: 'wavebox'});
       box.append(el('h3', {}, [w.direction + ' ', verdictBadge(d.verdict)]));
       if (w.kept < w.samples)

@@ -45,6 +45,12 @@ std::vector<T> decode(const std::string& b64) {
   return v;
 }
 
+// The JSON data block of a page.
+nlohmann::json page_data(const std::string& page) {
+  const size_t a = page.find("id=\"isolink-data\">") + 18, b = page.find("</script>", a);
+  return nlohmann::json::parse(page.substr(a, b - a));
+}
+
 TEST(HtmlReport, Base64MatchesRfc4648) {
   // The test vectors of RFC 4648 section 10.
   const std::vector<std::pair<std::string, std::string>> cases = {{"", ""},
@@ -106,13 +112,28 @@ TEST(HtmlReport, WaveJsonRoundTrips) {
   std::vector<float> vf = decode<float>(j["v"].get<std::string>());
   ASSERT_EQ(vf.size(), 1000u);
   for (size_t i = 0; i < v.size(); ++i) ASSERT_NEAR(vf[i], v[i], 1e-6);
-  // Not uniform: the times as Float64.
+  EXPECT_NEAR(j["t_last"].get<double>(), t.back(), 1e-18);
+  // A record that stops between grid points is still a grid, with its last time given.
+  std::vector<double> cut = t;
+  cut.back() = cut[998] + 0.4e-9;
+  j = wave_json({"down", cut, v}, 10'000);
+  ASSERT_TRUE(j.contains("dt"));
+  EXPECT_EQ(j["t_last"].get<double>(), cut.back());
+  // Both directions of a symmetric link: the samples once, the second refers to the first.
+  const nlohmann::json data = page_data(
+      run_report_html({{"name", "x"}}, ordered_json::object(), {{"down", t, v}, {"up", t, v}}, ""));
+  ASSERT_EQ(data["waves"].size(), 2u);
+  EXPECT_TRUE(data["waves"][0].contains("v"));
+  EXPECT_EQ(data["waves"][1]["same_as"], 0);
+  EXPECT_EQ(data["waves"][1]["direction"], "up");
+  // Not uniform: the times as Float32 offsets from t0.
   t[500] += 0.3e-9;
   j = wave_json({"down", t, v}, 10'000);
   EXPECT_FALSE(j.contains("dt"));
-  const std::vector<double> tt = decode<double>(j["t"].get<std::string>());
+  const std::vector<float> tt = decode<float>(j["t"].get<std::string>());
   ASSERT_EQ(tt.size(), 1000u);
-  EXPECT_EQ(tt[500], t[500]);
+  for (size_t i = 0; i < t.size(); ++i)  // within 1 ps here
+    ASSERT_NEAR(j["t0"].get<double>() + tt[i], t[i], 1e-12) << i;
   // Reduced: at most the budget, the extremes kept.
   j = wave_json({"down", t, v}, 100);
   EXPECT_LE(j["kept"].get<size_t>(), 100u);
@@ -136,9 +157,7 @@ TEST(HtmlReport, PageIsSelfContained) {
                        std::regex::icase);
   EXPECT_FALSE(std::regex_search(page, net));
   // One data block; what it holds parses back to what went in.
-  const size_t a = page.find("id=\"isolink-data\">") + 18, b = page.find("</script>", a);
-  const nlohmann::json data = nlohmann::json::parse(page.substr(a, b - a));
-  EXPECT_EQ(data["report"]["name"], "t</b>");
+  EXPECT_EQ(page_data(page)["report"]["name"], "t</b>");
 }
 
 }  // namespace
