@@ -3,7 +3,8 @@
 
   html_browser_test.py CHROMIUM OIIOTOOL OUT_DIR [--max-mb 8] [--screenshot FILE] -- ISOLINK ARGS...
 
-Runs `ISOLINK ARGS... -o OUT_DIR` (run, sweep or pack), then checks OUT_DIR/report.html:
+Runs `ISOLINK ARGS... -o OUT_DIR` (run, sweep or pack; OUT_DIR is removed first), then checks
+OUT_DIR/report.html (the screenshot goes to OUT_DIR_screenshot.png unless --screenshot says):
 - the file names no network address of any kind and is under --max-mb megabytes;
 - chromium (no network: --disable-background-networking and friends, and the page has nothing to
   fetch) loads it, and within the virtual-time budget the script sets data-ready="1" on <body>;
@@ -17,6 +18,7 @@ import csv
 import json
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -80,6 +82,7 @@ def main():
     max_mb = float(opts[opts.index("--max-mb") + 1]) if "--max-mb" in opts else 8.0
     shot = opts[opts.index("--screenshot") + 1] if "--screenshot" in opts else None
 
+    shutil.rmtree(out, ignore_errors=True)  # the test's own folder: a fresh report each run
     p = subprocess.run(cmd + ["-o", out, "-q"], capture_output=True, text=True, timeout=600)
     if p.returncode not in (0, 1):
         fail("%s exited %d: %s" % (" ".join(cmd), p.returncode, p.stderr[-2000:]))
@@ -122,7 +125,7 @@ def main():
     if plots and canvases < 2 * plots:  # dygraph draws each plot on two canvases
         fail("%d canvases for %d plots" % (canvases, plots))
 
-    shot = shot or os.path.join(out, "screenshot.png")
+    shot = shot or out + "_screenshot.png"
     with tempfile.TemporaryDirectory() as profile:
         chromium(browser, ["--virtual-time-budget=30000", "--window-size=1400,1800",
                            "--screenshot=" + os.path.abspath(shot), url], profile)
