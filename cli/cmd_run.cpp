@@ -1,5 +1,5 @@
 // isolink run: a link spec simulated with its traffic, each receiver scored, and the report
-// bundle (eye.png, wave.png, report.json, report.md, wave.csv) written to a folder.
+// bundle (eye.png, wave.png, report.json, report.md, report.html, wave.csv) written to a folder.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -45,7 +45,8 @@ constexpr double kLongTrafficSeconds = 20e-3;
 // What a report folder holds: the bundle's files and the worst-case images
 // (worst_<direction>_<metric>.png, reports/worst_png.h).
 const std::vector<std::string> kBundleFiles = [] {
-  std::vector<std::string> names = {"eye.png", "wave.png", "report.json", "report.md", "wave.csv"};
+  std::vector<std::string> names = {"eye.png",   "wave.png", "report.json",
+                                    "report.md", "wave.csv", "report.html"};
   for (const char* d : {"down", "up"})
     for (const char* m : {"vstart", "vend", "width_min", "width_max", "edge"})
       names.push_back(fmt::format("worst_{}_{}.png", d, m));
@@ -136,6 +137,16 @@ int run_run(const RunArgs& a) {
   if (Status s = write_file_atomic(bundle->path("report.json"), json.dump(2) + "\n"); !s.ok())
     return fail(s);
   if (Status s = write_file_atomic(bundle->path("report.md"), md); !s.ok()) return fail(s);
+  std::string eye_png;
+  if (std::find(images.begin(), images.end(), "eye.png") != images.end()) {
+    StatusOr<std::string> png = read_input_file(bundle->path("eye.png"));
+    if (!png) return fail(png.status());
+    eye_png = std::move(*png);
+  }
+  if (Status s = write_file_atomic(bundle->path("report.html"),
+                                   run_report_page(*spec, *run, json, eye_png));
+      !s.ok())
+    return fail(s);
   if (Status s = bundle->commit(); !s.ok()) return fail(s);
   std::vector<std::string> warned;  // both directions share most warnings: print each once
   for (const DirectionRun& d : run->directions)
@@ -159,7 +170,7 @@ void add_run_command(CLI::App& app, int* exit_code) {
   CLI::App* cmd = app.add_subcommand(
       "run",
       "Simulate a link spec with its traffic, score each receiver and write the report "
-      "(eye.png, wave.png, report.json, report.md, wave.csv)");
+      "(eye.png, wave.png, report.json, report.md, report.html, wave.csv)");
   cmd->add_option("spec", args->spec, "Link spec (YAML), e.g. netlists/examples/xfmr_12m.yaml")
       ->required();
   cmd->add_option("-o,--output", args->out_dir, "Report folder (default reports/out/<name>)");

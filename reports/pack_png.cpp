@@ -10,10 +10,12 @@ namespace isolink::reports {
 namespace {
 
 constexpr int kBoxW = 132, kBoxH = 64;  // device boxes
-constexpr int kPitchX = 196, kPitchY = 200;
 constexpr int kLeft = 150, kTop = 150;  // first box's top-left corner
 constexpr int kHopWidth = 9;
-constexpr double kGreenAt = 0.12;  // relative margin drawn fully green (the width cap)
+constexpr int kLabelPad = 2;   // text to the edge of its backing box
+constexpr int kLineClear = 7;  // a label's distance from the hop line's centre
+constexpr int kFrame = 4;      // the weakest hop's frame, outside its label
+constexpr int kClear = 10;     // free space between a label (with frame) and anything else
 
 Color mix(Color a, Color b, double t) {
   t = std::clamp(t, 0.0, 1.0);
@@ -25,7 +27,134 @@ std::string length_text(double m) {
   return m < 0.1 ? fmt::format("{:g} cm", std::round(m * 1000) / 10) : fmt::format("{:g} m", m);
 }
 
+// A hop label's lines: number, length, isolation, margin.
+struct LabelLine {
+  std::string text;
+  int size = 15;
+  FontFace face = FontFace::kSans;
+  Color color = kInk;
+};
+std::vector<LabelLine> label_lines(const PackDiagram& d, const PackDiagram::Hop& h) {
+  const bool weak = h.index == d.weakest;
+  const std::string m = !h.pass                   ? "FAIL"
+                        : std::isfinite(h.margin) ? fmt::format("{:+.1f} %", h.margin * 100)
+                                                  : "-";
+  return {{fmt::format("hop {}", h.index), 16, weak ? FontFace::kBold : FontFace::kSans,
+           weak ? kFail : kInk},
+          {length_text(h.length), 15, FontFace::kSans, kInk},
+          {h.isolation, 15, FontFace::kSans, kMuted},
+          {m, 15, h.pass ? FontFace::kSans : FontFace::kBold, h.pass ? kInk : kFail}};
+}
+
+// Backing-box sizes of a label's lines.
+std::vector<std::pair<int, int>> line_sizes(const Canvas& c, const std::vector<LabelLine>& ls) {
+  std::vector<std::pair<int, int>> out;
+  for (const LabelLine& l : ls) {
+    const Canvas::TextExtent e = c.measure(l.text, l.size, l.face);
+    out.emplace_back(e.width + 2 * kLabelPad, e.ascent + e.descent + 2 * kLabelPad);
+  }
+  return out;
+}
+
+// Lines stacked downwards from top, centred on x.
+std::vector<Rect> stack_lines(const std::vector<std::pair<int, int>>& sz, double x, int top,
+                              size_t from, size_t to) {
+  std::vector<Rect> r;
+  for (size_t i = from; i < to; ++i) {
+    const int x0 = static_cast<int>(std::lround(x - sz[i].first / 2.0));
+    r.push_back({x0, top, x0 + sz[i].first, top + sz[i].second});
+    top += sz[i].second;
+  }
+  return r;
+}
+
+Rect bounds_of(const std::vector<Rect>& rs) {
+  Rect b = rs.front();
+  for (const Rect& r : rs)
+    b = {std::min(b.x0, r.x0), std::min(b.y0, r.y0), std::max(b.x1, r.x1), std::max(b.y1, r.y1)};
+  return b;
+}
+
 }  // namespace
+
+PackLayout pack_layout(const PackDiagram& d, const Canvas& c) {
+  PackLayout L;
+  const int nodes = d.devices + 1;
+  const int rows = (nodes + 8) / 9;  // at most 9 boxes a row, rows filled evenly
+  const int per_row = (nodes + rows - 1) / rows;
+  // Extents of the labels: widest line; above a horizontal line ("hop N") and below it (the rest);
+  // a vertical hop's whole stack.
+  int widest = 0, above = 0, below = 0, stack = 0;
+  for (const PackDiagram::Hop& h : d.hops) {
+    const auto sz = line_sizes(c, label_lines(d, h));
+    int b = 0, s = 0;
+    for (size_t i = 0; i < sz.size(); ++i) {
+      widest = std::max(widest, sz[i].first);
+      s += sz[i].second;
+      if (i > 0) b += sz[i].second;
+    }
+    above = std::max(above, sz[0].second);
+    below = std::max(below, b);
+    stack = std::max(stack, s);
+  }
+  const int reach_up = kLineClear + above + kFrame, reach_down = kLineClear + below + kFrame;
+  // The gap between boxes holds the widest label and its frame with room on both sides.
+  const int pitch_x = kBoxW + std::max(64, widest + 2 * (kFrame + kClear));
+  // Between rows: the labels below one row's line, a turn's stack, the labels above the next's.
+  const int down = std::max(reach_down, kBoxH / 2), up = std::max(reach_up, kBoxH / 2);
+  const int pitch_y = std::max(200, down + up + stack + 2 * (kFrame + 2 * kClear));
+  for (int k = 0; k < nodes; ++k) {
+    const int r = k / per_row, col = r % 2 == 0 ? k % per_row : per_row - 1 - k % per_row;
+    const int x = kLeft + col * pitch_x, y = kTop + r * pitch_y;
+    L.boxes.push_back({x, y, x + kBoxW, y + kBoxH});
+  }
+  const int last_line = kTop + (rows - 1) * pitch_y + kBoxH / 2;
+  L.ring_y = last_line + std::max(kBoxH / 2 + 40, reach_down + reach_up + kClear);
+  L.ring_x = kLeft - 80;
+  L.width = std::max(1400, kLeft + (per_row - 1) * pitch_x + kBoxW + 150);
+  const int bottom = static_cast<int>(d.ring ? L.ring_y + reach_down : last_line + reach_down);
+  L.legend_y = bottom + 60;
+  L.height = L.legend_y + 60;
+
+  for (const PackDiagram::Hop& h : d.hops) {
+    const auto sz = line_sizes(c, label_lines(d, h));
+    double x = 0, y = 0;
+    bool across = false;  // a vertical line: the whole stack centred between the rows
+    if (h.ring_return) {
+      if (!d.ring) continue;
+      const Rect& top = L.boxes[static_cast<size_t>(d.devices)];
+      x = ((top.x0 + top.x1) / 2.0 + L.ring_x) / 2, y = L.ring_y;
+    } else if (h.index >= 1 && h.index <= d.devices) {
+      const Rect a = L.boxes[static_cast<size_t>(h.index - 1)];
+      const Rect b = L.boxes[static_cast<size_t>(h.index)];
+      if (a.y0 == b.y0) {
+        x = (std::min(a.x1, b.x1) + std::max(a.x0, b.x0)) / 2.0, y = (a.y0 + a.y1) / 2.0;
+      } else {
+        across = true;
+        x = (a.x0 + a.x1) / 2.0;
+        // Centred in the band free of both rows' horizontal labels.
+        const int band0 = std::min(a.y0, b.y0) + kBoxH / 2 + down + kFrame + 2 * kClear;
+        const int band1 = std::max(a.y0, b.y0) + kBoxH / 2 - up - kFrame - 2 * kClear;
+        y = (band0 + band1) / 2.0 - stack / 2.0;
+      }
+    } else {
+      continue;
+    }
+    PackLayout::Label lab{.hop = h.index};
+    if (across) {
+      lab.lines = stack_lines(sz, x, static_cast<int>(std::lround(y)), 0, sz.size());
+    } else {
+      lab.lines =
+          stack_lines(sz, x, static_cast<int>(std::lround(y)) - kLineClear - sz[0].second, 0, 1);
+      for (const Rect& r :
+           stack_lines(sz, x, static_cast<int>(std::lround(y)) + kLineClear, 1, sz.size()))
+        lab.lines.push_back(r);
+    }
+    lab.bounds = bounds_of(lab.lines);
+    L.labels.push_back(std::move(lab));
+  }
+  return L;
+}
 
 Color margin_color(bool pass, double margin) {
   if (!pass) return kFail;
@@ -36,27 +165,18 @@ Color margin_color(bool pass, double margin) {
 }
 
 Status draw_pack_png(const PackDiagram& d, const std::string& path) {
-  const int nodes = d.devices + 1;
-  const int rows = (nodes + 8) / 9;  // at most 9 boxes a row, rows filled evenly
-  const int per_row = (nodes + rows - 1) / rows;
-  const int width = std::max(1400, kLeft + (per_row - 1) * kPitchX + kBoxW + 150);
-  const int height = kTop + (rows - 1) * kPitchY + kBoxH + (d.ring ? 170 : 90) + 110;
-  StatusOr<Canvas> cs = Canvas::create(width, height);
+  StatusOr<Canvas> measure = Canvas::create(1, 1);
+  if (!measure) return measure.status();
+  const PackLayout L = pack_layout(d, *measure);
+  StatusOr<Canvas> cs = Canvas::create(L.width, L.height);
   if (!cs) return cs.status();
   Canvas& c = *cs;
-
-  // Node k's box (snake order: odd rows run right to left).
-  auto box = [&](int k) {
-    const int r = k / per_row, col = r % 2 == 0 ? k % per_row : per_row - 1 - k % per_row;
-    const int x = kLeft + col * kPitchX, y = kTop + r * kPitchY;
-    return Rect{x, y, x + kBoxW, y + kBoxH};
-  };
   const PackDiagram::Hop* weakest = nullptr;
   for (const PackDiagram::Hop& h : d.hops)
     if (h.index == d.weakest) weakest = &h;
 
   c.text(40, 50, d.title, 30, kInk, FontFace::kBold, HAlign::kLeft, VAlign::kCenter);
-  c.text(width - 40, 50, d.verdict, 30, d.verdict == "PASS" ? kPass : kFail, FontFace::kBold,
+  c.text(L.width - 40, 50, d.verdict, 30, d.verdict == "PASS" ? kPass : kFail, FontFace::kBold,
          HAlign::kRight, VAlign::kCenter);
   if (weakest)
     c.text(40, 95,
@@ -68,72 +188,50 @@ Status draw_pack_png(const PackDiagram& d, const std::string& path) {
                            : std::string("-")),
            20, kMuted, FontFace::kSans, HAlign::kLeft, VAlign::kCenter);
 
-  // A hop's label: its number above the line, length and isolation below (beside a vertical
-  // line: all three centred on it); the weakest hop's framed in red.
-  auto label = [&](const PackDiagram::Hop& h, double x, double y, bool across) {
-    const bool weak = h.index == d.weakest;
-    const Color bg = kWhite.with_alpha(0.92f);
-    const double gap = across ? 0 : 9, up = across ? 28 : 0;
-    Rect a = draw_label(c, x, y - gap - up, fmt::format("hop {}", h.index), 16, weak ? kFail : kInk,
-                        HAlign::kCenter, VAlign::kBottom, bg, 2,
-                        weak ? FontFace::kBold : FontFace::kSans);
-    Rect b = draw_label(c, x, y + gap - up, length_text(h.length), 15, kInk, HAlign::kCenter,
-                        VAlign::kTop, bg, 2);
-    Rect e = draw_label(c, x, b.y1, h.isolation, 15, kMuted, HAlign::kCenter, VAlign::kTop, bg, 2);
-    const std::string m = !h.pass                   ? "FAIL"
-                          : std::isfinite(h.margin) ? fmt::format("{:+.1f} %", h.margin * 100)
-                                                    : "-";
-    Rect f = draw_label(c, x, e.y1, m, 15, h.pass ? kInk : kFail, HAlign::kCenter, VAlign::kTop, bg,
-                        2, h.pass ? FontFace::kSans : FontFace::kBold);
-    if (weak)
-      c.stroke_rect({std::min({a.x0, b.x0, e.x0, f.x0}) - 4, a.y0 - 4,
-                     std::max({a.x1, b.x1, e.x1, f.x1}) + 4, f.y1 + 4},
-                    kFail, 3);
-  };
-
-  // Chain hops.
+  // Hop lines first, then the boxes over their ends, then the labels.
   for (const PackDiagram::Hop& h : d.hops) {
-    if (h.ring_return || h.index < 1 || h.index > d.devices) continue;
-    const Rect a = box(h.index - 1), b = box(h.index);
     const LineStyle st{.color = margin_color(h.pass, h.margin), .width = kHopWidth};
-    if (a.y0 == b.y0) {
-      const double y = (a.y0 + a.y1) / 2.0;
-      const double x0 = std::min(a.x1, b.x1), x1 = std::max(a.x0, b.x0);
-      c.hline(y, x0, x1, st);
-      label(h, (x0 + x1) / 2, y, false);
-    } else {
-      const double x = (a.x0 + a.x1) / 2.0;
-      c.vline(x, a.y1, b.y0, st);
-      label(h, x, (a.y1 + b.y0) / 2.0, true);
+    if (h.ring_return) {
+      if (!d.ring) continue;
+      const Rect top = L.boxes[static_cast<size_t>(d.devices)], bridge = L.boxes[0];
+      const double xt = (top.x0 + top.x1) / 2.0, yb = (bridge.y0 + bridge.y1) / 2.0;
+      const std::vector<double> xs{xt, xt, L.ring_x, L.ring_x, static_cast<double>(bridge.x0)};
+      const std::vector<double> ys{static_cast<double>(top.y1), L.ring_y, L.ring_y, yb, yb};
+      c.polyline(xs, ys, st);
+      c.text(L.ring_x - 10, (yb + L.ring_y) / 2, "ring", 16, kMuted, FontFace::kSans,
+             HAlign::kCenter, VAlign::kBottom, true);
+      continue;
     }
+    if (h.index < 1 || h.index > d.devices) continue;
+    const Rect a = L.boxes[static_cast<size_t>(h.index - 1)];
+    const Rect b = L.boxes[static_cast<size_t>(h.index)];
+    if (a.y0 == b.y0)
+      c.hline((a.y0 + a.y1) / 2.0, std::min(a.x1, b.x1), std::max(a.x0, b.x0), st);
+    else
+      c.vline((a.x0 + a.x1) / 2.0, std::min(a.y1, b.y1), std::max(a.y0, b.y0), st);
   }
-  // The return hop: down from the top device, along the bottom, up the left side to the bridge.
-  for (const PackDiagram::Hop& h : d.hops) {
-    if (!h.ring_return) continue;
-    const Rect top = box(d.devices), bridge = box(0);
-    const double y_bottom = kTop + (rows - 1) * kPitchY + kBoxH + 70;
-    const double x_left = kLeft - 80;
-    const double xt = (top.x0 + top.x1) / 2.0, yb = (bridge.y0 + bridge.y1) / 2.0;
-    const LineStyle st{.color = margin_color(h.pass, h.margin), .width = kHopWidth};
-    const std::vector<double> xs{xt, xt, x_left, x_left, static_cast<double>(bridge.x0)};
-    const std::vector<double> ys{static_cast<double>(top.y1), y_bottom, y_bottom, yb, yb};
-    c.polyline(xs, ys, st);
-    label(h, (xt + x_left) / 2, y_bottom, false);
-    c.text(x_left - 10, (yb + y_bottom) / 2, "ring", 16, kMuted, FontFace::kSans, HAlign::kCenter,
-           VAlign::kBottom, true);
-  }
-  // Boxes over the line ends.
-  for (int k = 0; k < nodes; ++k) {
-    const Rect r = box(k);
+  for (size_t k = 0; k < L.boxes.size(); ++k) {
+    const Rect& r = L.boxes[k];
     c.fill_rect(r, k == 0 ? rgb(0xDCE6F2) : rgb(0xF4F4F4));
     c.stroke_rect(r, kInk, 2);
     const std::string name = k == 0 ? "bridge" : fmt::format("device {}", k);
     c.text((r.x0 + r.x1) / 2.0, (r.y0 + r.y1) / 2.0, name, 18, kInk,
            k == 0 ? FontFace::kBold : FontFace::kSans, HAlign::kCenter, VAlign::kCenter);
   }
+  for (const PackLayout::Label& lab : L.labels) {
+    const PackDiagram::Hop* h = nullptr;
+    for (const PackDiagram::Hop& x : d.hops)
+      if (x.index == lab.hop) h = &x;
+    const std::vector<LabelLine> lines = label_lines(d, *h);
+    for (size_t i = 0; i < lines.size() && i < lab.lines.size(); ++i)
+      draw_label(c, lab.lines[i].x0 + kLabelPad, lab.lines[i].y0 + kLabelPad, lines[i].text,
+                 lines[i].size, lines[i].color, HAlign::kLeft, VAlign::kTop,
+                 kWhite.with_alpha(0.92f), kLabelPad, lines[i].face);
+    if (lab.hop == d.weakest) c.stroke_rect(lab.bounds.inset(-kFrame), kFail, 3);
+  }
 
   // Legend: the colour scale of the margin.
-  const int ly = height - 70, lx = 40;
+  const int ly = L.legend_y, lx = 40;
   c.text(lx, ly, "worst relative margin per hop:", 18, kInk, FontFace::kSans, HAlign::kLeft,
          VAlign::kCenter);
   const int bx = lx + 300, bw = 420;

@@ -33,6 +33,25 @@ struct PackDiagram {
   std::vector<Hop> hops;
 };
 
+// Where everything goes. Labels are measured: the gap between boxes in a row is as wide as the
+// widest hop label (so no label reaches over a box), and the rows are far enough apart that the
+// labels of a turn's vertical hop sit between the labels of the rows above and below it.
+struct PackLayout {
+  int width = 0, height = 0;
+  std::vector<Rect> boxes;  // node k's box (0: the bridge)
+  struct Label {
+    int hop = 0;              // PackDiagram::Hop::index
+    std::vector<Rect> lines;  // "hop N", length, isolation, margin: each line's backing box
+    Rect bounds;              // all of them (the weakest hop's frame goes 4 px outside it)
+  };
+  std::vector<Label> labels;  // one per hop drawn, in d.hops order
+  double ring_y = 0;          // the return hop's run along the bottom (pixel row)
+  double ring_x = 0;          // and up the left side (pixel column)
+  int legend_y = 0;           // the colour scale's centre row
+};
+// `measure` is any canvas (text extents only; nothing is drawn on it).
+PackLayout pack_layout(const PackDiagram& d, const Canvas& measure);
+
 // The colour of a hop: red when it fails, else from orange (margin 0) through yellow to green
 // (relative margin >= 15 %; the width rule alone caps it near 12 %).
 Color margin_color(bool pass, double margin);

@@ -10,6 +10,7 @@
 
 #include "analysis/sweep_run.h"
 #include "base/file_io.h"
+#include "reports/html_report.h"
 #include "reports/pack_png.h"
 #include "reports/run_images.h"
 #include "reports/run_report.h"
@@ -372,6 +373,22 @@ PackDiagram pack_diagram(const PackSpec& pack, const PackResult& r) {
   return d;
 }
 
+namespace {
+
+// report.json for the page: each hop's directions keep their verdicts, reasons and worst margins
+// but not the per-pulse lists (16 hops of them made the page megabytes larger).
+ordered_json pack_html_json(const PackSpec& pack, const PackResult& r) {
+  ordered_json j = pack_report_json(pack, r);
+  for (ordered_json& h : j["hops"])
+    for (ordered_json& d : h["directions"])
+      for (const char* k : {"check", "tones"})
+        if (d.contains(k) && d[k].is_object())
+          for (const char* drop : {"pulses", "ringing", "idle", "decoded"}) d[k].erase(drop);
+  return j;
+}
+
+}  // namespace
+
 Status write_pack_bundle(const PackSpec& pack, const PackResult& r, const std::string& dir,
                          bool no_images, std::vector<std::string>* files) {
   namespace fs = std::filesystem;
@@ -429,6 +446,17 @@ Status write_pack_bundle(const PackSpec& pack, const PackResult& r, const std::s
       !s.ok())
     return s;
   files->push_back("report.md");
+  std::string png;
+  if (!diagram.empty()) {
+    StatusOr<std::string> bytes = read_input_file(dir + "/" + diagram);
+    if (!bytes) return bytes.status();
+    png = std::move(*bytes);
+  }
+  if (Status s =
+          write_file_atomic(dir + "/report.html", pack_report_html(pack_html_json(pack, r), png));
+      !s.ok())
+    return s;
+  files->push_back("report.html");
   return Status::Ok();
 }
 

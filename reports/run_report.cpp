@@ -9,6 +9,7 @@
 
 #include "netlists/link/cable.h"
 #include "netlists/link/cards.h"
+#include "reports/html_report.h"
 
 namespace isolink::reports {
 
@@ -176,21 +177,7 @@ std::string run_report_markdown(const link::LinkSpec& spec, const LinkRun& run,
     const link::ExpandedLink& x = run.directions.front().link;
     md += "- tx end: " + x.tx_bom + "\n- rx end: " + x.rx_bom + "\n";
   }
-  md += fmt::format("\n## Cable\n\n{} m of {} AWG {} twisted pair at {} degC", spec.cable.length,
-                    spec.cable.gauge, spec.cable.material == "pp" ? "PP" : "PVC",
-                    spec.cable.temperature);
-  if (spec.cable.r || spec.cable.l || spec.cable.c || spec.cable.g)
-    md += " (explicit per-metre values override the preset)";
-  if (!run.directions.empty())
-    md += fmt::format(", {} sections", run.directions.front().link.cable_segments);
-  if (StatusOr<link::CableModel> cm = link::cable_model(spec.cable); cm.ok()) {
-    const double a10 = std::real(cm->gamma_diff(10e6)) * spec.cable.length * 8.685889638;
-    md += fmt::format(
-        ": differential impedance {:.0f} ohm, velocity {:.2f} c, delay {:.1f} ns, "
-        "loss {:.2f} dB at 10 MHz",
-        cm->z_diff(), cm->velocity() / 299792458.0, spec.cable.length / cm->velocity() * 1e9, a10);
-  }
-  md += ".\n";
+  md += "\n## Cable\n\n" + cable_summary(spec, run) + "\n";
   md += "\n## Traffic\n\n";
   md += fmt::format("`{}`\n\n", spec.stimulus.to_script());
   md +=
@@ -238,6 +225,41 @@ std::string run_report_markdown(const link::LinkSpec& spec, const LinkRun& run,
       md += fmt::format("\n{}: transient engine ({}).\n", d.link.description, d.sim.engine_note);
   md += "\nFiles: `report.json` (all figures), `wave.csv` (the probes of every direction).\n";
   return md;
+}
+
+std::string cable_summary(const link::LinkSpec& spec, const LinkRun& run) {
+  std::string md =
+      fmt::format("{} m of {} AWG {} twisted pair at {} degC", spec.cable.length, spec.cable.gauge,
+                  spec.cable.material == "pp" ? "PP" : "PVC", spec.cable.temperature);
+  if (spec.cable.r || spec.cable.l || spec.cable.c || spec.cable.g)
+    md += " (explicit per-metre values override the preset)";
+  if (!run.directions.empty())
+    md += fmt::format(", {} sections", run.directions.front().link.cable_segments);
+  if (StatusOr<link::CableModel> cm = link::cable_model(spec.cable); cm.ok()) {
+    const double a10 = std::real(cm->gamma_diff(10e6)) * spec.cable.length * 8.685889638;
+    md += fmt::format(
+        ": differential impedance {:.0f} ohm, velocity {:.2f} c, delay {:.1f} ns, "
+        "loss {:.2f} dB at 10 MHz",
+        cm->z_diff(), cm->velocity() / 299792458.0, spec.cable.length / cm->velocity() * 1e9, a10);
+  }
+  return md + ".";
+}
+
+std::string run_report_page(const link::LinkSpec& spec, const LinkRun& run,
+                            const nlohmann::ordered_json& json, const std::string& eye_png) {
+  std::vector<HtmlWave> waves;
+  ordered_json vth = ordered_json::array();
+  for (const DirectionRun& d : run.directions) {
+    const Waveform& w = d.sim.wave;
+    waves.push_back({d.link.description, w.time, w.columns[0]});
+    vth.push_back(d.data ? d.rules.vth : d.tone_rules.vth);
+  }
+  ordered_json extra{
+      {"cable", cable_summary(spec, run)}, {"traffic", spec.stimulus.to_script()}, {"vth", vth}};
+  if (!run.directions.empty())
+    extra["bom"] = {{"tx", run.directions.front().link.tx_bom},
+                    {"rx", run.directions.front().link.rx_bom}};
+  return run_report_html(json, extra, waves, eye_png);
 }
 
 std::string run_summary_text(const link::LinkSpec& spec, const LinkRun& run) {

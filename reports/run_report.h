@@ -27,6 +27,13 @@ nlohmann::ordered_json run_report_json(const link::LinkSpec& spec, const LinkRun
 // A reviewer's page: verdict, worst margins per direction, BOM, cable, run time, the images.
 std::string run_report_markdown(const link::LinkSpec& spec, const LinkRun& run,
                                 const std::vector<std::string>& images);
+// The cable in one sentence: length, gauge, material, temperature, sections, impedance, delay
+// and loss at 10 MHz (report.md and report.html).
+std::string cable_summary(const link::LinkSpec& spec, const LinkRun& run);
+// report.html (html_report.h): json is run_report_json's object (with "worst_case" when it was
+// computed), eye_png the bytes of eye.png ("" when not drawn).
+std::string run_report_page(const link::LinkSpec& spec, const LinkRun& run,
+                            const nlohmann::ordered_json& json, const std::string& eye_png);
 // "pass" / "FAIL" lines for the terminal: one per direction, with the worst margins.
 std::string run_summary_text(const link::LinkSpec& spec, const LinkRun& run);
 

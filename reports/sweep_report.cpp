@@ -2,6 +2,9 @@
 
 #include <algorithm>
 
+#include "base/file_io.h"
+#include "reports/html_report.h"
+
 namespace isolink::reports {
 
 using SweepAxis = analysis::sweep::Axis;
@@ -76,6 +79,9 @@ Status render_sweep_plots(const SweepSpec& s, const std::vector<PointResult>& re
     if (Status st = render_mc_histogram_png(d, dir + "/mc_histogram.png"); !st.ok()) return st;
     files->push_back("mc_histogram.png");
   }
+  if (Status st = write_file_atomic(dir + "/report.html", sweep_report_html(s, results)); !st.ok())
+    return st;
+  files->push_back("report.html");
   return Status::Ok();
 }
 

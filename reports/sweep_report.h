@@ -18,7 +18,8 @@ SweepPlotData sweep_plot_data(const analysis::sweep::SweepSpec& s,
                               const std::vector<analysis::sweep::PointResult>& results);
 
 // Writes the charts that apply (margin: one axis or more; heatmap: two or more in grid mode;
-// histogram: Monte Carlo) into dir and appends their file names to *files.
+// histogram: Monte Carlo) and report.html (html_report.h) into dir and appends their file names
+// to *files.
 Status render_sweep_plots(const analysis::sweep::SweepSpec& s,
                           const std::vector<analysis::sweep::PointResult>& results,
                           const std::string& dir, std::vector<std::string>* files);

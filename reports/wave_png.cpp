@@ -72,6 +72,7 @@ void shade_frames(Canvas& c, const PlotArea& a, const eye::CheckResult& r, bool 
     const eye::FrameResult& f = r.frames[i];
     if (f.last_pulse >= r.pulses.size()) continue;
     const double t0 = f.start, t1 = r.pulses[f.last_pulse].b;
+    if (t1 < a.x.lo || t0 > a.x.hi) continue;  // outside the plot (a zoom inset)
     const Color fill = f.fails() ? kFrameFailing
                        : tone    ? kFrameTone
                        : f.byte  ? kFrameDecoded
@@ -179,6 +180,48 @@ std::vector<std::string> wrap(const Canvas& c, const std::vector<std::string>& w
   return lines;
 }
 
+// The marked pulse: orange in the plot inside a dashed orange box, and magnified in the zoom inset
+// below (framed in the same orange), with its label above the inset.
+void draw_marked(Canvas& c, const WavePanelLayout& L, const WavePanel& p, const AxisTicks& yt) {
+  const PlotArea& a = L.diff;
+  const PlotArea& z = *L.zoom;
+  const eye::CheckResult& r = *p.result;
+  const eye::PulseMetrics& pm = r.pulses[*p.marked];
+  const double lead = pm.edge.measured() ? pm.edge.value : 0.1 * p.rules->pulse_time;
+  std::vector<double> xs, ys;
+  clip_series(p.time, p.diff, pm.a - lead, pm.b, &xs, &ys);
+  c.series(a, xs, ys, LineStyle{.color = kMark, .width = 4});
+  const LineStyle dashed{.color = kMark, .width = 2, .dash = 6, .gap = 4};
+  Rect box{a.col(z.x.lo), a.rect.y0 + 2, a.col(z.x.hi) + 1, a.rect.y1 - 2};
+  if (box.width() < 6) box.x0 -= 3, box.x1 += 3;
+  c.line(box.x0, box.y0, box.x1, box.y0, dashed);
+  c.line(box.x0, box.y1, box.x1, box.y1, dashed);
+  c.line(box.x0, box.y0, box.x0, box.y1, dashed);
+  c.line(box.x1, box.y0, box.x1, box.y1, dashed);
+
+  const UnitScale tu = si_scale(std::max(std::abs(z.x.lo), std::abs(z.x.hi)), "s");
+  const AxisTicks zt = make_ticks(z.x, tu, 10);
+  style::LabelRow none;
+  shade_frames(c, z, r, r.tone, &none);
+  draw_grid(c, z, zt, yt, kGridOver);
+  clip_series(p.time, p.diff, z.x.lo, z.x.hi, &xs, &ys);
+  c.series(z, xs, ys, LineStyle{.color = kTrace, .width = 2});
+  for (double s : {+1.0, -1.0})
+    c.hline(z.row(s * p.rules->vth), z.rect.x0, z.rect.x1,
+            LineStyle{.color = kThreshold, .width = 2});
+  clip_series(p.time, p.diff, pm.a - lead, pm.b, &xs, &ys);
+  c.series(z, xs, ys, LineStyle{.color = kMark, .width = 4});
+  c.stroke_rect(z.rect.inset(-1), kMark, 2);
+  draw_axes(c, z, zt, yt, "time", "zoom", style::kLabelSize);
+  const std::string label = p.mark_label.empty() ? "marked pulse" : p.mark_label;
+  draw_runs(c, L.zoom_label.x0, L.zoom_label.y0 + 4,
+            {{"zoom on the worst pulse:  ", kInk, FontFace::kSans},
+             {label, kMark, FontFace::kBold},
+             {fmt::format("   (pulse {} at {})", pm.index, style::time_us(pm.a)), kMuted,
+              FontFace::kSans}},
+            style::kLabelSize, VAlign::kTop);
+}
+
 void draw_panel(Canvas& c, const WavePanelLayout& L, const WavePanel& p) {
   const eye::Rules& rules = *p.rules;
   const eye::CheckResult& r = *p.result;
@@ -204,17 +247,8 @@ void draw_panel(Canvas& c, const WavePanelLayout& L, const WavePanel& p) {
   draw_failing(c, a, p, r, rules.pulse_time, "", &marks, &failed);
   if (p.tones) draw_failing(c, a, p, *p.tones, 1e-6, "tone ", &marks, &failed);
   label_failing(c, a, marks, &failed);
-  if (p.marked && *p.marked < r.pulses.size()) {
-    const eye::PulseMetrics& pm = r.pulses[*p.marked];
-    const double lead = pm.edge.measured() ? pm.edge.value : 0.1 * rules.pulse_time;
-    std::vector<double> xs, ys;
-    clip_series(p.time, p.diff, pm.a - lead, pm.b, &xs, &ys);
-    c.series(a, xs, ys, LineStyle{.color = kMark, .width = 4});
-    const double xm = a.px((pm.a + pm.b) / 2);
-    c.text(xm, a.rect.y1 - 8, p.mark_label.empty() ? "marked" : p.mark_label, style::kLabelSize,
-           kMark, FontFace::kBold, HAlign::kCenter, VAlign::kBottom);
-  }
-  const bool last_plot = !L.pins;
+  if (L.zoom) draw_marked(c, L, p, yt);
+  const bool last_plot = !L.pins && !L.zoom;
   draw_axes(c, a, xt, yt, last_plot ? "time" : "", "differential v(P) - v(N)", style::kLabelSize);
 
   // Side: legend and notes.
@@ -303,8 +337,22 @@ WaveLayout wave_layout(const std::vector<WavePanel>& panels, const WaveReportInf
     const double t0 = p.time.empty() ? 0 : p.time.front();
     const double t1 = p.time.size() < 2 ? t0 + 1e-6 : p.time.back();
     const bool pins = !p.p.empty() && p.p.size() == p.time.size() && p.n.size() == p.time.size();
-    P.diff =
-        PlotArea::make({x0, py + 100, x1, py + (pins ? 560 : 840)}, t0, t1, -L.v_range, L.v_range);
+    const bool zoom =
+        !pins && p.marked && p.result && p.rules && *p.marked < p.result->pulses.size();
+    P.diff = PlotArea::make({x0, py + 100, x1,
+                             py + (pins   ? 560
+                                   : zoom ? 500
+                                          : 840)},
+                            t0, t1, -L.v_range, L.v_range);
+    if (zoom) {
+      // Four half bits either side of the pulse, inside the record.
+      const eye::PulseMetrics& pm = p.result->pulses[*p.marked];
+      const double T = p.rules->pulse_time;
+      const double z0 = std::max(t0, pm.a - 4 * T), z1 = std::min(t1, pm.b + 4 * T);
+      P.zoom_label = {x0, py + 548, x1, py + 580};
+      P.zoom = PlotArea::make({x0, py + 590, x1, py + 840}, z0, z1 > z0 ? z1 : z0 + T, -L.v_range,
+                              L.v_range);
+    }
     if (pins) {
       double lo = 1e300, hi = -1e300;
       for (std::span<const double> s : {p.p, p.n})

@@ -15,7 +15,9 @@
 // there is room. A failing pulse (PulseMetrics.failing) is drawn in kFail red from the start of the
 // edge into it to its end b, marked at the top and labelled "#index" (its index in
 // CheckResult.pulses) where there is room; nothing else in the image is that red except a FAIL
-// verdict. A `marked` pulse (isolink worst's worst pulse) is drawn in kMark orange with its label.
+// verdict. A `marked` pulse (isolink worst's worst pulse) is drawn in kMark orange, framed by a
+// dashed box, and shown again magnified in a zoom inset under the plot (4 half bits either side),
+// which carries its label: the label never sits on the frames' byte labels in the plot.
 // Optional `tones` (a tone check of the same record) adds its failing pulses as "tone #i".
 #pragma once
 
@@ -55,6 +57,8 @@ struct WavePanelLayout {
   Rect panel;                    // the whole panel
   PlotArea diff;                 // x = time (s), y = differential volts
   std::optional<PlotArea> pins;  // P, N and common mode (when p and n are given)
+  std::optional<PlotArea> zoom;  // the marked pulse magnified (when a pulse is marked)
+  Rect zoom_label;               // the band above the zoom inset that holds the marked label
   Rect side;                     // legends and notes, right of the plots
 };
 struct WaveLayout {

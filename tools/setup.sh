@@ -17,6 +17,8 @@ PACKAGES=(
   pybind11-dev python3-dev python3-numpy python3-pytest  # the Python module (python/) and its tests
   clang libclang-rt-14-dev  # libFuzzer targets (tests/fuzz) in CI
   clang-format  # the `format` test (tools/check_format.sh)
+  libjs-dygraphs  # report.html's plots, inlined at build time (reports/html_report.h)
+  chromium  # report.html in a headless browser (tests/reports/html_browser_test.py)
 )
 SUDO=""
 [ "$(id -u)" -eq 0 ] || SUDO="sudo"

@@ -74,8 +74,8 @@ std::vector<std::string> visible(const std::string& dir) {
   return n;
 }
 
-const std::vector<std::string> kBundle = {"eye.png", "report.json", "report.md", "wave.csv",
-                                          "wave.png"};
+const std::vector<std::string> kBundle = {"eye.png",   "report.html", "report.json",
+                                          "report.md", "wave.csv",    "wave.png"};
 
 TEST(KillDuringRun, ReportIsWholeOldOrWholeNew) {
   const std::string dir = test_dir(), out = dir + "/report";

@@ -55,7 +55,8 @@ TEST_P(RunExamples, BundleAndVerdict) {
       stem);
   const bool pass = std::string(ex.verdict) == "pass";
   EXPECT_EQ(r.code, pass ? 0 : 1) << r.err;
-  for (const char* f : {"eye.png", "wave.png", "report.json", "report.md", "wave.csv"})
+  for (const char* f :
+       {"eye.png", "wave.png", "report.json", "report.md", "wave.csv", "report.html"})
     EXPECT_TRUE(fs::exists(dir + "/" + f)) << f;
   for (const auto& e : fs::directory_iterator(dir))  // no temporary files left behind
     EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << e.path();

@@ -175,5 +175,56 @@ TEST(WavePng, TwoDirectionsAndErrors) {
   EXPECT_NE(s.message().find(path), std::string::npos) << s.message();
 }
 
+bool orange(const std::array<int, 3>& c) {
+  return c[0] > 200 && c[1] > 100 && c[1] < 190 && c[2] < 90;
+}
+
+// A worst-case image: the marked pulse is magnified in an inset under the plot, and its label sits
+// above the inset, not in the plot's bottom row where the frames' byte labels are.
+TEST(WavePng, MarkedPulseGetsAZoomInsetAndItsLabelClearOfTheFrameLabels) {
+  const Direction d = direction({0x80, 0x02, 0x15}, {});
+  ASSERT_TRUE(d.c.pass);
+  const size_t marked = d.c.frames[1].first_pulse + 3;
+  const eye::PulseMetrics& pm = d.c.pulses[marked];
+  WavePanel panel = d.panel("down: worst vstart", false);
+  panel.marked = marked;
+  panel.mark_label = "vstart 1.913 V (margin +0.213 V)";
+  const std::vector<WavePanel> panels{panel};
+  const WaveLayout L = wave_layout(panels, {});
+  const WavePanelLayout& P = L.panels[0];
+  ASSERT_TRUE(P.zoom.has_value());
+  const PlotArea& a = P.diff;
+  const PlotArea& z = *P.zoom;
+  // Four half bits (250 ns) either side of the pulse.
+  EXPECT_NEAR(z.x.lo, pm.a - 1e-6, 1e-12);
+  EXPECT_NEAR(z.x.hi, pm.b + 1e-6, 1e-12);
+  // Inset and label band lie below the plot, inside the panel, one under the other.
+  EXPECT_GT(P.zoom_label.y0, a.rect.y1 + 30);  // below the plot's tick labels
+  EXPECT_LE(P.zoom_label.y1, z.rect.y0);
+  EXPECT_LE(z.rect.y1 + 60, P.panel.y1);
+
+  const Png img = render(panels, "wave_marked");
+  // The inset is drawn: the trace and the orange pulse inside it.
+  const auto trace = [](const std::array<int, 3>& c) {
+    return c[0] == 0x1F && c[1] == 0x3A && c[2] == 0x5F;
+  };
+  EXPECT_GT(count_if(img, z.rect, trace), 300);
+  EXPECT_GT(count_if(img, z.rect, orange), 300);
+  // Magnified: the pulse spans far more columns in the inset than in the plot.
+  const double wide = z.px(pm.b) - z.px(pm.a), narrow = a.px(pm.b) - a.px(pm.a);
+  EXPECT_GT(wide, 8 * narrow);
+  // The label, in orange, in its band.
+  EXPECT_GT(count_if(img, P.zoom_label, orange), 150);
+  // Nothing orange in the plot's bottom label row apart from the dashed box around the zoom
+  // window (the old layout centred the label there, over the frame labels).
+  const int bx0 = a.col(z.x.lo) - 4, bx1 = a.col(z.x.hi) + 5;
+  const Rect bottom{a.rect.x0, a.rect.y1 - 30, a.rect.x1, a.rect.y1};
+  EXPECT_EQ(count_if(img, {bottom.x0, bottom.y0, bx0, bottom.y1}, orange), 0);
+  EXPECT_EQ(count_if(img, {bx1, bottom.y0, bottom.x1, bottom.y1}, orange), 0);
+  // The frames' byte labels are still there (dark text in that row outside the box).
+  const auto dark = [](const std::array<int, 3>& c) { return c[0] < 140 && c[1] < 140; };
+  EXPECT_GT(count_if(img, {bottom.x0, bottom.y0, bx0, bottom.y1}, dark), 50);
+}
+
 }  // namespace
 }  // namespace isolink::reports

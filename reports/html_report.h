@@ -1,0 +1,88 @@
+// report.html: the browser's view of a run, a sweep or a pack, as one self-contained file. The
+// page carries its data as JSON in a <script type="application/json"> block (report.json's
+// content plus the waveforms as base64 typed arrays and the images as data: URIs) and draws it
+// with Debian's dygraphs and the page script (reports/html/report.js), both inlined at build time:
+// no network reference of any kind, it opens offline. When every plot is drawn the script sets
+// data-ready="1" on <body> (the headless-browser test waits for it).
+//
+//   std::vector<HtmlWave> waves{{.direction = "down: bq79600 -> bq7961x", .time = w.time,
+//                                .values = *w.column("v(rxp,rxn)")}};
+//   std::string page = run_report_html(report_json, waves, eye_png_bytes);
+//   Status s = write_file_atomic(dir + "/report.html", page);
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "analysis/sweep_run.h"
+#include "base/status.h"
+
+namespace isolink::reports {
+
+// --- shared helpers (every page) ---
+
+// Text for HTML content and attribute values: & < > " ' escaped.
+std::string html_escape(std::string_view s);
+// RFC 4648 base64 (with padding).
+std::string base64(std::span<const uint8_t> bytes);
+// "data:image/png;base64,..." for PNG file bytes ("" for none).
+std::string png_data_uri(const std::string& png);
+// JSON for a <script type="application/json"> block: every "</" written "<\/" (still the same
+// JSON), so no string in it can close the block.
+std::string script_json(const nlohmann::ordered_json& j);
+// The whole document: the style, the data block, the library and the page script. `kind` is
+// "run", "sweep" or "pack" (the script draws that page from data).
+std::string html_page(const std::string& kind, const std::string& title,
+                      const nlohmann::ordered_json& data);
+
+// --- waveforms ---
+
+// One series to embed: samples at strictly increasing times.
+struct HtmlWave {
+  std::string direction;           // "down: bq79600 -> bq7961x"
+  std::span<const double> time;    // s (not owned)
+  std::span<const double> values;  // V (not owned)
+};
+// The base64 bytes a page spends on its waves at most (all distinct directions together): with the
+// rest (the library ~130 kB, report.json ~150 kB, the eye image ~1 MB) a page stays under 8 MB. A
+// uniform grid costs 16/3 bytes a sample (Float32 values), another 16/3 for Float32 time offsets
+// otherwise; a longer record is reduced by min/max buckets (every excursion kept) and the page
+// says so.
+inline constexpr size_t kHtmlWaveBytes = 6'000'000;
+// A wave as JSON: {direction, samples, kept, t0, and dt, t_last (a uniform grid: times t0 + i dt
+// within 1e-6 of dt, the last sample at t_last) or t (base64 Float32 offsets from t0), v (base64
+// Float32)}. At most max_samples are kept: a longer record is cut into max_samples / 2 buckets and
+// each keeps its lowest and highest sample (in time order). Non-finite values are written as NaN
+// (drawn as gaps).
+nlohmann::ordered_json wave_json(const HtmlWave& w, size_t max_samples);
+// The sample indices a record of n samples keeps at most max_samples of (all when n fits): per
+// bucket the index of the lowest and of the highest value, in time order.
+std::vector<size_t> minmax_keep(std::span<const double> v, size_t max_samples);
+
+// --- pages ---
+
+// A run (a wave equal to an earlier one is embedded once: {direction, same_as: its index}):
+// report is report.json's object (run_report_json, with "worst_case" when computed),
+// extra: {"bom": {"tx", "rx"}, "cable": text}; waves per direction; eye_png the eye.png file's
+// bytes ("" when not drawn).
+std::string run_report_html(const nlohmann::ordered_json& report,
+                            const nlohmann::ordered_json& extra, const std::vector<HtmlWave>& waves,
+                            const std::string& eye_png);
+// A sweep: its results (the rows of results.csv as objects), axes and title.
+std::string sweep_report_html(const analysis::sweep::SweepSpec& s,
+                              const std::vector<analysis::sweep::PointResult>& results);
+// A pack: report is report.json's object (pack_report_json); pack_png the diagram's bytes.
+std::string pack_report_html(const nlohmann::ordered_json& report, const std::string& pack_png);
+
+namespace detail {
+std::string_view dygraph_js();   // Debian's dygraph.min.js (licence and source-map comments cut)
+std::string_view dygraph_css();  // dygraph.min.css
+std::string_view page_js();      // reports/html/report.js
+std::string_view page_css();     // reports/html/report.css
+}  // namespace detail
+
+}  // namespace isolink::reports

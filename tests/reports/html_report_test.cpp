@@ -1,0 +1,164 @@
+#include "reports/html_report.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <regex>
+#include <string>
+#include <vector>
+
+namespace isolink::reports {
+namespace {
+
+using nlohmann::ordered_json;
+
+std::vector<uint8_t> unbase64(const std::string& s) {
+  auto val = [](char c) -> int {
+    if (c >= 'A' && c <= 'Z') return c - 'A';
+    if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+    if (c >= '0' && c <= '9') return c - '0' + 52;
+    return c == '+' ? 62 : c == '/' ? 63 : -1;
+  };
+  std::vector<uint8_t> out;
+  uint32_t acc = 0;
+  int bits = 0;
+  for (char c : s) {
+    const int v = val(c);
+    if (v < 0) break;
+    acc = (acc << 6) | static_cast<uint32_t>(v);
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out.push_back(static_cast<uint8_t>((acc >> bits) & 0xFF));
+    }
+  }
+  return out;
+}
+
+template <typename T>
+std::vector<T> decode(const std::string& b64) {
+  const std::vector<uint8_t> b = unbase64(b64);
+  std::vector<T> v(b.size() / sizeof(T));
+  std::memcpy(v.data(), b.data(), v.size() * sizeof(T));
+  return v;
+}
+
+// The JSON data block of a page.
+nlohmann::json page_data(const std::string& page) {
+  const size_t a = page.find("id=\"isolink-data\">") + 18, b = page.find("</script>", a);
+  return nlohmann::json::parse(page.substr(a, b - a));
+}
+
+TEST(HtmlReport, Base64MatchesRfc4648) {
+  // The test vectors of RFC 4648 section 10.
+  const std::vector<std::pair<std::string, std::string>> cases = {{"", ""},
+                                                                  {"f", "Zg=="},
+                                                                  {"fo", "Zm8="},
+                                                                  {"foo", "Zm9v"},
+                                                                  {"foob", "Zm9vYg=="},
+                                                                  {"fooba", "Zm9vYmE="},
+                                                                  {"foobar", "Zm9vYmFy"}};
+  for (const auto& [in, out] : cases)
+    EXPECT_EQ(base64({reinterpret_cast<const uint8_t*>(in.data()), in.size()}), out) << in;
+  const std::vector<uint8_t> all = [] {
+    std::vector<uint8_t> v(256);
+    for (int i = 0; i < 256; ++i) v[static_cast<size_t>(i)] = static_cast<uint8_t>(i);
+    return v;
+  }();
+  EXPECT_EQ(unbase64(base64(all)), all);
+}
+
+TEST(HtmlReport, EscapesTextAndScriptJson) {
+  EXPECT_EQ(html_escape("a<b & \"c\" 'd'>"), "a&lt;b &amp; &quot;c&quot; &#39;d&#39;&gt;");
+  const ordered_json j{{"name", "x</script><script>alert(1)</script>"}, {"v", NAN}};
+  const std::string s = script_json(j);
+  EXPECT_EQ(s.find("</"), std::string::npos) << s;
+  const nlohmann::json back = nlohmann::json::parse(s);  // still the same JSON
+  EXPECT_EQ(back["name"], "x</script><script>alert(1)</script>");
+  EXPECT_TRUE(back["v"].is_null());  // non-finite numbers never reach the page
+}
+
+// A one-sample spike in a million samples survives the min/max reduction, and the kept indices
+// run in time order.
+TEST(HtmlReport, MinMaxKeepsEveryExcursion) {
+  std::vector<double> v(1'000'000);
+  for (size_t i = 0; i < v.size(); ++i) v[i] = std::sin(static_cast<double>(i) * 1e-3);
+  v[654'321] = 7.5;
+  v[123'457] = -6.25;
+  const std::vector<size_t> keep = minmax_keep(v, 20'000);
+  EXPECT_LE(keep.size(), 20'000u);
+  EXPECT_GE(keep.size(), 19'000u);
+  for (size_t k = 1; k < keep.size(); ++k) ASSERT_LT(keep[k - 1], keep[k]);
+  EXPECT_NE(std::find(keep.begin(), keep.end(), 654'321u), keep.end());
+  EXPECT_NE(std::find(keep.begin(), keep.end(), 123'457u), keep.end());
+  EXPECT_EQ(minmax_keep(std::vector<double>(50, 1.0), 100).size(), 50u);
+}
+
+TEST(HtmlReport, WaveJsonRoundTrips) {
+  std::vector<double> t(1000), v(1000);
+  for (size_t i = 0; i < t.size(); ++i) {
+    t[i] = 2e-6 + static_cast<double>(i) * 1e-9;
+    v[i] = 1.7 * std::sin(static_cast<double>(i) * 0.01);
+  }
+  // A uniform grid: t0 and dt, values as Float32.
+  ordered_json j = wave_json({"down", t, v}, 10'000);
+  EXPECT_EQ(j["samples"], 1000);
+  EXPECT_EQ(j["kept"], 1000);
+  EXPECT_NEAR(j["t0"].get<double>(), 2e-6, 1e-18);
+  EXPECT_NEAR(j["dt"].get<double>(), 1e-9, 1e-21);
+  EXPECT_FALSE(j.contains("t"));
+  std::vector<float> vf = decode<float>(j["v"].get<std::string>());
+  ASSERT_EQ(vf.size(), 1000u);
+  for (size_t i = 0; i < v.size(); ++i) ASSERT_NEAR(vf[i], v[i], 1e-6);
+  EXPECT_NEAR(j["t_last"].get<double>(), t.back(), 1e-18);
+  // A record that stops between grid points is still a grid, with its last time given.
+  std::vector<double> cut = t;
+  cut.back() = cut[998] + 0.4e-9;
+  j = wave_json({"down", cut, v}, 10'000);
+  ASSERT_TRUE(j.contains("dt"));
+  EXPECT_EQ(j["t_last"].get<double>(), cut.back());
+  // Both directions of a symmetric link: the samples once, the second refers to the first.
+  const nlohmann::json data = page_data(
+      run_report_html({{"name", "x"}}, ordered_json::object(), {{"down", t, v}, {"up", t, v}}, ""));
+  ASSERT_EQ(data["waves"].size(), 2u);
+  EXPECT_TRUE(data["waves"][0].contains("v"));
+  EXPECT_EQ(data["waves"][1]["same_as"], 0);
+  EXPECT_EQ(data["waves"][1]["direction"], "up");
+  // Not uniform: the times as Float32 offsets from t0.
+  t[500] += 0.3e-9;
+  j = wave_json({"down", t, v}, 10'000);
+  EXPECT_FALSE(j.contains("dt"));
+  const std::vector<float> tt = decode<float>(j["t"].get<std::string>());
+  ASSERT_EQ(tt.size(), 1000u);
+  for (size_t i = 0; i < t.size(); ++i)  // within 1 ps here
+    ASSERT_NEAR(j["t0"].get<double>() + tt[i], t[i], 1e-12) << i;
+  // Reduced: at most the budget, the extremes kept.
+  j = wave_json({"down", t, v}, 100);
+  EXPECT_LE(j["kept"].get<size_t>(), 100u);
+  vf = decode<float>(j["v"].get<std::string>());
+  EXPECT_NEAR(*std::max_element(vf.begin(), vf.end()), 1.7, 1e-3);
+  EXPECT_NEAR(*std::min_element(vf.begin(), vf.end()), -1.7, 1e-3);
+}
+
+// The page is one file: the library and the script inlined, no network address of any kind, the
+// data block intact, and data-ready="0" until the script has drawn.
+TEST(HtmlReport, PageIsSelfContained) {
+  const ordered_json report{
+      {"verdict", "pass"}, {"name", "t</b>"}, {"directions", ordered_json::array()}};
+  const std::string page = run_report_html(report, ordered_json::object(), {}, "");
+  EXPECT_NE(page.find("<body data-kind=\"run\" data-ready=\"0\">"), std::string::npos);
+  EXPECT_NE(page.find("Dygraph"), std::string::npos);
+  EXPECT_GT(detail::dygraph_js().size(), 100'000u);
+  EXPECT_NE(page.find("data-ready"), std::string::npos);
+  EXPECT_NE(page.find("<title>isolink report: t&lt;/b&gt;</title>"), std::string::npos);
+  const std::regex net(R"((https?:|ftp:|wss?:)//|\bsrc\s*=\s*["']?//|@import|sourceMappingURL)",
+                       std::regex::icase);
+  EXPECT_FALSE(std::regex_search(page, net));
+  // One data block; what it holds parses back to what went in.
+  EXPECT_EQ(page_data(page)["report"]["name"], "t</b>");
+}
+
+}  // namespace
+}  // namespace isolink::reports
