@@ -398,8 +398,12 @@ StatusOr<CompareResult> compare_capture(const CompareInput& in, const link::Part
   r.direction = link::direction_name(opt.direction);
   StatusOr<Prepared> p = prepare(in, opt, r);
   if (!p) return p.status();
-  for (const std::string& k : opt.fit)  // bad keys are bad input, before any work
-    if (StatusOr<DesignValue> dv = design_value(p->spec, parts, k); !dv) return dv.status();
+  for (const std::string& k : opt.fit) {  // bad keys and bounds are bad input, before any work
+    StatusOr<DesignValue> dv = design_value(p->spec, parts, k);
+    if (!dv) return dv.status();
+    if (StatusOr<std::pair<double, double>> b = cd::fit_bounds(opt, k, dv->value); !b)
+      return b.status();
+  }
   const std::vector<double>& t = p->w.time;
   const std::vector<double>& v = p->w.columns[0];
   StatusOr<eye::CheckResult> check = eye::check_waveform(p->w, p->rules);
@@ -407,11 +411,11 @@ StatusOr<CompareResult> compare_capture(const CompareInput& in, const link::Part
   r.check = std::move(*check);
   r.noise_rms_v = idle_noise(t, v, r.check);
   r.quant_step_v = quantisation_step(v);
+  r.time = t;
+  r.capture = v;
   if (no_pulses(r.check, v, r.noise_rms_v, r.quant_step_v)) {
     r.verdict = "inconclusive";
     r.reasons.push_back("the record holds no daisy-chain pulses");
-    r.time = t;
-    r.capture = v;
     return r;
   }
   bool decoded = false;
@@ -462,8 +466,6 @@ StatusOr<CompareResult> compare_capture(const CompareInput& in, const link::Part
       vs.push_back(v[i]);
     }
   }
-  r.time = t;
-  r.capture = v;
   r.sim.resize(t.size());
   cd::synth_at(**e, *edges, r.offset_s, t, r.sim);
   std::vector<double> sw(ts.size());

@@ -6,6 +6,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 
 #include "analysis/compare_model.h"
 #include "analysis/sweep_spec.h"
@@ -232,6 +233,17 @@ std::string advice_of(const std::string& key) {
 
 }  // namespace
 
+StatusOr<std::pair<double, double>> fit_bounds(const CompareOptions& opt, const std::string& key,
+                                               double design) {
+  double lo = 0.2 * design, hi = 5 * design;
+  if (auto b = opt.bounds.find(key); b != opt.bounds.end()) std::tie(lo, hi) = b->second;
+  if (!(lo > 0 && lo <= design && design <= hi))
+    return Status::Error(
+        fmt::format("--bounds: error: {}={:g}:{:g} must hold the design value {:g} and be above 0",
+                    key, lo, hi, design));
+  return std::pair<double, double>{lo, hi};
+}
+
 Status run_fit(LinkModel& model, const link::LinkSpec& spec, const link::PartLibrary& parts,
                const CompareOptions& opt, const FitData& data, CompareResult& r,
                std::vector<double>& fitted) {
@@ -241,12 +253,9 @@ Status run_fit(LinkModel& model, const link::LinkSpec& spec, const link::PartLib
   for (const std::string& key : opt.fit) {
     StatusOr<DesignValue> d = design_value(spec, parts, key);
     if (!d) return d.status();
-    double lo = 0.2 * d->value, hi = 5 * d->value;
-    if (auto b = opt.bounds.find(key); b != opt.bounds.end()) std::tie(lo, hi) = b->second;
-    if (!(lo > 0 && lo <= d->value && d->value <= hi))
-      return Status::Error(fmt::format(
-          "--bounds: error: {}={:g}:{:g} must hold the design value {:g} and be above 0", key, lo,
-          hi, d->value));
+    StatusOr<std::pair<double, double>> b = fit_bounds(opt, key, d->value);
+    if (!b) return b.status();
+    const auto [lo, hi] = *b;
     params.push_back({0.0, std::log(lo / d->value), std::log(hi / d->value), 0.01});
     design.push_back(*d);
   }

@@ -49,6 +49,11 @@ class LinkModel {
 // "ends.x" -> {"tx.x", "rx.x"}, anything else -> {key}.
 std::vector<std::string> key_paths(const std::string& key);
 
+// A fitted key's bounds: CompareOptions::bounds, else 0.2x..5x the design value; an error when
+// they do not hold the design value or reach 0.
+StatusOr<std::pair<double, double>> fit_bounds(const CompareOptions& opt, const std::string& key,
+                                               double design);
+
 // The fit of CompareOptions::fit on the aligned capture: fills r.fit, r.unidentifiable,
 // r.findings, r.offset_after_fit_s and returns the simulation at `t` after the fit.
 struct FitData {

@@ -52,15 +52,16 @@ void panel(Canvas& c, const Rect& rect, std::span<const double> t, const std::ve
 
 Status write_compare_png(const analysis::CompareResult& r, const std::string& path) {
   if (r.time.size() < 2) return Status::Error(path + ": error: no waveform to draw");
-  const bool fitted = !r.sim_after_fit.empty();
+  const bool fitted = r.sim_after_fit.size() == r.time.size();
   const int zooms = static_cast<int>(r.worst_frames.size());
   const int w = 1800, h = 1150 + (zooms > 0 ? 330 : 0);
   StatusOr<Canvas> cv = Canvas::create(w, h);
   if (!cv) return cv.status();
   Canvas& c = *cv;
   const std::span<const double> t = r.time;
-  std::vector<double> res(t.size()), res_fit;
-  for (size_t i = 0; i < t.size(); ++i) res[i] = r.capture[i] - r.sim[i];
+  const bool simulated = r.sim.size() == t.size();  // not for an inconclusive record
+  std::vector<double> res(simulated ? t.size() : 0), res_fit;
+  for (size_t i = 0; i < res.size(); ++i) res[i] = r.capture[i] - r.sim[i];
   if (fitted) {
     res_fit.resize(t.size());
     for (size_t i = 0; i < t.size(); ++i) res_fit[i] = r.capture[i] - r.sim_after_fit[i];
