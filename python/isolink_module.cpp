@@ -20,11 +20,13 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "analysis/compare.h"
 #include "analysis/link_run.h"
 #include "analysis/pack_spec.h"
 #include "analysis/simulate.h"
@@ -187,6 +189,35 @@ py::dict load_spec(const std::string& path) {
   return to_python(reports::link_spec_json(take(link::read_link_spec_file(path))));
 }
 
+// isolink.compare: `isolink compare --json`'s object for a capture (one file, or P and N files)
+// and a link spec; errors (bad input) raise isolink.Error.
+py::dict compare(const std::vector<std::string>& capture, const std::string& spec,
+                 const std::string& direction, const std::vector<std::string>& fit,
+                 const std::map<std::string, std::pair<double, double>>& bounds,
+                 const std::string& frames, const std::string& p, const std::string& n,
+                 const std::string& diff, const std::vector<std::string>& parts_dirs) {
+  if (direction != "down" && direction != "up")
+    raise(Status::Error("direction: '" + direction + "' is none of down, up"));
+  analysis::CompareInput in{.files = capture, .spec_path = spec};
+  in.cols.p = p;
+  in.cols.n = n;
+  in.cols.diff = diff;
+  analysis::CompareOptions opt;
+  opt.direction = direction == "up" ? link::Direction::kUp : link::Direction::kDown;
+  opt.fit = fit;
+  opt.bounds = bounds;
+  opt.frames = frames;
+  StatusOr<analysis::CompareResult> r = Status::Error("not run");
+  {
+    py::gil_scoped_release nogil;
+    StatusOr<link::PartLibrary> parts = link::PartLibrary::load(parts_dirs);
+    r = parts ? analysis::compare_capture(in, *parts, opt)
+              : StatusOr<analysis::CompareResult>(parts.status());
+  }
+  if (!r) raise(r.status());
+  return to_python(analysis::compare_json(*r));
+}
+
 // A results.csv cell as Python: "" -> None, true/false -> bool, a number -> float (the point
 // index -> int), anything else (a variant's name, a reason) -> str.
 py::object cell(const std::string& name, const std::string& text) {
@@ -263,7 +294,7 @@ py::list sweep(const std::string& path, const std::optional<std::string>& out, i
 PYBIND11_MODULE(isolink, m) {
   using namespace isolink::python;
   m.doc() =
-      "isolink: signal integrity of BMS daisy-chain links (run, check, load_spec, sweep). "
+      "isolink: signal integrity of BMS daisy-chain links (run, check, compare, load_spec, sweep). "
       "Results are the JSON the isolink CLI writes, as dicts; errors raise isolink.Error with "
       "the CLI's file:line:col message.";
   static py::exception<ErrorTag> error(m, "Error", PyExc_ValueError);
@@ -279,6 +310,15 @@ PYBIND11_MODULE(isolink, m) {
         "Score samples v (V) at times t (s, increasing) against a rule set (bq7961x, bq79600, "
         "tone or a YAML rule file), as `isolink check --json`: its object as a dict, with "
         "'pass' (bool). expect: the bytes expected, in hex ('80 00 02 15').");
+  m.def("compare", &compare, py::arg("capture"), py::arg("spec"), py::kw_only(),
+        py::arg("direction") = "down", py::arg("fit") = std::vector<std::string>{},
+        py::arg("bounds") = std::map<std::string, std::pair<double, double>>{},
+        py::arg("frames") = "", py::arg("p") = "", py::arg("n") = "", py::arg("diff") = "",
+        py::arg("parts") = std::vector<std::string>{},
+        "Compare a scope capture (a list: one file, or the P and N files) with the link spec's "
+        "simulation of the same traffic, as `isolink compare --json`: its object as a dict "
+        "(verdict, offset_s, residual, fit, residual_after_fit, findings, ...). fit: keys as in "
+        "sweeps; bounds: {key: (low, high)} in SI units.");
   m.def("load_spec", &load_spec, py::arg("spec"),
         "Read a link spec: every key with its default filled in, as report.json's 'spec'.");
   m.def("sweep", &sweep, py::arg("sweep"), py::kw_only(), py::arg("out") = py::none(),
