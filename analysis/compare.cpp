@@ -71,7 +71,8 @@ cd::EdgeList drive_traffic(const traffic::Drive& d) {
 // Standard deviation of the capture in its idle stretches (0.5 us before to 3 us after every
 // pulse and ringing excluded), less a 64-sample moving average (slow tails are not noise).
 double idle_noise(const std::vector<double>& t, const std::vector<double>& v,
-                  const eye::CheckResult& c) {
+                  const eye::CheckResult& c,
+                  const std::vector<std::pair<double, double>>& windows = {}) {
   std::vector<char> busy(t.size(), 0);
   auto mark = [&](double a, double b) {
     auto lo = std::lower_bound(t.begin(), t.end(), a - 0.5e-6);
@@ -80,6 +81,7 @@ double idle_noise(const std::vector<double>& t, const std::vector<double>& v,
   };
   for (const eye::PulseMetrics& p : c.pulses) mark(p.a, p.b);
   for (const eye::Ringing& r : c.ringing) mark(r.start, r.end);
+  for (const auto& [a, b] : windows) mark(a, b);  // the traffic's frames
   const size_t w = 64;
   double sum = 0, sum2 = 0;
   size_t n = 0;
@@ -466,6 +468,9 @@ StatusOr<CompareResult> compare_capture(const CompareInput& in, const link::Part
       vs.push_back(v[i]);
     }
   }
+  // With the traffic's windows known, noise is taken outside them too (a broken link's pulses
+  // may never pass the threshold, so the check alone does not see them).
+  r.noise_rms_v = idle_noise(t, v, r.check, r.windows);
   r.sim.resize(t.size());
   cd::synth_at(**e, *edges, r.offset_s, t, r.sim);
   std::vector<double> sw(ts.size());

@@ -251,6 +251,25 @@ TEST(Compare, TransformerCaptureAgainstACapSpecStaysAMismatch) {
   EXPECT_GT(r.residual_after_fit->rms_v, r.threshold_rms_v);
 }
 
+TEST(Compare, BrokenLinkThatDecodesNothingIsFittedFromTheSpecStimulus) {
+  // A 47 pF rx cap: no pulse stays past the threshold, nothing decodes; the spec's stimulus is
+  // the traffic, aligned on the pulses' edges, and the fit finds the cap within 10 %.
+  const std::string spec = write_spec("cap.yaml", kCapLink);
+  const std::string cap = capture("broken.csv", kCapLink, {{"rx.isolation.cap", "47p", true}});
+  CompareOptions opt;
+  opt.fit = {"rx.isolation.cap"};
+  opt.bounds["rx.isolation.cap"] = {20e-12, 10e-9};
+  const CompareResult r = run(cap, spec, opt);
+  EXPECT_TRUE(r.check.frames.empty());
+  EXPECT_EQ(r.traffic_from, "spec stimulus (nothing decoded)");
+  EXPECT_EQ(r.verdict, "mismatch");
+  ASSERT_EQ(r.fit.size(), 1u);
+  EXPECT_NEAR(r.fit[0].value, 47e-12, 4.7e-12) << compare_text(r);
+  ASSERT_TRUE(r.offset_after_fit_s);
+  EXPECT_NEAR(*r.offset_after_fit_s, 3.3e-6, 1.5e-9);  // the trigger, as made
+  EXPECT_LT(r.noise_rms_v, 0.03);  // the traffic's windows are not taken for idle
+}
+
 TEST(Compare, RecordWithoutPulsesIsInconclusive) {
   std::string text = "x-axis,1\nsecond,Volt\n";
   std::mt19937_64 rng(3);
