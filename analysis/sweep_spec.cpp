@@ -553,6 +553,14 @@ std::optional<double> spec_number(const link::LinkSpec& spec, const std::string&
   return std::nullopt;
 }
 
+StatusOr<link::LinkSpec> spec_with(const std::string& text, const std::string& name,
+                                   const std::vector<Assignment>& assign) {
+  StatusOr<YamlDoc> doc = YamlDoc::from_text(text, name);
+  if (!doc) return doc.status();
+  if (Status st = apply(doc->root(), assign); !st.ok()) return st;
+  return link::read_link_spec(*doc);
+}
+
 std::vector<double> range_values(double from, double to, int steps, bool log) {
   std::vector<double> v;
   if (steps < 1) return v;

@@ -183,5 +183,10 @@ std::optional<double> key_number(const std::string& path, const std::string& tex
 // The spec's numeric value at a dotted path (defaults included); nullopt when the key is not
 // numeric or is not set (e.g. an inductance taken from the part).
 std::optional<double> spec_number(const link::LinkSpec& spec, const std::string& path);
+// The link spec of a file's text (`name` for diagnostics) with `assign` set in its YAML tree
+// first, each value as the spec reader takes it: the key-path setter of every sweep point, for a
+// caller that varies keys itself (isolink compare's fit).
+StatusOr<link::LinkSpec> spec_with(const std::string& text, const std::string& name,
+                                   const std::vector<Assignment>& assign);
 
 }  // namespace isolink::analysis::sweep

@@ -20,6 +20,7 @@ void add_sweep_command(CLI::App& app, int* exit_code);
 void add_noise_command(CLI::App& app, int* exit_code);
 void add_worst_command(CLI::App& app, int* exit_code);
 void add_pack_command(CLI::App& app, int* exit_code);
+void add_compare_command(CLI::App& app, int* exit_code);
 
 // isolink pack's options; `isolink run` passes a pack spec on with its own -o, --parts, -q.
 struct PackArgs {

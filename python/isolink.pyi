@@ -83,5 +83,20 @@ def check(
 ) -> dict[str, Any]:
     """`isolink check --json` for samples v (V) at times t (s), plus "pass"."""
 
+def compare(
+    capture: Sequence[str],
+    spec: str,
+    *,
+    direction: str = "down",
+    fit: Sequence[str] = [],
+    bounds: dict[str, tuple[float, float]] = {},
+    frames: str = "",
+    p: str = "",
+    n: str = "",
+    diff: str = "",
+    parts: Sequence[str] = [],
+) -> dict[str, Any]:
+    """`isolink compare --json`: a capture against the link spec's simulation (and a fit)."""
+
 def load_spec(spec: Spec) -> dict[str, Any]:
     """The link spec with every default filled in (report.json's "spec")."""

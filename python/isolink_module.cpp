@@ -21,11 +21,13 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "analysis/compare.h"
 #include "analysis/link_run.h"
 #include "analysis/noise.h"
 #include "analysis/pack.h"
@@ -345,6 +347,35 @@ py::dict check(const py::array_t<double, py::array::c_style | py::array::forceca
 }
 
 // isolink.load_spec: the link spec with every default filled in (report.json's "spec").
+// isolink.compare: `isolink compare --json`'s object for a capture (one file, or P and N files)
+// and a link spec; errors (bad input) raise isolink.Error.
+py::dict compare(const std::vector<std::string>& capture, const std::string& spec,
+                 const std::string& direction, const std::vector<std::string>& fit,
+                 const std::map<std::string, std::pair<double, double>>& bounds,
+                 const std::string& frames, const std::string& p, const std::string& n,
+                 const std::string& diff, const std::vector<std::string>& parts_dirs) {
+  if (direction != "down" && direction != "up")
+    raise(Status::Error("direction: '" + direction + "' is none of down, up"));
+  analysis::CompareInput in{.files = capture, .spec_path = spec};
+  in.cols.p = p;
+  in.cols.n = n;
+  in.cols.diff = diff;
+  analysis::CompareOptions opt;
+  opt.direction = direction == "up" ? link::Direction::kUp : link::Direction::kDown;
+  opt.fit = fit;
+  opt.bounds = bounds;
+  opt.frames = frames;
+  StatusOr<analysis::CompareResult> r = Status::Error("not run");
+  {
+    py::gil_scoped_release nogil;
+    StatusOr<link::PartLibrary> parts = link::PartLibrary::load(parts_dirs);
+    r = parts ? analysis::compare_capture(in, *parts, opt)
+              : StatusOr<analysis::CompareResult>(parts.status());
+  }
+  if (!r) raise(r.status());
+  return to_python(analysis::compare_json(*r));
+}
+
 py::object load_spec(const py::object& spec_obj) {
   const SpecArg arg = spec_arg(spec_obj, "spec");
   StatusOr<link::LinkSpec> spec = Status::Error("not read");
@@ -375,6 +406,25 @@ PYBIND11_MODULE(isolink, m) {
         py::arg("engine") = "auto", py::arg("step") = py::none(), py::arg("tstop") = py::none(),
         py::arg("tmax") = py::none(), py::arg("method") = py::none(),
         py::arg("reltol") = py::none(), doc::kSim);
+  m.def("compare", &compare, py::arg("capture"), py::arg("spec"), py::kw_only(),
+        py::arg("direction") = "down", py::arg("fit") = std::vector<std::string>{},
+        py::arg("bounds") = std::map<std::string, std::pair<double, double>>{},
+        py::arg("frames") = "", py::arg("p") = "", py::arg("n") = "", py::arg("diff") = "",
+        py::arg("parts") = std::vector<std::string>{},
+        "Compare a scope capture with the link spec's simulation of the same traffic, as "
+        "`isolink compare --json`.\n\n"
+        "Args:\n"
+        "    capture: a list of file paths: one capture, or the P and N files.\n"
+        "    spec: the link spec's path (YAML).\n"
+        "    direction: 'down' or 'up', the receiver that was probed.\n"
+        "    fit: link-spec keys to fit, dotted as in sweeps ('rx.isolation.cap').\n"
+        "    bounds: {key: (low, high)} in SI units (default 0.2x-5x the design value).\n"
+        "    frames: traffic when nothing decodes (a stimulus script, as --frames).\n"
+        "    p, n, diff: the capture's column names, as check's --p/--n/--diff.\n"
+        "    parts: extra part-library folders.\n\n"
+        "Returns:\n"
+        "    dict: verdict, direction, offset_s, residual {rms_v, max_v}, fit {key: {value, "
+        "initial, low, high, stderr}}, residual_after_fit, findings [...], in SI units.");
   m.def("sweep", &sweep, py::arg("sweep"), py::kw_only(), py::arg("out") = py::none(),
         py::arg("jobs") = 0, py::arg("engine") = "auto", py::arg("parts") = no_parts, doc::kSweep);
   m.def("pack", &pack, py::arg("pack_spec"), py::kw_only(), py::arg("jobs") = 0,
@@ -382,6 +432,4 @@ PYBIND11_MODULE(isolink, m) {
   m.def("check", &check, py::arg("t"), py::arg("v"), py::kw_only(), py::arg("rules") = "bq7961x",
         py::arg("expect") = py::none(), doc::kCheck);
   m.def("load_spec", &load_spec, py::arg("spec"), doc::kLoadSpec);
-  // compare(capture, spec, fit=[...]): `isolink compare`'s object, once that command exists
-  // (issue 31): a SpecArg for spec, the capture as a path, the command's JSON builder.
 }

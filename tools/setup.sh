@@ -13,6 +13,7 @@ PACKAGES=(
   libeigen3-dev libsuitesparse-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libfmt-dev
   libopenimageio-dev openimageio-tools libtbb-dev fonts-dejavu-core
   openmpi-bin libopenmpi-dev
+  libceres-dev  # isolink compare's fit (analysis/compare_fit.cpp)
   libgtest-dev libgmock-dev libbenchmark-dev ngspice
   pybind11-dev python3-dev python3-numpy python3-pytest  # the Python module (python/) and its tests
   clang libclang-rt-14-dev  # libFuzzer targets (tests/fuzz) in CI

@@ -1,0 +1,188 @@
+// isolink compare: a scope capture of a receiver against the link spec's simulation of the same
+// traffic, the residual between them, and the part values that explain it (issue 29).
+//
+//   CompareInput in{.files = {"scope.csv"}, .spec_path = "link.yaml"};
+//   in.cols.p = "CH1"; in.cols.n = "CH2";
+//   CompareOptions opt;  opt.fit = {"rx.isolation.cap"};
+//   StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
+//   StatusOr<CompareResult> r = compare_capture(in, *parts, opt);
+//   if (!r) { fputs(r.status().message().c_str(), stderr); return 2; }   // bad input
+//   std::puts(compare_json(*r).dump(2).c_str());
+//   return r->verdict == "match" ? 0 : 1;
+//
+// Contract:
+// - Units: SI throughout (s, V, F, H, ohm, m). Times of the result are capture times (the
+//   capture's own axis); `offset_s` is capture time minus the model's drive time, so a simulated
+//   sample at drive time t sits at capture time t + offset_s.
+// - Errors: a Status (file:line:col or file: error: ...) for bad input only: an unreadable capture
+//   or spec, an unknown or non-numeric fit key, bounds that do not hold the design value, a
+//   --frames script that does not build. A capture without daisy-chain pulses is not an error but
+//   the verdict "inconclusive"; a capture that differs from the design is "mismatch".
+// - Ownership: the result owns everything it holds (waveforms for the plots included); nothing
+//   refers back to the input.
+// - Numbers in the result are finite (a non-finite simulation is an error).
+// Method (analysis/README.md, section Compare, has the argument):
+// 1. The capture is read by eye::read_capture (every layout of `isolink check`) and checked with
+//    the receiver's rules; its decoded frames (byte, error bit, preamble start) are the traffic.
+//    With none decoded, the spec's stimulus (or CompareOptions::frames) is the traffic.
+// 2. The link is linear: the receiver's v(t) is v_idle + sum_k dL_k E(t - t_k), E the edge
+//    response (analysis/worst.h, the LTI engine's reduced model), evaluated at the capture's own
+//    sample times (E interpolated linearly on its 1 ns grid), so edges fall at any time.
+// 3. Alignment: a squared-error scan of integer lags on a 1 ns grid, then a golden-section
+//    search of the continuous offset; no amplitude scaling.
+// 4. Fit: Ceres Solver (Levenberg-Marquardt, bounds) over log(value / design) of each key and
+//    the offset, Jacobian by central differences (1 % steps); standard errors from J^T J at the
+//    solution scaled by the residual variance; rank deficiency reported per key.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "base/status.h"
+#include "base/waveform.h"
+#include "eye/check.h"
+#include "eye/waveform_csv.h"
+#include "netlists/link/expand.h"
+#include "netlists/link/link_spec.h"
+#include "netlists/link/parts.h"
+
+namespace isolink::analysis {
+
+struct CompareInput {
+  std::vector<std::string> files;  // the capture: one file, or P then N
+  eye::CsvColumns cols;            // --p / --n / --diff / --time, as `isolink check`
+  std::string spec_path;           // the link spec (YAML)
+};
+
+struct CompareOptions {
+  link::Direction direction = link::Direction::kDown;  // which receiver was probed
+  // A stimulus script (netlists/traffic/stimulus.h) used when nothing in the capture decodes;
+  // empty: the spec's own stimulus.
+  std::string frames;
+  std::vector<std::string> fit;                             // keys, dotted paths as in sweeps
+  std::map<std::string, std::pair<double, double>> bounds;  // key -> [low, high], SI
+  double model_floor_rel = 0.01;  // model floor of the verdict, a fraction of the peak |v|
+  int max_iterations = 30;        // Levenberg-Marquardt iterations
+  link::ExpandOptions expand;     // driver, load, encoding
+};
+
+struct Residual {
+  double rms_v = 0;
+  double max_v = 0;
+  size_t samples = 0;  // capture samples it is taken over
+};
+
+// One metric of one pulse, measured on the capture and on the simulation at the same pulse.
+struct MetricPair {
+  std::string metric;  // vstart | vend | width | edge
+  size_t pulse = 0;    // index in the capture's pulses
+  double time = 0;     // the pulse's start crossing (capture time, s)
+  double measured = 0, simulated = 0;
+};
+// Per metric over the pulses: how far the simulation is from the capture.
+struct MetricSummary {
+  std::string metric;
+  size_t pulses = 0;
+  double mean_diff = 0;     // mean of simulated - measured (V or s)
+  double max_abs_diff = 0;  // largest |simulated - measured|
+  double at_time = 0;       // the pulse where it is largest (capture time)
+};
+
+struct FitKey {
+  std::string key;
+  double value = 0, initial = 0, low = 0, high = 0;
+  double stderr_value = 0;  // standard error (SI), from J^T J at the solution
+  double tolerance = 0.10;  // the design's band, relative (part or default)
+  std::string tolerance_from;
+  bool identifiable = true;  // false: only a combination with other keys is determined
+};
+
+struct Finding {
+  std::string key;
+  double design = 0, fitted = 0, change_rel = 0;
+  std::string text;
+};
+
+// A generic bounded least-squares fit (the link fit is one use; tests fit closed forms).
+struct LsqParam {
+  double initial = 0, low = 0, high = 0;
+  double step = 0.01;  // central-difference step in the parameter's own units
+};
+struct LsqResult {
+  std::vector<double> x;
+  std::vector<double> stderr_x;  // sqrt(diag(sigma^2 (J^T J)^+)), sigma^2 = SSE / (m - n)
+  double sse = 0;                // sum of squared residuals at x
+  int iterations = 0;
+  int evaluations = 0;             // residual evaluations, derivatives included
+  std::string report;              // Ceres' brief report
+  std::vector<bool> identifiable;  // per parameter
+  std::vector<double> singular;    // of J with columns scaled to unit norm, decreasing
+};
+// Residuals at x; an error stops the fit.
+using ResidualFn = std::function<Status(std::span<const double> x, std::vector<double>& r)>;
+StatusOr<LsqResult> fit_least_squares(const ResidualFn& f, size_t residuals,
+                                      const std::vector<LsqParam>& params, int max_iterations);
+
+struct CompareResult {
+  std::string verdict;  // match | mismatch | inconclusive
+  std::string direction;
+  std::string receiver_rules;
+  std::string traffic_from;          // "capture: 7 frames decoded", "spec stimulus", "--frames"
+  std::vector<std::string> reasons;  // why not match
+  std::vector<std::string> notes;
+  double offset_s = 0;  // capture time - drive time, before the fit
+  Residual residual;    // before the fit
+  std::optional<double> offset_after_fit_s;
+  std::optional<Residual> residual_after_fit;
+  double noise_rms_v = 0;      // the capture's noise (idle segments, detrended)
+  double quant_step_v = 0;     // its quantisation step (0: none found)
+  double model_floor_v = 0;    // model_floor_rel x peak |v| of the simulation
+  double threshold_rms_v = 0;  // 3 noise + q / sqrt(12) + floor
+  double threshold_max_v = 0;  // 6 noise + q + 5 floor
+  std::vector<FitKey> fit;
+  std::vector<std::string> unidentifiable;  // sentences about rank deficiency
+  std::vector<Finding> findings;
+  std::vector<MetricSummary> metrics;  // before the fit
+  std::vector<MetricSummary> metrics_after_fit;
+  std::vector<std::pair<double, double>> windows;  // residual windows (capture time)
+  // For the plots: the capture and the simulation at its samples (full record).
+  std::vector<double> time, capture, sim, sim_after_fit;
+  std::vector<size_t> worst_frames;  // window indices, worst residual first (at most 3)
+  eye::CheckResult check;            // the capture's own check
+  eye::CaptureInfo input;
+  // Issue 29's "commands": the decoded bytes parsed as TI command frames; filled by the command
+  // parser when it exists, an empty array until then.
+  nlohmann::ordered_json commands = nlohmann::ordered_json::array();
+  int evaluations = 0;
+  double seconds = 0;
+};
+
+StatusOr<CompareResult> compare_capture(const CompareInput& in, const link::PartLibrary& parts,
+                                        const CompareOptions& opt = {});
+
+// The issue's JSON shape (verdict, direction, offset_s, residual, fit, residual_after_fit,
+// findings) and more: noise, thresholds, metrics, input, commands.
+nlohmann::ordered_json compare_json(const CompareResult& r);
+// A few lines for people.
+std::string compare_text(const CompareResult& r);
+// The Markdown report body.
+std::string compare_markdown(const CompareResult& r);
+
+// The design value of a numeric key: the spec's, else the board preset's (series_r, bypass_c,
+// termination), else the transformer part's; with its tolerance band (relative) and where that
+// comes from. An error when the key is not a numeric link-spec key with a value.
+struct DesignValue {
+  double value = 0;
+  double tol_low = 0.10, tol_high = 0.10;  // relative band below / above
+  std::string tolerance_from;
+};
+StatusOr<DesignValue> design_value(const link::LinkSpec& spec, const link::PartLibrary& parts,
+                                   const std::string& key);
+
+}  // namespace isolink::analysis

@@ -1,0 +1,317 @@
+// isolink compare's model and fit: the simulation at arbitrary times from the edge response, the
+// spec with keys replaced (sweep's key-path setter), and the bounded least-squares fit (Ceres).
+#include <ceres/ceres.h>
+#include <fmt/format.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <tuple>
+
+#include "analysis/compare_model.h"
+#include "analysis/sweep_spec.h"
+#include "netlists/link/cards.h"
+
+namespace isolink::analysis {
+namespace compare_detail {
+
+void synth_at(const EdgeResponse& e, const EdgeList& edges, double offset,
+              std::span<const double> t, std::span<double> out) {
+  std::fill(out.begin(), out.end(), e.v_idle);
+  if (t.empty() || e.e.empty()) return;
+  const double dt = e.dt;
+  const double first = -static_cast<double>(e.pre) * dt;  // E's first sample, from the edge
+  const double last = first + static_cast<double>(e.e.size() - 1) * dt;
+  std::vector<double> after(t.size() + 1, 0.0);  // E's last value from an index on
+  for (size_t k = 0; k < edges.t.size(); ++k) {
+    const double t0 = edges.t[k] + offset;
+    const double dl = edges.dl[k];
+    auto lo = std::lower_bound(t.begin(), t.end(), t0 + first);
+    auto hi = std::upper_bound(t.begin(), t.end(), t0 + last);
+    for (auto it = lo; it < hi; ++it) {
+      const double x = (*it - t0 - first) / dt;
+      const size_t i = static_cast<size_t>(x);
+      const double f = x - static_cast<double>(i);
+      const double y = i + 1 < e.e.size() ? e.e[i] + f * (e.e[i + 1] - e.e[i]) : e.e.back();
+      out[static_cast<size_t>(it - t.begin())] += dl * y;
+    }
+    after[static_cast<size_t>(hi - t.begin())] += dl * e.e.back();
+  }
+  double run = 0;
+  for (size_t i = 0; i < t.size(); ++i) {
+    run += after[i];
+    out[i] += run;
+  }
+}
+
+std::vector<std::string> key_paths(const std::string& key) {
+  if (key.rfind("ends.", 0) == 0) return {"tx." + key.substr(5), "rx." + key.substr(5)};
+  return {key};
+}
+
+LinkModel::LinkModel(std::string spec_text, std::string spec_path, const link::PartLibrary& parts,
+                     link::Direction d, const link::ExpandOptions& expand)
+    : text_(std::move(spec_text)), path_(std::move(spec_path)), parts_(parts), dir_(d) {
+  wopt_.expand = expand;
+}
+
+StatusOr<const EdgeResponse*> LinkModel::response(const std::vector<std::string>& keys,
+                                                  const std::vector<double>& values) {
+  if (cached_ && values == cached_values_) return &cached_response_;
+  std::vector<sweep::Assignment> assign;
+  for (size_t i = 0; i < keys.size(); ++i)
+    for (const std::string& path : key_paths(keys[i]))
+      assign.push_back({path, fmt::format("{:.12g}", values[i]), true});
+  StatusOr<link::LinkSpec> spec = sweep::spec_with(text_, path_, assign);
+  if (!spec) return spec.status();
+  StatusOr<EdgeResponse> e = edge_response(*spec, parts_, dir_, wopt_);
+  if (!e) return e.status();
+  for (double x : e->e)
+    if (!std::isfinite(x)) return Status::Error("the simulated edge response is not finite");
+  ++evaluations_;
+  cached_response_ = std::move(*e);
+  cached_values_ = values;
+  cached_ = true;
+  return &cached_response_;
+}
+
+namespace {
+
+// Residuals and their Jacobian by central differences of each parameter's own step.
+class CentralCost : public ceres::CostFunction {
+ public:
+  CentralCost(const ResidualFn& f, size_t m, const std::vector<LsqParam>& p, int* evals)
+      : f_(f), p_(p), evals_(evals) {
+    set_num_residuals(static_cast<int>(m));
+    mutable_parameter_block_sizes()->push_back(static_cast<int>(p.size()));
+  }
+  bool Evaluate(double const* const* x, double* residuals, double** jacobians) const override {
+    const size_t n = p_.size(), m = static_cast<size_t>(num_residuals());
+    std::vector<double> xv(x[0], x[0] + n), r;
+    if (!call(xv, r)) return false;
+    std::copy(r.begin(), r.end(), residuals);
+    if (!jacobians || !jacobians[0]) return true;
+    std::vector<double> rp, rm;
+    for (size_t j = 0; j < n; ++j) {
+      std::vector<double> xp = xv, xm = xv;
+      xp[j] += p_[j].step;
+      xm[j] -= p_[j].step;
+      if (!call(xp, rp) || !call(xm, rm)) return false;
+      for (size_t i = 0; i < m; ++i) jacobians[0][i * n + j] = (rp[i] - rm[i]) / (2 * p_[j].step);
+    }
+    return true;
+  }
+
+ private:
+  bool call(const std::vector<double>& x, std::vector<double>& r) const {
+    ++*evals_;
+    r.clear();
+    Status s = f_(x, r);
+    if (!s.ok()) {
+      last_error = s;
+      return false;
+    }
+    return r.size() == static_cast<size_t>(num_residuals());
+  }
+  const ResidualFn& f_;
+  const std::vector<LsqParam>& p_;
+  int* evals_;
+
+ public:
+  mutable Status last_error;
+};
+
+// Standard errors and identifiability from the Jacobian at the solution.
+void covariance(const Eigen::MatrixXd& J, double sse, LsqResult& out) {
+  const Eigen::Index m = J.rows(), n = J.cols();
+  Eigen::VectorXd norms = J.colwise().norm();
+  Eigen::MatrixXd Js = J;
+  for (Eigen::Index j = 0; j < n; ++j)
+    if (norms(j) > 0) Js.col(j) /= norms(j);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(Js, Eigen::ComputeThinV);
+  const Eigen::VectorXd s = svd.singularValues();
+  out.singular.assign(s.data(), s.data() + s.size());
+  out.identifiable.assign(static_cast<size_t>(n), true);
+  const double smax = s.size() ? s(0) : 0.0;
+  for (Eigen::Index k = 0; k < s.size(); ++k) {
+    if (s(k) > 1e-3 * smax) continue;  // a direction the capture barely sees
+    for (Eigen::Index j = 0; j < n; ++j)
+      if (std::abs(svd.matrixV()(j, k)) > 0.2 || norms(j) == 0)
+        out.identifiable[static_cast<size_t>(j)] = false;
+  }
+  for (Eigen::Index j = 0; j < n; ++j)
+    if (norms(j) == 0) out.identifiable[static_cast<size_t>(j)] = false;
+  const double sigma2 = m > n ? sse / static_cast<double>(m - n) : 0.0;
+  // (J^T J)^+ in the scaled columns: V diag(1/s^2) V^T, small singular values dropped.
+  Eigen::MatrixXd inv = Eigen::MatrixXd::Zero(n, n);
+  for (Eigen::Index k = 0; k < s.size(); ++k)
+    if (s(k) > 1e-12 * smax)
+      inv += svd.matrixV().col(k) * svd.matrixV().col(k).transpose() / (s(k) * s(k));
+  out.stderr_x.assign(static_cast<size_t>(n), 0.0);
+  for (Eigen::Index j = 0; j < n; ++j)
+    if (norms(j) > 0)
+      out.stderr_x[static_cast<size_t>(j)] = std::sqrt(sigma2 * inv(j, j)) / norms(j);
+}
+
+}  // namespace
+
+}  // namespace compare_detail
+
+StatusOr<LsqResult> fit_least_squares(const ResidualFn& f, size_t residuals,
+                                      const std::vector<LsqParam>& params, int max_iterations) {
+  namespace cd = compare_detail;
+  LsqResult out;
+  const size_t n = params.size();
+  if (n == 0 || residuals < n) return Status::Error("a fit needs more residuals than parameters");
+  for (const LsqParam& p : params)
+    if (!(p.low <= p.initial && p.initial <= p.high && p.step > 0))
+      return Status::Error(fmt::format("a fit parameter starts at {:g} outside [{:g}, {:g}]",
+                                       p.initial, p.low, p.high));
+  std::vector<double> x;
+  for (const LsqParam& p : params) x.push_back(p.initial);
+  auto* cost = new cd::CentralCost(f, residuals, params, &out.evaluations);
+  ceres::Problem problem;
+  problem.AddResidualBlock(cost, nullptr, x.data());
+  for (size_t j = 0; j < n; ++j) {
+    problem.SetParameterLowerBound(x.data(), static_cast<int>(j), params[j].low);
+    problem.SetParameterUpperBound(x.data(), static_cast<int>(j), params[j].high);
+  }
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = max_iterations;
+  so.num_threads = 1;
+  so.logging_type = ceres::SILENT;
+  so.function_tolerance = 1e-8;
+  so.parameter_tolerance = 1e-8;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+  if (!cost->last_error.ok() && summary.termination_type == ceres::FAILURE) return cost->last_error;
+  if (summary.termination_type == ceres::FAILURE)
+    return Status::Error("the fit failed: " + summary.message);
+  out.x = x;
+  out.iterations = static_cast<int>(summary.iterations.size());
+  out.report = summary.BriefReport();
+  // The Jacobian at the solution, for the standard errors.
+  std::vector<double> r(residuals), jac(residuals * n);
+  double* jp = jac.data();
+  const double* xp = x.data();
+  if (!cost->Evaluate(&xp, r.data(), &jp))
+    return cost->last_error.ok() ? Status::Error("the fit's model failed at its solution")
+                                 : cost->last_error;
+  out.sse = 0;
+  for (double v : r) out.sse += v * v;
+  Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J(
+      jac.data(), static_cast<Eigen::Index>(residuals), static_cast<Eigen::Index>(n));
+  cd::covariance(J, out.sse, out);
+  return out;
+}
+
+namespace compare_detail {
+namespace {
+
+std::string label_of(const std::string& key) {
+  std::string s = key;
+  if (s.rfind("ends.", 0) == 0) s = "both ends' " + s.substr(5);
+  std::replace(s.begin(), s.end(), '.', ' ');
+  std::replace(s.begin(), s.end(), '_', ' ');
+  return s;
+}
+
+std::string advice_of(const std::string& key) {
+  const std::string last = key.substr(key.rfind('.') + 1);
+  if (last == "cap" || last == "bypass_c" || last == "cable_side_c" || last == "esd")
+    return "check the part, its value and its solder joint";
+  if (last == "length")
+    return "check the cable's length, its type (material, gauge) and the "
+           "connectors on the way";
+  if (last == "termination" || last == "series_r")
+    return "check the resistor's value, its placement and its solder joints";
+  if (last == "inductance" || last == "leakage" || last == "dcr" || last == "winding_c")
+    return "check the transformer's part number, its orientation and its solder joints";
+  return "check the part and its assembly";
+}
+
+}  // namespace
+
+StatusOr<std::pair<double, double>> fit_bounds(const CompareOptions& opt, const std::string& key,
+                                               double design) {
+  double lo = 0.2 * design, hi = 5 * design;
+  if (auto b = opt.bounds.find(key); b != opt.bounds.end()) std::tie(lo, hi) = b->second;
+  if (!(lo > 0 && lo <= design && design <= hi))
+    return Status::Error(
+        fmt::format("--bounds: error: {}={:g}:{:g} must hold the design value {:g} and be above 0",
+                    key, lo, hi, design));
+  return std::pair<double, double>{lo, hi};
+}
+
+Status run_fit(LinkModel& model, const link::LinkSpec& spec, const link::PartLibrary& parts,
+               const CompareOptions& opt, const FitData& data, CompareResult& r,
+               std::vector<double>& fitted) {
+  const size_t nk = opt.fit.size();
+  std::vector<LsqParam> params;
+  std::vector<DesignValue> design;
+  for (const std::string& key : opt.fit) {
+    StatusOr<DesignValue> d = design_value(spec, parts, key);
+    if (!d) return d.status();
+    StatusOr<std::pair<double, double>> b = fit_bounds(opt, key, d->value);
+    if (!b) return b.status();
+    const auto [lo, hi] = *b;
+    params.push_back({0.0, std::log(lo / d->value), std::log(hi / d->value), 0.01});
+    design.push_back(*d);
+  }
+  params.push_back({0.0, -50.0, 50.0, 0.05});  // the offset, ns from the aligned one
+  const std::span<const double> t = data.t, v = data.v;
+  std::vector<double> s(t.size()), values(nk);
+  const ResidualFn f = [&](std::span<const double> x, std::vector<double>& res) -> Status {
+    for (size_t j = 0; j < nk; ++j) values[j] = design[j].value * std::exp(x[j]);
+    StatusOr<const EdgeResponse*> e = model.response(opt.fit, values);
+    if (!e) return e.status();
+    synth_at(**e, *data.edges, data.offset + x[nk] * 1e-9, t, s);
+    res.resize(t.size());
+    for (size_t i = 0; i < t.size(); ++i) res[i] = v[i] - s[i];
+    return Status::Ok();
+  };
+  StatusOr<LsqResult> fit = fit_least_squares(f, t.size(), params, opt.max_iterations);
+  if (!fit) return fit.status();
+  fitted.resize(nk);
+  std::vector<std::string> unident;
+  for (size_t j = 0; j < nk; ++j) {
+    FitKey k;
+    k.key = opt.fit[j];
+    k.initial = design[j].value;
+    k.value = fitted[j] = design[j].value * std::exp(fit->x[j]);
+    k.low = design[j].value * std::exp(params[j].low);
+    k.high = design[j].value * std::exp(params[j].high);
+    k.stderr_value = k.value * fit->stderr_x[j];
+    k.tolerance = std::max(design[j].tol_low, design[j].tol_high);
+    k.tolerance_from = design[j].tolerance_from;
+    k.identifiable = fit->identifiable[j];
+    if (!k.identifiable) unident.push_back(k.key);
+    r.fit.push_back(k);
+    const double rel = k.value / k.initial - 1;
+    if (k.identifiable && (rel < -design[j].tol_low || rel > design[j].tol_high)) {
+      const config::Unit u = sweep::key_unit(key_paths(k.key).front());
+      const char* sym = config::unit_symbol(u);
+      r.findings.push_back(
+          {k.key, k.initial, k.value, rel,
+           fmt::format("{} behaves like {} against {} in the design ({:+.0f} %): {}",
+                       label_of(k.key), link::format_si(k.value, sym),
+                       link::format_si(k.initial, sym), rel * 100, advice_of(k.key))});
+    }
+  }
+  if (!unident.empty()) {
+    std::string keys;
+    for (const std::string& k : unident) keys += (keys.empty() ? "" : ", ") + k;
+    r.unidentifiable.push_back(fmt::format(
+        "{} {} not separately identifiable from this capture (the fit's Jacobian is rank "
+        "deficient): only a combination is determined (two isolation caps in series show only "
+        "their series value); fit one of them, or hold the others at the design",
+        keys, unident.size() > 1 ? "are" : "is"));
+  }
+  r.offset_after_fit_s = data.offset + fit->x[nk] * 1e-9;
+  r.notes.push_back(fmt::format("fit: {} ({} simulations)", fit->report, model.evaluations()));
+  return Status::Ok();
+}
+
+}  // namespace compare_detail
+}  // namespace isolink::analysis

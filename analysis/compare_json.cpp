@@ -1,0 +1,187 @@
+// isolink compare's result as JSON (issue 29's shape and more), text and Markdown.
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "analysis/compare.h"
+#include "analysis/sweep_spec.h"
+#include "netlists/link/cards.h"
+
+namespace isolink::analysis {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+// Non-finite numbers never reach the output: null instead.
+json num(double v) {
+  return std::isfinite(v) ? json(v) : json(nullptr);
+}
+
+json residual_json(const Residual& r) {
+  return {{"rms_v", num(r.rms_v)}, {"max_v", num(r.max_v)}, {"samples", r.samples}};
+}
+
+json metrics_json(const std::vector<MetricSummary>& ms) {
+  json out = json::object();
+  for (const MetricSummary& m : ms)
+    out[m.metric] = {{"pulses", m.pulses},
+                     {"mean_diff", num(m.mean_diff)},
+                     {"max_abs_diff", num(m.max_abs_diff)},
+                     {"at_s", num(m.at_time)}};
+  return out;
+}
+
+const char* metric_unit(const std::string& m) {
+  return m == "vstart" || m == "vend" ? "V" : "s";
+}
+
+std::string si(double v, const char* unit) {
+  return link::format_si(v, unit);
+}
+
+std::string key_unit_symbol(const std::string& key) {
+  const std::string path = key.rfind("ends.", 0) == 0 ? "tx." + key.substr(5) : key;
+  return config::unit_symbol(sweep::key_unit(path));
+}
+
+}  // namespace
+
+nlohmann::ordered_json compare_json(const CompareResult& r) {
+  json j;
+  j["verdict"] = r.verdict;
+  j["direction"] = r.direction;
+  j["offset_s"] = num(r.offset_s);
+  j["residual"] = residual_json(r.residual);
+  json fit = json::object();
+  for (const FitKey& k : r.fit)
+    fit[k.key] = {{"value", num(k.value)},
+                  {"initial", num(k.initial)},
+                  {"low", num(k.low)},
+                  {"high", num(k.high)},
+                  {"stderr", num(k.stderr_value)},
+                  {"tolerance_rel", num(k.tolerance)},
+                  {"tolerance_from", k.tolerance_from},
+                  {"identifiable", k.identifiable}};
+  j["fit"] = fit;
+  j["residual_after_fit"] = r.residual_after_fit ? residual_json(*r.residual_after_fit) : json();
+  if (r.offset_after_fit_s) j["offset_after_fit_s"] = num(*r.offset_after_fit_s);
+  json findings = json::array();
+  for (const Finding& f : r.findings)
+    findings.push_back({{"key", f.key},
+                        {"design", num(f.design)},
+                        {"fitted", num(f.fitted)},
+                        {"change_rel", num(f.change_rel)},
+                        {"text", f.text}});
+  j["findings"] = findings;
+  j["reasons"] = r.reasons;
+  j["unidentifiable"] = r.unidentifiable;
+  j["traffic_from"] = r.traffic_from;
+  j["rules"] = r.receiver_rules;
+  j["noise"] = {{"rms_v", num(r.noise_rms_v)},
+                {"quantisation_step_v", num(r.quant_step_v)},
+                {"model_floor_v", num(r.model_floor_v)},
+                {"threshold_rms_v", num(r.threshold_rms_v)},
+                {"threshold_max_v", num(r.threshold_max_v)}};
+  j["metrics"] = metrics_json(r.metrics);
+  if (!r.metrics_after_fit.empty()) j["metrics_after_fit"] = metrics_json(r.metrics_after_fit);
+  json windows = json::array();
+  for (const auto& [a, b] : r.windows) windows.push_back({num(a), num(b)});
+  j["windows_s"] = windows;
+  j["capture_check"] = {{"verdict", r.check.verdict()},
+                        {"pulses", r.check.pulses.size()},
+                        {"frames", r.check.frames.size()},
+                        {"bytes", r.check.bytes.size()}};
+  j["commands"] = r.commands;
+  j["notes"] = r.notes;
+  j["simulations"] = r.evaluations;
+  j["seconds"] = num(r.seconds);
+  j["input"] = eye::capture_json(r.input);
+  return j;
+}
+
+std::string compare_text(const CompareResult& r) {
+  std::string s = fmt::format("{}  compare ({}, {}; traffic: {})\n", r.verdict, r.direction,
+                              r.receiver_rules, r.traffic_from);
+  if (r.verdict == "inconclusive") {
+    for (const std::string& x : r.reasons) s += "  " + x + "\n";
+    return s;
+  }
+  s += fmt::format("  offset {:.4f} us; residual rms {:.1f} mV, max {:.0f} mV over {} samples\n",
+                   r.offset_s * 1e6, r.residual.rms_v * 1e3, r.residual.max_v * 1e3,
+                   r.residual.samples);
+  s += fmt::format(
+      "  capture noise {:.1f} mV rms, quantisation step {:.2f} mV, model floor {:.1f} mV: "
+      "match needs rms <= {:.1f} mV and max <= {:.0f} mV\n",
+      r.noise_rms_v * 1e3, r.quant_step_v * 1e3, r.model_floor_v * 1e3, r.threshold_rms_v * 1e3,
+      r.threshold_max_v * 1e3);
+  for (const MetricSummary& m : r.metrics)
+    if (m.pulses)
+      s += fmt::format("  {:<6} simulated - measured: mean {}, worst {} over {} pulses\n", m.metric,
+                       si(m.mean_diff, metric_unit(m.metric)),
+                       si(m.max_abs_diff, metric_unit(m.metric)), m.pulses);
+  for (const FitKey& k : r.fit) {
+    const std::string u = key_unit_symbol(k.key);
+    s += fmt::format("  fit {} = {} +/- {} (design {}, bounds {} .. {}){}\n", k.key,
+                     si(k.value, u.c_str()), si(k.stderr_value, u.c_str()),
+                     si(k.initial, u.c_str()), si(k.low, u.c_str()), si(k.high, u.c_str()),
+                     k.identifiable ? "" : "  not identifiable");
+  }
+  if (r.residual_after_fit)
+    s += fmt::format("  after the fit: residual rms {:.1f} mV, max {:.0f} mV\n",
+                     r.residual_after_fit->rms_v * 1e3, r.residual_after_fit->max_v * 1e3);
+  for (const std::string& u : r.unidentifiable) s += "  note: " + u + "\n";
+  for (const Finding& f : r.findings) s += "  finding: " + f.text + "\n";
+  for (const std::string& x : r.reasons) s += "  reason: " + x + "\n";
+  return s;
+}
+
+std::string compare_markdown(const CompareResult& r) {
+  std::string s = fmt::format("# isolink compare: {}\n\n", r.verdict);
+  s += fmt::format("Direction {}, receiver rules {}, traffic from the {}.\n\n", r.direction,
+                   r.receiver_rules, r.traffic_from);
+  for (const std::string& x : r.reasons) s += "- " + x + "\n";
+  if (!r.reasons.empty()) s += "\n";
+  if (r.verdict == "inconclusive") return s;
+  s += "| | rms | max |\n|---|---|---|\n";
+  s += fmt::format("| residual | {:.1f} mV | {:.0f} mV |\n", r.residual.rms_v * 1e3,
+                   r.residual.max_v * 1e3);
+  if (r.residual_after_fit)
+    s += fmt::format("| after the fit | {:.1f} mV | {:.0f} mV |\n",
+                     r.residual_after_fit->rms_v * 1e3, r.residual_after_fit->max_v * 1e3);
+  s += fmt::format("| match threshold | {:.1f} mV | {:.0f} mV |\n\n", r.threshold_rms_v * 1e3,
+                   r.threshold_max_v * 1e3);
+  s += fmt::format(
+      "Capture noise {:.1f} mV rms (idle stretches), quantisation step {:.2f} mV, model floor "
+      "{:.1f} mV; offset {:.4f} us (capture time minus drive time).\n\n",
+      r.noise_rms_v * 1e3, r.quant_step_v * 1e3, r.model_floor_v * 1e3, r.offset_s * 1e6);
+  if (!r.fit.empty()) {
+    s += "| key | fitted | stderr | design | bounds | tolerance | identifiable |\n";
+    s += "|---|---|---|---|---|---|---|\n";
+    for (const FitKey& k : r.fit) {
+      const std::string u = key_unit_symbol(k.key);
+      s += fmt::format("| {} | {} | {} | {} | {} .. {} | {:.0f} % ({}) | {} |\n", k.key,
+                       si(k.value, u.c_str()), si(k.stderr_value, u.c_str()),
+                       si(k.initial, u.c_str()), si(k.low, u.c_str()), si(k.high, u.c_str()),
+                       k.tolerance * 100, k.tolerance_from, k.identifiable ? "yes" : "no");
+    }
+    s += "\n";
+  }
+  for (const std::string& u : r.unidentifiable) s += "Note: " + u + "\n\n";
+  if (!r.findings.empty()) {
+    s += "## Findings\n\n";
+    for (const Finding& f : r.findings) s += "- " + f.text + "\n";
+    s += "\n";
+  }
+  s += "## Pulse metrics, simulated minus measured\n\n| metric | pulses | mean | worst |\n";
+  s += "|---|---|---|---|\n";
+  const std::vector<MetricSummary>& ms =
+      r.metrics_after_fit.empty() ? r.metrics : r.metrics_after_fit;
+  for (const MetricSummary& m : ms)
+    s += fmt::format("| {} | {} | {} | {} |\n", m.metric, m.pulses,
+                     si(m.mean_diff, metric_unit(m.metric)),
+                     si(m.max_abs_diff, metric_unit(m.metric)));
+  if (!r.metrics_after_fit.empty()) s += "\n(after the fit)\n";
+  return s;
+}
+
+}  // namespace isolink::analysis

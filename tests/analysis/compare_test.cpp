@@ -1,0 +1,317 @@
+// isolink compare (analysis/compare.h), on synthetic captures whose truth is known: the link
+// simulated by the transient engine (compare fits with the LTI model's edge response), then a
+// scope's bandwidth limit, clock, noise, 8-bit quantisation and trigger offset, written in a real
+// scope layout (synthetic_capture.h).
+// - the fitter against closed forms: an RC step's time constant, exactly and with noise (its
+//   standard error against the textbook sigma / sqrt(sum (dv/dtau)^2));
+// - the superposition at arbitrary times against analysis::synthesize on its grid;
+// - a nominal capture: match, no findings, the trigger offset recovered;
+// - a halved rx isolation cap, a longer cable, another termination: mismatch, and the fit finds
+//   the truth (caps and length within 10 %, termination within 20 %), the finding names the key;
+// - a transformer capture against a cap spec: mismatch even after fitting the cable length;
+// - a record without pulses: inconclusive; bad keys and bounds: errors.
+#include "analysis/compare.h"
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <random>
+
+#include "analysis/compare_model.h"
+#include "analysis/worst.h"
+#include "base/file_io.h"
+#include "tests/analysis/synthetic_capture.h"
+
+namespace isolink::analysis {
+namespace {
+
+const char* kCapLink = R"(name: cap-2m
+tx: {device: bq7961x, isolation: {type: cap, cap: 2.2n}}
+rx: {device: bq7961x, isolation: {type: cap, cap: 2.2n}}
+cable: {length: 2, material: pp, gauge: 24}
+stimulus: {frames: ["stack-write reg=0x0100 data=02B778BC"], direction: down}
+)";
+
+const char* kXfmrLink = R"(name: xfmr-2m
+tx: {device: bq7961x, isolation: {type: transformer, part: HMU1228NL}}
+rx: {device: bq7961x, isolation: {type: transformer, part: HMU1228NL}}
+cable: {length: 2, material: pp, gauge: 24}
+stimulus: {frames: ["stack-write reg=0x0100 data=02B778BC"], direction: down}
+)";
+
+std::string tmp_dir() {
+  const std::string d =
+      (std::filesystem::temp_directory_path() / fmt::format("isolink_compare_test_{}", ::getpid()))
+          .string();
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+std::string write_spec(const std::string& name, const char* text) {
+  const std::string p = tmp_dir() + "/" + name;
+  EXPECT_TRUE(write_file_atomic(p, text).ok());
+  return p;
+}
+
+const link::PartLibrary& parts() {
+  static const link::PartLibrary lib = *link::PartLibrary::load({});
+  return lib;
+}
+
+// A capture of `spec_text` with `truth` applied, through the scope model.
+std::string capture(const std::string& name, const char* spec_text,
+                    std::vector<sweep::Assignment> truth, testing::ScopeModel scope = {}) {
+  const std::string p = tmp_dir() + "/" + name;
+  Status s = testing::write_synthetic_capture(spec_text, name + ".yaml", truth, scope, p);
+  EXPECT_TRUE(s.ok()) << s.message();
+  return p;
+}
+
+CompareResult run(const std::string& cap, const std::string& spec, CompareOptions opt = {},
+                  eye::CsvColumns cols = {}) {
+  CompareInput in{.files = {cap}, .cols = cols, .spec_path = spec};
+  StatusOr<CompareResult> r = compare_capture(in, parts(), opt);
+  EXPECT_TRUE(r.ok()) << r.status().message();
+  return r.ok() ? *r : CompareResult{};
+}
+
+TEST(CompareFit, RcTimeConstantExactly) {
+  // v(t) = 1 - exp(-t / tau) sampled every 10 ns over 5 us, tau = 470 ns; the fit starts at
+  // 1 us and is bounded to [100 ns, 5 us].
+  const double tau = 470e-9;
+  std::vector<double> t, v;
+  for (int i = 0; i < 500; ++i) {
+    t.push_back(i * 10e-9);
+    v.push_back(1 - std::exp(-t.back() / tau));
+  }
+  const ResidualFn f = [&](std::span<const double> x, std::vector<double>& r) {
+    r.resize(t.size());
+    for (size_t i = 0; i < t.size(); ++i) r[i] = v[i] - (1 - std::exp(-t[i] / (x[0] * 1e-9)));
+    return Status::Ok();
+  };
+  StatusOr<LsqResult> fit = fit_least_squares(f, t.size(), {{1000, 100, 5000, 0.01}}, 50);
+  ASSERT_TRUE(fit.ok()) << fit.status().message();
+  EXPECT_NEAR(fit->x[0], 470.0, 1e-6);
+  EXPECT_LT(fit->sse, 1e-18);
+}
+
+TEST(CompareFit, RcTimeConstantWithNoiseAndItsStandardError) {
+  // The same RC with Gaussian noise sigma = 10 mV: the standard error must be the closed form
+  // sigma / sqrt(sum_i (dv_i / dtau)^2), dv/dtau = -t / tau^2 exp(-t / tau), and the estimate
+  // within 4 of them of the truth.
+  const double tau = 470e-9, sigma = 0.01;
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> n(0, sigma);
+  std::vector<double> t, v;
+  double s2 = 0;
+  for (int i = 0; i < 500; ++i) {
+    t.push_back(i * 10e-9);
+    v.push_back(1 - std::exp(-t.back() / tau) + n(rng));
+    const double d = -t.back() / (tau * tau) * std::exp(-t.back() / tau) * 1e-9;  // per ns
+    s2 += d * d;
+  }
+  const ResidualFn f = [&](std::span<const double> x, std::vector<double>& r) {
+    r.resize(t.size());
+    for (size_t i = 0; i < t.size(); ++i) r[i] = v[i] - (1 - std::exp(-t[i] / (x[0] * 1e-9)));
+    return Status::Ok();
+  };
+  StatusOr<LsqResult> fit = fit_least_squares(f, t.size(), {{1000, 100, 5000, 0.01}}, 50);
+  ASSERT_TRUE(fit.ok()) << fit.status().message();
+  const double se = sigma / std::sqrt(s2);  // ns
+  EXPECT_NEAR(fit->stderr_x[0], se, 0.15 * se);
+  EXPECT_NEAR(fit->x[0], 470.0, 4 * se);
+}
+
+TEST(CompareFit, TwoProportionalParametersAreNotIdentifiable) {
+  // v = a b t: only the product is determined; the fit must say so for both.
+  std::vector<double> t, v;
+  for (int i = 1; i <= 50; ++i) {
+    t.push_back(i);
+    v.push_back(6.0 * i);
+  }
+  const ResidualFn f = [&](std::span<const double> x, std::vector<double>& r) {
+    r.resize(t.size());
+    for (size_t i = 0; i < t.size(); ++i) r[i] = v[i] - x[0] * x[1] * t[i];
+    return Status::Ok();
+  };
+  StatusOr<LsqResult> fit =
+      fit_least_squares(f, t.size(), {{1, 0.1, 10, 0.01}, {1, 0.1, 10, 0.01}}, 50);
+  ASSERT_TRUE(fit.ok()) << fit.status().message();
+  EXPECT_NEAR(fit->x[0] * fit->x[1], 6.0, 1e-6);
+  EXPECT_FALSE(fit->identifiable[0]);
+  EXPECT_FALSE(fit->identifiable[1]);
+}
+
+TEST(CompareModel, SuperpositionAtAnyTimeEqualsTheGridSynthesis) {
+  StatusOr<link::LinkSpec> spec = link::read_link_spec_text(kCapLink, "cap.yaml");
+  ASSERT_TRUE(spec.ok());
+  StatusOr<EdgeResponse> e = edge_response(*spec, parts(), link::Direction::kDown, {});
+  ASSERT_TRUE(e.ok()) << e.status().message();
+  Traffic tr{.frames = {{0x5A, 0}, {0xC3, 1}}, .gaps = {1e-6, 3.8e-6}};
+  traffic::EncodingOptions enc;
+  const Waveform w = synthesize(*e, tr, enc, 0, 30e-6);
+  compare_detail::EdgeList edges;
+  // The same two frames as level changes (what compare replays from decoded frames).
+  for (size_t f = 0; f < 2; ++f) {
+    traffic::EncodingOptions ef = enc;
+    ef.error_bit = tr.frames[f].error_bit;
+    const std::vector<int> hb = traffic::byte_half_bits(tr.frames[f].byte, ef);
+    const double t0 = tr.frame_start(f, traffic::byte_duration(enc));
+    int level = 0;
+    for (size_t j = 0; j <= hb.size(); ++j) {
+      const int next = j < hb.size() ? hb[j] : 0;
+      if (next != level) edges.t.push_back(t0 + j * enc.half_bit), edges.dl.push_back(next - level);
+      level = next;
+    }
+  }
+  std::vector<double> out(w.time.size());
+  compare_detail::synth_at(*e, edges, 0.0, w.time, out);
+  double worst = 0;
+  for (size_t i = 0; i < out.size(); ++i)
+    worst = std::max(worst, std::abs(out[i] - w.columns[0][i]));
+  EXPECT_LT(worst, 1e-9);
+  // Half a sample later, each value is the mean of its neighbours' (linear interpolation).
+  std::vector<double> mid(w.time.size() - 1), tm(w.time.size() - 1);
+  for (size_t i = 0; i + 1 < w.time.size(); ++i) tm[i] = (w.time[i] + w.time[i + 1]) / 2;
+  compare_detail::synth_at(*e, edges, 0.0, tm, mid);
+  for (size_t i = 0; i + 1 < w.time.size(); i += 997)
+    EXPECT_NEAR(mid[i], (w.columns[0][i] + w.columns[0][i + 1]) / 2, 1e-9);
+}
+
+TEST(Compare, NominalCaptureMatchesAndTheTriggerOffsetIsRecovered) {
+  const std::string spec = write_spec("cap.yaml", kCapLink);
+  testing::ScopeModel scope;  // 2.5 GS/s, 300 MHz, 10 mV, 8 bits over +/-5 V, 3.3 us
+  const CompareResult r = run(capture("nominal.csv", kCapLink, {}, scope), spec);
+  EXPECT_EQ(r.verdict, "match") << compare_text(r);
+  EXPECT_TRUE(r.findings.empty());
+  EXPECT_EQ(r.traffic_from, "capture: 9 frames decoded");
+  // Drive time t is capture time t + trigger, plus the bandwidth limit's delay (tau = 0.53 ns).
+  EXPECT_NEAR(r.offset_s, scope.trigger, 1.5e-9);
+  // The noise estimate: 10 mV per channel, the differential sqrt(2) x; quantised at 10 V / 256.
+  EXPECT_NEAR(r.quant_step_v, 10.0 / 256, 1e-6);
+  EXPECT_NEAR(r.noise_rms_v, 10e-3 * std::sqrt(2.0), 4e-3);
+}
+
+TEST(Compare, HalvedRxCapIsAMismatchAndTheFitFindsIt) {
+  const std::string spec = write_spec("cap.yaml", kCapLink);
+  testing::ScopeModel scope;
+  scope.sample_rate = 1.25e9;
+  scope.bandwidth = 200e6;
+  scope.noise_v = 15e-3;
+  scope.trigger = -2.7e-6;
+  scope.layout = "rigol";
+  const std::string cap =
+      capture("half_cap.csv", kCapLink, {{"rx.isolation.cap", "1.1n", true}}, scope);
+  eye::CsvColumns cols{.p = "CH1", .n = "CH2"};
+  const CompareResult before = run(cap, spec, {}, cols);
+  EXPECT_EQ(before.verdict, "mismatch");
+  CompareOptions opt;
+  opt.fit = {"rx.isolation.cap"};
+  const CompareResult r = run(cap, spec, opt, cols);
+  EXPECT_EQ(r.verdict, "mismatch");
+  ASSERT_EQ(r.fit.size(), 1u);
+  EXPECT_NEAR(r.fit[0].value, 1.1e-9, 0.1 * 1.1e-9) << compare_text(r);
+  EXPECT_DOUBLE_EQ(r.fit[0].initial, 2.2e-9);
+  EXPECT_NEAR(r.fit[0].low, 0.44e-9, 1e-15);
+  EXPECT_NEAR(r.fit[0].high, 11e-9, 1e-15);
+  ASSERT_EQ(r.findings.size(), 1u);
+  EXPECT_EQ(r.findings[0].key, "rx.isolation.cap");
+  EXPECT_NEAR(r.findings[0].change_rel, -0.5, 0.05);
+  EXPECT_NE(r.findings[0].text.find("rx isolation cap behaves like"), std::string::npos);
+  ASSERT_TRUE(r.residual_after_fit);
+  EXPECT_LT(r.residual_after_fit->rms_v, r.threshold_rms_v);
+  EXPECT_LT(r.residual_after_fit->rms_v, 0.5 * r.residual.rms_v);
+}
+
+TEST(Compare, CableLengthAndTerminationAreRecovered) {
+  const std::string spec = write_spec("cap.yaml", kCapLink);
+  const std::string cap = capture(
+      "long.csv", kCapLink, {{"cable.length", "3.2", true}, {"rx.termination", "1300", true}});
+  CompareOptions opt;
+  opt.fit = {"cable.length", "rx.termination"};
+  const CompareResult r = run(cap, spec, opt);
+  ASSERT_EQ(r.fit.size(), 2u);
+  EXPECT_NEAR(r.fit[0].value, 3.2, 0.32) << compare_text(r);
+  EXPECT_NEAR(r.fit[1].value, 1300, 260) << compare_text(r);
+  EXPECT_EQ(r.verdict, "mismatch");  // both are outside their 10 % bands
+  EXPECT_EQ(r.findings.size(), 2u);
+}
+
+TEST(Compare, TransformerCaptureAgainstACapSpecStaysAMismatch) {
+  const std::string spec = write_spec("cap.yaml", kCapLink);
+  const std::string cap = capture("xfmr.csv", kXfmrLink, {});
+  CompareOptions opt;
+  opt.fit = {"cable.length"};
+  const CompareResult r = run(cap, spec, opt);
+  EXPECT_EQ(r.verdict, "mismatch") << compare_text(r);
+  ASSERT_TRUE(r.residual_after_fit);
+  EXPECT_GT(r.residual_after_fit->rms_v, r.threshold_rms_v);
+}
+
+TEST(Compare, BrokenLinkThatDecodesNothingIsFittedFromTheSpecStimulus) {
+  // A 47 pF rx cap: no pulse stays past the threshold, nothing decodes; the spec's stimulus is
+  // the traffic, aligned on the pulses' edges, and the fit finds the cap within 10 %.
+  const std::string spec = write_spec("cap.yaml", kCapLink);
+  const std::string cap = capture("broken.csv", kCapLink, {{"rx.isolation.cap", "47p", true}});
+  CompareOptions opt;
+  opt.fit = {"rx.isolation.cap"};
+  opt.bounds["rx.isolation.cap"] = {20e-12, 10e-9};
+  const CompareResult r = run(cap, spec, opt);
+  EXPECT_TRUE(r.check.frames.empty());
+  EXPECT_EQ(r.traffic_from, "spec stimulus (nothing decoded)");
+  EXPECT_EQ(r.verdict, "mismatch");
+  ASSERT_EQ(r.fit.size(), 1u);
+  EXPECT_NEAR(r.fit[0].value, 47e-12, 4.7e-12) << compare_text(r);
+  ASSERT_TRUE(r.offset_after_fit_s);
+  EXPECT_NEAR(*r.offset_after_fit_s, 3.3e-6, 1.5e-9);  // the trigger, as made
+  EXPECT_LT(r.noise_rms_v, 0.03);  // the traffic's windows are not taken for idle
+}
+
+TEST(Compare, RecordWithoutPulsesIsInconclusive) {
+  std::string text = "x-axis,1\nsecond,Volt\n";
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> n(0, 0.01);
+  for (int i = 0; i < 20000; ++i) text += fmt::format("{:.6e},{:.5f}\n", i * 4e-10, n(rng));
+  const std::string cap = tmp_dir() + "/quiet.csv";
+  ASSERT_TRUE(write_file_atomic(cap, text).ok());
+  const CompareResult r = run(cap, write_spec("cap.yaml", kCapLink));
+  EXPECT_EQ(r.verdict, "inconclusive");
+}
+
+TEST(Compare, BadKeysAndBoundsAreRefused) {
+  const std::string spec = write_spec("cap.yaml", kCapLink);
+  const std::string cap = tmp_dir() + "/tiny.csv";  // checked before the capture is looked at
+  ASSERT_TRUE(write_file_atomic(cap, "t,v\n0,0\n1e-9,0.1\n2e-9,0\n").ok());
+  CompareInput in{.files = {cap}, .spec_path = spec};
+  CompareOptions opt;
+  opt.fit = {"rx.isolation.colour"};
+  StatusOr<CompareResult> r = compare_capture(in, parts(), opt);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("rx.isolation.colour"), std::string::npos);
+  opt.fit = {"cable.gauge"};
+  EXPECT_FALSE(compare_capture(in, parts(), opt).ok());
+  opt.fit = {"cable.length"};
+  opt.bounds["cable.length"] = {5, 10};  // does not hold the design's 2 m
+  r = compare_capture(in, parts(), opt);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("--bounds"), std::string::npos);
+}
+
+TEST(Compare, DesignValuesComeFromTheSpecTheBoardAndThePart) {
+  StatusOr<link::LinkSpec> spec = link::read_link_spec_text(kXfmrLink, "x.yaml");
+  ASSERT_TRUE(spec.ok());
+  StatusOr<DesignValue> l = design_value(*spec, parts(), "rx.isolation.inductance");
+  ASSERT_TRUE(l.ok()) << l.status().message();
+  EXPECT_GT(l->value, 150e-6);  // HMU1228NL: OCL 150-370 uH
+  EXPECT_LT(l->value, 370e-6);
+  StatusOr<DesignValue> t = design_value(*spec, parts(), "rx.termination");
+  ASSERT_TRUE(t.ok());
+  EXPECT_DOUBLE_EQ(t->value, 1000);  // the bq7961x board preset
+  EXPECT_DOUBLE_EQ(t->tol_low, 0.10);
+}
+
+}  // namespace
+}  // namespace isolink::analysis
