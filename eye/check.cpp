@@ -13,8 +13,8 @@
 #include "base/csv.h"
 #include "base/file_io.h"
 #include "base/hex.h"
-#include "eye/verdict.h"
 #include "eye/commands.h"
+#include "eye/verdict.h"
 
 namespace isolink::eye {
 namespace {

@@ -351,11 +351,16 @@ py::dict check(const py::array_t<double, py::array::c_style | py::array::forceca
 // and a link spec; errors (bad input) raise isolink.Error.
 py::dict compare(const std::vector<std::string>& capture, const std::string& spec,
                  const std::string& direction, const std::vector<std::string>& fit,
-                 const std::map<std::string, std::pair<double, double>>& bounds,
-                 const std::string& frames, const std::string& p, const std::string& n,
-                 const std::string& diff, const std::vector<std::string>& parts_dirs) {
+                 const py::dict& bounds_obj, const std::string& frames, const std::string& p,
+                 const std::string& n, const std::string& diff,
+                 const std::vector<std::string>& parts_dirs) {
   if (direction != "down" && direction != "up")
     raise(Status::Error("direction: '" + direction + "' is none of down, up"));
+  std::map<std::string, std::pair<double, double>> bounds;
+  for (const auto& [key, range] : bounds_obj) {
+    const auto pair = range.cast<std::pair<double, double>>();
+    bounds[key.cast<std::string>()] = pair;
+  }
   analysis::CompareInput in{.files = capture, .spec_path = spec};
   in.cols.p = p;
   in.cols.n = n;
@@ -408,9 +413,8 @@ PYBIND11_MODULE(isolink, m) {
         py::arg("reltol") = py::none(), doc::kSim);
   m.def("compare", &compare, py::arg("capture"), py::arg("spec"), py::kw_only(),
         py::arg("direction") = "down", py::arg("fit") = std::vector<std::string>{},
-        py::arg("bounds") = std::map<std::string, std::pair<double, double>>{},
-        py::arg("frames") = "", py::arg("p") = "", py::arg("n") = "", py::arg("diff") = "",
-        py::arg("parts") = std::vector<std::string>{},
+        py::arg("bounds") = py::dict(), py::arg("frames") = "", py::arg("p") = "",
+        py::arg("n") = "", py::arg("diff") = "", py::arg("parts") = std::vector<std::string>{},
         "Compare a scope capture with the link spec's simulation of the same traffic, as "
         "`isolink compare --json`.\n\n"
         "Args:\n"

@@ -89,7 +89,7 @@ PACK = {
                               "tx": {"device": "bq7961x"}}],
 }
 # The noise analysis over a narrow band (a few points keep it short).
-NOISE = dict(BASE, noise={"f_start": "1meg", "f_stop": "100meg", "points_per_decade": 2,
+NOISE = dict(BASE, noise={"band": ["1meg", "100meg"], "points_per_decade": 2,
                           "time_domain": False})
 
 

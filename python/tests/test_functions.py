@@ -76,7 +76,7 @@ def test_run_with_worst_has_the_worst_case(worst_dict):
     assert r["worst_case"]["directions"][0]["worst"]["vstart"]["value"] <= spec_vstart + 1e-9
 
 
-NOISE = dict(ONE_BYTE, noise={"f_start": "1meg", "f_stop": "100meg", "points_per_decade": 2,
+NOISE = dict(ONE_BYTE, noise={"band": ["1meg", "100meg"], "points_per_decade": 2,
                               "time_domain": False})
 
 

@@ -82,7 +82,7 @@ TEST(InputFile, FifoWithoutEndStopsAtTheDeadline) {
             path +
                 ": error: no end of input after 0.3 s (a FIFO or pipe, not a regular file: "
                 "read for at most 0.3 s and 64 MiB; save its content to a file)");
-  EXPECT_GE(took, 0.3);
+  EXPECT_GE(took, 0.29);  // the deadline, less poll()'s rounding to whole milliseconds
   EXPECT_LT(took, 5.0);
   // a writer that writes a line and holds the pipe open: the same
   const int w = ::open(path.c_str(), O_RDWR);  // RDWR: does not wait for a reader
