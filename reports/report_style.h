@@ -8,6 +8,7 @@
 #include <cmath>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "eye/check.h"
@@ -91,8 +92,11 @@ inline std::string time_us(double t) {
 // Drops whole labels that would overlap the one placed before (x ranges), for long records.
 struct LabelRow {
   double last_right = -1e18;
+  std::vector<std::pair<double, double>> reserved;  // column spans no label may touch
   bool fits(double left, double right, double gap = 6) {
     if (left < last_right + gap) return false;
+    for (const auto& [x0, x1] : reserved)
+      if (left < x1 + gap && right > x0 - gap) return false;
     last_right = right;
     return true;
   }

@@ -87,10 +87,17 @@ void shade_frames(Canvas& c, const PlotArea& a, const eye::CheckResult& r, bool 
                                          : f.fault;
     text = fmt::format("F{} {}", i, text);
     const int w = c.measure(text, style::kLabelSize).width;
-    const double x = std::max(static_cast<double>(span.x0) + 3, a.rect.x0 + 3.0);
-    if (x + w < a.rect.x1 - 2 && labels->fits(x, x + w))
-      c.text(x, a.rect.y1 - 6, text, style::kLabelSize, f.fails() ? kFrameFailText : kMuted,
-             FontFace::kSans, HAlign::kLeft, VAlign::kBottom);
+    // At the frame's start, or else just right of a reserved span (the marked pulse's box)
+    // while still inside the frame.
+    std::vector<double> xs{std::max(static_cast<double>(span.x0) + 3, a.rect.x0 + 3.0)};
+    for (const auto& [r0, r1] : labels->reserved)
+      if (r1 + 8 > xs.front() && r1 + 8 + w < span.x1) xs.push_back(r1 + 8);
+    for (double x : xs)
+      if (x + w < a.rect.x1 - 2 && labels->fits(x, x + w)) {
+        c.text(x, a.rect.y1 - 6, text, style::kLabelSize, f.fails() ? kFrameFailText : kMuted,
+               FontFace::kSans, HAlign::kLeft, VAlign::kBottom);
+        break;
+      }
   }
 }
 
@@ -180,6 +187,14 @@ std::vector<std::string> wrap(const Canvas& c, const std::vector<std::string>& w
   return lines;
 }
 
+// The dashed box in the plot around the zoom inset's time window.
+Rect marked_box(const WavePanelLayout& L) {
+  const PlotArea& a = L.diff;
+  Rect box{a.col(L.zoom->x.lo), a.rect.y0 + 2, a.col(L.zoom->x.hi) + 1, a.rect.y1 - 2};
+  if (box.width() < 6) box.x0 -= 3, box.x1 += 3;
+  return box;
+}
+
 // The marked pulse: orange in the plot inside a dashed orange box, and magnified in the zoom inset
 // below (framed in the same orange), with its label above the inset.
 void draw_marked(Canvas& c, const WavePanelLayout& L, const WavePanel& p, const AxisTicks& yt) {
@@ -192,8 +207,7 @@ void draw_marked(Canvas& c, const WavePanelLayout& L, const WavePanel& p, const 
   clip_series(p.time, p.diff, pm.a - lead, pm.b, &xs, &ys);
   c.series(a, xs, ys, LineStyle{.color = kMark, .width = 4});
   const LineStyle dashed{.color = kMark, .width = 2, .dash = 6, .gap = 4};
-  Rect box{a.col(z.x.lo), a.rect.y0 + 2, a.col(z.x.hi) + 1, a.rect.y1 - 2};
-  if (box.width() < 6) box.x0 -= 3, box.x1 += 3;
+  const Rect box = marked_box(L);
   c.line(box.x0, box.y0, box.x1, box.y0, dashed);
   c.line(box.x0, box.y1, box.x1, box.y1, dashed);
   c.line(box.x0, box.y0, box.x0, box.y1, dashed);
@@ -232,6 +246,10 @@ void draw_panel(Canvas& c, const WavePanelLayout& L, const WavePanel& p) {
   const AxisTicks yt = make_ticks(a.y, UnitScale{1, "V"}, 8);
 
   style::LabelRow frame_labels;
+  if (L.zoom) {  // the dashed box's sides would cross a frame label inside it
+    const Rect box = marked_box(L);
+    frame_labels.reserved.emplace_back(box.x0, box.x1);
+  }
   if (p.tones) shade_frames(c, a, *p.tones, true, &frame_labels);
   shade_frames(c, a, r, r.tone, &frame_labels);
   draw_grid(c, a, xt, yt, kGridOver);

@@ -7,6 +7,9 @@
   const app = document.getElementById('app');
   const kind = document.body.dataset.kind;
   let pending = 0;  // plots and images still drawing
+  // Every plot, for scripting and for the browser test (tests/reports/html_browser_test.py):
+  // {kind: 'wave' | 'margin', graph: the Dygraph, ...}.
+  const plots = window.isolinkPlots = [];
   function waitFor() { ++pending; let done = false;
     return function () { if (done) return; done = true; if (--pending === 0) ready(); }; }
   function ready() { document.body.dataset.ready = '1'; }
@@ -102,13 +105,16 @@
     function lower(x) { let lo = 0, hi = n; while (lo < hi) { const m = (lo + hi) >> 1; if (t[m] < x) lo = m + 1; else hi = m; } return lo; }
     function isBad(x) { for (const b of bad) if (x >= b[0] && x <= b[1]) return true; return false; }
     let built = null;  // [t0, t1, step] of the data now in the plot
-    function rows(x0, x1) {
+    // The samples of [x0, x1] for a view `w` wide: every sample when the view holds at most
+    // 2 x kBuckets of them, else the min and max of each of kBuckets buckets per view width.
+    function rows(x0, x1, w) {
       const i0 = Math.max(0, lower(x0) - 1), i1 = Math.min(n, lower(x1) + 1);
+      const nb = Math.max(1, Math.ceil(kBuckets * (x1 - x0) / w));
       const out = [];
       const push = bad.length ? i => out.push([t[i], v[i], isBad(t[i]) ? v[i] : null]) : i => out.push([t[i], v[i]]);
-      if (i1 - i0 <= 2 * kBuckets) { for (let i = i0; i < i1; ++i) push(i); return out; }
-      for (let b = 0; b < kBuckets; ++b) {
-        const a = i0 + Math.floor((i1 - i0) * b / kBuckets), z = i0 + Math.floor((i1 - i0) * (b + 1) / kBuckets);
+      if (i1 - i0 <= 2 * nb) { for (let i = i0; i < i1; ++i) push(i); return out; }
+      for (let b = 0; b < nb; ++b) {
+        const a = i0 + Math.floor((i1 - i0) * b / nb), z = i0 + Math.floor((i1 - i0) * (b + 1) / nb);
         let lo = a, hi = a;
         for (let i = a; i < z; ++i) { if (v[i] < v[lo]) lo = i; if (v[i] > v[hi]) hi = i; }
         push(Math.min(lo, hi)); if (hi !== lo) push(Math.max(lo, hi));
@@ -128,7 +134,7 @@
       const x0 = Math.max(full[0], range[0] - w), x1 = Math.min(full[1], range[1] + w);
       built = [x0, x1, w];
       rebuilding = true;
-      g.updateOptions({file: rows(x0, x1), dateWindow: range});
+      g.updateOptions({file: rows(x0, x1, w), dateWindow: range});
       rebuilding = false;
     }
     function underlay(ctx, area, gr) {
@@ -170,7 +176,7 @@
       }
       ctx.restore();
     }
-    g = new Dygraph(div, rows(full[0], full[1]), {
+    g = new Dygraph(div, rows(full[0], full[1], full[1] - full[0]), {
       labels: ['time', 'v(P) - v(N)'].concat(bad.length ? ['failing pulse'] : []),
       colors: ['#1f3f77', '#e00000'],
       series: {'failing pulse': {strokeWidth: 2.5}},
@@ -195,6 +201,7 @@
           setTimeout(() => rebuild(gr.xAxisRange()), 0);
       },
     });
+    plots.push({kind: 'wave', graph: g, time: t});
     // Wheel: zoom around the cursor.
     div.addEventListener('wheel', e => {
       if (!e.ctrlKey && !e.altKey) return;  // a plain wheel scrolls the page
@@ -379,7 +386,9 @@
     const order = xs.map((x, i) => i).sort((a, b) => xs[a] - xs[b]);
     const rows = order.map(ix => [xs[ix], ...Array.from({length: nser}, (_, is) => {
       const l = cells[ix + ',' + is]; const m = l ? worst(l) : null; return m == null ? null : m * 100; })]);
-    const labels = [ax.name, ...(ax1 ? ax1.labels.map(l => ax1.name + ' = ' + l) : ['worst margin'])];
+    // A numeric axis names its values with their unit ("1.538 nF"), as an engineer reads them.
+    const valueText = (a, i) => a.values.length ? si(a.values[i], a.unit) : a.labels[i];
+    const labels = [ax.name, ...(ax1 ? ax1.labels.map((l, i) => ax1.name + ' = ' + valueText(ax1, i)) : ['worst margin'])];
     const div = el('div', {cls: 'plot margin'}), legend = el('div', {cls: 'legend'}), info = el('div', {cls: 'pointinfo', id: 'point-info', text: 'Hover a point for its values; click it to open its row.'});
     host.append(div, legend, info);
     const done = waitFor();
@@ -392,7 +401,7 @@
     }
     const g = new Dygraph(div, rows, {
       labels: labels, labelsDiv: legend, legend: 'always',
-      drawPoints: true, pointSize: 4, highlightCircleSize: 7, strokeWidth: 2,
+      drawPoints: true, pointSize: 4, highlightCircleSize: 7, strokeWidth: 2, xRangePad: 12,
       xlabel: ax.name + unit, ylabel: 'worst relative margin (%)',
       logscale: false, axes: {x: {logscale: !!ax.log && ax.values.length > 0,
         axisLabelFormatter: x => ax.values.length ? fmt(x, 3) : (ax.labels[Math.round(x)] || ''),
@@ -422,6 +431,7 @@
         const name = g.getHighlightSeries(); openRows(cellOf(sel, g.getLabels().indexOf(name))); },
       drawCallback: (gr, initial) => { if (initial) done(); },
     });
+    plots.push({kind: 'margin', graph: g});
     host.append(el('p', {cls: 'note', text: 'Squares: points that fail (or a cell where any point fails). The shaded side of 0 % passes.'}));
   }
 

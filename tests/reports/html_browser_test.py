@@ -12,7 +12,11 @@ OUT_DIR/report.html (the screenshot goes to OUT_DIR_screenshot.png unless --scre
   points in results.csv (sweep: PASS only when every point passes);
 - every plot drew: one dygraph canvas per waveform / margin plot;
 - a screenshot is not blank: enough non-white pixels, many colours, and the waveform trace's own
-  colour (#1f3f77) or the margin plot's present.
+  colour (#1f3f77) or the margin plot's present;
+- with real mouse events (DevTools protocol on a pipe, cdp_pipe.py): a run's waveform, dragged to
+  a 500 ns window (two pulses), shows every sample in it (full resolution) where the whole record was min/max
+  decimated; a sweep's margin plot, hovered on a point, names that cell's points with their
+  verdicts from results.csv and plots their worst margin, and a click highlights their rows.
 """
 import csv
 import json
@@ -22,6 +26,10 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import cdp_pipe  # noqa: E402
 
 CHROMIUM_FLAGS = [
     "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
@@ -74,6 +82,107 @@ def pixel_stats(oiiotool, path, want):
     return w, h, nonwhite / total, len(colours), near
 
 
+# The dygraph, its data and where a data point lies on the page, evaluated in the page.
+PLOT_JS = "(() => { const p = isolinkPlots.find(p => p.kind === %r); return p ? (%s) : null; })()"
+
+
+def check_wave_zoom(b):
+    """Drag-zoom the first waveform to 500 ns: every sample of the record inside it is plotted."""
+    g = "p.graph"
+    before = b.eval(PLOT_JS % ("wave", "{rows: %s.numRows(), samples: p.time.length, "
+                                       "t0: p.time[0], t1: p.time[p.time.length - 1]}" % g))
+    if before is None:
+        fail("no waveform plot registered in isolinkPlots")
+    if before["samples"] > 4000 and before["rows"] > 4100:
+        fail("whole record: %d rows for %d samples (no min/max decimation)"
+             % (before["rows"], before["samples"]))
+    a = before["t0"] + 0.3 * (before["t1"] - before["t0"])
+    b.eval("window.scrollTo(0, 0)")
+    # As a reviewer zooms: a first drag to about a tenth of the record, then one to 500 ns
+    # (dygraph ignores drags under 10 pixels, which 500 ns of a long record is).
+    for z in (a + 0.1 * (before["t1"] - before["t0"]), a + 500e-9):
+        pos = b.eval(PLOT_JS % ("wave", "(() => { const g = p.graph, r = g.graphDiv.getBoundingClientRect(),"
+                                        " ar = g.getArea(); return {xa: r.left + g.toDomXCoord(%r),"
+                                        " xz: r.left + g.toDomXCoord(%r), y: r.top + ar.y + ar.h / 2}; })()"
+                                % (a, z)))
+        b.drag(pos["xa"], pos["y"], pos["xz"], pos["y"])
+        time.sleep(0.3)  # the rebuild after a zoom runs from a timer
+    count = ("(() => { const g = p.graph, r = g.xAxisRange(); let rows = 0, samples = 0;"
+             " for (let i = 0; i < g.numRows(); ++i) { const x = g.getValue(i, 0);"
+             " if (x >= r[0] && x <= r[1]) ++rows; }"
+             " for (const x of p.time) if (x >= r[0] && x <= r[1]) ++samples;"
+             " return {lo: r[0], hi: r[1], rows: rows, samples: samples}; })()")
+    ok = b.wait_for(PLOT_JS % ("wave", count) + ".rows === " + PLOT_JS % ("wave", count) +
+                    ".samples", timeout=20)
+    after = b.eval(PLOT_JS % ("wave", count))
+    span = after["hi"] - after["lo"]
+    if not 400e-9 < span < 600e-9:
+        fail("the drag over 500 ns zoomed to %.3g s" % span)
+    if not ok or after["rows"] < 50:
+        fail("zoomed to %.3g s: %d rows plotted for %d samples" % (span, after["rows"],
+                                                                  after["samples"]))
+    print("zoom: whole record %d rows for %d samples; dragged to %.3g ns: %d of %d samples"
+          % (before["rows"], before["samples"], span * 1e9, after["rows"], after["samples"]))
+
+
+def check_sweep_hover_click(b, out):
+    """Hover a margin-plot point: it names its cell's points and verdicts; a click marks the rows.
+
+    The point's x is placed with toPercentXCoord: dygraph 2.2.1's toDomXCoord ignores a log axis."""
+    with open(os.path.join(out, "results.csv")) as f:
+        rows = sorted(csv.DictReader(f), key=lambda r: int(r["point"]))  # written as they finish
+    pick = b.eval(PLOT_JS % ("margin", "(() => { const g = p.graph, n = g.numRows(),"
+                                       " ns = g.getLabels().length - 1, row = Math.min(2, n - 1),"
+                                       " col = Math.min(3, ns), x = g.getValue(row, 0),"
+                                       " y = g.getValue(row, col), r = g.graphDiv.getBoundingClientRect(),"
+                                       " ar = g.getArea(); return {px: r.left + ar.x + g.toPercentXCoord(x) * ar.w,"
+                                       " py: r.top + g.toDomYCoord(y), x: x, y: y, col: col,"
+                                       " labels: g.getLabels()}; })()"))
+    if pick is None:
+        fail("no margin plot registered in isolinkPlots")
+    x_key = pick["labels"][0]
+    cell = [r for r in rows if abs(float(r[x_key]) - pick["x"]) <= 1e-9 * abs(pick["x"])]
+    series = pick["labels"][pick["col"]]
+    if " = " in series:  # one line per value of the second axis, in the sweep's order
+        s_key = series.split(" = ")[0]
+        values = list(dict.fromkeys(r[s_key] for r in rows))
+        cell = [r for r in cell if r[s_key] == values[pick["col"] - 1]]
+    if not cell:
+        fail("no results.csv row at %s = %g" % (x_key, pick["x"]))
+    margins = [float(r["worst_margin_rel"]) for r in cell if r["worst_margin_rel"]]
+    if margins and abs(min(margins) * 100 - pick["y"]) > 1e-4:
+        fail("the plot shows %g %% where results.csv's worst is %g %%" % (pick["y"], min(margins) * 100))
+    b.eval("window.scrollTo(0, 0)")
+    b.mouse("mouseMoved", pick["px"], pick["py"])
+    want = ["point %s:" % r["point"] for r in cell]
+    info_js = "document.getElementById('point-info').textContent"
+    if not b.wait_for(" && ".join("%s.includes(%r)" % (info_js, w) for w in want), timeout=10):
+        fail("hovering %s = %g shows %r, expected %s" % (x_key, pick["x"], b.eval(info_js), want))
+    info = b.eval(info_js)
+    for r in cell:
+        line = next(l for l in info.split("\n") if l.startswith("point %s:" % r["point"]))
+        if r["verdict"].upper() not in line:
+            fail("hover line %r does not say %s" % (line, r["verdict"].upper()))
+    b.click(pick["px"], pick["py"])
+    marked = "Array.from(document.querySelectorAll('tr.hl')).map(t => t.id).sort().join(',')"
+    expect = ",".join(sorted("point-" + r["point"] for r in cell))
+    if not b.wait_for("%s === %r" % (marked, expect), timeout=10):
+        fail("a click marked rows %r, expected %r" % (b.eval(marked), expect))
+    print("hover on %s = %g: %s; click marked %s" % (x_key, pick["x"], info.replace("\n", " | "),
+                                                     expect))
+
+
+def interact(browser, url, kind, out):
+    with tempfile.TemporaryDirectory() as profile:
+        with cdp_pipe.Browser(browser, CHROMIUM_FLAGS, url, profile) as b:
+            if not b.wait_for("document.body && document.body.dataset.ready === '1'", timeout=90):
+                fail("data-ready never became 1 under the DevTools pipe")
+            if kind == "run":
+                check_wave_zoom(b)
+            elif kind == "sweep":
+                check_sweep_hover_click(b, out)
+
+
 def main():
     argv = sys.argv[1:]
     sep = argv.index("--")
@@ -124,6 +233,9 @@ def main():
     canvases = len(re.findall(r"<canvas", dom))
     if plots and canvases < 2 * plots:  # dygraph draws each plot on two canvases
         fail("%d canvases for %d plots" % (canvases, plots))
+
+    if kind in ("run", "sweep") and (plots or kind == "sweep"):
+        interact(browser, url, kind, out)
 
     shot = shot or out + "_screenshot.png"
     with tempfile.TemporaryDirectory() as profile:

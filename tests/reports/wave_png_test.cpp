@@ -224,6 +224,17 @@ TEST(WavePng, MarkedPulseGetsAZoomInsetAndItsLabelClearOfTheFrameLabels) {
   // The frames' byte labels are still there (dark text in that row outside the box).
   const auto dark = [](const std::array<int, 3>& c) { return c[0] < 140 && c[1] < 140; };
   EXPECT_GT(count_if(img, {bottom.x0, bottom.y0, bx0, bottom.y1}, dark), 50);
+  // No frame label inside the dashed box, where its sides would cross the text: no grey text
+  // pixels (kMuted 0x666666 and its anti-aliased edges) in that part of the row. The frame that
+  // holds the marked pulse starts inside the box, so its label would otherwise sit there.
+  ASSERT_GT(a.col(d.c.frames[1].start), bx0);
+  ASSERT_LT(a.col(d.c.frames[1].start) + 40, bx1);
+  const auto grey = [](const std::array<int, 3>& c) {
+    return std::abs(c[0] - c[1]) < 10 && std::abs(c[1] - c[2]) < 10 && c[0] < 0xB0;
+  };
+  EXPECT_EQ(count_if(img, {bx0, bottom.y0, bx1, bottom.y1}, grey), 0);
+  // That frame's label moves just right of the box, still inside the frame.
+  EXPECT_GT(count_if(img, {bx1, bottom.y0, bx1 + 120, bottom.y1}, grey), 30);
 }
 
 }  // namespace
