@@ -7,7 +7,8 @@
 //   // per direction: the link's transient and its check (run_link), for the noise budget
 //   NoiseDirectionInput in{link::Direction::kDown, &check, &rules, &wave};
 //   StatusOr<NoiseResult> r = analyze_noise(spec, *parts, {&in, 1});
-//   r->pass, r->directions[0].points[k].immunity, noise_json(*r).dump(2)
+//   r->pass, r->directions[0].points[k].immunity, reports::noise_json(*r).dump(2)
+//   (reports/noise_report.h)
 //
 // Model (analysis/README.md has the choices and their sources):
 //   - The boards' grounds are kept apart (expand_link with tx_ground "gtx", rx_ground "grx"),
@@ -28,7 +29,6 @@
 
 #include <complex>
 #include <cstdint>
-#include <nlohmann/json_fwd.hpp>
 #include <optional>
 #include <span>
 #include <string>
@@ -250,10 +250,6 @@ struct NoiseRun {
 };
 StatusOr<NoiseRun> run_noise(const link::LinkSpec& spec, const link::PartLibrary& parts);
 
-// The shape of `isolink noise --json` (issue 16) with more fields.
-nlohmann::ordered_json noise_json(const NoiseResult& r);
-// The report.md section ("## Noise immunity ...").
-std::string noise_markdown(const NoiseResult& r);
 // The immunity the verdict uses (noise.verdict_on): the worst corner's or the statistical one.
 struct VerdictImmunity {
   double value = 0;

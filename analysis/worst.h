@@ -6,7 +6,7 @@
 //   StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
 //   StatusOr<WorstResult> w = worst_case(spec, *parts, {});
 //   for (const DirectionWorst& d : w->directions) d.metric("vstart")->value ...
-//   std::puts(worst_json(*w).dump(2).c_str());
+//   std::puts(reports::worst_json(*w).dump(2).c_str());  // reports/worst_report.h
 //   return w->pass ? 0 : 1;
 //
 // Method (the README "Worst case over all traffic" has the argument in full):
@@ -37,7 +37,6 @@
 
 #include <cstdint>
 #include <functional>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -191,18 +190,7 @@ StatusOr<WorstResult> worst_case(const link::LinkSpec& spec, const link::PartLib
 StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::Rules& rules,
                                               const WorstOptions& opt);
 
-// The stimulus block that replays a metric's traffic in `isolink run` (YAML flow map).
-std::string reproduce_stimulus(const WorstMetric& m, link::Direction d);
-// The same block as JSON, exactly the keys `stimulus:` takes (frames, gaps as times with their
-// unit, "3.85u", direction): `spec["stimulus"] = reproduce` replays it. worst_json's `reproduce`.
-nlohmann::ordered_json reproduce_json(const WorstMetric& m, link::Direction d);
 // The traffic as a StimulusSpec (frames "raw HH nocrc [err]", gaps, the direction).
 link::StimulusSpec reproduce_spec(const WorstMetric& m, link::Direction d);
-
-// JSON (the shape of issue 12: verdict, directions[].worst.{vstart, vend, width_min, width_max,
-// edge}), Markdown section body, terminal lines.
-nlohmann::ordered_json worst_json(const WorstResult& r);
-std::string worst_markdown(const WorstResult& r);
-std::string worst_summary_text(const WorstResult& r);
 
 }  // namespace isolink::analysis

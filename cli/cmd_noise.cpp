@@ -14,6 +14,7 @@
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
 #include "reports/noise_png.h"
+#include "reports/noise_report.h"
 #include "reports/run_report.h"
 
 namespace isolink::cli {
@@ -64,15 +65,15 @@ int run_noise(const NoiseArgs& a) {
     images.push_back("noise.png");
   }
   nlohmann::ordered_json j = reports::run_report_json(*spec, *run);
-  j["noise"] = analysis::noise_json(*noise);
+  j["noise"] = reports::noise_json(*noise);
   if (Status s = write_file_atomic(dir + "/report.json", j.dump(2) + "\n"); !s.ok()) return fail(s);
   std::string md =
-      reports::run_report_markdown(*spec, *run, {}) + "\n" + analysis::noise_markdown(*noise);
+      reports::run_report_markdown(*spec, *run, {}) + "\n" + reports::noise_markdown(*noise);
   for (const std::string& i : images) md += fmt::format("![{}]({})\n", i, i);
   if (Status s = write_file_atomic(dir + "/report.md", md); !s.ok()) return fail(s);
 
   if (a.json) {
-    std::puts(analysis::noise_json(*noise).dump(2).c_str());
+    std::puts(reports::noise_json(*noise).dump(2).c_str());
   } else {
     const char* unit = noise->spec.level_unit();
     for (const analysis::NoiseDirection& d : noise->directions) {

@@ -21,6 +21,7 @@
 #include "reports/run_images.h"
 #include "reports/run_report.h"
 #include "reports/worst_png.h"
+#include "reports/worst_report.h"
 
 namespace isolink::cli {
 using namespace isolink::analysis;  // run_link, LinkRun, run_waveforms
@@ -124,8 +125,8 @@ int run_run(const RunArgs& a) {
   nlohmann::ordered_json json = run_report_json(*spec, *run);
   std::string md = run_report_markdown(*spec, *run, images);
   if (worst) {
-    json["worst_case"] = analysis::worst_json(*worst);
-    md += "\n## Worst case over all traffic\n\n" + analysis::worst_markdown(*worst);
+    json["worst_case"] = reports::worst_json(*worst);
+    md += "\n## Worst case over all traffic\n\n" + reports::worst_markdown(*worst);
     if (!a.no_images) {
       std::vector<std::string> files;
       if (Status s = reports::render_worst_pngs(*worst, spec->name, {}, bundle->staging(), &files);
@@ -157,7 +158,7 @@ int run_run(const RunArgs& a) {
       }
   if (!a.quiet) {
     std::fputs(run_summary_text(*spec, *run).c_str(), stdout);
-    if (worst) std::fputs(analysis::worst_summary_text(*worst).c_str(), stdout);
+    if (worst) std::fputs(reports::worst_summary_text(*worst).c_str(), stdout);
     std::printf("report: %s/report.md\n", dir.c_str());
   }
   return run->pass ? 0 : 1;

@@ -15,6 +15,7 @@
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
 #include "reports/worst_png.h"
+#include "reports/worst_report.h"
 
 namespace isolink::cli {
 namespace {
@@ -52,7 +53,7 @@ int run_worst(const WorstArgs& a) {
   StatusOr<analysis::WorstResult> w = analysis::worst_case(*spec, *parts, opt);
   line.finish();
   if (!w) return fail(w.status().with_context(a.spec));
-  const std::string json = analysis::worst_json(*w).dump(2) + "\n";
+  const std::string json = reports::worst_json(*w).dump(2) + "\n";
   if (!a.out_dir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(a.out_dir, ec);
@@ -61,7 +62,7 @@ int run_worst(const WorstArgs& a) {
           fmt::format("{}: error: cannot create the folder: {}", a.out_dir, ec.message())));
     if (Status s = write_file_atomic(a.out_dir + "/worst.json", json); !s.ok()) return fail(s);
     std::string md = fmt::format("# Worst case over all traffic: {}\n\n{}", spec->name,
-                                 analysis::worst_markdown(*w));
+                                 reports::worst_markdown(*w));
     if (!a.no_images) {
       std::vector<std::string> images;
       if (Status s = reports::render_worst_pngs(*w, spec->name, {}, a.out_dir, &images); !s.ok())
@@ -73,11 +74,11 @@ int run_worst(const WorstArgs& a) {
   if (a.json) {
     std::fputs(json.c_str(), stdout);
   } else if (!a.quiet) {
-    std::fputs(analysis::worst_summary_text(*w).c_str(), stdout);
+    std::fputs(reports::worst_summary_text(*w).c_str(), stdout);
     for (const analysis::DirectionWorst& d : w->directions)
       for (const analysis::WorstMetric& m : d.metrics)
         std::printf("  reproduce %s %s: %s\n", link::direction_name(d.direction), m.name.c_str(),
-                    analysis::reproduce_stimulus(m, d.direction).c_str());
+                    reports::reproduce_stimulus(m, d.direction).c_str());
   }
   return w->pass ? 0 : 1;
 }

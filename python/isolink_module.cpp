@@ -6,7 +6,7 @@
 //   m = isolink.check(t, v, rules="bq7961x")                   # `isolink check --json`
 //
 // Every result is the JSON the CLI writes for the same input, built by the same functions
-// (reports::run_report_json, analysis::worst_json, noise_json, reports::pack_report_json,
+// (reports::run_report_json, reports::worst_json, reports::noise_json, reports::pack_report_json,
 // eye::to_json, the sweep's results.csv rows), turned into dicts and lists: a name means the same
 // thing in both front ends and the two cannot drift. Errors raise isolink.Error (a ValueError)
 // whose text is the CLI's message. No analysis happens here: each function reads its input the
@@ -46,8 +46,10 @@
 #include "netlists/link/parts.h"
 #include "python/convert.h"
 #include "python/docstrings.h"
+#include "reports/noise_report.h"
 #include "reports/pack_report.h"
 #include "reports/run_report.h"
+#include "reports/worst_report.h"
 
 namespace isolink::python {
 namespace {
@@ -113,7 +115,7 @@ py::dict run(const py::object& spec_obj, const std::optional<std::string>& direc
   if (!lr) raise(lr.status().with_context(arg.where()));
   if (wr && !*wr) raise(wr->status().with_context(arg.where() + ", worst case"));
   nlohmann::ordered_json j = reports::run_report_json(*spec, *lr);
-  if (wr) j["worst_case"] = analysis::worst_json(**wr);  // as cmd_run.cpp
+  if (wr) j["worst_case"] = reports::worst_json(**wr);  // as cmd_run.cpp
   py::dict out = to_python(j);
   out["pass"] = lr->pass;
   py::list dirs = out["directions"];
@@ -148,7 +150,7 @@ py::object worst(const py::object& spec_obj, const std::optional<std::string>& d
   if (!spec) raise(spec.status());
   if (!parts) raise(parts.status());
   if (!w) raise(w.status().with_context(arg.where()));
-  return to_python(analysis::worst_json(*w));
+  return to_python(reports::worst_json(*w));
 }
 
 // isolink.noise: `isolink noise SPEC --json`.
@@ -166,7 +168,7 @@ py::object noise(const py::object& spec_obj, const Strings& parts_dirs) {
   if (!spec) raise(spec.status());
   if (!parts) raise(parts.status());
   if (!nr) raise(nr.status().with_context(arg.where()));
-  py::object out = to_python(analysis::noise_json(nr->noise));
+  py::object out = to_python(reports::noise_json(nr->noise));
   warn_once(sim_warnings(nr->run));
   return out;
 }

@@ -14,6 +14,7 @@
 #include "reports/pack_png.h"
 #include "reports/run_images.h"
 #include "reports/run_report.h"
+#include "reports/worst_report.h"
 
 namespace isolink::reports {
 
@@ -92,7 +93,7 @@ nlohmann::ordered_json pack_report_json(const PackSpec& pack, const PackResult& 
       analysis::WorstResult one;
       one.directions = {h.worst[k]};
       one.pass = h.worst[k].pass;
-      const ordered_json wj = analysis::worst_json(one)["directions"][0];
+      const ordered_json wj = worst_json(one)["directions"][0];
       run["directions"][k]["worst_verdict"] = wj["verdict"];
       run["directions"][k]["worst_reasons"] = wj["reasons"];
       run["directions"][k]["worst"] = wj["worst"];

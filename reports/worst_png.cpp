@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "reports/wave_png.h"
+#include "reports/worst_report.h"
 
 namespace isolink::reports {
 
@@ -36,7 +37,7 @@ Status render_worst_pngs(const analysis::WorstResult& r, const std::string& spec
       const std::string name =
           fmt::format("worst_{}_{}.png", link::direction_name(d.direction), m.name);
       WaveReportInfo info{.spec = spec_name + " - worst case over all traffic",
-                          .source = analysis::reproduce_stimulus(m, d.direction)};
+                          .source = reproduce_stimulus(m, d.direction)};
       if (Status s = render_wave_png({panel}, info, dir + "/" + name); !s.ok()) return s;
       files->push_back(name);
     }

@@ -17,6 +17,7 @@
 
 #include "reports/pack_report.h"
 #include "reports/run_report.h"
+#include "reports/worst_report.h"
 
 namespace isolink::analysis {
 namespace {
@@ -359,7 +360,7 @@ TEST(PackWorst, HopWorstEqualsWorstCaseOfItsSpecAlone) {
     StatusOr<WorstResult> alone = worst_case(p->hops[k].spec, *parts, wo);
     ASSERT_TRUE(alone.ok()) << alone.status().message();
     ASSERT_EQ(h.worst.size(), alone->directions.size());
-    if (k == 0) first_alone = worst_json(*alone);
+    if (k == 0) first_alone = reports::worst_json(*alone);
     bool hop_pass = true;
     for (size_t d = 0; d < h.worst.size(); ++d) {
       const DirectionWorst& x = h.worst[d];

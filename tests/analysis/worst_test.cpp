@@ -23,6 +23,7 @@
 #include "netlists/link/link_spec.h"
 #include "netlists/traffic/command.h"
 #include "netlists/traffic/encoding.h"
+#include "reports/worst_report.h"
 
 namespace isolink::analysis {
 namespace {
@@ -334,7 +335,7 @@ TEST(WorstCase, ReproduceBlocksShowTheWorstValueInTheTransient) {
   const DirectionWorst& w = full_worst();
   WorstResult all;
   all.directions = {w};
-  const nlohmann::ordered_json j = worst_json(all);
+  const nlohmann::ordered_json j = reports::worst_json(all);
   const std::string base(kLink);
   const std::string head = base.substr(0, base.find("stimulus:"));
   for (const WorstMetric& m : w.metrics) {
