@@ -365,27 +365,50 @@ const std::string* ScopeLayout::find(std::string_view key) const {
   return nullptr;
 }
 
-StatusOr<ScopeLayout> detect_layout(
-    const std::vector<std::string>& head, const std::string& source, bool more_lines,
-    const std::vector<std::pair<std::string, std::string>>& extra_preamble) {
-  auto err = [&](int line, const std::string& msg) {
-    return Status::Error(line > 0 ? fmt::format("{}:{}: error: {}", source, line, msg)
-                                  : fmt::format("{}: error: {}", source, msg));
-  };
-  ScopeLayout l;
-  std::vector<std::string_view> f, g;
-  auto line_no = [](size_t i) { return static_cast<int>(i) + 1; };
-  auto next_nonblank = [&](size_t i) {
-    while (i < head.size() && trim_cell(head[i]).empty()) ++i;
-    return i;
-  };
-  if (!head.empty() && head[0].size() >= 2 &&
-      ((head[0][0] == '\xFF' && head[0][1] == '\xFE') ||
-       (head[0][0] == '\xFE' && head[0][1] == '\xFF')))
-    return err(1, "the file is UTF-16 text: save or convert it as UTF-8 (or ASCII) CSV");
+namespace {
 
-  auto finish_columns = [&](const std::vector<std::string_view>& names,
-                            const std::vector<std::string_view>* units, size_t nfields) {
+// detect_layout's work: the three format detectors, tried in order until one names the layout,
+// then the time column. One object per call; it reads `head` and fills `l_`.
+class LayoutDetector {
+ public:
+  LayoutDetector(const std::vector<std::string>& head, const std::string& source, bool more_lines)
+      : head_(head), source_(source), more_lines_(more_lines) {}
+
+  StatusOr<ScopeLayout> run(const std::vector<std::pair<std::string, std::string>>& extra) {
+    if (!head_.empty() && head_[0].size() >= 2 &&
+        ((head_[0][0] == '\xFF' && head_[0][1] == '\xFE') ||
+         (head_[0][0] == '\xFE' && head_[0][1] == '\xFF')))
+      return err(1, "the file is UTF-16 text: save or convert it as UTF-8 (or ASCII) CSV");
+    if (Status st = key_value_header(); !st.ok()) return st;
+    if (l_.name.empty()) tektronix_classic();
+    if (l_.name.empty())
+      if (Status st = names_and_units(); !st.ok()) return st;
+    l_.preamble.insert(l_.preamble.end(), extra.begin(), extra.end());
+    if (Status st = time_column(); !st.ok()) return st;
+    return std::move(l_);
+  }
+
+ private:
+  Status err(int line, const std::string& msg) const {
+    return Status::Error(line > 0 ? fmt::format("{}:{}: error: {}", source_, line, msg)
+                                  : fmt::format("{}: error: {}", source_, msg));
+  }
+  static int line_no(size_t i) { return static_cast<int>(i) + 1; }
+  size_t next_nonblank(size_t i) const {
+    while (i < head_.size() && trim_cell(head_[i]).empty()) ++i;
+    return i;
+  }
+  std::optional<size_t> prev_nonblank(size_t i) const {
+    while (i > 0) {
+      --i;
+      if (!trim_cell(head_[i]).empty()) return i;
+    }
+    return std::nullopt;
+  }
+
+  // The columns from a names row and a units row (either may be absent) over nfields fields.
+  void finish_columns(const std::vector<std::string_view>& names,
+                      const std::vector<std::string_view>* units, size_t nfields) {
     const size_t n = std::max(names.size(), nfields);
     for (size_t k = 0; k < n; ++k) {
       ScopeColumn c;
@@ -401,250 +424,276 @@ StatusOr<ScopeLayout> detect_layout(
                     (!raw.empty() && time_name(bare.empty() ? raw : bare));
       const std::string lo = lower(bare);
       c.meta = lo == "start" || lo == "increment";
-      if (!raw.empty() || k < nfields) l.columns.push_back(std::move(c));
+      if (!raw.empty() || k < nfields) l_.columns.push_back(std::move(c));
     }
-  };
+  }
 
   // 1. "Key: value" header ending in "Data:" (Keysight Infiniium).
-  for (size_t i = 0; i < head.size(); ++i) {
-    if (lower(trim_cell(head[i])) != "data:") continue;
-    l.name = "key: value header";
-    key_values(head, i, false, &l.preamble);
-    const size_t d = next_nonblank(i + 1);
-    if (d >= head.size()) return err(line_no(i), "no data after \"Data:\"");
-    l.data_line = line_no(d);
-    l.delim = detect_delimiter(head[d]);
-    split_fields(head[d], l.delim, &f);
-    l.decimal_comma = guess_decimal_comma(l.delim, f);
-    if (!numeric_row(f, l.decimal_comma))
-      return err(l.data_line, fmt::format("expected a row of numbers after \"Data:\", found '{}'",
-                                          trim_cell(head[d])));
-    l.data_fields = f.size();
-    const std::string* yu = l.find("YUnits");
-    const std::string* xu = l.find("XUnits");
-    const std::string* src = l.find("Source");
-    if (f.size() == 1) {
+  Status key_value_header() {
+    for (size_t i = 0; i < head_.size(); ++i) {
+      if (lower(trim_cell(head_[i])) != "data:") continue;
+      l_.name = "key: value header";
+      key_values(head_, i, false, &l_.preamble);
+      const size_t d = next_nonblank(i + 1);
+      if (d >= head_.size()) return err(line_no(i), "no data after \"Data:\"");
+      l_.data_line = line_no(d);
+      l_.delim = detect_delimiter(head_[d]);
+      split_fields(head_[d], l_.delim, &f_);
+      l_.decimal_comma = guess_decimal_comma(l_.delim, f_);
+      if (!numeric_row(f_, l_.decimal_comma))
+        return err(l_.data_line,
+                   fmt::format("expected a row of numbers after \"Data:\", found '{}'",
+                               trim_cell(head_[d])));
+      l_.data_fields = f_.size();
+      key_value_columns();
+      break;
+    }
+    return Status::Ok();
+  }
+  // The columns of a "Key: value" file: its YUnits, XUnits and Source lines name them.
+  void key_value_columns() {
+    const std::string* yu = l_.find("YUnits");
+    const std::string* xu = l_.find("XUnits");
+    const std::string* src = l_.find("Source");
+    if (f_.size() == 1) {
       ScopeColumn c;
       c.name = src ? *src : "Y";
       c.channel = canonical_channel(c.name);
       if (yu)
         if (auto u = parse_unit(*yu)) c.unit = *u;
-      l.columns.push_back(c);
-    } else {
-      ScopeColumn t;
-      t.name = "time";
-      t.time_like = true;
-      if (xu)
-        if (auto u = parse_unit(*xu)) t.unit = *u;
-      l.columns.push_back(t);
-      for (size_t k = 1; k < f.size(); ++k) {
-        ScopeColumn c;
-        c.field = k;
-        c.name = f.size() == 2 && src ? *src : fmt::format("column {}", k + 1);
-        c.channel = canonical_channel(c.name);
-        if (yu)
-          if (auto u = parse_unit(*yu)) c.unit = *u;
-        l.columns.push_back(c);
-      }
-      l.time = 0;
+      l_.columns.push_back(c);
+      return;
     }
-    break;
+    ScopeColumn t;
+    t.name = "time";
+    t.time_like = true;
+    if (xu)
+      if (auto u = parse_unit(*xu)) t.unit = *u;
+    l_.columns.push_back(t);
+    for (size_t k = 1; k < f_.size(); ++k) {
+      ScopeColumn c;
+      c.field = k;
+      c.name = f_.size() == 2 && src ? *src : fmt::format("column {}", k + 1);
+      c.channel = canonical_channel(c.name);
+      if (yu)
+        if (auto u = parse_unit(*yu)) c.unit = *u;
+      l_.columns.push_back(c);
+    }
+    l_.time = 0;
   }
 
   // 2. Tektronix TDS/TBS classic: "Record Length,2500,Points,-0.000025,0.04," from line 1.
-  if (l.name.empty()) {
+  void tektronix_classic() {
     const size_t d = next_nonblank(0);
-    if (d < head.size()) {
-      split_fields(head[d], ',', &f);
-      double x;
-      if (f.size() >= 5 && parse_cell(f[3], false, &x) && parse_cell(f[4], false, &x) &&
-          !trim_cell(f[0]).empty() && !parse_cell(f[0], false, &x)) {
-        l.name = "tektronix classic";
-        l.delim = ',';
-        l.data_line = line_no(d);
-        l.data_fields = f.size();
-        for (size_t i = d; i < head.size(); ++i) {
-          split_fields(head[i], ',', &g);
-          if (g.size() >= 2 && !trim_cell(g[0]).empty())
-            l.preamble.emplace_back(std::string(unquote(g[0])), std::string(unquote(g[1])));
-        }
-        ScopeColumn t;
-        t.name = "time";
-        t.field = 3;
-        t.time_like = true;
-        t.unit = Unit{UnitKind::kTime, 1, "s"};
-        if (const std::string* hu = l.find("Horizontal Units"))
-          if (auto u = parse_unit(*hu)) t.unit = *u;
-        ScopeColumn c;
-        const std::string* src = l.find("Source");
-        c.name = src && !src->empty() ? *src : "value";
-        c.channel = canonical_channel(c.name);
-        c.field = 4;
-        if (const std::string* vu = l.find("Vertical Units"))
-          if (auto u = parse_unit(*vu)) c.unit = *u;
-        l.columns = {t, c};
-        l.time = 0;
-      }
+    if (d >= head_.size()) return;
+    split_fields(head_[d], ',', &f_);
+    double x;
+    if (!(f_.size() >= 5 && parse_cell(f_[3], false, &x) && parse_cell(f_[4], false, &x) &&
+          !trim_cell(f_[0]).empty() && !parse_cell(f_[0], false, &x)))
+      return;
+    l_.name = "tektronix classic";
+    l_.delim = ',';
+    l_.data_line = line_no(d);
+    l_.data_fields = f_.size();
+    for (size_t i = d; i < head_.size(); ++i) {
+      split_fields(head_[i], ',', &g_);
+      if (g_.size() >= 2 && !trim_cell(g_[0]).empty())
+        l_.preamble.emplace_back(std::string(unquote(g_[0])), std::string(unquote(g_[1])));
     }
+    ScopeColumn t;
+    t.name = "time";
+    t.field = 3;
+    t.time_like = true;
+    t.unit = Unit{UnitKind::kTime, 1, "s"};
+    if (const std::string* hu = l_.find("Horizontal Units"))
+      if (auto u = parse_unit(*hu)) t.unit = *u;
+    ScopeColumn c;
+    const std::string* src = l_.find("Source");
+    c.name = src && !src->empty() ? *src : "value";
+    c.channel = canonical_channel(c.name);
+    c.field = 4;
+    if (const std::string* vu = l_.find("Vertical Units"))
+      if (auto u = parse_unit(*vu)) c.unit = *u;
+    l_.columns = {t, c};
+    l_.time = 0;
   }
 
   // 3. Names / units rows above the first run of data rows.
-  if (l.name.empty()) {
-    size_t d = head.size();
-    for (size_t i = 0; i < head.size() && d == head.size(); ++i) {
-      if (trim_cell(head[i]).empty()) continue;
-      const char delim = detect_delimiter(head[i]);
-      split_fields(head[i], delim, &f);
-      const bool dc = guess_decimal_comma(delim, f);
-      if (!numeric_row(f, dc)) continue;
-      // a numeric line inside a preamble is followed by text with another field count
-      const size_t j = next_nonblank(i + 1);
-      bool ok = true;
-      if (j < head.size()) {
-        split_fields(head[j], delim, &g);
-        ok = g.size() == f.size() || numeric_row(g, dc);
-      }
-      if (ok) {
-        d = i;
-        l.delim = delim;
-        l.decimal_comma = dc;
-      }
-    }
-    if (d == head.size()) {
-      std::string last;
-      int last_no = 0;
-      for (size_t i = 0; i < head.size(); ++i)
-        if (!trim_cell(head[i]).empty()) {
-          last = std::string(trim_cell(head[i]).substr(0, 60));
-          last_no = line_no(i);
-        }
-      if (last_no == 0) return err(0, "the file is empty");
-      return err(
-          last_no,
-          fmt::format("no data found{}: expected rows of numbers (e.g. \"-1.0e-06,0.52\"), "
-                      "optionally under a line of names (e.g. \"TIME,CH1,CH2\") and a "
-                      "units row (e.g. \"s,V,V\"); the last line read was '{}'",
-                      more_lines ? fmt::format(" in the first {} lines", head.size()) : "", last));
-    }
-    l.data_line = line_no(d);
-    split_fields(head[d], l.delim, &f);
-    l.data_fields = f.size();
-    auto prev_nonblank = [&](size_t i) -> std::optional<size_t> {
-      while (i > 0) {
-        --i;
-        if (!trim_cell(head[i]).empty()) return i;
-      }
-      return std::nullopt;
-    };
-    std::optional<size_t> above = prev_nonblank(d);
+  Status names_and_units() {
+    size_t d = head_.size();
+    if (Status st = find_data_row(&d); !st.ok()) return st;
+    l_.data_line = line_no(d);
+    split_fields(head_[d], l_.delim, &f_);
+    l_.data_fields = f_.size();
     std::vector<std::string_view> units, names;
     std::optional<size_t> names_at;
+    header_rows(d, &names, &units, &names_at);
+    const size_t pre_end = names_at ? *names_at : (l_.units_line ? l_.units_line - 1 : d);
+    key_values(head_, pre_end, l_.decimal_comma, &l_.preamble);
+    finish_columns(names, units.empty() ? nullptr : &units, l_.data_fields);
+    if (Status st = rigol_channel_rows(head_, pre_end, &l_, source_); !st.ok()) return st;
+    l_.name = !names.empty() ? (units.empty() ? "header" : "header + units row")
+                             : (!units.empty() ? "units row" : "no header");
+    return rigol_start_increment(units);
+  }
+
+  // The first row of numbers that the next non-blank row continues (same field count or numbers
+  // too): a numeric line inside a preamble is followed by text with another field count.
+  Status find_data_row(size_t* d) {
+    for (size_t i = 0; i < head_.size() && *d == head_.size(); ++i) {
+      if (trim_cell(head_[i]).empty()) continue;
+      const char delim = detect_delimiter(head_[i]);
+      split_fields(head_[i], delim, &f_);
+      const bool dc = guess_decimal_comma(delim, f_);
+      if (!numeric_row(f_, dc)) continue;
+      const size_t j = next_nonblank(i + 1);
+      bool ok = true;
+      if (j < head_.size()) {
+        split_fields(head_[j], delim, &g_);
+        ok = g_.size() == f_.size() || numeric_row(g_, dc);
+      }
+      if (ok) {
+        *d = i;
+        l_.delim = delim;
+        l_.decimal_comma = dc;
+      }
+    }
+    if (*d < head_.size()) return Status::Ok();
+    std::string last;
+    int last_no = 0;
+    for (size_t i = 0; i < head_.size(); ++i)
+      if (!trim_cell(head_[i]).empty()) {
+        last = std::string(trim_cell(head_[i]).substr(0, 60));
+        last_no = line_no(i);
+      }
+    if (last_no == 0) return err(0, "the file is empty");
+    return err(
+        last_no,
+        fmt::format("no data found{}: expected rows of numbers (e.g. \"-1.0e-06,0.52\"), "
+                    "optionally under a line of names (e.g. \"TIME,CH1,CH2\") and a "
+                    "units row (e.g. \"s,V,V\"); the last line read was '{}'",
+                    more_lines_ ? fmt::format(" in the first {} lines", head_.size()) : "", last));
+  }
+
+  // Above the data row d: a units row ("s,V,V"), and above it (or above d) a names row.
+  void header_rows(size_t d, std::vector<std::string_view>* names,
+                   std::vector<std::string_view>* units, std::optional<size_t>* names_at) {
+    std::optional<size_t> above = prev_nonblank(d);
     if (above) {
-      split_fields(head[*above], l.delim, &g);
-      if (units_row(g, l.decimal_comma) && !numeric_row(g, l.decimal_comma)) {
-        units = g;
-        l.units_line = line_no(*above);
+      split_fields(head_[*above], l_.delim, &g_);
+      if (units_row(g_, l_.decimal_comma) && !numeric_row(g_, l_.decimal_comma)) {
+        *units = g_;
+        l_.units_line = line_no(*above);
         above = prev_nonblank(*above);
       }
     }
-    if (above) {
-      split_fields(head[*above], l.delim, &g);
-      double x;
-      bool tail_numeric = g.size() >= 2;
-      for (size_t k = 1; k < g.size(); ++k)
-        tail_numeric = tail_numeric && parse_cell(g[k], l.decimal_comma, &x);
-      const bool first_time = !g.empty() && time_name(split_name_unit(unquote(g[0])).first);
-      const bool is_names = !numeric_row(g, l.decimal_comma) && g.size() >= 2 &&
-                            !(g.size() >= 1 && preamble_key(g[0])) &&
-                            !(tail_numeric && !first_time && units.empty());
-      if (is_names) {
-        names = g;
-        names_at = *above;
-        l.header_line = line_no(*above);
-      }
+    if (!above) return;
+    split_fields(head_[*above], l_.delim, &g_);
+    double x;
+    bool tail_numeric = g_.size() >= 2;
+    for (size_t k = 1; k < g_.size(); ++k)
+      tail_numeric = tail_numeric && parse_cell(g_[k], l_.decimal_comma, &x);
+    const bool first_time = !g_.empty() && time_name(split_name_unit(unquote(g_[0])).first);
+    const bool is_names = !numeric_row(g_, l_.decimal_comma) && g_.size() >= 2 &&
+                          !(g_.size() >= 1 && preamble_key(g_[0])) &&
+                          !(tail_numeric && !first_time && units->empty());
+    if (is_names) {
+      *names = g_;
+      *names_at = *above;
+      l_.header_line = line_no(*above);
     }
-    const size_t pre_end = names_at ? *names_at : (l.units_line ? l.units_line - 1 : d);
-    key_values(head, pre_end, l.decimal_comma, &l.preamble);
-    finish_columns(names, units.empty() ? nullptr : &units, l.data_fields);
-    if (Status st = rigol_channel_rows(head, pre_end, &l, source); !st.ok()) return st;
-    l.name = !names.empty() ? (units.empty() ? "header" : "header + units row")
-                            : (!units.empty() ? "units row" : "no header");
-    // Rigol X,CH1,Start,Increment with the values under Start and Increment.
+  }
+
+  // Rigol X,CH1,Start,Increment with the values under Start and Increment.
+  Status rigol_start_increment(const std::vector<std::string_view>& units) {
     int ks = -1, ki = -1;
-    for (size_t k = 0; k < l.columns.size(); ++k) {
-      const std::string lo = lower(split_name_unit(l.columns[k].name).first);
+    for (size_t k = 0; k < l_.columns.size(); ++k) {
+      const std::string lo = lower(split_name_unit(l_.columns[k].name).first);
       if (lo == "start") ks = static_cast<int>(k);
       if (lo == "increment") ki = static_cast<int>(k);
     }
-    if (ks >= 0 && ki >= 0) {
-      double s = 0, inc = 0;
-      const std::vector<std::string_view>& src = units.empty() ? f : units;
-      const size_t fs = l.columns[static_cast<size_t>(ks)].field;
-      const size_t fi = l.columns[static_cast<size_t>(ki)].field;
-      if (fs < src.size() && fi < src.size() && parse_cell(src[fs], l.decimal_comma, &s) &&
-          parse_cell(src[fi], l.decimal_comma, &inc) && inc > 0) {
-        l.name = "rigol start/increment";
-        l.t0 = s;
-        l.dt = inc;
-        l.time_is_index = true;
-        l.time = 0;
-        l.columns[0].time_like = true;
-        l.time_from = fmt::format("rebuilt: t = Start + X * Increment ({:g} + X * {:g} s)", s, inc);
-        // the data rows hold fewer fields than the header when Start/Increment are empty
-        std::erase_if(l.columns,
-                      [&](const ScopeColumn& c) { return c.meta && c.field >= l.data_fields; });
-      } else {
-        return err(l.units_line ? l.units_line : l.data_line,
-                   "the header names Start and Increment columns but no numbers were found under "
-                   "them: expected e.g. \"Sequence,Volt,-1e-05,1e-09\"");
-      }
-    }
+    if (ks < 0 || ki < 0) return Status::Ok();
+    double s = 0, inc = 0;
+    const std::vector<std::string_view>& src = units.empty() ? f_ : units;
+    const size_t fs = l_.columns[static_cast<size_t>(ks)].field;
+    const size_t fi = l_.columns[static_cast<size_t>(ki)].field;
+    if (!(fs < src.size() && fi < src.size() && parse_cell(src[fs], l_.decimal_comma, &s) &&
+          parse_cell(src[fi], l_.decimal_comma, &inc) && inc > 0))
+      return err(l_.units_line ? l_.units_line : l_.data_line,
+                 "the header names Start and Increment columns but no numbers were found under "
+                 "them: expected e.g. \"Sequence,Volt,-1e-05,1e-09\"");
+    l_.name = "rigol start/increment";
+    l_.t0 = s;
+    l_.dt = inc;
+    l_.time_is_index = true;
+    l_.time = 0;
+    l_.columns[0].time_like = true;
+    l_.time_from = fmt::format("rebuilt: t = Start + X * Increment ({:g} + X * {:g} s)", s, inc);
+    // the data rows hold fewer fields than the header when Start/Increment are empty
+    std::erase_if(l_.columns,
+                  [&](const ScopeColumn& c) { return c.meta && c.field >= l_.data_fields; });
+    return Status::Ok();
   }
-  l.preamble.insert(l.preamble.end(), extra_preamble.begin(), extra_preamble.end());
 
-  // Which column is time.
-  if (l.time < 0 && !l.columns.empty()) {
-    for (size_t k = 0; k < l.columns.size(); ++k)
-      if (l.columns[k].time_like) {
-        l.time = static_cast<int>(k);
-        break;
-      }
-    const bool signals_only = l.columns.size() == 1;
-    if (l.time < 0 && !signals_only) l.time = 0;  // default: the first column
-  }
-  if (l.time >= 0) {
-    ScopeColumn& tc = l.columns[static_cast<size_t>(l.time)];
+  // Which column is time, and how time is rebuilt when it counts samples or is absent.
+  Status time_column() {
+    if (l_.time < 0 && !l_.columns.empty()) {
+      for (size_t k = 0; k < l_.columns.size(); ++k)
+        if (l_.columns[k].time_like) {
+          l_.time = static_cast<int>(k);
+          break;
+        }
+      const bool signals_only = l_.columns.size() == 1;
+      if (l_.time < 0 && !signals_only) l_.time = 0;  // default: the first column
+    }
+    if (l_.time < 0) {
+      if (!interval_from_preamble(l_, &l_.t0, &l_.dt, &l_.time_from))
+        return err(l_.data_line,
+                   "one column of values and no time: expected a time column, or the sample "
+                   "interval in the preamble ('Sample Interval', 'XInc'; for an R&S .Wfm.csv "
+                   "keep its header file NAME.csv or NAME.bin beside it)");
+      return Status::Ok();
+    }
+    ScopeColumn& tc = l_.columns[static_cast<size_t>(l_.time)];
     tc.time_like = true;
-    if (tc.unit.kind == UnitKind::kIndex && !l.time_is_index) {
+    if (tc.unit.kind == UnitKind::kIndex && !l_.time_is_index) {
       double t0 = 0, dt = 0;
       std::string from;
-      if (!interval_from_preamble(l, &t0, &dt, &from))
-        return err(l.units_line ? l.units_line : l.header_line,
+      if (!interval_from_preamble(l_, &t0, &dt, &from))
+        return err(l_.units_line ? l_.units_line : l_.header_line,
                    fmt::format("column {} ('{}') counts samples ({}) and no sample interval was "
                                "found: expected Start and Increment columns, or a 'Sample "
                                "Interval' / 'XInc' line in the preamble",
                                tc.field + 1, tc.name, tc.unit.text));
-      l.time_is_index = true;
-      l.t0 = t0;
-      l.dt = dt;
-      l.time_from = fmt::format("rebuilt from sample numbers: t = {:g} + x * {:g} s", t0, dt);
+      l_.time_is_index = true;
+      l_.t0 = t0;
+      l_.dt = dt;
+      l_.time_from = fmt::format("rebuilt from sample numbers: t = {:g} + x * {:g} s", t0, dt);
     }
-    if (l.time_from.empty())
-      l.time_from = fmt::format("column {} ('{}'){}", tc.field + 1, tc.name,
-                                tc.unit.scale != 1 ? fmt::format(" in {}", tc.unit.text) : "");
+    if (l_.time_from.empty())
+      l_.time_from = fmt::format("column {} ('{}'){}", tc.field + 1, tc.name,
+                                 tc.unit.scale != 1 ? fmt::format(" in {}", tc.unit.text) : "");
     if (tc.unit.kind != UnitKind::kNone && tc.unit.kind != UnitKind::kTime &&
         tc.unit.kind != UnitKind::kIndex)
-      return err(l.units_line ? l.units_line : l.header_line,
+      return err(l_.units_line ? l_.units_line : l_.header_line,
                  fmt::format("the time column {} ('{}') is in {}, not seconds", tc.field + 1,
                              tc.name, tc.unit.text));
-  } else {
-    if (!interval_from_preamble(l, &l.t0, &l.dt, &l.time_from))
-      return err(l.data_line,
-                 "one column of values and no time: expected a time column, or the sample "
-                 "interval in the preamble ('Sample Interval', 'XInc'; for an R&S .Wfm.csv keep "
-                 "its header file NAME.csv or NAME.bin beside it)");
+    return Status::Ok();
   }
-  return l;
+
+  const std::vector<std::string>& head_;
+  const std::string& source_;
+  const bool more_lines_;
+  ScopeLayout l_;
+  std::vector<std::string_view> f_, g_;  // the fields of the data row, of the row looked at
+};
+
+}  // namespace
+
+StatusOr<ScopeLayout> detect_layout(
+    const std::vector<std::string>& head, const std::string& source, bool more_lines,
+    const std::vector<std::pair<std::string, std::string>>& extra_preamble) {
+  return LayoutDetector(head, source, more_lines).run(extra_preamble);
 }
 
 StatusOr<std::string> check_probe_step(const ScopeLayout& l, const ScopeColumn& c, double step,
