@@ -39,6 +39,18 @@ inline constexpr long kAutoLtiMaxSteps = 400'000;
 // The most output rows a --step grid may ask for.
 inline constexpr size_t kMaxGridRows = 10'000'000;
 
+// The memory one run may take (issue 28): what grows with the run is bounded by it, and a run
+// whose least need is over it is refused before the engine starts, with a diagnostic at the
+// .tran card naming the limit. What is counted (8 bytes a value; `columns` = time + probes):
+// - the transient engine: one row per accepted step, at least span / TMAX rows, at most
+//   max_steps (lowered so that twice the rows, a vector's growth, fit);
+// - a --step grid: span / step rows;
+// - the LTI output grid: at most GridOptions::max_rows rows, lowered so that four copies of
+//   them fit (rows, midpoints, the next pass);
+// - the LTI march: 1 + 2 x sources x probes values a step, max_steps lowered so twice that fits;
+// - the reduced model's basis: at most 384 MB (solver/reduced_model.cpp, kMaxBasisBytes).
+inline constexpr double kMemoryLimitBytes = 1024.0 * 1024.0 * 1024.0;
+
 struct SimulationRequest {
   std::vector<std::string> probes;           // v(a), v(a,b), i(name)
   std::optional<double> tstop, tstep, tmax;  // override the netlist's .tran
@@ -66,7 +78,17 @@ struct SimulationResult {
   std::vector<std::string> warnings;  // formatted, for stderr
   int nodes = 0, unknowns = 0, elements = 0;
   double seconds = 0.0;  // wall time of the engine
+  // auto: wall time spent on the LTI engine before it gave way to the transient (part of
+  // `seconds`); 0 when it did not.
+  double lti_attempt_seconds = 0.0;
+  double reltol = 0.0, trtol = 0.0;  // the transient's tolerances (engine transient)
 };
+
+// The accuracy the engine that produced `r` promises, one sentence with its figures, for the
+// run's statistics (issue 28: `auto` never trades accuracy silently): the reduced model's bound
+// per edge from its check, the march's and the transient's error control and what they gave
+// against converged references (README, section Solver).
+std::string engine_accuracy(const SimulationResult& r);
 
 StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const SimulationRequest& req);
 

@@ -21,7 +21,7 @@ for i in $(seq -f %03g "$first" "$last"); do
       echo "$i $d reduced $(grep -o 'order [0-9]*' <<<"$out" | head -1) $(grep -o '[0-9.]* s;' <<<"$out")"
     else
       march=$((march + 1))
-      echo "$i $d MARCH $(grep -o 'reduced model not used.*' <<<"$out")"
+      echo "$i $d MARCH $(grep -o "march ran because.*" <<<"$out")"
     fi
   done
 done

@@ -43,6 +43,46 @@ std::optional<double> si_option(const char* flag, const std::string& text, bool*
   return v;
 }
 
+// The run's statistics on stderr: the engine, why auto took it when it fell back, how long each
+// part took and the accuracy it promises (analysis::engine_accuracy).
+void print_sim_stats(const SimulationResult& r, size_t rows, const std::string& target) {
+  const std::string grid =
+      r.grid.coarse_step > 0
+          ? fmt::format("{} rows at most {:g} s apart, down to {:g} s where the response bends",
+                        rows, r.grid.coarse_step, r.grid.step)
+          : fmt::format("{} rows every {:g} s", rows, r.grid.step);
+  if (r.engine == Engine::Lti && r.lti.method == "reduced model")
+    std::cerr << fmt::format(
+        "isolink sim: LTI engine, reduced model: {} nodes, {} unknowns; order {} ({} poles, {} "
+        "expansion points), transfer within {:.1e} of the peak at {} check frequencies ({} "
+        "factorizations); {} corners; {:.3f} s; {}{}\n",
+        r.nodes, r.unknowns, r.lti.model.order, r.lti.model.poles, r.lti.model.expansion_points,
+        r.lti.model.error, r.lti.model.check_points, r.lti.factorizations, r.grid.corners,
+        r.seconds, grid, target);
+  else if (r.engine == Engine::Lti)
+    std::cerr << fmt::format(
+        "isolink sim: LTI engine, march: {} nodes, {} unknowns; responses to {:g} s in {} steps "
+        "({} rejected, {} factorizations){}; {} corners; {:.3f} s; {}{}\n",
+        r.nodes, r.unknowns, r.lti.settled_at, r.lti.steps, r.lti.rejected, r.lti.factorizations,
+        r.lti.settled ? ", settled" : "", r.grid.corners, r.seconds, grid, target);
+  if (r.engine == Engine::Lti && !r.lti.note.empty())
+    std::cerr << fmt::format(
+        "isolink sim: the march ran because the reduced model did not pass its check ({}); the "
+        "model took {:.3f} s, the march {:.3f} s\n",
+        r.lti.note, r.lti.model_seconds, r.lti.march_seconds);
+  if (r.engine == Engine::Transient && !r.engine_note.empty())
+    std::cerr << fmt::format(
+        "isolink sim: transient engine, not LTI: {} (the LTI attempt took {:.3f} s)\n",
+        r.engine_note, r.lti_attempt_seconds);
+  if (r.engine == Engine::Transient)
+    std::cerr << fmt::format(
+        "isolink sim: {} nodes, {} unknowns; {} steps accepted, {} rejected, {} factorizations "
+        "({} reused), {:.3f} s; {} rows{}\n",
+        r.nodes, r.unknowns, r.stats.accepted, r.stats.rejected, r.stats.factorizations,
+        r.stats.reuses, r.seconds, rows, target);
+  std::cerr << "isolink sim: accuracy: " << engine_accuracy(r) << "\n";
+}
+
 int run_sim(const SimArgs& a) {
   bool bad = false;
   std::optional<double> step = si_option("--step", a.step, &bad);
@@ -96,31 +136,7 @@ int run_sim(const SimArgs& a) {
     return 2;
   }
   const std::string target = a.output.empty() || a.output == "-" ? "" : " -> " + a.output;
-  if (!a.quiet && r->engine == Engine::Lti && r->lti.method == "reduced model")
-    std::cerr << fmt::format(
-        "isolink sim: LTI engine, reduced model: {} nodes, {} unknowns; order {} ({} poles, {} "
-        "expansion points), transfer within {:.1e} of the peak at {} check frequencies ({} "
-        "factorizations); {} corners; {:.3f} s; {} rows every {:g} s{}\n",
-        r->nodes, r->unknowns, r->lti.model.order, r->lti.model.poles,
-        r->lti.model.expansion_points, r->lti.model.error, r->lti.model.check_points,
-        r->lti.factorizations, r->grid.corners, r->seconds, out.samples(), r->grid.step, target);
-  else if (!a.quiet && r->engine == Engine::Lti)
-    std::cerr << fmt::format(
-        "isolink sim: LTI engine: {} nodes, {} unknowns; responses to {:g} s in {} steps ({} "
-        "rejected, {} factorizations){}; {} corners; {:.3f} s; {} rows every {:g} s{}\n",
-        r->nodes, r->unknowns, r->lti.settled_at, r->lti.steps, r->lti.rejected,
-        r->lti.factorizations, r->lti.settled ? ", settled" : "", r->grid.corners, r->seconds,
-        out.samples(), r->grid.step, target);
-  if (!a.quiet && r->engine == Engine::Lti && !r->lti.note.empty())
-    std::cerr << "isolink sim: LTI march (reduced model not used: " << r->lti.note << ")\n";
-  if (!a.quiet && r->engine == Engine::Transient && !r->engine_note.empty())
-    std::cerr << "isolink sim: transient engine (not LTI: " << r->engine_note << ")\n";
-  if (!a.quiet && r->engine == Engine::Transient)
-    std::cerr << fmt::format(
-        "isolink sim: {} nodes, {} unknowns; {} steps accepted, {} rejected, {} factorizations "
-        "({} reused), {:.3f} s; {} rows{}\n",
-        r->nodes, r->unknowns, r->stats.accepted, r->stats.rejected, r->stats.factorizations,
-        r->stats.reuses, r->seconds, out.samples(), target);
+  if (!a.quiet) print_sim_stats(*r, out.samples(), target);
   return 0;
 }
 }  // namespace

@@ -114,13 +114,17 @@ nlohmann::ordered_json run_report_json(const link::LinkSpec& spec, const LinkRun
                                    {"ac_error_hz", m.error_frequency}};
       } else if (!d.sim.lti.note.empty()) {
         solver["lti_note"] = d.sim.lti.note;
+        solver["reduced_model_seconds"] = d.sim.lti.model_seconds;
+        solver["march_seconds"] = d.sim.lti.march_seconds;
       }
       solver["response_span_s"] = d.sim.lti.settled_at;
       solver["grid_step_s"] = d.sim.grid.step;
       solver["rows"] = d.sim.grid.rows;
     } else if (!d.sim.engine_note.empty()) {
       solver["engine_note"] = d.sim.engine_note;
+      solver["lti_attempt_seconds"] = d.sim.lti_attempt_seconds;
     }
+    solver["accuracy"] = analysis::engine_accuracy(d.sim);
     if (!d.same_as.empty()) solver["same_circuit_as"] = d.same_as;
     ordered_json j{{"direction", link::direction_name(d.link.direction)},
                    {"transmitter", d.link.transmitter},
@@ -199,7 +203,7 @@ std::string run_report_markdown(const link::LinkSpec& spec, const LinkRun& run,
                       d.sim.unknowns, steps, rejected,
                       lti ? d.sim.lti.factorizations : d.sim.stats.factorizations, d.sim.seconds);
   }
-  for (const DirectionRun& d : run.directions)
+  for (const DirectionRun& d : run.directions) {
     if (!d.same_as.empty())
       md += fmt::format(
           "\n{}: the same circuit and traffic as {} (the same parts at both ends): its waveform, "
@@ -210,19 +214,25 @@ std::string run_report_markdown(const link::LinkSpec& spec, const LinkRun& run,
           "\n{}: waveform by the LTI engine from a reduced model (order {}, {} poles, {} "
           "expansion points; its transfer within {:.1e} of the peak of the exact AC solution at "
           "{} frequencies from 1 kHz to 3 GHz), superposing {} source corners in closed form; "
-          "output every {:.3g} ns (linear interpolation within 1 mV).\n",
+          "output rows at most {:.3g} ns apart, down to {:.3g} ns where the response bends "
+          "(linear interpolation within 1 mV).\n",
           d.link.description, d.sim.lti.model.order, d.sim.lti.model.poles,
           d.sim.lti.model.expansion_points, d.sim.lti.model.error, d.sim.lti.model.check_points,
-          d.sim.grid.corners, d.sim.grid.step * 1e9);
+          d.sim.grid.corners, d.sim.grid.coarse_step * 1e9, d.sim.grid.step * 1e9);
     else if (d.sim.engine == analysis::Engine::Lti)
       md += fmt::format(
           "\n{}: waveform by the LTI engine, superposing {} source corners on step "
-          "responses marched to {:.3g} us; output every {:.3g} ns (linear "
+          "responses marched to {:.3g} us ({}); output every {:.3g} ns (linear "
           "interpolation within 1 mV).\n",
           d.link.description, d.sim.grid.corners, d.sim.lti.settled_at * 1e6,
+          d.sim.lti.note.empty() ? "the march was asked for"
+                                 : "the reduced model did not pass its check: " + d.sim.lti.note,
           d.sim.grid.step * 1e9);
     else if (!d.sim.engine_note.empty())
-      md += fmt::format("\n{}: transient engine ({}).\n", d.link.description, d.sim.engine_note);
+      md += fmt::format("\n{}: transient engine ({}; the LTI attempt took {:.3f} s).\n",
+                        d.link.description, d.sim.engine_note, d.sim.lti_attempt_seconds);
+    if (d.same_as.empty()) md += fmt::format("Accuracy: {}.\n", analysis::engine_accuracy(d.sim));
+  }
   md += "\nFiles: `report.json` (all figures), `wave.csv` (the probes of every direction).\n";
   return md;
 }

@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <complex>
+#include <functional>
 
 #include "solver/mna_system.h"
 
@@ -180,7 +182,10 @@ StatusOr<LtiResponses> LtiResponses::compute(const Circuit& circuit,
     std::vector<const SourceFunction*> functions;
     for (const Source& src : r.sources_) functions.push_back(src.function);
     ro.edge_time = opt.edge_time > 0 ? opt.edge_time : shortest_edge(functions, opt.horizon);
+    const auto started = std::chrono::steady_clock::now();
     StatusOr<ReducedModel> model = reduce_circuit(circuit, unit, dc_solutions, probes, ro);
+    r.stats_.model_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     if (model) {
       r.stats_.method = "reduced model";
       r.stats_.model = model->stats;
@@ -194,6 +199,7 @@ StatusOr<LtiResponses> LtiResponses::compute(const Circuit& circuit,
     r.stats_.note = model.status().message();
   }
   r.stats_.method = "march";
+  const auto march_started = std::chrono::steady_clock::now();
 
   r.tau_.push_back(0.0);
   r.r_.assign(nk, std::vector<std::vector<double>>(np, std::vector<double>{0.0}));
@@ -377,6 +383,8 @@ StatusOr<LtiResponses> LtiResponses::compute(const Circuit& circuit,
     for (size_t p = 0; p < np; ++p)
       r.end_slope_[k][p] = (r.r_[k][p][e] - r.r_[k][p][e - 1]) / (r.tau_[e] - r.tau_[e - 1]);
   r.stats_.factorizations += sys.klu.factorizations();
+  r.stats_.march_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - march_started).count();
   return r;
 }
 
@@ -496,7 +504,7 @@ void LtiResponses::superpose(const std::vector<SourceInput>& inputs, double t0, 
 
 void LtiResponses::modal_add(const std::vector<SourceInput>& inputs,
                              const std::vector<double>& times, double uniform_dt,
-                             std::vector<std::vector<double>>& out) const {
+                             std::vector<std::vector<double>>& out, ModeRates* rates) const {
   const ReducedModel& m = *model_;
   const size_t nm = m.poles.size(), np = labels_.size();
   const size_t nk = std::min(sources_.size(), inputs.size());
@@ -533,7 +541,11 @@ void LtiResponses::modal_add(const std::vector<SourceInput>& inputs,
       }
     }
   };
-  Step uniform, scratch;
+  // The uniform step, and a few recent others (a pass over the midpoints of a locally refined
+  // grid repeats a handful of gaps: twice each refinement level's step).
+  Step uniform;
+  std::array<Step, 8> recent;
+  size_t next_recent = 0;
   if (uniform_dt > 0) uniform.set(m, uniform_dt);
   bool active = false;  // a corner has passed: before it everything is zero
   // A cached step serves any h within 1e-9 of it: times t0 + i dt differ from i dt by rounding
@@ -541,8 +553,12 @@ void LtiResponses::modal_add(const std::vector<SourceInput>& inputs,
   // (each query restarts from its own time), only the phase e^{ph} is off by |p| 1e-9 h.
   auto step_for = [&](double h) -> const Step* {
     if (std::fabs(h - uniform.h) <= 1e-9 * uniform.h) return &uniform;
-    if (!(std::fabs(h - scratch.h) <= 1e-9 * scratch.h)) scratch.set(m, h);
-    return &scratch;
+    for (const Step& st : recent)
+      if (std::fabs(h - st.h) <= 1e-9 * st.h) return &st;
+    Step& st = recent[next_recent];
+    next_recent = (next_recent + 1) % recent.size();
+    st.set(m, h);
+    return &st;
   };
   auto advance = [&](double h) {
     if (!(h > 0) || !active) return;
@@ -631,6 +647,44 @@ void LtiResponses::modal_add(const std::vector<SourceInput>& inputs,
     }
     fast.resize(kept), dr.resize(kept), di.resize(kept);
   };
+  // ModeRates: each mode's weight on the probes, and the transient part d = x - x_ss of its state
+  // (x_ss = -(b + g t) / p - g / p^2 follows the input; d decays as e^{p t}).
+  // ModeRates: each mode's weight on the probes (squared, over the threshold squared), and the
+  // transient part d = x - x_ss of its state (x_ss = -(b + g t) / p - g / p^2 follows the input;
+  // d decays as e^{p t}), from 1 / p and 1 / p^2 kept as real arrays.
+  std::vector<double> w2, ipr, ipi, ip2r, ip2i, speed;
+  if (rates) {
+    rates->rate.assign(times.size(), 0.0);
+    w2.assign(nm, 0.0);
+    for (size_t p = 0; p < np && p < rates->probe_weight.size(); ++p)
+      for (size_t i = 0; i < nm; ++i)
+        w2[i] = std::max(w2[i], rates->probe_weight[p] * std::abs(m.output[p][i]));
+    for (size_t i = 0; i < nm; ++i) {
+      w2[i] = w2[i] * w2[i] / (rates->threshold * rates->threshold);
+      const std::complex<double> ip = 1.0 / m.poles[i], ip2 = ip * ip;
+      ipr.push_back(ip.real()), ipi.push_back(ip.imag());
+      ip2r.push_back(ip2.real()), ip2i.push_back(ip2.imag());
+      speed.push_back(std::abs(m.poles[i]));
+    }
+  }
+  auto rate_at = [&](size_t j) {
+    if (!rates) return;
+    double fastest = 0.0;
+    auto consider = [&](size_t i, double d_r, double d_i) {
+      if (w2[i] * (d_r * d_r + d_i * d_i) > 1.0) fastest = std::max(fastest, speed[i]);
+    };
+    if (!tail) {
+      for (size_t i = 0; i < nm; ++i)
+        consider(i, xr[i] + br[i] * ipr[i] - bi[i] * ipi[i] + gr[i] * ip2r[i] - gi[i] * ip2i[i],
+                 xi[i] + br[i] * ipi[i] + bi[i] * ipr[i] + gr[i] * ip2i[i] + gi[i] * ip2r[i]);
+    } else {
+      for (size_t i : slow)
+        consider(i, xr[i] + br[i] * ipr[i] - bi[i] * ipi[i],
+                 xi[i] + br[i] * ipi[i] + bi[i] * ipr[i]);
+      for (size_t f = 0; f < fast.size(); ++f) consider(fast[f], dr[f], di[f]);
+    }
+    rates->rate[j] = fastest;
+  };
   double tc = times.empty() ? 0.0 : times[0];
   if (!corners.empty()) tc = std::min(tc, corners[0].t);
   size_t c = 0;
@@ -640,6 +694,7 @@ void LtiResponses::modal_add(const std::vector<SourceInput>& inputs,
       tail_step(tq - tc);
       tc = tq;
       if (j % 64 == 0) prune();
+      rate_at(j);
       for (size_t p = 0; p < np; ++p) {
         double d = tail_const[p];
         for (size_t i : slow) d += outr[p][i] * xr[i] - outi[p][i] * xi[i];
@@ -664,6 +719,7 @@ void LtiResponses::modal_add(const std::vector<SourceInput>& inputs,
     tc = tq;
     if (!active) continue;
     if (c == corners.size() && j + 1 < times.size()) enter_tail(times.back() - tc);
+    rate_at(j);
     for (size_t p = 0; p < np; ++p) {
       const double *orr = outr[p].data(), *oi = outi[p].data();
       double y0 = 0, y1 = 0;  // two partial sums: a shorter dependency chain
@@ -700,91 +756,166 @@ std::vector<std::vector<double>> LtiResponses::values(const std::vector<SourceIn
   return out;
 }
 
+namespace {
+
+using Rows = std::vector<std::vector<double>>;  // [probe][row]
+
+// The reduced model's first grid level: the uniform grid of step dt, plus every corner inside the
+// span as a row of its own.
+std::vector<double> first_level(double tstart, double tstop, double dt,
+                                const std::vector<double>& corners) {
+  std::vector<double> t;
+  const long count = static_cast<long>(std::floor((tstop - tstart) / dt * (1 + 1e-12))) + 1;
+  for (long i = 0; i < count; ++i) t.push_back(tstart + static_cast<double>(i) * dt);
+  t.insert(t.end(), corners.begin(), corners.end());
+  std::sort(t.begin(), t.end());
+  std::vector<double> out;  // closer than 1e-6 dt: one row (the uniform one first)
+  for (double x : t)
+    if (out.empty() || x >= out.back() + 1e-6 * dt) out.push_back(x);
+  return out;
+}
+
+// GridOptions' rule by local refinement, as adaptive quadrature refines: every interval not yet
+// accepted is tested at its midpoint; one that fails is split there (the midpoint, already
+// computed, becomes a row) and its two halves are tested in the next pass. Each pass evaluates
+// only the new midpoints. A midpoint alone can be fooled by a mode that turns through a whole
+// period inside the interval (0, 0 and 0 at its ends and middle: the 15 m transformer link's
+// ringing was 9 mV off that way), so an interval is also split while it is longer than 1 / |p|
+// of the fastest mode still active at either end (`evaluate` gives those rates, ModeRates): the
+// grid is sized from the circuit's time constants where they act. Returns the finest step; sets
+// `warning` when max_rows stops it.
+using Evaluate = std::function<Rows(const std::vector<double>&, double, std::vector<double>&)>;
+double refine_grid(std::vector<double>& times, Rows& rows, const Evaluate& evaluate,
+                   const LtiResponses::GridOptions& grid, const std::vector<bool>& is_current,
+                   double dt, std::string& warning) {
+  const size_t np = is_current.size();
+  std::vector<double> mids, row_rate, mid_rate;
+  Rows mid_values;
+  {  // The first level's rows and midpoints in one pass (interleaved: dt / 2 is cached).
+    std::vector<double> all, rate;
+    all.reserve(2 * times.size());
+    for (size_t j = 0; j < times.size(); ++j) {
+      all.push_back(times[j]);
+      if (j + 1 < times.size()) all.push_back(0.5 * (times[j] + times[j + 1]));
+    }
+    rows = evaluate(all, 0.5 * dt, rate);
+    mid_values.resize(np);
+    for (size_t p = 0; p < np; ++p) {
+      mid_values[p].resize(times.size() - 1);
+      for (size_t j = 0; j + 1 < times.size(); ++j) mid_values[p][j] = rows[p][2 * j + 1];
+      for (size_t j = 0; 2 * j < all.size(); ++j) rows[p][j] = rows[p][2 * j];
+      rows[p].resize(times.size());
+    }
+    for (size_t j = 0; j < times.size(); ++j) row_rate.push_back(rate[2 * j]);
+    for (size_t j = 0; j + 1 < times.size(); ++j) mid_rate.push_back(rate[2 * j + 1]);
+  }
+  std::vector<size_t> open(times.size() - 1);  // intervals [times[i], times[i + 1]] to test
+  for (size_t i = 0; i < open.size(); ++i) open[i] = i;
+  double finest = dt;
+  while (!open.empty()) {
+    std::vector<char> split(open.size(), 0);
+    size_t splits = 0;
+    double worst = 0.0;
+    for (size_t j = 0; j < open.size(); ++j) {
+      const size_t i = open[j];
+      double e = 0.0;
+      for (size_t p = 0; p < np; ++p) {
+        if (!grid.grid_probes.empty() && (p >= grid.grid_probes.size() || !grid.grid_probes[p]))
+          continue;
+        const double scale = is_current[p] ? 1e3 : 1.0;  // 1 mV -> 1 uA
+        e = std::max(e, scale * std::fabs(mid_values[p][j] - 0.5 * (rows[p][i] + rows[p][i + 1])));
+      }
+      worst = std::max(worst, e);
+      const double rate = std::max(row_rate[i], row_rate[i + 1]);
+      if (e > 0.5 * grid.interp_tol || (times[i + 1] - times[i]) * rate > 1.0)
+        split[j] = 1, ++splits;
+    }
+    if (splits == 0) break;
+    if (static_cast<long>(times.size() + splits) > grid.max_rows) {
+      warning = fmt::format(
+          "LTI output grid stopped at {} rows (step {:g} s): linear interpolation between rows "
+          "may be off by up to {:.3g} mV, over the {:g} mV target",
+          times.size(), finest, 2e3 * worst, 1e3 * grid.interp_tol);
+      break;
+    }
+    // The failing midpoints join the rows; their halves are the next pass's intervals.
+    std::vector<double> new_times, new_rate;
+    new_times.reserve(times.size() + splits);
+    new_rate.reserve(times.size() + splits);
+    Rows new_rows(np);
+    for (auto& r : new_rows) r.reserve(times.size() + splits);
+    std::vector<size_t> new_open;
+    new_open.reserve(2 * splits);
+    size_t j = 0;
+    for (size_t i = 0; i < times.size(); ++i) {
+      new_times.push_back(times[i]);
+      new_rate.push_back(row_rate[i]);
+      for (size_t p = 0; p < np; ++p) new_rows[p].push_back(rows[p][i]);
+      if (j == open.size() || open[j] != i) continue;  // open is ascending
+      if (split[j]) {
+        new_open.push_back(new_times.size() - 1);
+        new_times.push_back(0.5 * (times[i] + times[i + 1]));
+        new_rate.push_back(mid_rate[j]);
+        for (size_t p = 0; p < np; ++p) new_rows[p].push_back(mid_values[p][j]);
+        new_open.push_back(new_times.size() - 1);
+        finest = std::min(finest, 0.5 * (times[i + 1] - times[i]));
+      }
+      ++j;
+    }
+    times = std::move(new_times);
+    row_rate = std::move(new_rate);
+    rows = std::move(new_rows);
+    open = std::move(new_open);
+    mids.resize(open.size());
+    for (size_t k = 0; k < open.size(); ++k) mids[k] = 0.5 * (times[open[k]] + times[open[k] + 1]);
+    mid_values = evaluate(mids, 0.0, mid_rate);
+  }
+  return finest;
+}
+
+}  // namespace
+
 Waveform LtiResponses::modal_waveform(const std::vector<SourceInput>& inputs,
                                       const GridOptions& grid, const std::vector<double>& base,
                                       GridInfo& gi) const {
   const size_t np = labels_.size();
   const double span = grid.tstop - grid.tstart;
-  auto evaluate = [&](const std::vector<double>& times, double dt) {
-    std::vector<std::vector<double>> v(np);
+  // The modes the grid must resolve: a share over a twentieth of the tolerance on a grid probe.
+  ModeRates mode_rates;
+  mode_rates.threshold = 0.05 * grid.interp_tol;
+  for (size_t p = 0; p < np; ++p) {
+    const bool looked_at =
+        grid.grid_probes.empty() || (p < grid.grid_probes.size() && grid.grid_probes[p]);
+    mode_rates.probe_weight.push_back(!looked_at ? 0.0 : is_current_[p] ? 1e3 : 1.0);
+  }
+  auto evaluate = [&](const std::vector<double>& times, double dt, std::vector<double>& rate) {
+    Rows v(np);
     for (size_t p = 0; p < np; ++p) v[p].assign(times.size(), base[p]);
-    modal_add(inputs, times, dt, v);
+    modal_add(inputs, times, dt, v, &mode_rates);
+    rate = std::move(mode_rates.rate);
     return v;
   };
-  auto uniform = [&](double dt) {
-    const long count = static_cast<long>(std::floor(span / dt * (1 + 1e-12))) + 1;
-    std::vector<double> t(static_cast<size_t>(count));
-    for (long i = 0; i < count; ++i)
-      t[static_cast<size_t>(i)] = grid.tstart + static_cast<double>(i) * dt;
-    return t;
-  };
   std::vector<double> times;
-  std::vector<std::vector<double>> rows;
+  Rows rows;
   double dt = grid.step;
   if (dt > 0) {
-    times = uniform(dt);
-    rows = evaluate(times, dt);
+    times = first_level(grid.tstart, grid.tstop, dt, {});
+    rows = Rows(np);
+    for (size_t p = 0; p < np; ++p) rows[p].assign(times.size(), base[p]);
+    modal_add(inputs, times, dt, rows);
   } else {
-    // The rule of GridOptions, on the uniform grid plus the corners: every interval between
-    // consecutive rows is tested at its midpoint (one pass over rows and midpoints together).
+    // Rows gather where the response bends (after each corner, for as long as its fast modes
+    // last) and stay coarse elsewhere: 1 ns and 1 ms time constants over 5 ms take about
+    // 66,000 rows, where uniform halving went to its 4,000,000-row limit.
     std::vector<double> corners;
     for (const SourceInput& in : inputs)
       for (const Ramp& ramp : in.ramps)
         if (ramp.t > grid.tstart && ramp.t < grid.tstop) corners.push_back(ramp.t);
-    std::sort(corners.begin(), corners.end());
     dt = span;
     while (dt > coarsest_grid_step(span)) dt *= 0.5;
-    while (true) {
-      const std::vector<double> u = uniform(dt);
-      times.clear();
-      const double tiny = dt * 1e-6;
-      size_t c = 0;
-      for (double t : u) {
-        for (; c < corners.size() && corners[c] < t; ++c)
-          if (corners[c] <= t - tiny && (times.empty() || corners[c] >= times.back() + tiny))
-            times.push_back(corners[c]);
-        if (times.empty() || t > times.back()) times.push_back(t);
-      }
-      std::vector<double> all;  // rows and midpoints, interleaved
-      all.reserve(2 * times.size());
-      for (size_t j = 0; j < times.size(); ++j) {
-        all.push_back(times[j]);
-        if (j + 1 < times.size()) all.push_back(0.5 * (times[j] + times[j + 1]));
-      }
-      rows = evaluate(all, 0.5 * dt);
-      const std::vector<std::vector<double>>& v = rows;
-      double worst = 0.0;
-      for (size_t p = 0; p < np; ++p) {
-        if (!grid.grid_probes.empty() && (p >= grid.grid_probes.size() || !grid.grid_probes[p]))
-          continue;
-        const double scale = is_current_[p] ? 1e3 : 1.0;
-        for (size_t j = 1; j + 1 < all.size(); j += 2)
-          worst = std::max(worst, scale * std::fabs(v[p][j] - 0.5 * (v[p][j - 1] + v[p][j + 1])));
-      }
-      // The rows are the even entries: compacted in place (no copies of the largest arrays).
-      for (size_t p = 0; p < np; ++p) {
-        for (size_t j = 0; 2 * j < all.size(); ++j) rows[p][j] = rows[p][2 * j];
-        rows[p].resize(times.size());
-      }
-      if (worst <= 0.5 * grid.interp_tol) break;
-      if (2 * static_cast<long>(times.size()) - 1 > grid.max_rows) {
-        gi.warning = fmt::format(
-            "LTI output grid stopped at {} rows (step {:g} s): linear interpolation between rows "
-            "may be off by up to {:.3g} mV, over the {:g} mV target",
-            times.size(), dt, 2e3 * worst, 1e3 * grid.interp_tol);
-        break;
-      }
-      // The error of a smooth response falls as dt^2: go straight to the level that should
-      // meet the tolerance (then tested like any other), skipping the levels on the way; never
-      // finer than max_rows allows.
-      const double target = dt * std::sqrt(0.5 * grid.interp_tol / worst) * 0.9;
-      int halvings = 1;
-      while (halvings < 30 && dt * std::ldexp(1.0, -halvings) > target &&
-             static_cast<double>(times.size()) * std::ldexp(1.0, halvings + 1) <
-                 static_cast<double>(grid.max_rows))
-        ++halvings;
-      dt = std::ldexp(dt, -halvings);
-    }
+    gi.coarse_step = dt;
+    times = first_level(grid.tstart, grid.tstop, dt, corners);
+    dt = refine_grid(times, rows, evaluate, grid, is_current_, dt, gi.warning);
   }
   Waveform w;
   w.time = std::move(times);

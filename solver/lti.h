@@ -99,12 +99,14 @@ SourceInput pwl_input(const std::vector<double>& t, const std::vector<double>& v
 struct LtiStats {
   long steps = 0;  // accepted march steps
   long rejected = 0;
-  int factorizations = 0;   // numeric (march + DC)
-  double settled_at = 0.0;  // s, end of the march (the horizon unless it settled before)
-  bool settled = false;     // stopped early by the settling criterion
-  std::string method;       // "march" or "reduced model"
-  std::string note;         // auto: why the reduced model was not used
-  ReducedModelStats model;  // the reduced model's figures (method "reduced model")
+  int factorizations = 0;      // numeric (march + DC)
+  double settled_at = 0.0;     // s, end of the march (the horizon unless it settled before)
+  bool settled = false;        // stopped early by the settling criterion
+  std::string method;          // "march" or "reduced model"
+  std::string note;            // auto: why the reduced model was not used
+  double model_seconds = 0.0;  // s, building and checking the reduced model (passed or not)
+  double march_seconds = 0.0;  // s, the march (method "march")
+  ReducedModelStats model;     // the reduced model's figures (method "reduced model")
 };
 
 // Why the circuit cannot take the LTI engine (an element that is not LTI, a source that is not
@@ -148,7 +150,10 @@ class LtiResponses {
     // errs most; for a single kink inside a cell the worst error is at most twice the midpoint's,
     // so linear interpolation between rows stays within interp_tol. Cells that hold a source corner
     // are left out of the test, and every corner inside the span is a row of its own (so the grid
-    // is uniform plus the corners, and a probe on a driven node is exact).
+    // is uniform plus the corners, and a probe on a driven node is exact). That is the march's
+    // grid. The reduced model's refines locally instead: the first level as above (20 ns, or
+    // span / 65536), then only the cells whose midpoint fails are halved, again and again, so
+    // rows gather after the corners where a fast response bends and stay coarse elsewhere.
     double interp_tol = 1e-3;       // V for voltage probes (A/1000 for currents: 1 uA)
     std::vector<bool> grid_probes;  // which probes the rule looks at (empty = all)
     long max_rows = 4'000'000;      // the rule stops refining here (a warning says so)
@@ -162,7 +167,11 @@ class LtiResponses {
   struct GridInfo {
     long corners = 0;  // ramps superposed
     long rows = 0;
-    double step = 0.0;         // s, the grid's step
+    // s, the grid's step; with the reduced model and no given step, the finest step of the
+    // locally refined grid (rows are at most coarse_step apart, coarse_step / 2^m where the
+    // response bends)
+    double step = 0.0;
+    double coarse_step = 0.0;  // s, the refined grid's first level (0: a uniform grid)
     std::string warning;       // set when the rule hit max_rows before meeting interp_tol
     bool over_budget = false;  // stopped by max_evaluations: the waveform is empty
     double evaluations = 0.0;  // predicted probe evaluations of the levels computed (or refused)
@@ -183,10 +192,19 @@ class LtiResponses {
   bool reduced() const { return model_.has_value(); }
 
  private:
+  // The output grid's view of the modes: at each time, the largest |p_i| among the modes whose
+  // transient share (the part of the state that still decays, times max over probes of
+  // probe_weight |out_pi|) is over threshold: the time scale the grid must resolve there.
+  struct ModeRates {
+    std::vector<double> probe_weight;  // per probe: 0 (not looked at), 1 (V) or 1e3 (A)
+    double threshold = 0.0;
+    std::vector<double> rate;  // per time, 1/s
+  };
   // Reduced model: adds the ramps' response (without the base) at times[0..count) into out[p][j].
   // uniform_dt > 0 says that most consecutive times are that far apart (its step is cached).
   void modal_add(const std::vector<SourceInput>& inputs, const std::vector<double>& times,
-                 double uniform_dt, std::vector<std::vector<double>>& out) const;
+                 double uniform_dt, std::vector<std::vector<double>>& out,
+                 ModeRates* rates = nullptr) const;
   Waveform modal_waveform(const std::vector<SourceInput>& inputs, const GridOptions& grid,
                           const std::vector<double>& base, GridInfo& gi) const;
 

@@ -32,6 +32,10 @@ Status ReducedModelOptions::validate() const {
   return Status::Ok();
 }
 
+double ReducedModelOptions::edge_error_bound() const {
+  return tol * std::log(f_max / f_min) / std::numbers::pi;
+}
+
 std::complex<double> ReducedModel::transfer(size_t k, size_t p, std::complex<double> s) const {
   std::complex<double> h = direct[k][p];
   for (size_t i = 0; i < poles.size(); ++i) {
@@ -178,6 +182,22 @@ StatusOr<ReducedModel> reduce_in_form(const Circuit& circuit,
     for (int i = 0; i < n; ++i) x[i] = dc_solutions[k][i + 1];
     basis.add(x, g, c);
   }
+  // A voltage source's excitation is its own branch unknown (unit at its branch row). The
+  // Galerkin projection tests each equation only along the basis, and the source's equation
+  // v_a - v_b = u only along a basis direction that moves the source's current on its own.
+  // The DC and Krylov vectors never do that when node a has no resistor (a source straight
+  // into an inductor: KCL at a ties the source's current to the inductor's in every one of
+  // them), so v_a was left undetermined and the projected pencil singular in both sign forms
+  // (issue 28: V -> L -> R). The excitation itself is that direction; one more per source.
+  for (size_t k = 0; k < nk; ++k) {
+    Eigen::VectorXd e(n);
+    bool on_branch = false;
+    for (int i = 0; i < n; ++i) {
+      e[i] = excitations[k][i + 1];
+      on_branch |= e[i] != 0 && !circuit.unknown_is_node(i + 1);
+    }
+    if (on_branch) basis.add(e, g, c);
+  }
   // Adds the Krylov vectors at j 2 pi f; false when none was new.
   auto expand_at = [&](double f) -> StatusOr<bool> {
     if (Status s = ac->factor(f); !s.ok()) return s;
@@ -293,8 +313,15 @@ StatusOr<ReducedModel> reduce_in_form(const Circuit& circuit,
       return Status::Error("reduced model: the eigenvectors are singular");
     double lmax = 0;
     for (int i = 0; i < q; ++i) lmax = std::max(lmax, std::abs(lambda[i]));
+    // Instantaneous: lambda = 0, or a mode so fast (|lambda| under 1e-6 / (2 pi f_max): a time
+    // constant of 0.05 fs, a pole over 2e16 rad/s) that its share 1 / (1 + (s - sigma) lambda)
+    // is constant within 1e-6 over the whole band. The zero eigenvalues of a singular Cr come
+    // out at about 1e-12 of the largest, of either sign: on V -> L -> R at +-1e-19 s against
+    // 9e-8 s, one was a pole at -8.9e18 rad/s and the other a right-half-plane pole, dropped,
+    // and v(in) lost its direct term (error 1).
+    const double instant = 1e-6 / (2 * std::numbers::pi * opt.f_max);
     for (int i = 0; i < q; ++i) {
-      if (std::abs(lambda[i]) <= 1e-14 * lmax) {
+      if (std::abs(lambda[i]) <= std::max(1e-14 * lmax, instant)) {
         ++mod.stats.direct_modes;
         for (size_t k = 0; k < nk; ++k)
           for (size_t p = 0; p < np; ++p) mod.direct[k][p] += (cw(p, i) * d(i, k)).real();

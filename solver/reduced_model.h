@@ -85,6 +85,9 @@ struct ReducedModelOptions {
   // 0: no weighting (every frequency counts fully, as for a step input).
   double edge_time = 0.0;
   Status validate() const;  // names the field, its value and the rule
+  // The bound the check guarantees (above) on the step response's error, per unit of edge
+  // amplitude: tol ln(f_max / f_min) / pi (9.5e-5 with the defaults).
+  double edge_error_bound() const;
 };
 
 struct ReducedModelStats {

@@ -118,4 +118,36 @@ TEST(SimCommand, UnknownOptionIsWarnedAndIgnored) {
       << r.err;
 }
 
+// Issue 28: auto never trades accuracy silently. Each run states its engine, why auto took it,
+// how long it took and the accuracy that engine promises, with the figures of its options.
+TEST(SimCommand, StatesTheEngineWhyHowLongAndTheAccuracyItPromises) {
+  const std::string sin = write_temp("sin_rc.cir",
+                                     "sin\nV1 in 0 SIN(0 1 1meg)\nR1 in a 1k\nC1 a 0 1n\n"
+                                     ".tran 10n 5u\n.end\n");
+  Result r = run("sim " + sin + " -p 'v(a)' -o /dev/null");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("transient engine, not LTI: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("source 'v1' is not a continuous piecewise-linear"), std::string::npos);
+  EXPECT_NE(r.err.find("(the LTI attempt took 0.0"), std::string::npos) << r.err;
+  // trtol 0.1 x reltol 1e-3, then with --reltol 1e-5.
+  EXPECT_NE(r.err.find("accuracy: transient: local truncation error per step within trtol x "
+                       "reltol = 0.0001 of each unknown's peak (reltol 0.001)"),
+            std::string::npos)
+      << r.err;
+  r = run("sim " + sin + " -p 'v(a)' -o /dev/null --reltol 1e-5");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("= 1e-06 of each unknown's peak (reltol 1e-05)"), std::string::npos)
+      << r.err;
+  // The reduced model: its bound per volt of edge, 2e-5 ln(3 GHz / 1 kHz) / pi = 0.095 mV.
+  const std::string rc =
+      write_temp("pwl_rc.cir",
+                 "rc\nV1 in 0 PWL(0 0 1u 0 1.01u 1)\nR1 in a 1k\nC1 a 0 1n\n.tran 10n 5u\n.end\n");
+  r = run("sim " + rc + " -p 'v(a)' -o /dev/null");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("LTI engine, reduced model"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("accuracy: reduced model within"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("within 0.095 mV per volt of edge (0.47 mV for 5 V)"), std::string::npos)
+      << r.err;
+}
+
 }  // namespace

@@ -407,9 +407,11 @@ void expect_grid_matches(const Built& b, double tstop, size_t probe,
   for (size_t i = 0; i < w.time.size(); ++i) {
     at_rows = std::max(at_rows, std::fabs(w.columns[probe][i] - exact(w.time[i])));
     if (i + 1 == w.time.size()) continue;
-    const double t = 0.5 * (w.time[i] + w.time[i + 1]);
-    between = std::max(between,
-                       std::fabs(0.5 * (w.columns[probe][i] + w.columns[probe][i + 1]) - exact(t)));
+    for (double f : {0.25, 0.5, 0.75}) {  // linear interpolation inside each cell
+      const double t = w.time[i] + f * (w.time[i + 1] - w.time[i]);
+      const double lin = (1 - f) * w.columns[probe][i] + f * w.columns[probe][i + 1];
+      between = std::max(between, std::fabs(lin - exact(t)));
+    }
   }
   EXPECT_LT(at_rows, tol) << w.time.size() << " rows";
   EXPECT_LT(between, 1e-3) << w.time.size() << " rows";  // the grid rule's 1 mV
@@ -426,16 +428,22 @@ TEST(LtiSlowCircuits, RcWithOneSecondTimeConstantOverSevenSeconds) {
 }
 
 TEST(LtiSlowCircuits, RlWithTenMillisecondTimeConstant) {
-  // 10 mH into 1 ohm: the resistor's voltage follows a 1 us edge with tau = 10 ms.
+  // 10 mH into 1 ohm: the resistor's voltage follows a 1 us edge with tau = 10 ms. The source
+  // drives the inductor directly (no resistor at its node), which made the reduced model's
+  // projection singular in both sign forms until the source's own branch joined the basis.
   auto b = make({card("v1", {"in", "0"}, {call("pwl", {0, 0, 1e-3, 0, 1.001e-3, 1})}),
                  card("l1", {"in", "x"}, {num(10e-3)}), card("r1", {"x", "0"}, {num(1)})},
-                {"v(x)"});
-  // Auto: the reduced model refuses this circuit (its projection is singular at the mid-band
-  // shift), and the march gives the responses, within its step_reltol (1e-5 of the step per unit
-  // time, 1.5e-5 measured); the grid is the same rule either way.
-  expect_grid_matches(
-      *b, 60e-3, 0, [](double t) { return lag_edge(t, 1e-3, 1e-6, 10e-3); }, 5e-5, 300'000,
-      Method::Auto);
+                {"v(x)", "i(l1)", "v(in)"});
+  const auto exact = [](double t) { return lag_edge(t, 1e-3, 1e-6, 10e-3); };
+  expect_grid_matches(*b, 60e-3, 0, exact, 1e-6, 70'000);
+  // The inductor's current (1 ohm: the same curve in A) and the driven node, from the model.
+  LtiResponses lti = responses(*b, 60e-3, Method::Reduced);
+  EXPECT_EQ(lti.stats().method, "reduced model");
+  const auto in = lti.netlist_inputs(60e-3);
+  for (double t : {0.5e-3, 1.0005e-3, 2e-3, 11e-3, 45e-3}) {
+    EXPECT_NEAR(lti.value(1, t, in), exact(t), 1e-6) << t;
+    EXPECT_NEAR(lti.value(2, t, in), edge(t, 1e-3, 1e-6), 1e-9) << t;
+  }
 }
 
 TEST(LtiSlowCircuits, CouplingCapWithTenMegohmBleederIdlingFourMilliseconds) {
@@ -446,6 +454,37 @@ TEST(LtiSlowCircuits, CouplingCapWithTenMegohmBleederIdlingFourMilliseconds) {
   expect_grid_matches(
       *b, 4e-3, 0, [](double t) { return edge(t, 1e-6, 10e-9) - lag_edge(t, 1e-6, 10e-9, 22e-3); },
       1e-6, 70'000);
+}
+
+TEST(LtiSlowCircuits, NanosecondAndMillisecondTimeConstantsInOneCircuit) {
+  // One source, two RC sections: 1 ohm / 1 nF (tau 1 ns) and 1 kohm / 1 uF (tau 1 ms), a 1 ns
+  // edge up at 1 us and down at 2.5 ms, over 5 ms. Uniform halving went to its 4,000,000-row
+  // limit for the 1 ns section; the locally refined grid keeps 65,537 first-level rows and
+  // refines only after the two edges.
+  auto b = make({card("v1", {"in", "0"},
+                      {call("pwl", {0, 0, 1e-6, 0, 1.001e-6, 1, 2.5e-3, 1, 2.500001e-3, 0})}),
+                 card("r1", {"in", "a"}, {num(1)}), card("c1", {"a", "0"}, {num(1e-9)}),
+                 card("r2", {"in", "b"}, {num(1e3)}), card("c2", {"b", "0"}, {num(1e-6)})},
+                {"v(a)", "v(b)"});
+  auto pulse = [](double t, double tau) {
+    return lag_edge(t, 1e-6, 1e-9, tau) - lag_edge(t, 2.5e-3, 1e-9, tau);
+  };
+  // Each section against its closed form, at and between rows (the 1 mV rule), rows bounded.
+  expect_grid_matches(
+      *b, 5e-3, 0, [&](double t) { return pulse(t, 1e-9); }, 1e-6, 70'000);
+  expect_grid_matches(
+      *b, 5e-3, 1, [&](double t) { return pulse(t, 1e-3); }, 1e-6, 70'000);
+  // The nanosecond response is resolved where it happens: rows within 10 ns after each edge.
+  LtiResponses lti = responses(*b, 5e-3, Method::Reduced);
+  LtiResponses::GridInfo info;
+  const Waveform w = lti.waveform(lti.netlist_inputs(5e-3), {.tstop = 5e-3}, &info);
+  for (double edge_at : {1.001e-6, 2.500001e-3}) {
+    const auto rows_in = std::count_if(
+        w.time.begin(), w.time.end(), [&](double t) { return t > edge_at && t < edge_at + 10e-9; });
+    EXPECT_GE(rows_in, 5) << edge_at;
+  }
+  EXPECT_LT(info.step, 1e-9);                          // refined below the fast time constant
+  EXPECT_NEAR(info.coarse_step, 5e-3 / 65536, 1e-15);  // and coarse elsewhere
 }
 
 TEST(Lti, OptionsAreValidatedByName) {
