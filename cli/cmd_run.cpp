@@ -15,6 +15,7 @@
 #include "base/file_io.h"
 #include "base/progress.h"
 #include "cli/commands.h"
+#include "cli/common_options.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
 #include "netlists/traffic/stimulus.h"
@@ -33,7 +34,7 @@ struct RunArgs {
   std::string out_dir;
   std::vector<std::string> part_dirs;
   std::string direction;
-  std::string engine = "auto";
+  Engine engine = Engine::Auto;
   bool no_images = false;
   bool no_worst = false;
   bool quiet = false;
@@ -99,7 +100,7 @@ int run_run(const RunArgs& a) {
   ProgressLine line({.label = "isolink run", .enabled = !a.quiet});
   auto progress = [&line](const std::string& what, double f) { line.show_fraction(what, f); };
   RunOptions ro;
-  ro.engine = *parse_engine(a.engine);  // CLI11 checked the choice
+  ro.engine = a.engine;
   ro.progress = progress;
   StatusOr<LinkRun> run = run_link(*spec, *parts, ro);
   if (!run) return fail(run.status().with_context(a.spec));
@@ -175,14 +176,10 @@ void add_run_command(CLI::App& app, int* exit_code) {
   cmd->add_option("spec", args->spec, "Link spec (YAML), e.g. netlists/examples/xfmr_12m.yaml")
       ->required();
   cmd->add_option("-o,--output", args->out_dir, "Report folder (default reports/out/<name>)");
-  cmd->add_option("--parts", args->part_dirs, "Extra part-library folder (repeatable)");
+  add_parts_option(*cmd, &args->part_dirs);
   cmd->add_option("--direction", args->direction, "Override the spec: down | up | both")
       ->check(CLI::IsMember({"down", "up", "both"}));
-  cmd->add_option(
-         "--engine", args->engine,
-         "auto (the default: LTI where it is the cheaper engine, else transient), lti (exact "
-         "superposition), transient")
-      ->check(CLI::IsMember({"auto", "lti", "transient"}));
+  add_engine_option(*cmd, &args->engine);
   cmd->add_flag("--no-images", args->no_images, "Skip eye.png and wave.png");
   cmd->add_flag("--no-worst", args->no_worst,
                 "Skip the worst case over all traffic (its report section and verdict)");

@@ -12,6 +12,7 @@
 #include "base/file_io.h"
 #include "base/progress.h"
 #include "cli/commands.h"
+#include "cli/common_options.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
 #include "reports/worst_png.h"
@@ -94,7 +95,7 @@ void add_worst_command(CLI::App& app, int* exit_code) {
   cmd->add_option("spec", args->spec, "Link spec (YAML)")->required();
   cmd->add_option("-o,--output", args->out_dir,
                   "Write worst.json, worst.md and the images to this folder");
-  cmd->add_option("--parts", args->part_dirs, "Extra part-library folder (repeatable)");
+  add_parts_option(*cmd, &args->part_dirs);
   cmd->add_option("--direction", args->direction, "Override the spec: down | up | both")
       ->check(CLI::IsMember({"down", "up", "both"}));
   cmd->add_option("--edge-engine", args->edge_engine,
