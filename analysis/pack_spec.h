@@ -48,7 +48,7 @@ struct HopSpec {
   SourceLoc loc;        // the entry in the pack file
 };
 
-// Command timing (domain.md section 7); the README's section "Packs" derives the formulas.
+// Command timing (docs/physics.md section 7); the README's section "Packs" derives the formulas.
 struct TimingSpec {
   double bridge_delay = 12e-6;    // s, bridge byte delay including re-clock
   double device_delay = 3e-6;     // s, per stack device (re-clock)
