@@ -1,6 +1,6 @@
 // Pack specs: a whole battery pack's daisy chain in YAML, read into one link spec per hop.
 //
-//   StatusOr<PackSpec> pack = read_pack_spec_file("netlists/examples/pack_16.yaml");
+//   StatusOr<PackSpec> pack = read_pack_spec_file("netlists/examples/pack/pack_16.yaml");
 //   if (!pack) return pack.status();          // "pack.yaml:12:5: error: key 'cable.lenght' ..."
 //   for (const HopSpec& h : pack->hops) ... h.spec (a link::LinkSpec) ...
 //   // then run_pack (analysis/pack.h).

@@ -71,7 +71,7 @@ void add_pack_command(CLI::App& app, int* exit_code) {
       "Simulate every hop of a pack spec (each distinct circuit once), check the ring's "
       "cable breaks and command timing, write the pack report (report.md, report.json, "
       "pack.png, hop_NN/)");
-  cmd->add_option("spec", args->spec, "Pack spec (YAML), e.g. netlists/examples/pack_16.yaml")
+  cmd->add_option("spec", args->spec, "Pack spec (YAML), e.g. netlists/examples/pack/pack_16.yaml")
       ->required();
   cmd->add_option("-o,--output", args->out_dir, "Report folder (default reports/out/<name>)");
   cmd->add_option("-j,--jobs", args->jobs, "Threads across distinct hops (0: all cores)");

@@ -173,7 +173,8 @@ void add_run_command(CLI::App& app, int* exit_code) {
       "run",
       "Simulate a link spec with its traffic, score each receiver and write the report "
       "(eye.png, wave.png, report.json, report.md, report.html, wave.csv)");
-  cmd->add_option("spec", args->spec, "Link spec (YAML), e.g. netlists/examples/xfmr_12m.yaml")
+  cmd->add_option("spec", args->spec,
+                  "Link spec (YAML), e.g. netlists/examples/transformer_15m.yaml")
       ->required();
   cmd->add_option("-o,--output", args->out_dir, "Report folder (default reports/out/<name>)");
   add_parts_option(*cmd, &args->part_dirs);

@@ -1,7 +1,7 @@
 // Link specs: a daisy-chain hop described as an isolation BOM in YAML (the engineer's view),
 // read into plain structs with every default drawn from docs/physics.md section 4.
 //
-//   StatusOr<LinkSpec> spec = read_link_spec_file("netlists/examples/xfmr_12m.yaml");
+//   StatusOr<LinkSpec> spec = read_link_spec_file("netlists/examples/transformer_15m.yaml");
 //   if (!spec) return spec.status();          // "file:line:col: error: key 'cable.length' ..."
 //   // then expand_link(*spec, parts, Direction::kDown) (expand.h) gives the circuit.
 // Keys (netlists/link/README.md has the full table):
