@@ -81,6 +81,10 @@ struct WorstMargin {
   std::string role;    // place in the frame
 };
 
+// Contract of the functions below: t in seconds, v in volts, the spans read during the call and
+// not kept; seg must come from segment() over the same t and v (its indices point into them), t
+// strictly increasing and finite (check_samples checks; these do not). No errors: every pulse
+// gets its metrics, NaN where one is undefined (no edge before the first pulse).
 SegmentParams segment_params(const Rules& r);
 // The largest f(v[j]) over j in [lo, hi), at least `floor`, taken a SIMD register of samples at
 // a time (std::experimental::simd): the eye check's per-sample loops. f maps a double and a

@@ -74,6 +74,9 @@ struct Segmentation {
   std::vector<FrameSpan> frames;  // runs of joined pulses; every pulse is in exactly one
 };
 
+// Contract of the functions below: t in seconds, v in volts (the differential at the pins); the
+// spans are read during the call and not kept; the caller guarantees t strictly increasing, finite
+// and the same size as v (check_samples checks it and returns an error; these do not).
 // Rule 8.1: every excursion of either sign, in time order. t strictly increasing, same size as v.
 std::vector<Excursion> find_excursions(std::span<const double> t, std::span<const double> v,
                                        double vth);
