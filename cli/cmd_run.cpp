@@ -33,7 +33,7 @@ struct RunArgs {
   std::string spec;
   std::string out_dir;
   std::vector<std::string> part_dirs;
-  std::string direction;
+  std::optional<std::vector<link::Direction>> directions;  // --direction
   Engine engine = Engine::Auto;
   bool no_images = false;
   bool no_worst = false;
@@ -64,7 +64,7 @@ int run_run(const RunArgs& a) {
   // A pack spec (a file with `hops:`) runs as `isolink pack`.
   if (StatusOr<config::YamlDoc> doc = config::YamlDoc::load_file(a.spec);
       doc && analysis::is_pack_spec(*doc)) {
-    if (!a.direction.empty())
+    if (a.directions)
       return fail(
           Status::Error(fmt::format("{}: error: --direction is for link specs; a pack "
                                     "runs each hop in the directions it carries",
@@ -73,10 +73,7 @@ int run_run(const RunArgs& a) {
   }
   StatusOr<link::LinkSpec> spec = link::read_link_spec_file(a.spec);
   if (!spec) return fail(spec.status());
-  if (a.direction == "down") spec->stimulus.directions = {link::Direction::kDown};
-  if (a.direction == "up") spec->stimulus.directions = {link::Direction::kUp};
-  if (a.direction == "both")
-    spec->stimulus.directions = {link::Direction::kDown, link::Direction::kUp};
+  if (a.directions) spec->stimulus.directions = *a.directions;
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load(a.part_dirs);
   if (!parts) return fail(parts.status());
 
@@ -178,8 +175,7 @@ void add_run_command(CLI::App& app, int* exit_code) {
       ->required();
   cmd->add_option("-o,--output", args->out_dir, "Report folder (default reports/out/<name>)");
   add_parts_option(*cmd, &args->part_dirs);
-  cmd->add_option("--direction", args->direction, "Override the spec: down | up | both")
-      ->check(CLI::IsMember({"down", "up", "both"}));
+  add_directions_option(*cmd, &args->directions);
   add_engine_option(*cmd, &args->engine);
   cmd->add_flag("--no-images", args->no_images, "Skip eye.png and wave.png");
   cmd->add_flag("--no-worst", args->no_worst,

@@ -28,4 +28,18 @@ CLI::Option* add_parts_option(CLI::App& cmd, std::vector<std::string>* dirs) {
       ->allow_extra_args(false);
 }
 
+CLI::Option* add_directions_option(CLI::App& cmd,
+                                   std::optional<std::vector<link::Direction>>* dirs) {
+  return cmd
+      .add_option_function<std::string>(
+          "--direction",
+          [dirs](const std::string& d) {
+            if (d == "down") *dirs = {link::Direction::kDown};
+            if (d == "up") *dirs = {link::Direction::kUp};
+            if (d == "both") *dirs = {link::Direction::kDown, link::Direction::kUp};
+          },
+          "override the spec's stimulus.direction: down (its tx end transmits), up, or both")
+      ->check(CLI::IsMember({"down", "up", "both"}));
+}
+
 }  // namespace isolink::cli

@@ -99,4 +99,35 @@ TEST(PartsOption, TakesOnePathSoTheSpecAfterItIsStillTheSpec) {
   EXPECT_TRUE(std::filesystem::exists(out));
 }
 
+TEST(DirectionOption, RunAndWorstShowTheSameHelpAndRefuseOtherValues) {
+  const std::string first = help_line("run", "--direction");
+  ASSERT_NE(first, "");
+  EXPECT_NE(first.find("{down,up,both}"), std::string::npos) << first;
+  EXPECT_EQ(help_line("worst", "--direction"), first);
+  for (const std::string cmd : {"run", "worst"}) {
+    CliResult r = run_isolink(
+        kBinary,
+        cmd + " " + kExamples + "/cap_2m.yaml --direction sideways -o " + test_dir() + "/x",
+        "sideways");
+    EXPECT_EQ(r.code, 2) << cmd;
+    EXPECT_NE(r.err.find("--direction: sideways not in {down,up,both}"), std::string::npos)
+        << cmd << ": " << r.err;
+  }
+}
+
+TEST(DirectionOption, ReplacesTheSpecsDirections) {
+  // cap_2m.yaml's stimulus runs both directions; --direction up leaves only the up one.
+  const std::string out = test_dir() + "/up";
+  CliResult r = run_isolink(kBinary,
+                            "run " + kExamples +
+                                "/cap_2m.yaml --direction up --no-worst "
+                                "--no-images -q -o " +
+                                out,
+                            "up");
+  ASSERT_LE(r.code, 1) << r.err;
+  const std::string json = isolink::testing::slurp(out + "/report.json");
+  EXPECT_NE(json.find("\"direction\": \"up\""), std::string::npos) << json.substr(0, 400);
+  EXPECT_EQ(json.find("\"direction\": \"down\""), std::string::npos);
+}
+
 }  // namespace
