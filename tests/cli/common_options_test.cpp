@@ -20,15 +20,23 @@ using isolink::testing::CliResult;
 using isolink::testing::run_isolink;
 using isolink::testing::test_dir;
 
-// The line of `isolink CMD --help` that declares option (CLI11 puts an option and its help on
-// one line); empty when there is none.
+// The entry of `isolink CMD --help` that declares option: its line, and the description CLI11
+// puts on the next line when the option's name column overflows; empty when there is none.
 std::string help_line(const std::string& cmd, const std::string& option) {
   CliResult r = run_isolink(kBinary, cmd + " --help", "help_" + cmd);
   EXPECT_EQ(r.code, 0) << cmd << ": " << r.err;
   std::istringstream in(r.out);
-  for (std::string line; std::getline(in, line);)
-    if (line.find("  " + option + " ") != std::string::npos) return line;
-  return "";
+  std::string entry;
+  for (std::string line; std::getline(in, line);) {
+    const size_t text = line.find_first_not_of(' ');
+    if (!entry.empty()) {
+      if (text == std::string::npos || text < 6 || line[text] == '-') break;
+      entry += "\n" + line;
+    } else if (line.rfind("  " + option + " ", 0) == 0) {
+      entry = line;
+    }
+  }
+  return entry;
 }
 
 // The commands that take each option, with arguments that would make them run.
