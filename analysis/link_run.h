@@ -3,7 +3,7 @@
 //
 //   StatusOr<PartLibrary> parts = PartLibrary::load(part_dirs);
 //   StatusOr<LinkRun> run = run_link(spec, *parts, {});
-//   for (const DirectionRun& d : run->directions) ... d.data_check->pass, d.sim.wave ...
+//   for (const DirectionRun& d : run->directions) ... d.data->pass, d.sim.wave ...
 //   return run->pass ? 0 : 1;
 // Each direction is its own simulation (the link is half-duplex), by the engine RunOptions::engine
 // names (auto: LTI where it is the cheaper engine, else the transient; analysis/simulate.h). Data

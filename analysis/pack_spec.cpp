@@ -34,7 +34,7 @@ bool is_pack_spec(const YamlDoc& doc) {
 
 namespace {
 
-constexpr int kMaxDevices = 64;  // domain.md: a stack of 2-64 devices
+constexpr int kMaxDevices = 64;  // the most devices a pack may hold (our limit)
 
 struct Reader {
   std::string text;  // the pack file

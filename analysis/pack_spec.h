@@ -1,6 +1,6 @@
 // Pack specs: a whole battery pack's daisy chain in YAML, read into one link spec per hop.
 //
-//   StatusOr<PackSpec> pack = read_pack_spec_file("netlists/examples/pack_16.yaml");
+//   StatusOr<PackSpec> pack = read_pack_spec_file("netlists/examples/pack/pack_16.yaml");
 //   if (!pack) return pack.status();          // "pack.yaml:12:5: error: key 'cable.lenght' ..."
 //   for (const HopSpec& h : pack->hops) ... h.spec (a link::LinkSpec) ...
 //   // then run_pack (analysis/pack.h).
@@ -48,7 +48,7 @@ struct HopSpec {
   SourceLoc loc;        // the entry in the pack file
 };
 
-// Command timing (domain.md section 7); the README's section "Packs" derives the formulas.
+// Command timing (docs/physics.md section 7); the README's section "Packs" derives the formulas.
 struct TimingSpec {
   double bridge_delay = 12e-6;    // s, bridge byte delay including re-clock
   double device_delay = 3e-6;     // s, per stack device (re-clock)

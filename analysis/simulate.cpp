@@ -21,10 +21,26 @@ const char* engine_name(Engine e) {
   return "auto";
 }
 
+const char* engine_summary(Engine e) {
+  switch (e) {
+    case Engine::Auto:
+      return "the default: LTI where the circuit allows it and it is the cheaper engine, else "
+             "transient";
+    case Engine::Lti:
+      return "exact superposition of edge responses; an error if the circuit does not allow it";
+    case Engine::Transient:
+      return "time stepping, any circuit";
+  }
+  return "";
+}
+
 StatusOr<Engine> parse_engine(const std::string& text) {
-  for (Engine e : {Engine::Auto, Engine::Lti, Engine::Transient})
+  std::string choices;
+  for (Engine e : kEngines) {
     if (text == engine_name(e)) return e;
-  return Status::Error("engine '" + text + "' is not one of auto, lti, transient");
+    choices += (choices.empty() ? "" : ", ") + std::string(engine_name(e));
+  }
+  return Status::Error("engine '" + text + "' is not one of " + choices);
 }
 
 std::string engine_accuracy(const SimulationResult& r) {

@@ -6,6 +6,7 @@
 //   for (auto& w : r->warnings) print(w);
 #pragma once
 
+#include <array>
 #include <functional>
 #include <optional>
 #include <string>
@@ -23,7 +24,11 @@ namespace isolink::analysis {
 // of the run, kAutoLtiMaxSteps, kAutoLtiBudget), else the transient; lti: the LTI engine or an
 // error naming the element; transient: always the transient.
 enum class Engine { Auto, Lti, Transient };
+// Every engine, in the order the choices are listed (parse_engine, the CLI's --engine, Python).
+inline constexpr std::array<Engine, 3> kEngines = {Engine::Auto, Engine::Lti, Engine::Transient};
 const char* engine_name(Engine e);
+// What the engine does, in a few words for --engine's help ("LTI where ...").
+const char* engine_summary(Engine e);
 // "auto", "lti", "transient" -> Engine; an error names the value and the choices.
 StatusOr<Engine> parse_engine(const std::string& text);
 

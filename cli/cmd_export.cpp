@@ -8,6 +8,7 @@
 
 #include "base/file_io.h"
 #include "cli/commands.h"
+#include "cli/common_options.h"
 #include "netlists/link/expand.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
@@ -64,7 +65,7 @@ void add_export_command(CLI::App& app, int* exit_code) {
   cmd->add_option("--direction", args->direction, "Which end transmits: down (tx end) or up")
       ->check(CLI::IsMember({"down", "up"}));
   cmd->add_option("-o,--output", args->output, "Output file (default: standard output)");
-  cmd->add_option("--parts", args->part_dirs, "Extra part-library folder (repeatable)");
+  add_parts_option(*cmd, &args->part_dirs);
   cmd->callback([args, exit_code] { *exit_code = run_export(*args); });
 }
 

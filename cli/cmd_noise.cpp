@@ -10,6 +10,7 @@
 #include "analysis/noise.h"
 #include "base/file_io.h"
 #include "cli/commands.h"
+#include "cli/common_options.h"
 #include "netlists/link/cards.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
@@ -107,7 +108,7 @@ void add_noise_command(CLI::App& app, int* exit_code) {
       "noise.png, report.md, report.json; exit 1 when the test level fails");
   cmd->add_option("spec", args->spec, "Link spec (YAML) with an optional noise: block")->required();
   cmd->add_option("-o,--output", args->out_dir, "Report folder (default reports/out/<name>)");
-  cmd->add_option("--parts", args->part_dirs, "Extra part-library folder (repeatable)");
+  add_parts_option(*cmd, &args->part_dirs);
   cmd->add_flag("--json", args->json, "Print the noise result as JSON on stdout");
   cmd->add_flag("--no-images", args->no_images, "Skip noise.png");
   cmd->add_option("--export-spice", args->spice,

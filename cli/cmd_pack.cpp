@@ -13,6 +13,7 @@
 #include "analysis/pack_spec.h"
 #include "base/progress.h"
 #include "cli/commands.h"
+#include "cli/common_options.h"
 #include "netlists/link/parts.h"
 #include "reports/pack_report.h"
 
@@ -70,11 +71,11 @@ void add_pack_command(CLI::App& app, int* exit_code) {
       "Simulate every hop of a pack spec (each distinct circuit once), check the ring's "
       "cable breaks and command timing, write the pack report (report.md, report.json, "
       "pack.png, hop_NN/)");
-  cmd->add_option("spec", args->spec, "Pack spec (YAML), e.g. netlists/examples/pack_16.yaml")
+  cmd->add_option("spec", args->spec, "Pack spec (YAML), e.g. netlists/examples/pack/pack_16.yaml")
       ->required();
   cmd->add_option("-o,--output", args->out_dir, "Report folder (default reports/out/<name>)");
   cmd->add_option("-j,--jobs", args->jobs, "Threads across distinct hops (0: all cores)");
-  cmd->add_option("--parts", args->part_dirs, "Extra part-library folder (repeatable)");
+  add_parts_option(*cmd, &args->part_dirs);
   cmd->add_flag("--no-worst", args->no_worst,
                 "Skip the worst case over all traffic (its report columns and verdict)");
   cmd->add_flag("--no-images", args->no_images, "Skip pack.png and the per-hop images");

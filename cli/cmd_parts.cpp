@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cli/commands.h"
+#include "cli/common_options.h"
 #include "netlists/link/cards.h"
 #include "netlists/link/parts.h"
 
@@ -235,10 +236,7 @@ void add_parts_command(CLI::App& app, int* exit_code) {
   CLI::App* cmd = app.add_subcommand(
       "parts", "List the part library (built-in netlists/parts plus --parts folders)");
   cmd->add_option("part", args->part, "show one part's figures and their sources");
-  cmd->add_option("--parts", args->dirs,
-                  "a folder of part YAML files (or one file); repeatable; later parts with the "
-                  "same number override earlier ones")
-      ->allow_extra_args(false);
+  add_parts_option(*cmd, &args->dirs);
   cmd->add_flag("--json", args->json, "print JSON: figures with ranges and sources, and the model");
   cmd->callback([args, exit_code] { *exit_code = run_parts(*args); });
 }

@@ -15,6 +15,7 @@
 #include "base/file_io.h"
 #include "base/progress.h"
 #include "cli/commands.h"
+#include "cli/common_options.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
 #include "netlists/traffic/stimulus.h"
@@ -32,8 +33,8 @@ struct RunArgs {
   std::string spec;
   std::string out_dir;
   std::vector<std::string> part_dirs;
-  std::string direction;
-  std::string engine = "auto";
+  std::optional<std::vector<link::Direction>> directions;  // --direction
+  Engine engine = Engine::Auto;
   bool no_images = false;
   bool no_worst = false;
   bool quiet = false;
@@ -63,7 +64,7 @@ int run_run(const RunArgs& a) {
   // A pack spec (a file with `hops:`) runs as `isolink pack`.
   if (StatusOr<config::YamlDoc> doc = config::YamlDoc::load_file(a.spec);
       doc && analysis::is_pack_spec(*doc)) {
-    if (!a.direction.empty())
+    if (a.directions)
       return fail(
           Status::Error(fmt::format("{}: error: --direction is for link specs; a pack "
                                     "runs each hop in the directions it carries",
@@ -72,10 +73,7 @@ int run_run(const RunArgs& a) {
   }
   StatusOr<link::LinkSpec> spec = link::read_link_spec_file(a.spec);
   if (!spec) return fail(spec.status());
-  if (a.direction == "down") spec->stimulus.directions = {link::Direction::kDown};
-  if (a.direction == "up") spec->stimulus.directions = {link::Direction::kUp};
-  if (a.direction == "both")
-    spec->stimulus.directions = {link::Direction::kDown, link::Direction::kUp};
+  if (a.directions) spec->stimulus.directions = *a.directions;
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load(a.part_dirs);
   if (!parts) return fail(parts.status());
 
@@ -99,7 +97,7 @@ int run_run(const RunArgs& a) {
   ProgressLine line({.label = "isolink run", .enabled = !a.quiet});
   auto progress = [&line](const std::string& what, double f) { line.show_fraction(what, f); };
   RunOptions ro;
-  ro.engine = *parse_engine(a.engine);  // CLI11 checked the choice
+  ro.engine = a.engine;
   ro.progress = progress;
   StatusOr<LinkRun> run = run_link(*spec, *parts, ro);
   if (!run) return fail(run.status().with_context(a.spec));
@@ -172,17 +170,13 @@ void add_run_command(CLI::App& app, int* exit_code) {
       "run",
       "Simulate a link spec with its traffic, score each receiver and write the report "
       "(eye.png, wave.png, report.json, report.md, report.html, wave.csv)");
-  cmd->add_option("spec", args->spec, "Link spec (YAML), e.g. netlists/examples/xfmr_12m.yaml")
+  cmd->add_option("spec", args->spec,
+                  "Link spec (YAML), e.g. netlists/examples/transformer_15m.yaml")
       ->required();
   cmd->add_option("-o,--output", args->out_dir, "Report folder (default reports/out/<name>)");
-  cmd->add_option("--parts", args->part_dirs, "Extra part-library folder (repeatable)");
-  cmd->add_option("--direction", args->direction, "Override the spec: down | up | both")
-      ->check(CLI::IsMember({"down", "up", "both"}));
-  cmd->add_option(
-         "--engine", args->engine,
-         "auto (the default: LTI where it is the cheaper engine, else transient), lti (exact "
-         "superposition), transient")
-      ->check(CLI::IsMember({"auto", "lti", "transient"}));
+  add_parts_option(*cmd, &args->part_dirs);
+  add_directions_option(*cmd, &args->directions);
+  add_engine_option(*cmd, &args->engine);
   cmd->add_flag("--no-images", args->no_images, "Skip eye.png and wave.png");
   cmd->add_flag("--no-worst", args->no_worst,
                 "Skip the worst case over all traffic (its report section and verdict)");

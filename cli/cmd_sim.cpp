@@ -11,6 +11,7 @@
 #include "base/progress.h"
 #include "base/si_number.h"
 #include "cli/commands.h"
+#include "cli/common_options.h"
 
 namespace isolink::cli {
 using namespace isolink::analysis;  // simulate_netlist
@@ -25,7 +26,7 @@ struct SimArgs {
   std::string output;
   std::string step, tstop, tmax;  // SPICE numbers: 10n, 1u
   std::string method;
-  std::string engine = "auto";
+  Engine engine = Engine::Auto;
   double reltol = 0;
   bool quiet = false;
 };
@@ -98,7 +99,7 @@ int run_sim(const SimArgs& a) {
   req.probes = a.probes;
   req.tstop = tstop;
   req.tmax = tmax;
-  req.engine = *parse_engine(a.engine);  // CLI11 checked the choice
+  req.engine = a.engine;
   if (step) req.grid_step = *step;
   if (a.reltol > 0) req.reltol = a.reltol;
   if (a.method == "trap") req.method = IntegrationMethod::Trapezoidal;
@@ -153,11 +154,7 @@ void add_sim_command(CLI::App& app, int* exit_code) {
   cmd->add_option("--step", args->step,
                   "output on a uniform grid of DT seconds (10n); default: LTI picks a grid where "
                   "linear interpolation is within 1 mV, the transient writes its steps");
-  cmd->add_option(
-         "--engine", args->engine,
-         "auto (LTI where the circuit allows it and it is the cheaper engine, else transient), lti "
-         "(error if the circuit does not allow it), transient")
-      ->check(CLI::IsMember({"auto", "lti", "transient"}));
+  add_engine_option(*cmd, &args->engine);
   cmd->add_option("--tstop", args->tstop, "end time in seconds (overrides .tran)");
   cmd->add_option("--tmax", args->tmax, "largest time step in seconds (overrides .tran)");
   cmd->add_option("--method", args->method, "integration method (overrides .options method)")

@@ -17,6 +17,7 @@
 #include "base/csv.h"
 #include "base/file_io.h"
 #include "cli/commands.h"
+#include "cli/common_options.h"
 #include "netlists/link/parts.h"
 #include "reports/plot.h"
 #include "reports/sweep_report.h"
@@ -38,7 +39,7 @@ struct SweepArgs {
   bool no_plots = false;
   bool quiet = false;
   bool list = false;
-  std::string engine = "auto";
+  Engine engine = Engine::Auto;
 };
 
 int fail(const Status& s) {
@@ -106,7 +107,7 @@ int run_sweep_command(const SweepArgs& a) {
   opt.plots = !a.no_plots;
   opt.render_plots = reports::render_sweep_plots;
   opt.quiet = a.quiet;
-  opt.point.run.engine = *parse_engine(a.engine);  // CLI11 checked the choice
+  opt.point.run.engine = a.engine;
   if (!a.quiet && rank == 0) {
     std::fprintf(stderr, "sweep: %s: %zu points (%zu grid point%s%s)%s -> %s\n", spec->path.c_str(),
                  spec->size(), spec->grid_size(), spec->grid_size() == 1 ? "" : "s",
@@ -161,11 +162,8 @@ void add_sweep_command(CLI::App& app, int* exit_code) {
   cmd->add_option("-o,--output", args->out_dir, "Output folder (default reports/out/<name>)");
   cmd->add_option("-j,--jobs", args->jobs, "Points run at once (default: all cores)")
       ->check(CLI::Range(1, 4096));
-  cmd->add_option("--parts", args->part_dirs, "Extra part-library folder (repeatable)");
-  cmd->add_option(
-         "--engine", args->engine,
-         "auto (the default: LTI where it is the cheaper engine, else transient), lti, transient")
-      ->check(CLI::IsMember({"auto", "lti", "transient"}));
+  add_parts_option(*cmd, &args->part_dirs);
+  add_engine_option(*cmd, &args->engine);
   cmd->add_flag("--resume", args->resume, "Skip the points already in DIR/results.csv");
   cmd->add_flag("--keep-waves", args->keep_waves,
                 "Write every point's waveforms to DIR/waves/point_NNNNN.csv");

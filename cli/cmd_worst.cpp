@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "base/file_io.h"
 #include "base/progress.h"
 #include "cli/commands.h"
+#include "cli/common_options.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
 #include "reports/worst_png.h"
@@ -24,7 +26,7 @@ struct WorstArgs {
   std::string spec;
   std::string out_dir;
   std::vector<std::string> part_dirs;
-  std::string direction;
+  std::optional<std::vector<link::Direction>> directions;  // --direction
   std::string edge_engine = "auto";
   bool json = false;
   bool no_images = false;
@@ -39,10 +41,7 @@ int fail(const Status& s) {
 int run_worst(const WorstArgs& a) {
   StatusOr<link::LinkSpec> spec = link::read_link_spec_file(a.spec);
   if (!spec) return fail(spec.status());
-  if (a.direction == "down") spec->stimulus.directions = {link::Direction::kDown};
-  if (a.direction == "up") spec->stimulus.directions = {link::Direction::kUp};
-  if (a.direction == "both")
-    spec->stimulus.directions = {link::Direction::kDown, link::Direction::kUp};
+  if (a.directions) spec->stimulus.directions = *a.directions;
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load(a.part_dirs);
   if (!parts) return fail(parts.status());
   // Progress on stderr while it runs, when it is a terminal (base/progress.h).
@@ -94,9 +93,8 @@ void add_worst_command(CLI::App& app, int* exit_code) {
   cmd->add_option("spec", args->spec, "Link spec (YAML)")->required();
   cmd->add_option("-o,--output", args->out_dir,
                   "Write worst.json, worst.md and the images to this folder");
-  cmd->add_option("--parts", args->part_dirs, "Extra part-library folder (repeatable)");
-  cmd->add_option("--direction", args->direction, "Override the spec: down | up | both")
-      ->check(CLI::IsMember({"down", "up", "both"}));
+  add_parts_option(*cmd, &args->part_dirs);
+  add_directions_option(*cmd, &args->directions);
   cmd->add_option("--edge-engine", args->edge_engine,
                   "Edge response: auto (the reduced model, checked against the exact AC solution; "
                   "the transient when it does not pass) | transient")

@@ -173,7 +173,7 @@ StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const d
 
   Segmentation seg = segment(t, v, segment_params(rules));
   if (!rules.tone) {
-    // Item 4a: when a run's half bits make whole frames up to its second-last pulse, its last
+    // Rule 8.4a: when a run's half bits make whole frames up to its second-last pulse, its last
     // pulse is the line's kickback after the postamble (AC coupling swinging back past the
     // threshold when the driver goes idle), not the start of a frame: the receiver blanks it
     // (tblank), and joining it would stretch the postamble's width to the kickback's start.
@@ -191,7 +191,7 @@ StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const d
   r.idle = find_idle_undershoots(t, v, seg, rules);
   const FrameFormat& fmt_ = r.frame_format;
 
-  // Item 12: decode each run of joined pulses.
+  // Rule 8.12: decode each run of joined pulses.
   size_t structural = 0;  // frames whose couplets form a byte (metrics aside)
   size_t inverted = 0;    // runs that decode only with every sign flipped (P and N swapped?)
   for (const FrameSpan& fs : seg.frames) {
@@ -294,7 +294,7 @@ StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const d
 
   r.worst = worst_margins(r.pulses);
 
-  // Item 11: the verdict (eye/verdict.h): failures measured on the link, then what keeps the
+  // Rule 8.11: the verdict (eye/verdict.h): failures measured on the link, then what keeps the
   // record from showing that the link works (no verdict of pass without it).
   const double peak = largest_magnitude(v);
   VerdictFacts facts;

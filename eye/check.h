@@ -88,15 +88,22 @@ struct CheckResult {
   const char* verdict() const { return pass ? "pass" : inconclusive ? "inconclusive" : "fail"; }
 };
 
-// Checks time/value samples (t strictly increasing) against rules. The verdict is formed by
+// Checks time/value samples against rules: t in seconds, strictly increasing; v the differential
+// V(P) - V(N) at the receiver pins in volts; both only read during the call (the result owns
+// copies of what it reports). The verdict is formed by
 // eye/verdict.h's decide_verdict (one rule for every path): fail when the record shows the link
 // (a frame forms a byte, or a daisy-chain run) and something measured fails; "inconclusive"
 // (pass = false, inconclusive = true) when it cannot show the link (no pulses, levels 100x off,
 // nothing decoded and no daisy-chain run of failing pulses) or nothing fails but a pulse is cut;
 // hints follow when the samples look like the wrong units, the wrong column or swapped P and N.
+// A failing link is a result (pass = false), not an error. Errors (nothing measured): t and v of
+// different sizes, fewer than two samples, a non-finite sample, time not increasing (the message
+// names the sample), rules that do not pass validate_rules, a command_idle that is not a finite
+// time >= 0, a SOF value other than 0 or 1. Thread-safe: no shared state.
 StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const double> v,
                                     const Rules& rules, const CheckOptions& opt = {});
-// Checks column `column` of w.
+// Checks column `column` of w (its time axis in s, the column in V); an error, besides
+// check_samples' own, when w has no such column.
 StatusOr<CheckResult> check_waveform(const Waveform& w, const Rules& rules,
                                      const CheckOptions& opt = {}, size_t column = 0);
 
@@ -108,7 +115,8 @@ inline constexpr size_t kMaxJsonPulses = 10'000;
 nlohmann::ordered_json to_json(const CheckResult& r);
 // A few lines for people: verdict, worst margin per metric with place, counts, failures.
 std::string summary_text(const CheckResult& r, const std::string& source = "");
-// The per-pulse table as CSV, written to a temp file then renamed.
+// The per-pulse table as CSV (times in s, levels in V), written to a temp file then renamed
+// (base/file_io.h): on an error (the folder cannot be written) path is left as it was.
 Status write_pulses_csv(const CheckResult& r, const std::string& path);
 
 }  // namespace isolink::eye

@@ -45,6 +45,9 @@ struct EyeGrid {
   double dv_per_px() const { return (v_hi - v_lo) / ny; }  // volts per row
 };
 
+// Owns its counts; the samples passed in are read during the call and not kept. nx and ny below 1
+// are taken as 1; nothing here returns an error (samples outside the voltage range count as
+// outside()). Not thread-safe: one histogram per thread, or add under a lock.
 class EyeHistogram {
  public:
   explicit EyeHistogram(const EyeGrid& grid);

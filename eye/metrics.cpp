@@ -32,7 +32,7 @@ SegmentParams segment_params(const Rules& r) {
 }
 
 namespace {
-// Item 5: a pulse's width (to the next pulse's start when joined to it) and its class k.
+// Rule 8.5: a pulse's width (to the next pulse's start when joined to it) and its class k.
 double pulse_width(const Segmentation& seg, size_t i) {
   const PulseSpan& ps = seg.pulses[i];
   return seg.joined_next[i] ? seg.pulses[i + 1].a - ps.a : ps.b - ps.a;
@@ -65,7 +65,7 @@ std::vector<PulseMetrics> measure_pulses(std::span<const double> t, std::span<co
     const bool joined = seg.joined_next[i];
     m.idle = !joined;
 
-    // Item 5-6: width and class.
+    // Rules 8.5-8.6: width and class.
     const double width = pulse_width(seg, i);
     m.k = pulse_class(width, r);
     m.half_bits = std::clamp(m.k, 1, kMaxHalfBits);
@@ -95,7 +95,7 @@ std::vector<PulseMetrics> measure_pulses(std::span<const double> t, std::span<co
       }
     }
 
-    // Item 7: edge time into this pulse.
+    // Rule 8.7: edge time into this pulse.
     if (i > 0 && seg.joined_next[i - 1]) {
       m.edge.value = ps.a - seg.pulses[i - 1].b;
       m.edge.limit = r.edge_max;
@@ -107,7 +107,7 @@ std::vector<PulseMetrics> measure_pulses(std::span<const double> t, std::span<co
       }
     }
 
-    // Item 2: dips fail.
+    // Rule 8.2: dips fail.
     for (const Dip& d : ps.dips) {
       m.weak_fail = true;
       m.fails.push_back(fmt::format("dip: {:.1f} ns below {:.2f} V at {:.4f} us, lowest {:.3f} V",
@@ -120,7 +120,7 @@ std::vector<PulseMetrics> measure_pulses(std::span<const double> t, std::span<co
       continue;
     }
 
-    // Item 8: VSTART, VEND.
+    // Rule 8.8: VSTART, VEND.
     const double mid = 0.5 * (ps.a + ps.b);
     // s*v is vth at a; the samples from a up to mid, then mid itself (interpolated).
     const size_t j = static_cast<size_t>(
@@ -134,7 +134,7 @@ std::vector<PulseMetrics> measure_pulses(std::span<const double> t, std::span<co
     m.vstart.value = vstart;
     m.vend.value = vend;
 
-    // Item 9: amplitude rule, droop.
+    // Rule 8.9: amplitude rule, droop.
     m.vend.limit = r.vend_min;
     m.vend.margin = vend - r.vend_min;
     m.vstart.limit = r.vstart_required(vend);

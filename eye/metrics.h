@@ -1,4 +1,4 @@
-// Eye metrics per pulse (design.md "Eye metrics" items 5-11): width and class, edge time,
+// Eye metrics per pulse (docs/physics.md section 8, rules 8.5-8.11): width and class, edge time,
 // VSTART / VEND / droop judged by the amplitude rule, idle undershoot, margins.
 //
 // Usage:
@@ -81,6 +81,10 @@ struct WorstMargin {
   std::string role;    // place in the frame
 };
 
+// Contract of the functions below: t in seconds, v in volts, the spans read during the call and
+// not kept; seg must come from segment() over the same t and v (its indices point into them), t
+// strictly increasing and finite (check_samples checks; these do not). No errors: every pulse
+// gets its metrics, NaN where one is undefined (no edge before the first pulse).
 SegmentParams segment_params(const Rules& r);
 // The largest f(v[j]) over j in [lo, hi), at least `floor`, taken a SIMD register of samples at
 // a time (std::experimental::simd): the eye check's per-sample loops. f maps a double and a
@@ -97,19 +101,19 @@ double running_max(std::span<const double> v, size_t lo, size_t hi, double floor
   for (; j < hi; ++j) out = std::max(out, f(v[j]));
   return out;
 }
-// Item 5: the half bits pulse i of seg carries for decoding (PulseMetrics::half_bits).
+// Rule 8.5: the half bits pulse i of seg carries for decoding (PulseMetrics::half_bits).
 int pulse_half_bits(const Segmentation& seg, size_t i, const Rules& r);
-// Items 5-9 for every pulse of seg.
+// Rules 8.5-8.9 for every pulse of seg.
 // warning_texts false: PulseMetrics::warnings left empty (CheckOptions::warning_texts).
 std::vector<PulseMetrics> measure_pulses(std::span<const double> t, std::span<const double> v,
                                          const Segmentation& seg, const Rules& r,
                                          bool warning_texts = true);
-// Item 10, after every frame.
+// Rule 8.10, after every frame.
 std::vector<IdleUndershoot> find_idle_undershoots(std::span<const double> t,
                                                   std::span<const double> v,
                                                   const Segmentation& seg, const Rules& r);
-// Item 11: per metric (vstart, vend, width, edge, droop) the judged pulse with the smallest margin;
-// metrics nothing was judged on are left out.
+// Rule 8.11: per metric (vstart, vend, width, edge, droop) the judged pulse with the smallest
+// margin; metrics nothing was judged on are left out.
 std::vector<WorstMargin> worst_margins(const std::vector<PulseMetrics>& pulses);
 
 }  // namespace isolink::eye

@@ -98,7 +98,7 @@ Segmentation segment(std::span<const double> t, std::span<const double> v, const
   Segmentation seg;
   const std::vector<Excursion> ex = find_excursions(t, v, p.vth);
 
-  // Item 2: merge neighbouring same-sign excursions less than merge_gap apart.
+  // Rule 8.2: merge neighbouring same-sign excursions less than merge_gap apart.
   std::vector<PulseSpan> merged;
   merged.reserve(ex.size());
   for (size_t k = 0; k < ex.size(); ++k) {
@@ -137,7 +137,7 @@ Segmentation segment(std::span<const double> t, std::span<const double> v, const
     merged.push_back(std::move(ps));
   }
 
-  // Item 3: short (merged) excursions are ringing, not pulses. One cut by the record is kept as
+  // Rule 8.3: short (merged) excursions are ringing, not pulses. One cut by the record is kept as
   // a (truncated) pulse: its length is unknown.
   for (size_t k = 0; k < merged.size(); ++k) {
     PulseSpan& ps = merged[k];
@@ -148,7 +148,7 @@ Segmentation segment(std::span<const double> t, std::span<const double> v, const
     }
   }
 
-  // Item 4: transitions and frames.
+  // Rule 8.4: transitions and frames.
   const size_t np = seg.pulses.size();
   seg.joined_next.assign(np, false);
   for (size_t i = 0; i + 1 < np; ++i) {

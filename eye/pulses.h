@@ -1,5 +1,5 @@
-// Pulse extraction (design.md "Eye metrics" items 1-4): threshold excursions, merging across dips,
-// ringing, transitions and frames.
+// Pulse extraction (docs/physics.md section 8, rules 8.1-8.4): threshold excursions, merging across
+// dips, ringing, transitions and frames.
 //
 // Usage:
 //   SegmentParams p{.vth = 1.2, .merge_gap = 100e-9, .min_pulse = 100e-9, .transition_gap =
@@ -74,15 +74,18 @@ struct Segmentation {
   std::vector<FrameSpan> frames;  // runs of joined pulses; every pulse is in exactly one
 };
 
-// Item 1: every excursion of either sign, in time order. t strictly increasing, same size as v.
+// Contract of the functions below: t in seconds, v in volts (the differential at the pins); the
+// spans are read during the call and not kept; the caller guarantees t strictly increasing, finite
+// and the same size as v (check_samples checks it and returns an error; these do not).
+// Rule 8.1: every excursion of either sign, in time order. t strictly increasing, same size as v.
 std::vector<Excursion> find_excursions(std::span<const double> t, std::span<const double> v,
                                        double vth);
-// Items 1-4.
+// Rules 8.1-8.4.
 Segmentation segment(std::span<const double> t, std::span<const double> v, const SegmentParams& p);
 // Rebuilds frames from pulses and joined_next.
 void build_frames(Segmentation* seg);
-// Item 4a: pulse i is the line's kickback after a complete frame, not a pulse: it moves to ringing
-// (after_frame), the pulse before it runs into idle, and the frames are rebuilt.
+// Rule 8.4a: pulse i is the line's kickback after a complete frame, not a pulse: it moves to
+// ringing (after_frame), the pulse before it runs into idle, and the frames are rebuilt.
 void drop_frame_tail(Segmentation* seg, size_t i);
 
 }  // namespace isolink::eye

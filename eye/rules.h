@@ -7,7 +7,8 @@
 // Shipped sets (eye/rules/*.yaml, embedded at build time): bq7961x, bq79600 (bridge), tone.
 // A user file may start with "base: bq7961x" and then override only the keys it names;
 // without a base every key is required. Numbers take SPICE suffixes (250n, 4u).
-// Every rule set is validated when it is loaded (validate_rules).
+// Every rule set is validated when it is loaded (validate_rules). Units: volts and seconds
+// throughout (Rules' fields say which); a Rules is a plain value, copied freely.
 #pragma once
 
 #include <string>
@@ -65,9 +66,14 @@ std::vector<std::string> builtin_rule_names();
 // The YAML text of a shipped rule set ("" when there is none by that name).
 std::string_view builtin_rule_text(std::string_view name);
 
-// Parses and validates YAML text; source names the file in error messages.
+// Parses and validates YAML text; source names the file in error messages. Errors: YAML syntax,
+// an unknown or missing key, a value that is not a number with its unit, an unknown base, a
+// limit validate_rules refuses; each as "SOURCE:LINE:COL: error: KEY: ...".
 StatusOr<Rules> parse_rules(std::string_view yaml_text, const std::string& source);
-// A shipped name (bq7961x, bq79600, tone) or a path to a YAML file.
+// A shipped name (bq7961x, bq79600, tone) or a path to a YAML file. The shipped sets are parsed
+// once and cached (thread-safe); a file is read each call (size-limited, base/file_io.h). Errors:
+// neither a shipped name nor a readable file (the message lists the shipped names), or
+// parse_rules' errors.
 StatusOr<Rules> load_rules(const std::string& name_or_path);
 // Checks every limit (vth > 0, min < max, ...); the message names the field, value and rule.
 Status validate_rules(const Rules& r);

@@ -58,6 +58,9 @@ struct BinaryTrace {
 std::optional<std::string> binary_kind(const std::string& path);
 // The same from the file's name and its first bytes (at least 64 when the file has them).
 std::optional<std::string> binary_kind_of(const std::string& path, std::string_view head);
+// Every trace of the file, t in seconds and v in volts, owned by the result. Errors
+// ("FILE:byte OFFSET: error: WHY"): an unreadable file, a format that is refused (above), a
+// header field that cannot be honoured, a count beyond the file's length, non-finite scaling.
 StatusOr<std::vector<BinaryTrace>> read_binary(const std::string& path);
 
 }  // namespace isolink::eye

@@ -77,6 +77,8 @@ struct Verdict {
   std::vector<std::string> reasons;  // failures first, then what leaves it open; empty on pass
 };
 
+// A pure function of its inputs (read during the call, not kept): every input gives a verdict,
+// there is no error. pulses in time order, as measure_pulses gives them.
 Verdict decide_verdict(std::span<const PulseMetrics> pulses, const Rules& rules,
                        const VerdictFacts& facts);
 

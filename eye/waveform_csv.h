@@ -59,6 +59,12 @@ struct CaptureInfo {
   std::vector<std::string> notes;  // ambiguities resolved, units assumed
 };
 
+// Errors ("FILE:LINE: error: ..." where a line applies, nothing returned): an unreadable or
+// oversized file, no data rows, a column that is not there, a field that is not a number, time
+// that does not increase strictly; with two files, P and N the same column, or captures that do
+// not share a time base or span (the message says which). info may be null; when given, it is
+// filled on success (its contents are unspecified after an error). The Waveform holds the time axis
+// (s) and one column, the differential (V).
 StatusOr<Waveform> parse_differential_csv(std::string_view text, const std::string& source,
                                           const CsvColumns& cols = {}, CaptureInfo* info = nullptr);
 StatusOr<Waveform> read_differential_csv(const std::string& path, const CsvColumns& cols = {},

@@ -6,7 +6,7 @@
 //   bool good = crc16_frame_ok(f);         // true: CRC over the whole frame is 0
 // Variant: polynomial x^16+x^15+x^2+1 (0x8005), bits reflected (shift right with 0xA001),
 // initial value 0xFFFF, no final XOR ("CRC-16/MODBUS"); check value over "123456789" = 0x4B37.
-// It reproduces the four worked examples of domain.md section 7 byte for byte.
+// It reproduces the four worked examples of docs/physics.md section 7 byte for byte.
 #pragma once
 
 #include <cstdint>

@@ -7,7 +7,7 @@
 //   std::vector<int> w = frame_wire_bits(0x80, fmt);  // 0 0 1 00000001 0 (sync, SOF, data, err)
 //   std::vector<int> h = frame_half_bits(0x80, fmt);  // +1/-1 per half bit (26 with SOF)
 //   std::vector<DecodedByte> d = decode_half_bits(h, fmt);   // d[0].byte == 0x80
-// Encoding (design.md item 12, domain.md section 2): 0 = (-, +), 1 = (+, -); frame = preamble
+// Encoding (docs/physics.md rule 8.12 and section 2): 0 = (-, +), 1 = (+, -); frame = preamble
 // (+), sync 0 0, [SOF], 8 data bits, error bit, postamble (-).
 #pragma once
 

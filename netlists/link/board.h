@@ -1,5 +1,5 @@
 // Board networks between a device's COM pins and its isolation parts, with per-device presets
-// from domain.md section 4.
+// from docs/physics.md section 4.
 //
 //   StatusOr<BoardNetwork> b = board_preset("bq7961x");
 //   add_board_network(cards, "rxb", "rxp", "rxn", "rxlp", "rxln", *b);

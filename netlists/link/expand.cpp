@@ -21,7 +21,7 @@ StatusOr<BoardNetwork> board_for(const EndSpec& end) {
   StatusOr<BoardNetwork> b = board_preset(end.device);
   if (!b) return b.status();
   const std::string& type = end.isolation.type;
-  // BQ79606A: 10 kohm with cap and cap + choke, 1 kohm with a transformer (domain.md 4.4).
+  // BQ79606A: 10 kohm with cap and cap + choke, 1 kohm with a transformer (docs/physics.md 4.4).
   if (end.device == "bq79606a" && type.rfind("transformer", 0) == 0) b->termination = 1e3;
   if (end.series_r) b->r_line = *end.series_r;
   if (end.bypass_c) b->bypass_c = *end.bypass_c;

@@ -1,7 +1,7 @@
 // Link specs: a daisy-chain hop described as an isolation BOM in YAML (the engineer's view),
-// read into plain structs with every default drawn from domain.md.
+// read into plain structs with every default drawn from docs/physics.md section 4.
 //
-//   StatusOr<LinkSpec> spec = read_link_spec_file("netlists/examples/xfmr_12m.yaml");
+//   StatusOr<LinkSpec> spec = read_link_spec_file("netlists/examples/transformer_15m.yaml");
 //   if (!spec) return spec.status();          // "file:line:col: error: key 'cable.length' ..."
 //   // then expand_link(*spec, parts, Direction::kDown) (expand.h) gives the circuit.
 // Keys (netlists/link/README.md has the full table):
@@ -115,7 +115,7 @@ struct NoiseSpec {
                                       // calibration jig: 50 ohm line, 50 ohm at each end)
   double clamp_r = 50;                // ohm: the clamp's source impedance in the loop (the
                                       // generator's 50 ohm through the 1:1 probe)
-  double pin_limit = 20;              // V, receiver pins' common-mode limit (domain.md 2)
+  double pin_limit = 20;              // V, receiver pins' common-mode limit (docs/physics.md 2)
   bool time_domain = true;            // confirm the worst frequency with a transient + the checker
   int samples = 200;                  // Monte Carlo boards over the tolerances (uniform in each)
   int seed = 1;                       // their random seed

@@ -1,4 +1,4 @@
-// Daisy-chain command frames (domain.md section 7) from readable text.
+// Daisy-chain command frames (docs/physics.md section 7) from readable text.
 //
 // Usage:
 //   StatusOr<std::vector<uint8_t>> b = command_bytes("stack-write reg=0x0100 data=02B778BC");

@@ -16,7 +16,8 @@
 // Timing defaults (our choice, see netlists/traffic/README.md):
 //   lead 1 us idle before the first item, so the solver starts from the idle operating point;
 //   byte_gap 3.8 us idle between the byte frames of one command: a byte every 10.3 us, the
-//     UART byte time at 1 Mbps (domain.md section 7) that the bridge re-sends at, 10.3 - 6.5 us;
+//     UART byte time at 1 Mbps (docs/physics.md section 7) that the bridge re-sends at, 10.3 - 6.5
+//     us;
 //   frame_gap 12 us idle between commands / tones / patterns: the bridge's 12 us byte delay,
 //     and longer than tblank (4 us), so the idle check after every command sees a quiet line;
 //   tail 5 us idle after the last item: covers tblank (4 us) for the undershoot check.

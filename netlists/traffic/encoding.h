@@ -1,4 +1,4 @@
-// Byte -> half-bits: the daisy-chain byte frame of domain.md section 2 / design.md item 12.
+// Byte -> half-bits: the daisy-chain byte frame of docs/physics.md section 2 and rule 8.12.
 //
 // Usage:
 //   EncodingOptions opt;                               // 250 ns pulses, SOF 1, LSB first, error 0
@@ -21,8 +21,8 @@
 
 namespace isolink::traffic {
 
-// The frame layout (sof, sof_value: our reading 1, see design.md; bit_order) plus the timing
-// and the error bit of the bytes sent.
+// The frame layout (sof, sof_value: our reading 1, see docs/physics.md section 2; bit_order) plus
+// the timing and the error bit of the bytes sent.
 struct EncodingOptions : FrameFormat {
   double half_bit = 250e-9;  // pulse (half-bit) width, s
   int error_bit = 0;         // byte-error bit (1 asks the sender to resend)

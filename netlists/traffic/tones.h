@@ -1,4 +1,4 @@
-// Daisy-chain tones: runs of same-polarity couplets with 1 us pulses (domain.md section 2).
+// Daisy-chain tones: runs of same-polarity couplets with 1 us pulses (docs/physics.md section 2).
 //
 // Usage:
 //   StatusOr<Tone> t = parse_tone("wake");

@@ -15,7 +15,7 @@ A = 2.5     # plateau (V)
 
 
 def frame_half_bits(byte):
-    """Preamble +, sync 00, SOF 1, 8 data bits LSB first, error bit 0, postamble - (design.md
+    """Preamble +, sync 00, SOF 1, 8 data bits LSB first, error bit 0, postamble - (docs/physics.md rule 8.12;
     'Eye metrics' 12): a bit 0 is (-, +), a 1 is (+, -)."""
     couplet = {0: [-1, 1], 1: [1, -1]}
     bits = [0, 0, 1] + [(byte >> i) & 1 for i in range(8)] + [0]

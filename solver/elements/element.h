@@ -28,7 +28,7 @@ class Circuit;
 class MnaPattern;
 class SourceFunction;
 
-using Slot = int;  // index into a matrix value array; MnaPattern::kTrash for ground entries
+using Slot = int;  // index into a matrix value array; MnaPattern::trash() for ground entries
 
 // How an element joins two nodes at DC, for the topology checks before the operating point.
 // Inductive: an inductor, a short at DC; one that would close a loop of voltage sources and

@@ -444,8 +444,8 @@ TEST(NoiseStatistics, NeverBelowTheCornerSeededAndVerdictOnChoosesTheFigure) {
               a.contributors[0].share);
 }
 
-// TI's BCI setup (domain.md 6: ISO 11452-4, 1.7 m, 1 Mbps): the three isolation types with TI's
-// parts. Capacitor-only has the lowest immunity over most of the band; capacitor + choke and
+// TI's BCI setup (docs/physics.md 6: ISO 11452-4, 1.7 m, 1 Mbps): the three isolation types with
+// TI's parts. Capacitor-only has the lowest immunity over most of the band; capacitor + choke and
 // transformer are far better.
 // DISABLED: the model does not reproduce TI's ranking yet (issue 16 left open on this point).
 // Since issue 30 (1-400 MHz, worst corner, down; analysis/README.md "Installation assumptions"):

@@ -154,7 +154,7 @@ TEST(Check, RecordCutMidFrameIsTruncatedAndInconclusive) {
   EXPECT_EQ(r->failing(), 0u);
 }
 
-// Item 4a: an AC-coupled line swings back past the threshold when the driver goes idle after a
+// Rule 8.4a: an AC-coupled line swings back past the threshold when the driver goes idle after a
 // frame ending in a double pulse (error bit 1, postamble). That kickback is no pulse: the receiver
 // blanks it (tblank), and the postamble runs into idle instead of being stretched to it.
 TEST(Check, KickbackAfterACompleteFrameIsNoPulse) {

@@ -1,5 +1,5 @@
-// Synthetic waveforms just inside and just outside every limit of design.md "Eye metrics".
-// Frames are byte 0x00 (preamble, sync, SOF, data, error bit, postamble): its pulses are
+// Synthetic waveforms just inside and just outside every limit of docs/physics.md section 8 ("Eye
+// metrics"). Frames are byte 0x00 (preamble, sync, SOF, data, error bit, postamble): its pulses are
 // 0 +, 1 -, 2 +, 3 -, 4 ++ (double), 5 -- (double), 6 +, ...; V = 2 V, edges 20 ns full swing.
 #include "eye/metrics.h"
 
@@ -299,7 +299,7 @@ TEST(Metrics, RingingAfterPostamble) {
       EXPECT_EQ(r.bytes, std::vector<uint8_t>{0x15});
     } else {
       // 110 ns is long enough for a pulse, but it follows a whole frame: the line's kickback
-      // after the postamble (item 4a), allowed like any overshoot of the other sign
+      // after the postamble (rule 8.4a), allowed like any overshoot of the other sign
       ASSERT_EQ(r.ringing.size(), 1u);
       EXPECT_TRUE(r.ringing[0].after_frame);
       EXPECT_NEAR(r.ringing[0].end - r.ringing[0].start, 110 * ns, 0.01 * ns);

@@ -43,7 +43,7 @@ TEST(LinkSpec, AFiveLineSpecIsComplete) {
   EXPECT_EQ(s->tx.device, "bq79600");  // the bridge drives the first hop
   EXPECT_EQ(s->rx.device, "bq7961x");
   EXPECT_EQ(s->tx.isolation.type, "cap");
-  EXPECT_DOUBLE_EQ(s->tx.isolation.cap, 2.2e-9);  // domain.md 4.2
+  EXPECT_DOUBLE_EQ(s->tx.isolation.cap, 2.2e-9);  // docs/physics.md 4.2
   EXPECT_EQ(s->cable.material, "pp");
   EXPECT_EQ(s->cable.gauge, 24);
   EXPECT_DOUBLE_EQ(s->cable.temperature, 25);

@@ -85,7 +85,7 @@ TEST(Encoding, DoublePulseCountsByHand) {
 }
 
 TEST(Encoding, DoublesSitWhereAdjacentWireBitsDiffer) {
-  // domain.md: where two adjacent bits differ, two same-polarity pulses touch.
+  // docs/physics.md section 2: where two adjacent bits differ, two same-polarity pulses touch.
   for (int b = 0; b < 256; ++b) {
     const std::vector<int> w = byte_wire_bits(static_cast<uint8_t>(b), {});
     int changes = 0;
