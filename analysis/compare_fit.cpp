@@ -126,8 +126,8 @@ StatusOr<std::shared_ptr<const EdgeResponse>> LinkModel::response(
 
 namespace {
 
-// Residuals and their Jacobian by central differences of each parameter's own step. The point
-// and its 2n neighbours are evaluated in parallel (oneTBB, `threads` at most; 0: all cores): a
+// Residuals and their Jacobian by differences of each parameter's own step. The point and its
+// neighbours are evaluated in parallel (oneTBB, `threads` at most; 0: all cores): a
 // link fit's evaluation is a new edge response, and the columns are independent.
 class CentralCost : public ceres::CostFunction {
  public:
@@ -140,11 +140,13 @@ class CentralCost : public ceres::CostFunction {
     const size_t n = p_.size(), m = static_cast<size_t>(num_residuals());
     const std::vector<double> xv(x[0], x[0] + n);
     const bool jac = jacobians && jacobians[0];
-    // Point 0 is x; with the Jacobian, 2j + 1 and 2j + 2 are x +/- step_j e_j.
-    std::vector<std::vector<double>> xs(jac ? 2 * n + 1 : 1, xv), rs(xs.size());
+    // Point 0 is x; with the Jacobian, j + 1 is x + step_j e_j (forward), or 2j + 1 and 2j + 2
+    // are x +/- step_j e_j (central).
+    const size_t per = central_ ? 2 : 1;
+    std::vector<std::vector<double>> xs(jac ? per * n + 1 : 1, xv), rs(xs.size());
     for (size_t j = 0; jac && j < n; ++j) {
-      xs[2 * j + 1][j] += p_[j].step;
-      xs[2 * j + 2][j] -= p_[j].step;
+      xs[per * j + 1][j] += p_[j].step;
+      if (central_) xs[2 * j + 2][j] -= p_[j].step;
     }
     std::atomic<bool> ok{true};
     arena_.execute([&] {
@@ -155,11 +157,16 @@ class CentralCost : public ceres::CostFunction {
     if (!ok) return false;
     std::copy(rs[0].begin(), rs[0].end(), residuals);
     for (size_t j = 0; jac && j < n; ++j) {
-      const std::vector<double>&rp = rs[2 * j + 1], &rm = rs[2 * j + 2];
-      for (size_t i = 0; i < m; ++i) jacobians[0][i * n + j] = (rp[i] - rm[i]) / (2 * p_[j].step);
+      const std::vector<double>&rp = rs[per * j + 1], &rm = rs[central_ ? 2 * j + 2 : 0];
+      const double h = static_cast<double>(per) * p_[j].step;
+      for (size_t i = 0; i < m; ++i) jacobians[0][i * n + j] = (rp[i] - rm[i]) / h;
     }
     return true;
   }
+  // Forward differences while the fit iterates (n new points per Jacobian: they steer the
+  // search, whose residuals are exact, so the minimum found is the same to well under the
+  // standard errors), central ones for the standard errors at the solution.
+  void set_central(bool central) { central_ = central; }
   int evaluations() const { return evals_.load(); }
   Status last_error() const {
     std::lock_guard<std::mutex> lock(error_mutex_);
@@ -180,6 +187,7 @@ class CentralCost : public ceres::CostFunction {
   }
   const ResidualFn& f_;
   const std::vector<LsqParam>& p_;
+  bool central_ = false;
   mutable tbb::task_arena arena_;
   mutable std::atomic<int> evals_{0};
   mutable std::mutex error_mutex_;
@@ -262,6 +270,7 @@ StatusOr<LsqResult> fit_least_squares(const ResidualFn& f, size_t residuals,
   std::vector<double> r(residuals), jac(residuals * n);
   double* jp = jac.data();
   const double* xp = x.data();
+  cost->set_central(true);
   if (!cost->Evaluate(&xp, r.data(), &jp))
     return cost->last_error().ok() ? Status::Error("the fit's model failed at its solution")
                                    : cost->last_error();
