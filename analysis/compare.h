@@ -31,8 +31,9 @@
 // 3. Alignment: a squared-error scan of integer lags on a 1 ns grid, then a golden-section
 //    search of the continuous offset; no amplitude scaling.
 // 4. Fit: Ceres Solver (Levenberg-Marquardt, bounds) over log(value / design) of each key and
-//    the offset, Jacobian by central differences (1 % steps); standard errors from J^T J at the
-//    solution scaled by the residual variance; rank deficiency reported per key.
+//    the offset, Jacobian by forward differences while iterating and central ones at the solution
+//    (1 % steps; its points evaluated in parallel); standard errors from J^T J at the solution
+//    scaled by the residual variance; rank deficiency reported per key.
 #pragma once
 
 #include <functional>
@@ -126,7 +127,8 @@ struct LsqResult {
   std::vector<double> singular;    // of J with columns scaled to unit norm, decreasing
 };
 // Residuals at x; an error stops the fit. Called from several threads at once (the Jacobian's
-// 2n + 1 points are evaluated in parallel, `threads` at most, 0: all cores): it must write only r.
+// n + 1 points, 2n + 1 at the solution, are evaluated in parallel, `threads` at most, 0: all
+// cores): it must write only r.
 using ResidualFn = std::function<Status(std::span<const double> x, std::vector<double>& r)>;
 StatusOr<LsqResult> fit_least_squares(const ResidualFn& f, size_t residuals,
                                       const std::vector<LsqParam>& params, int max_iterations,
