@@ -87,8 +87,8 @@ struct ReducedModelOptions {
   // Hz: expansion points to start from besides f_min and f_max / 10, e.g. a neighbouring
   // circuit's (ReducedModelStats::points: the same link with one part a few percent off). The
   // search and its check are unchanged, so the model passes the same check; it just usually
-  // needs one build instead of several (isolink compare's fit: 3.5x fewer, tests in
-  // tests/solver/reduced_model_test.cpp). Points outside the band are ignored.
+  // needs fewer builds (isolink compare's fit on a 15 m cap link: 0.28 s of CPU per model
+  // against 0.54 s; tests/solver/reduced_model_test.cpp). Points outside the band are ignored.
   std::vector<double> start_points;
   Status validate() const;  // names the field, its value and the rule
 };
