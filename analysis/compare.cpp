@@ -424,7 +424,7 @@ StatusOr<CompareResult> compare_capture(const CompareInput& in, const link::Part
   StatusOr<cd::EdgeList> edges = traffic_of(*p, opt, r, &decoded);
   if (!edges) return edges.status();
   cd::LinkModel model(p->spec_text, in.spec_path, parts, opt.direction, opt.expand);
-  StatusOr<const EdgeResponse*> e = model.response({}, {});
+  StatusOr<std::shared_ptr<const EdgeResponse>> e = model.response({}, {});
   if (!e) return e.status().with_context(in.spec_path);
 
   // Coarse offset: the first decoded frame's crossing, else the first pulses' half-peak edges.
@@ -488,7 +488,7 @@ StatusOr<CompareResult> compare_capture(const CompareInput& in, const link::Part
     std::vector<double> fitted;
     cd::FitData data{ts, vs, &*edges, r.offset_s};
     if (Status s = cd::run_fit(model, p->spec, parts, opt, data, r, fitted); !s.ok()) return s;
-    StatusOr<const EdgeResponse*> ef = model.response(opt.fit, fitted);
+    StatusOr<std::shared_ptr<const EdgeResponse>> ef = model.response(opt.fit, fitted);
     if (!ef) return ef.status();
     r.sim_after_fit.resize(t.size());
     cd::synth_at(**ef, *edges, *r.offset_after_fit_s, t, r.sim_after_fit);

@@ -31,8 +31,9 @@
 // 3. Alignment: a squared-error scan of integer lags on a 1 ns grid, then a golden-section
 //    search of the continuous offset; no amplitude scaling.
 // 4. Fit: Ceres Solver (Levenberg-Marquardt, bounds) over log(value / design) of each key and
-//    the offset, Jacobian by central differences (1 % steps); standard errors from J^T J at the
-//    solution scaled by the residual variance; rank deficiency reported per key.
+//    the offset, Jacobian by forward differences while iterating and central ones at the solution
+//    (1 % steps; its points evaluated in parallel); standard errors from J^T J at the solution
+//    scaled by the residual variance; rank deficiency reported per key.
 #pragma once
 
 #include <functional>
@@ -69,6 +70,7 @@ struct CompareOptions {
   std::map<std::string, std::pair<double, double>> bounds;  // key -> [low, high], SI
   double model_floor_rel = 0.01;  // model floor of the verdict, a fraction of the peak |v|
   int max_iterations = 30;        // Levenberg-Marquardt iterations
+  int threads = 0;                // the fit's Jacobian columns evaluated at once (0: all cores)
   link::ExpandOptions expand;     // driver, load, encoding
 };
 
@@ -124,10 +126,13 @@ struct LsqResult {
   std::vector<bool> identifiable;  // per parameter
   std::vector<double> singular;    // of J with columns scaled to unit norm, decreasing
 };
-// Residuals at x; an error stops the fit.
+// Residuals at x; an error stops the fit. Called from several threads at once (the Jacobian's
+// n + 1 points, 2n + 1 at the solution, are evaluated in parallel, `threads` at most, 0: all
+// cores): it must write only r.
 using ResidualFn = std::function<Status(std::span<const double> x, std::vector<double>& r)>;
 StatusOr<LsqResult> fit_least_squares(const ResidualFn& f, size_t residuals,
-                                      const std::vector<LsqParam>& params, int max_iterations);
+                                      const std::vector<LsqParam>& params, int max_iterations,
+                                      int threads = 0);
 
 struct CompareResult {
   std::string verdict;  // match | mismatch | inconclusive
@@ -154,11 +159,8 @@ struct CompareResult {
   // For the plots: the capture and the simulation at its samples (full record).
   std::vector<double> time, capture, sim, sim_after_fit;
   std::vector<size_t> worst_frames;  // window indices, worst residual first (at most 3)
-  eye::CheckResult check;            // the capture's own check
+  eye::CheckResult check;            // the capture's own check (its commands: check.commands)
   eye::CaptureInfo input;
-  // Issue 29's "commands": the decoded bytes parsed as TI command frames; filled by the command
-  // parser when it exists, an empty array until then.
-  nlohmann::ordered_json commands = nlohmann::ordered_json::array();
   int evaluations = 0;
   double seconds = 0;
 };
@@ -167,7 +169,8 @@ StatusOr<CompareResult> compare_capture(const CompareInput& in, const link::Part
                                         const CompareOptions& opt = {});
 
 // The issue's JSON shape (verdict, direction, offset_s, residual, fit, residual_after_fit,
-// findings) and more: noise, thresholds, metrics, input, commands.
+// findings) and more: noise, thresholds, metrics, input, and the capture's commands exactly as
+// `isolink check --json` gives them (commands, commands_omitted, commands_note).
 nlohmann::ordered_json compare_json(const CompareResult& r);
 // A few lines for people.
 std::string compare_text(const CompareResult& r);

@@ -5,6 +5,7 @@
 
 #include "analysis/compare.h"
 #include "analysis/sweep_spec.h"
+#include "eye/commands.h"
 #include "netlists/link/cards.h"
 
 namespace isolink::analysis {
@@ -91,7 +92,7 @@ nlohmann::ordered_json compare_json(const CompareResult& r) {
                         {"pulses", r.check.pulses.size()},
                         {"frames", r.check.frames.size()},
                         {"bytes", r.check.bytes.size()}};
-  j["commands"] = r.commands;
+  eye::set_commands_json(r.check, j);
   j["notes"] = r.notes;
   j["simulations"] = r.evaluations;
   j["seconds"] = num(r.seconds);
@@ -132,6 +133,8 @@ std::string compare_text(const CompareResult& r) {
   for (const std::string& u : r.unidentifiable) s += "  note: " + u + "\n";
   for (const Finding& f : r.findings) s += "  finding: " + f.text + "\n";
   for (const std::string& x : r.reasons) s += "  reason: " + x + "\n";
+  if (const std::string note = eye::commands_note(r.check); !note.empty()) s += "  " + note + "\n";
+  s += eye::commands_text(r.check.commands);
   return s;
 }
 

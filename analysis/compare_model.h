@@ -3,7 +3,11 @@
 // spec with fitted keys set. Internal to analysis/ (compare.h is the interface).
 #pragma once
 
+#include <atomic>
+#include <deque>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <span>
 #include <string>
 #include <vector>
@@ -21,29 +25,37 @@ struct EdgeList {
 };
 
 // v(t) = v_idle + sum_k dl_k E(t - offset - t_k) at each time of `t` (sorted), E interpolated
-// linearly on its grid, 0 before it and its last value after it.
+// linearly on its grid, 0 before it and its last value after it. Edges a whole number of grid
+// steps apart (a frame's half bits) are summed on the grid first and interpolated once.
 void synth_at(const EdgeResponse& e, const EdgeList& edges, double offset,
               std::span<const double> t, std::span<double> out);
 
-// The link model with some keys replaced: edge responses by key values, the last one cached.
+// The link model with some keys replaced: edge responses by key values. Safe to call from
+// several threads at once (the fit's Jacobian evaluates its columns in parallel): each call
+// builds its own spec and circuit; the last kKept responses are kept, so the point a Jacobian is
+// taken at, and its offset-only columns, cost nothing. What does not change between evaluations
+// is reused: the first response's reduced-model expansion points start every later model's
+// search (the same link with parts a few percent off needs nearly the same points; the model
+// still passes its full check).
 class LinkModel {
  public:
   LinkModel(std::string spec_text, std::string spec_path, const link::PartLibrary& parts,
             link::Direction d, const link::ExpandOptions& expand);
   // The edge response with keys[i] = values[i] (empty: the design).
-  StatusOr<const EdgeResponse*> response(const std::vector<std::string>& keys,
-                                         const std::vector<double>& values);
-  int evaluations() const { return evaluations_; }
+  StatusOr<std::shared_ptr<const EdgeResponse>> response(const std::vector<std::string>& keys,
+                                                         const std::vector<double>& values);
+  int evaluations() const { return evaluations_.load(); }
 
  private:
+  static constexpr size_t kKept = 16;
   std::string text_, path_;
   const link::PartLibrary& parts_;
   link::Direction dir_;
   WorstOptions wopt_;
-  std::vector<double> cached_values_;
-  bool cached_ = false;
-  EdgeResponse cached_response_;
-  int evaluations_ = 0;
+  std::mutex mutex_;                  // guards kept_ and start_points_
+  std::vector<double> start_points_;  // Hz, the first response's expansion points
+  std::deque<std::pair<std::vector<double>, std::shared_ptr<const EdgeResponse>>> kept_;
+  std::atomic<int> evaluations_{0};
 };
 
 // "ends.x" -> {"tx.x", "rx.x"}, anything else -> {key}.

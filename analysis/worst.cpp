@@ -477,6 +477,7 @@ StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::Par
     LtiOptions lo;
     lo.method = LtiOptions::Method::Reduced;
     lo.horizon = lead + opt.max_span;
+    lo.reduced.start_points = opt.reduced_start_points;
     if (opt.progress) opt.progress("edge response, reduced model", 0.0);
     StatusOr<LtiResponses> lti = LtiResponses::compute(circuit, {*probe}, lo);
     if (lti) {
@@ -500,6 +501,7 @@ StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::Par
           "reduced model (order {}, {} poles, {} expansion points, AC error {:.1e} of peak up to "
           "3 GHz), sampled on a {:g} ns grid",
           m.order, m.poles, m.expansion_points, m.error, opt.dt * 1e9);
+      out.expansion_points = m.points;
       out.seconds = seconds_since(start);
       return out;
     }

@@ -63,6 +63,9 @@ struct EdgeResponse {
   std::string engine;       // what produced it ("reduced model, order 119 ...", "transient ...")
   std::string engine_note;  // edge_engine auto: why the reduced model was not used
   double seconds = 0;       // wall time
+  // Hz, the reduced model's expansion points (WorstOptions::reduced_start_points of a
+  // neighbouring link); empty from the transient.
+  std::vector<double> expansion_points;
   // e at n samples after the corner: 0 before the record, e.back() after it.
   double at(long n) const {
     const long i = n + pre;
@@ -82,6 +85,10 @@ struct WorstOptions {
   // back to the transient when the model does not pass; `transient` always runs the transient.
   enum class EdgeEngine { Auto, Transient };
   EdgeEngine edge_engine = EdgeEngine::Auto;
+  // Hz: the reduced model's first expansion points (ReducedModelOptions::start_points), e.g. the
+  // expansion_points of the same link with other part values (isolink compare's fit); the model
+  // passes the same check either way.
+  std::vector<double> reduced_start_points;
   double reltol = 1e-6;       // transient tolerance of the edge response
   double settle_tol = 20e-6;  // V: settled when a half bit's response stays below this
   double max_memory = 20e-6;  // s: longest memory searched; B there is reported as the bound

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "base/hex.h"
+#include "cli/capture_options.h"
 #include "cli/commands.h"
 #include "eye/check.h"
 #include "eye/rules.h"
@@ -92,16 +93,7 @@ void add_check_command(CLI::App& app, int* exit_code) {
   cmd->add_option("--rules", args->rules,
                   "a shipped rule set (bq7961x, bq79600, tone) or a YAML rule file")
       ->capture_default_str();
-  cmd->add_option("--time", args->cols.time,
-                  "time column (name, channel, #K or 1-based index; default: the time column)");
-  cmd->add_option("--diff", args->cols.diff,
-                  "differential column (name, channel such as CH1, #K or 1-based index; default: "
-                  "the first channel)");
-  auto* p = cmd->add_option("--p", args->cols.p,
-                            "P column: the differential is P - N (with two files: P's column in "
-                            "the first)");
-  auto* n = cmd->add_option("--n", args->cols.n, "N column (with two files: in the second)");
-  cmd->get_option("--diff")->excludes(p)->excludes(n);
+  add_capture_column_options(*cmd, args->cols);
   cmd->add_flag("--json", args->json, "print one JSON object instead of the summary");
   cmd->add_option("--pulses-csv", args->pulses_csv, "write the per-pulse table to this CSV file");
   cmd->add_option("--expect", args->expect,

@@ -14,6 +14,7 @@
 #include "analysis/sweep_spec.h"
 #include "base/file_io.h"
 #include "base/si_number.h"
+#include "cli/capture_options.h"
 #include "cli/commands.h"
 #include "netlists/link/parts.h"
 #include "reports/compare_png.h"
@@ -31,6 +32,7 @@ struct CompareArgs {
   bool json = false;
   std::string out_dir;
   std::vector<std::string> part_dirs;
+  int jobs = 0;
 };
 
 int fail(const std::string& message) {
@@ -80,6 +82,9 @@ int run_compare(const CompareArgs& a) {
   analysis::CompareOptions opt;
   opt.direction = a.direction == "up" ? link::Direction::kUp : link::Direction::kDown;
   opt.frames = a.frames;
+  if (a.jobs < 0)
+    return fail(fmt::format("error: option -j = {}: must be >= 0 (0: all cores)", a.jobs));
+  opt.threads = a.jobs;
   for (size_t i = 0; i < a.fit.size();) {
     const size_t c = std::min(a.fit.find(',', i), a.fit.size());
     if (c > i) opt.fit.push_back(a.fit.substr(i, c - i));
@@ -116,11 +121,7 @@ void add_compare_command(CLI::App& app, int* exit_code) {
                   "or P then N), then the link spec")
       ->required()
       ->expected(2, 3);
-  cmd->add_option("--time", args->cols.time, "time column (as isolink check)");
-  cmd->add_option("--diff", args->cols.diff, "differential column (as isolink check)");
-  auto* p = cmd->add_option("--p", args->cols.p, "P column: the differential is P - N");
-  auto* n = cmd->add_option("--n", args->cols.n, "N column");
-  cmd->get_option("--diff")->excludes(p)->excludes(n);
+  add_capture_column_options(*cmd, args->cols);
   cmd->add_option("--direction", args->direction, "the receiver probed: down (rx end) or up")
       ->check(CLI::IsMember({"down", "up"}))
       ->capture_default_str();
@@ -133,6 +134,8 @@ void add_compare_command(CLI::App& app, int* exit_code) {
   cmd->add_option("--bounds", args->bounds,
                   "KEY=LO:HI bounds of a fitted key (default 0.2x..5x its design value); "
                   "repeatable");
+  cmd->add_option("-j,--jobs", args->jobs,
+                  "simulations the fit runs at once (its Jacobian's columns; default: all cores)");
   cmd->add_flag("--json", args->json, "print one JSON object instead of the summary");
   cmd->add_option("-o,--output", args->out_dir,
                   "write compare.png, report.md and report.json to this folder");

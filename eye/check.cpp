@@ -485,10 +485,7 @@ json to_json(const CheckResult& r) {
     decoded["mismatch"] = r.expect_detail.empty() ? json(nullptr) : json(r.expect_detail);
   }
   j["decoded"] = std::move(decoded);
-  j["commands"] = commands_json(r.commands);
-  j["commands_omitted"] = r.commands.size() - std::min(r.commands.size(), kMaxJsonPulses);
-  const std::string note = commands_note(r);
-  j["commands_note"] = note.empty() ? json(nullptr) : json(note);
+  set_commands_json(r, j);
   return j;
 }
 

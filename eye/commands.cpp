@@ -98,6 +98,13 @@ json commands_json(std::span<const ParsedFrame> commands) {
   return out;
 }
 
+void set_commands_json(const CheckResult& r, json& j) {
+  j["commands"] = commands_json(r.commands);
+  j["commands_omitted"] = r.commands.size() - std::min(r.commands.size(), kMaxJsonPulses);
+  const std::string note = commands_note(r);
+  j["commands_note"] = note.empty() ? json(nullptr) : json(note);
+}
+
 std::string commands_text(std::span<const ParsedFrame> commands) {
   if (commands.empty()) return "";
   const size_t bad = static_cast<size_t>(std::count_if(

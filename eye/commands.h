@@ -32,6 +32,10 @@ std::vector<ParsedFrame> parse_commands(const CheckResult& r,
 // crc_ok, flags, ok, cut_by_record, at_record_start, bytes, first_frame, frame_count, text}; at
 // most kMaxJsonPulses entries (the count of the rest goes to the caller's "commands_omitted").
 nlohmann::ordered_json commands_json(std::span<const ParsedFrame> commands);
+// Sets j's "commands" (commands_json of r.commands), "commands_omitted" (how many the array left
+// out) and "commands_note" (commands_note(r), null when empty): the fields of `isolink check
+// --json`, for every output that reports a check's commands (isolink compare's JSON too).
+void set_commands_json(const CheckResult& r, nlohmann::ordered_json& j);
 // "commands (N, M malformed):" then a line per command (the first 20), or "" when none.
 std::string commands_text(std::span<const ParsedFrame> commands);
 // One sentence on what a malformed command means next to the waveform's verdict, or "" when

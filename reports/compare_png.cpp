@@ -20,7 +20,12 @@ struct Series {
   std::span<const double> y;
   Color color;
   std::string label;
+  double width = 1.5;
 };
+
+// The capture is drawn first and wide, the simulations narrow over it: a simulation that fits
+// leaves the capture visible as a band around it (drawn last, the capture's noise hid them).
+constexpr double kCaptureWidth = 4.0, kSimWidth = 1.3;
 
 // One panel of waveforms over [t0, t1] (capture time), y range from the data.
 void panel(Canvas& c, const Rect& rect, std::span<const double> t, const std::vector<Series>& s,
@@ -43,7 +48,7 @@ void panel(Canvas& c, const Rect& rect, std::span<const double> t, const std::ve
   for (const Series& x : s)
     if (x.y.size() == t.size() && hi > lo)
       c.series(a, t.subspan(lo, hi - lo), x.y.subspan(lo, hi - lo),
-               LineStyle{.color = x.color, .width = 1.5});
+               LineStyle{.color = x.color, .width = x.width});
   draw_axes(c, a, xt, yt, "capture time", y_title, kFont - 2);
   c.text(rect.x0, rect.y0 - 8, title, kFont, kInk, FontFace::kBold);
 }
@@ -67,12 +72,18 @@ Status write_compare_png(const analysis::CompareResult& r, const std::string& pa
     for (size_t i = 0; i < t.size(); ++i) res_fit[i] = r.capture[i] - r.sim_after_fit[i];
   }
   const Color verdict = r.verdict == "match" ? kPass : kFail;
-  draw_runs(c, 40, 20,
-            {{"isolink compare: ", kInk, FontFace::kBold},
-             {r.verdict, verdict, FontFace::kBold},
-             {fmt::format("   {} ({}), traffic: {}", r.direction, r.receiver_rules, r.traffic_from),
-              kInk}},
-            24);
+  // Runs placed by hand: draw_runs measures a run's ink, so a trailing space vanished
+  // ("compare:mismatch").
+  const std::string head = "isolink compare:";
+  const double gap = c.measure("n", 24, FontFace::kBold).width;
+  double x = 40;
+  c.text(x, 20, head, 24, kInk, FontFace::kBold);
+  x += c.measure(head, 24, FontFace::kBold).width + gap;
+  c.text(x, 20, r.verdict, 24, verdict, FontFace::kBold);
+  x += c.measure(r.verdict, 24, FontFace::kBold).width + 2 * gap;
+  c.text(x, 20,
+         fmt::format("{} ({}), traffic from the {}", r.direction, r.receiver_rules, r.traffic_from),
+         24, kInk);
   std::string line2 = fmt::format("residual rms {:.1f} mV, max {:.0f} mV", r.residual.rms_v * 1e3,
                                   r.residual.max_v * 1e3);
   if (r.residual_after_fit)
@@ -80,19 +91,29 @@ Status write_compare_png(const analysis::CompareResult& r, const std::string& pa
                          r.residual_after_fit->rms_v * 1e3, r.residual_after_fit->max_v * 1e3);
   line2 += fmt::format("; match needs rms <= {:.1f} mV", r.threshold_rms_v * 1e3);
   c.text(40, 80, line2, kFont, kInk);
-  if (!r.findings.empty()) c.text(40, 106, r.findings.front().text, kFont, kFail);
+  // The findings (two lines at most; report.md lists them all), else what blocks a verdict.
+  std::vector<std::string> lines;
+  for (const analysis::Finding& f : r.findings) lines.push_back(f.text);
+  if (lines.size() > 2) {
+    const size_t more = lines.size() - 1;
+    lines.resize(1);
+    lines.push_back(fmt::format("and {} more findings (report.md)", more));
+  }
+  for (size_t i = 0; i < lines.size(); ++i)
+    c.text(40, 106 + 24 * static_cast<double>(i), lines[i], kFont, kFail);
   double t0 = t.front(), t1 = t.back();
   if (!r.windows.empty()) {
     t0 = std::max(t0, r.windows.front().first - 0.5e-6);
     t1 = std::min(t1, r.windows.back().second + 0.5e-6);
   }
-  std::vector<Series> wave = {{r.capture, kCapture, "capture"}, {r.sim, kSimBefore, "design"}};
-  if (fitted) wave.push_back({r.sim_after_fit, kSimAfter, "after the fit"});
+  std::vector<Series> wave = {{r.capture, kCapture, "capture", kCaptureWidth},
+                              {r.sim, kSimBefore, "design", kSimWidth}};
+  if (fitted) wave.push_back({r.sim_after_fit, kSimAfter, "after the fit", kSimWidth});
   panel(c, {130, 170, w - 60, 620}, t, wave, t0, t1, "capture and simulation", "v(rxp,rxn)");
   std::vector<Series> rs = {{res, kSimBefore, "design"}};
   if (fitted) rs.push_back({res_fit, kSimAfter, "after the fit"});
   panel(c, {130, 700, w - 60, 1020}, t, rs, t0, t1, "residual: capture - simulation", "residual");
-  std::vector<LegendEntry> legend = {{"capture", LineStyle{.color = kCapture, .width = 3}},
+  std::vector<LegendEntry> legend = {{"capture", LineStyle{.color = kCapture, .width = 5}},
                                      {"design", LineStyle{.color = kSimBefore, .width = 3}}};
   if (fitted) legend.push_back({"after the fit", LineStyle{.color = kSimAfter, .width = 3}});
   const Rect ls = legend_size(c, legend, kFont);
@@ -102,7 +123,12 @@ Status write_compare_png(const analysis::CompareResult& r, const std::string& pa
     const auto& win = r.windows[r.worst_frames[static_cast<size_t>(k)]];
     const int x0 = 130 + k * (zw + 90);
     panel(c, {x0, 1130, x0 + zw, 1400}, t, wave, win.first, win.second,
-          fmt::format("worst window {} ({:.2f} us)", k + 1, win.first * 1e6), "v(rxp,rxn)");
+          fmt::format("frame with the {} residual, {:.2f} us",
+                      k == 0   ? "largest"
+                      : k == 1 ? "2nd largest"
+                               : "3rd largest",
+                      win.first * 1e6),
+          "v(rxp,rxn)");
   }
   return c.write_png(path);
 }

@@ -366,7 +366,11 @@ StatusOr<ReducedModel> reduce_in_form(const Circuit& circuit,
   std::vector<double> used;
   std::vector<std::pair<double, double>> open;  // check intervals not yet refined
   for (size_t i = 0; i + 1 < freqs.size(); ++i) open.push_back({freqs[i], freqs[i + 1]});
-  for (double f : {opt.f_min, opt.f_max / 10}) {
+  std::vector<double> first = {opt.f_min, opt.f_max / 10};
+  for (double f : opt.start_points)
+    if (f >= opt.f_min && f <= opt.f_max && std::find(first.begin(), first.end(), f) == first.end())
+      first.push_back(f);
+  for (double f : first) {
     StatusOr<bool> added = expand_at(f);
     if (!added) return added.status();
     used.push_back(f);
@@ -459,6 +463,7 @@ StatusOr<ReducedModel> reduce_in_form(const Circuit& circuit,
   model.stats.check_points = static_cast<int>(freqs.size());
   model.stats.expansion_points = st.expansion_points;
   model.stats.steps = st.steps;
+  model.stats.points = used;
   return model;
 }
 
