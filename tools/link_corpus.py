@@ -1,22 +1,14 @@
-#!/ usr / bin / env python3
-""
-        "Seeded random link specs over the whole space a user can describe (issue 28's corpus).
+#!/usr/bin/env python3
+"""Seeded random link specs over the whole space a user can describe (issue 28's corpus).
 
-        python3 tools /
-        link_corpus.py-- seed 1 --count 300 --out DIR #DIR /
-        link_000
-            .yaml...
+    python3 tools/link_corpus.py --seed 1 --count 300 --out DIR   # DIR/link_000.yaml ...
 
-        Every spec is a complete
-        link(both ends, cable, one stack - write each way)
-            .The space : -devices : tx bq79600
-    | bq7961x | bq79606a,
-    rx bq7961x | bq79606a(the bridge sits at the base);
-- isolation per end:none, cap(1 / 2.2 / 4.7 / 10 nF), capchoke(one or two chokes of the library),
-                    transformer(each library transformer), transformer_choke;
-both ends drawn independently, so most links are asymmetric;
-- terminations 1 k or 10 k;
-X caps(0 or 100 pF - 1 nF) and Y caps(0 or 10 - 470 pF per line);
+Every spec is a complete link (both ends, cable, one stack-write each way). The space:
+  - devices: tx bq79600 | bq7961x | bq79606a, rx bq7961x | bq79606a (the bridge sits at the base);
+  - isolation per end: none, cap (1 / 2.2 / 4.7 / 10 nF), capchoke (one or two chokes of the
+    library), transformer (each library transformer), transformer_choke; both ends drawn
+    independently, so most links are asymmetric;
+  - terminations 1 k or 10 k; X caps (0 or 100 pF - 1 nF) and Y caps (0 or 10 - 470 pF per line);
   - cable 0.1-100 m, log-uniform, with 100 m and 0.1 m always in (the first two specs),
     PP or PVC, every AWG size 18-30, temperature -40..85 degC.
 The same seed gives the same files on every machine (Python's random.Random is specified).
