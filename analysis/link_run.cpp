@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <functional>
+#include <optional>
 
 namespace isolink::analysis {
 
@@ -64,7 +65,7 @@ StatusOr<DirectionRun> run_direction_synthesized(link::ExpandedLink link, const 
   if (!w) return w.status().with_context(dr.link.description);
   dr.sim.wave = std::move(*w);
   dr.sim.engine = Engine::Lti;
-  dr.sim.engine_note = "v(rxp,rxn) synthesized from the edge response: " + e.engine;
+  dr.sim.engine_note = "synthesized from the edge response: " + e.engine;
   dr.sim.seconds =
       e.seconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (Status s = score_direction(dr); !s.ok()) return s;
@@ -156,30 +157,69 @@ StatusOr<LinkRun> run_link(const link::LinkSpec& spec, const link::PartLibrary& 
       [](size_t) {});
 }
 
+namespace {
+
+// Why the drive cannot be superposed on a grid of step dt: its first level change off the grid,
+// or empty.
+std::string off_grid_why(const traffic::Drive& drive, double dt) {
+  for (const traffic::DriveSegment& g : drive.segments) {
+    traffic::Drive one;
+    one.segments = {g};
+    if (!on_grid(one, dt))
+      return fmt::format(
+          "the drive changes level at {:.7g} us (off the {:g} ns grid of the edge response)",
+          g.start * 1e6, dt * 1e9);
+  }
+  return "";
+}
+
+}  // namespace
+
 StatusOr<LinkRun> run_link_from_edges(const link::LinkSpec& spec, const link::PartLibrary& parts,
                                       const RunOptions& opt, const WorstOptions& wopt,
                                       std::vector<EdgeResponse>& edges) {
-  edges.clear();
-  size_t done =
-      0;  // directions run so far (edges has one per direction while all were synthesized)
+  WorstOptions fine = wopt;  // the synthesis grid
+  fine.dt = wopt.dt / kSynthesisOversample;
+  std::vector<std::optional<EdgeResponse>> per;  // per direction run so far, on wopt's grid
   StatusOr<LinkRun> run = run_each_direction(
       spec, parts, opt,
       [&](link::ExpandedLink ex, link::Direction d) -> StatusOr<DirectionRun> {
-        const bool all_synthesized = edges.size() == done++;
-        if (!on_grid(ex.drive, wopt.dt) || !all_synthesized)
-          return run_direction(std::move(ex), opt);
-        StatusOr<EdgeResponse> e = edge_response(spec, parts, d, wopt);
-        if (!e) return e.status().with_context("worst case");
-        StatusOr<DirectionRun> dr = run_direction_synthesized(std::move(ex), *e);
-        edges.push_back(std::move(*e));
+        per.emplace_back();
+        std::string why = off_grid_why(ex.drive, fine.dt);
+        if (why.empty()) {
+          StatusOr<EdgeResponse> e = edge_response(spec, parts, d, fine);
+          if (e) {
+            StatusOr<DirectionRun> dr = run_direction_synthesized(std::move(ex), *e);
+            per.back() = coarsened(*e, kSynthesisOversample, wopt);
+            return dr;
+          }
+          why = "edge response: " + e.status().message();
+        }
+        StatusOr<DirectionRun> dr = run_direction(std::move(ex), opt);
+        if (dr) dr->simulated_why = std::move(why);
         return dr;
       },
-      [&](size_t same) {
-        if (edges.size() == done && same < edges.size()) edges.push_back(edges[same]);
-        ++done;
-      });
-  if (run && edges.size() != run->directions.size()) edges.clear();
+      [&](size_t same) { per.push_back(per[same]); });
+  edges.clear();
+  if (!run) return run;
+  for (std::optional<EdgeResponse>& e : per) {
+    if (!e) {
+      edges.clear();
+      break;
+    }
+    edges.push_back(std::move(*e));
+  }
   return run;
+}
+
+std::string simulated_note(const LinkRun& run) {
+  std::string note;
+  for (const DirectionRun& d : run.directions)
+    if (!d.simulated_why.empty() && d.same_as.empty())
+      note +=
+          fmt::format("{}{}: {}", note.empty() ? "" : "; ", link::direction_name(d.link.direction),
+                      d.simulated_why.substr(0, d.simulated_why.find('\n')));
+  return note;
 }
 
 std::vector<int> same_circuits(const LinkRun& run) {

@@ -37,6 +37,10 @@ struct DirectionRun {
   // The direction whose simulation this is, when both are the same circuit and traffic
   // (link::circuit_key: the same parts at both ends): simulated once. Empty when simulated.
   std::string same_as;
+  // run_link_from_edges: empty when v(rxp,rxn) was synthesized from the edge response, else why
+  // this direction was simulated instead ("the drive changes level at 1.0003 us (off the 1 ns
+  // grid of the edge response)"). Always empty from run_link.
+  std::string simulated_why;
 };
 
 struct LinkRun {
@@ -58,16 +62,30 @@ const std::vector<std::string>& run_probes();
 
 StatusOr<LinkRun> run_link(const link::LinkSpec& spec, const link::PartLibrary& parts,
                            const RunOptions& opt = {});
-// run_link for a caller that computes the worst case as well (the sweep): each direction's edge
-// response (edge_response with `wopt`) also gives its traffic's v(rxp,rxn), by exact
-// superposition on the response's 1 ns grid (run_direction_synthesized), instead of a second
-// model of the link and a finer output grid. A direction whose drive is off that grid is
-// simulated (run_direction). `edges` receives one response per direction, for worst_case, or
-// none when a direction was simulated. A direction with the same circuit key as one before
-// (link::circuit_key) takes its response and result (same_as).
+// The sweep's fast path synthesizes the traffic on a grid this many times finer than the worst
+// case's (WorstOptions::dt, 1 ns): 0.25 ns. Between samples the eye checker interpolates
+// linearly, which errs by up to dt^2 / 8 |v''|: on the 1 ns grid up to 3.2 mV and 29 ps against
+// the LTI engine's run on the corpus test's links (short cables, sharp ringing), on 0.25 ns
+// within 1 mV and 25 ps (tests/analysis/fast_path_test.cpp).
+inline constexpr int kSynthesisOversample = 4;
+
+// run_link on the sweep's fast path: each direction's edge response (edge_response with `wopt`,
+// sampled kSynthesisOversample times finer than wopt.dt) gives its traffic's waveform by exact
+// superposition on that grid (run_direction_synthesized), instead of a model of the link stepped
+// through the traffic; the same response, every kSynthesisOversample-th sample (coarsened),
+// serves worst_case. The waveform has v(rxp,rxn) and the probes of wopt.more_probes (all of
+// run_probes() when the caller needs the pins or the driver: the noise analysis, waveform
+// files). A direction is simulated (run_direction) instead, and says why in its simulated_why,
+// when its drive changes level off the fine grid or its edge response cannot be computed (it
+// has not settled within wopt.max_span, say). `edges` receives one response per direction on
+// wopt.dt's grid, for worst_case, or none when a direction was simulated. A direction with the
+// same circuit key as one before (link::circuit_key) takes its response and result (same_as).
 StatusOr<LinkRun> run_link_from_edges(const link::LinkSpec& spec, const link::PartLibrary& parts,
                                       const RunOptions& opt, const WorstOptions& wopt,
                                       std::vector<EdgeResponse>& edges);
+// "down: why; up: why" over the directions of a run_link_from_edges run that were simulated;
+// empty when every direction was synthesized.
+std::string simulated_note(const LinkRun& run);
 // Per direction of `run`, the index of the earlier direction it is the same circuit as (its
 // same_as), or -1: what worst_case needs to skip its own circuit keys.
 std::vector<int> same_circuits(const LinkRun& run);
@@ -76,9 +94,9 @@ std::vector<int> same_circuits(const LinkRun& run);
 StatusOr<DirectionRun> run_direction(link::ExpandedLink link, const RunOptions& opt = {});
 
 // One expanded direction scored on v(rxp,rxn) synthesized from its edge response (worst.h,
-// synthesize_drive: exact superposition on the response's 1 ns grid) instead of simulated: the
-// sweep's path when it computes the worst case, whose edge response it shares. The waveform has
-// that one column; an error when a level change of the drive is off the grid.
+// synthesize_drive: exact superposition on the response's grid) instead of simulated: the
+// sweep's path. The waveform has that column and one per probe of e.more; an error when a level
+// change of the drive is off the grid.
 StatusOr<DirectionRun> run_direction_synthesized(link::ExpandedLink link, const EdgeResponse& e);
 // Scores dr.sim.wave (column 0, v(rxp,rxn)) with the receiver's rules: dr.rules, data, tones,
 // pass. Used by both of the above.

@@ -26,12 +26,13 @@ namespace isolink::analysis::sweep {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-// The columns after the point's own: verdict .. fail_reason, [the noise columns], seconds, error.
+// The columns after the point's own: verdict .. fail_reason, [the noise columns], seconds, error,
+// path.
 const std::vector<std::string> kResultColumns = {
     "verdict",         "worst_metric",  "worst_margin_rel",
     "margin_vstart_V", "margin_vend_V", "margin_width_ns",
     "margin_edge_ns",  "decoded_ok",    "fail_reason",
-    "seconds",         "error"};
+    "seconds",         "error",         "path"};
 constexpr size_t kBeforeNoise = 9;  // verdict .. fail_reason
 const std::vector<std::string> kNoiseColumns = {"noise.verdict",
                                                 "noise.immunity_min_db",
@@ -124,6 +125,7 @@ PointResult score_pack(const PackResult& p) {
   PointResult r;
   if (p.weakest > 0) r = score_run(p.hops[static_cast<size_t>(p.weakest - 1)].run);
   r.verdict = p.pass ? "pass" : "fail";
+  r.path = "simulated: a pack (every hop simulated)";
   r.decoded_ok.reset();
   r.reason.clear();
   std::string failing;
@@ -171,6 +173,7 @@ std::string results_row(const PointResult& r) {
   }
   add(fmt::format("{:.2f}", r.seconds));
   add(r.error);
+  add(r.path);
   for (const std::string& c : r.extra) add(c);
   return line + "\n";
 }
@@ -238,6 +241,7 @@ StatusOr<PointResult> parse_results_row(std::string_view line, const RowShape& s
   if (!parse_double(f[k++], &r.seconds)) return Status::Error("bad seconds");
   if (std::isnan(r.seconds)) r.seconds = 0;
   r.error = f[k++];
+  r.path = f[k++];
   r.extra.assign(f.begin() + static_cast<long>(k), f.end());
   return r;
 }
@@ -339,6 +343,37 @@ PointResult::Worst worst_cells(const WorstResult& r) {
   return w;
 }
 
+namespace {
+
+// Why a point must be simulated rather than synthesized from its edge responses, or empty.
+std::string fast_path_refused(const link::LinkSpec& spec, const PointOptions& opt, double dt) {
+  if (opt.simulate) return "--simulate";
+  if (opt.run.engine == Engine::Transient) return "--engine transient";
+  // Waveform files at sim.tstep: the synthesis grid (dt) resampled, exact on a multiple of it.
+  const double k = spec.sim.tstep / dt;
+  if (!opt.waves_dir.empty() && (k < 1 - 1e-9 || std::abs(k - std::round(k)) > 1e-6))
+    return fmt::format(
+        "waveform files at sim.tstep {:g} ns (not a multiple of the {:g} ns grid "
+        "of the edge response)",
+        spec.sim.tstep * 1e9, dt * 1e9);
+  return "";
+}
+
+}  // namespace
+
+nlohmann::ordered_json path_counts(const std::vector<PointResult>& results) {
+  size_t edges = 0, simulated = 0;
+  nlohmann::ordered_json first = nullptr;  // the first simulated point (by index) and why
+  for (const PointResult& r : results) {
+    if (r.path == "edges") ++edges;
+    if (r.path.rfind("simulated", 0) != 0) continue;
+    ++simulated;
+    if (first.is_null() || r.index < first["point"].get<size_t>())
+      first = {{"point", r.index}, {"path", r.path}};
+  }
+  return {{"edges", edges}, {"simulated", simulated}, {"first_simulated", first}};
+}
+
 PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t index,
                       const PointOptions& opt) {
   const double t0 = now_seconds();
@@ -352,6 +387,7 @@ PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t
     r.decoded_ok.reset();
     r.reason.clear();
     r.error = first_line(message);
+    r.path.clear();
     r.noise.reset();
     if (s.noise_outputs) r.noise.emplace();
     r.worst.reset();
@@ -383,19 +419,24 @@ PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t
       r.seconds = now_seconds() - t0;
       return r;
     }
-    // With the worst case asked for (and no waveform files), each direction's edge response
-    // serves both (run_link_from_edges).
-    const WorstOptions wopt{.expand = opt.run.expand};
+    // The fast path (analysis/README.md "The sweep's fast path"): each direction's edge
+    // response gives the spec traffic's waveform and serves the worst case.
+    WorstOptions wopt{.expand = opt.run.expand};
+    const std::string simulate_why =
+        fast_path_refused(po.point.spec, opt, wopt.dt / kSynthesisOversample);
+    if (s.noise_outputs || !opt.waves_dir.empty())  // they read the pins (and the files the driver)
+      wopt.more_probes.assign(run_probes().begin() + 1, run_probes().end());
     std::vector<EdgeResponse> edges;
-    StatusOr<LinkRun> run =
-        s.worst_outputs && opt.waves_dir.empty() && opt.run.engine != Engine::Transient
-            ? run_link_from_edges(po.point.spec, parts, opt.run, wopt, edges)
-            : run_link(po.point.spec, parts, opt.run);
+    StatusOr<LinkRun> run = simulate_why.empty()
+                                ? run_link_from_edges(po.point.spec, parts, opt.run, wopt, edges)
+                                : run_link(po.point.spec, parts, opt.run);
     if (!run) return fail(run.status().message());
     std::vector<std::string> cells = std::move(r.cells);
     r = score_run(*run);
     r.index = index;
     r.cells = std::move(cells);
+    const std::string note = simulate_why.empty() ? simulated_note(*run) : simulate_why;
+    r.path = note.empty() ? "edges" : "simulated: " + note;
     if (s.noise_outputs) {
       StatusOr<NoiseResult> noise = analyze_noise_of_run(po.point.spec, parts, *run);
       if (!noise) return fail("noise: " + noise.status().message());
@@ -731,6 +772,7 @@ nlohmann::ordered_json summary_json(const SweepSpec& s, const std::vector<PointR
   // Errors count as not passing: a point that cannot be simulated is not a pass.
   j["pass_yield"] = done ? ordered_json(static_cast<double>(pass) / done) : ordered_json(nullptr);
   j["worst_metric_counts"] = worst_metrics;
+  j["paths"] = path_counts(results);
   if (worst) {
     ordered_json w = point_json(s, *worst);
     w["verdict"] = worst->verdict;

@@ -11,7 +11,12 @@
 // completion order; `point` is the point's index (sort by it). Columns:
 //   point, <one per swept key, named by its dotted path>, [sample, mc.<key>...], verdict
 //   (pass | fail | error), worst_metric, worst_margin_rel, margin_vstart_V, margin_vend_V,
-//   margin_width_ns, margin_edge_ns, decoded_ok, fail_reason, seconds, error
+//   margin_width_ns, margin_edge_ns, decoded_ok, fail_reason, seconds, error, path
+// path says how the point's waveforms were obtained: "edges" (the fast path, run_link_from_edges:
+// each direction's traffic superposed from its edge response on the response's 1 ns grid; the
+// same verdicts and margins as a simulation within 1 mV and 25 ps, analysis/README.md) or
+// "simulated: <why>" (--engine transient, waveform files asked at a sim.tstep off that grid, a
+// drive level change off it, an edge response that cannot be computed, a pack point).
 // Margins are each metric's worst (smallest) margin over the directions and over the data and
 // tone checks, in the metric's unit: distance to the limit, positive = inside (eye/metrics.h).
 // worst_margin_rel is the smallest of margin / |limit| over the four metrics (the fraction by which
@@ -58,7 +63,7 @@
 // worst case over all traffic is `isolink pack`'s, not the sweep's). The columns above describe
 // the pack: verdict is the pack's (every hop passes), worst_metric .. margin_edge_ns are the
 // weakest hop's (PackResult::weakest), decoded_ok covers every hop, fail_reason names each
-// failing hop ("hop 3: width; hop 9: vstart"); after error come weakest_hop (its index),
+// failing hop ("hop 3: width; hop 9: vstart"); after error and path come weakest_hop (its index),
 // failing_hops (their indices, space-separated) and hop_<K>_margin_rel per hop K (its smallest
 // margin / |limit| over its directions, the ring's return hop included). --keep-waves writes
 // point_NNNNN_hop_KK.csv per hop.
@@ -135,6 +140,11 @@ struct PointResult {
   std::string reason;              // fail_reason: why a failing point fails ("dip; decode: sync")
   double seconds = 0;              // wall time of the point
   std::string error;
+  // How the waveform was obtained: "edges" (the fast path: superposed from each direction's edge
+  // response, run_link_from_edges) or "simulated: why" (the transient or the LTI engine's own
+  // run: --engine transient, waveform files off the 1 ns grid, traffic off it, a pack...); empty
+  // on error rows.
+  std::string path;
   // The noise columns (`outputs: [noise]`); present (maybe empty) exactly when the sweep has them.
   using Noise = PointNoise;
   std::optional<Noise> noise;  // indexed by link::Direction (down, up)
@@ -146,7 +156,7 @@ struct PointResult {
   std::vector<std::string> extra;
 };
 
-// The columns a pack sweep adds after `error` (none for a link sweep).
+// The columns a pack sweep adds after `path` (none for a link sweep).
 std::vector<std::string> pack_columns(const SweepSpec& s);
 // Scores a pack run: the pack's verdict; worst_metric, worst_margin_rel and the margins of the
 // weakest hop; decoded_ok over every hop; fail_reason per failing hop ("hop 3: width"); extra.
@@ -155,7 +165,7 @@ PointResult score_pack(const PackResult& r);
 // The results.csv header for a sweep.
 std::vector<std::string> results_header(const SweepSpec& s);
 // What a results.csv row of a sweep holds: the point's cells, the optional families, the pack's
-// columns after `error`.
+// columns after `path`.
 struct RowShape {
   size_t cells = 0;        // point_columns().size()
   bool noise = false;      // the noise columns
@@ -166,7 +176,7 @@ struct RowShape {
 RowShape row_shape(const SweepSpec& s);
 // One CSV line (with '\n').
 std::string results_row(const PointResult& r);
-// Parses a line written by results_row for a sweep of that shape (fields after `error` go to
+// Parses a line written by results_row for a sweep of that shape (fields after `path` go to
 // extra).
 StatusOr<PointResult> parse_results_row(std::string_view line, const RowShape& shape);
 // The result as the CSV stores it (numbers rounded to what is written).
@@ -184,6 +194,7 @@ PointResult::Worst worst_cells(const WorstResult& r);
 struct PointOptions {
   RunOptions run;
   std::string waves_dir;  // non-empty: write each point's waveforms there (--keep-waves)
+  bool simulate = false;  // every point through run_link, off the fast path (--simulate)
 };
 // Makes, runs and scores point `index`; never fails (errors become verdict "error").
 PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t index,
@@ -208,6 +219,10 @@ struct SweepOptions {
   // own loading takes (0.3-0.6 s of OpenImageIO's plug-ins, with both cores waiting).
   std::function<void()> on_pool_ready;
 };
+
+// summary.json's `paths`: {"edges": N, "simulated": M, "first_simulated": {"point", "path"} or
+// null}: how many points took the fast path, and the first that did not and why.
+nlohmann::ordered_json path_counts(const std::vector<PointResult>& results);
 
 struct SweepOutcome {
   size_t points = 0, pass = 0, fail = 0, error = 0;

@@ -103,17 +103,19 @@ StatusOr<PatternBasis> pattern_basis(const traffic::EncodingOptions& enc) {
   return pb;
 }
 
-// v[i] += sum dL E(origin + i - n_edge) for i in [0, v.size()): the record of E where it
-// overlaps, its last value after it (a running sum, so long records cost what E's length does).
-void add_edges(const EdgeResponse& e, const std::vector<std::pair<long, int>>& edges, long origin,
-               std::vector<double>& v) {
+// v[i] += sum dL E(origin + i - n_edge) for i in [0, v.size()): the record of E (resp, its corner
+// at resp[pre]) where it overlaps, its last value after it (a running sum, so long records cost
+// what E's length does). add_edges: E = e.e; EdgeResponse::more's columns are added the same way.
+void add_response(const std::vector<double>& resp, long pre,
+                  const std::vector<std::pair<long, int>>& edges, long origin,
+                  std::vector<double>& v) {
   const long n = static_cast<long>(v.size());
   std::vector<double> step(static_cast<size_t>(n) + 1, 0.0);
   for (const auto& [at, dl] : edges) {
-    const long zero = at - origin - e.pre;  // window sample of e[0]; E is 0 before it
+    const long zero = at - origin - pre;  // window sample of e[0]; E is 0 before it
     const long first = std::max(0L, zero);
-    const long body_end = std::min(n, zero + static_cast<long>(e.e.size()));
-    step[static_cast<size_t>(std::min(n, std::max(first, body_end)))] += e.e.back() * dl;
+    const long body_end = std::min(n, zero + static_cast<long>(resp.size()));
+    step[static_cast<size_t>(std::min(n, std::max(first, body_end)))] += resp.back() * dl;
   }
   // The bodies block by block of v (4096 samples, in the first-level cache), every edge's part
   // of each: a long record with hundreds of edges otherwise streams all of v once per edge.
@@ -121,13 +123,13 @@ void add_edges(const EdgeResponse& e, const std::vector<std::pair<long, int>>& e
   for (long b0 = 0; b0 < n; b0 += kBlock) {
     const long b1 = std::min(n, b0 + kBlock);
     for (const auto& [at, dl] : edges) {
-      const long zero = at - origin - e.pre;
+      const long zero = at - origin - pre;
       const long lo = std::max(b0, zero);
-      const long hi = std::min(b1, zero + static_cast<long>(e.e.size()));
+      const long hi = std::min(b1, zero + static_cast<long>(resp.size()));
       if (lo >= hi) continue;
       const double w = dl;
       double* out = v.data() + lo;
-      const double* body = e.e.data() + (lo - zero);
+      const double* body = resp.data() + (lo - zero);
       for (long i = 0; i < hi - lo; ++i) out[i] += w * body[i];
     }
   }
@@ -136,6 +138,11 @@ void add_edges(const EdgeResponse& e, const std::vector<std::pair<long, int>>& e
     level += step[static_cast<size_t>(i)];
     v[static_cast<size_t>(i)] += level;
   }
+}
+
+void add_edges(const EdgeResponse& e, const std::vector<std::pair<long, int>>& edges, long origin,
+               std::vector<double>& v) {
+  add_response(e.e, e.pre, edges, origin, v);
 }
 
 // Per-metric "key": lower is worse. vstart, vend: the value; width_min: width - window min;
@@ -416,6 +423,42 @@ const WorstMetric* DirectionWorst::metric(const std::string& name) const {
   return nullptr;
 }
 
+namespace {
+
+// e.settle and e.drift over the last 10 % of the record (half: a half bit in samples).
+void measure_settling(EdgeResponse& e, long half) {
+  const long n = static_cast<long>(e.e.size());
+  e.settle = 0;
+  e.drift = 0;
+  for (long i = n - n / 10; i < n; ++i) {
+    e.settle = std::max(e.settle, std::abs(e.e[static_cast<size_t>(i)] - e.e.back()));
+    e.drift = std::max(e.drift,
+                       std::abs(e.e[static_cast<size_t>(i)] - e.e[static_cast<size_t>(i - half)]));
+  }
+}
+
+}  // namespace
+
+EdgeResponse coarsened(const EdgeResponse& e, int k, const WorstOptions& opt) {
+  if (k <= 1) {
+    EdgeResponse out = e;
+    out.more.clear();
+    return out;
+  }
+  EdgeResponse out;  // the fields, not the fine records
+  out.v_idle = e.v_idle;
+  out.span = e.span;
+  out.engine_note = e.engine_note;
+  out.seconds = e.seconds;
+  out.dt = e.dt * k;
+  out.pre = e.pre / k;
+  for (size_t i = static_cast<size_t>(e.pre % k); i < e.e.size(); i += static_cast<size_t>(k))
+    out.e.push_back(e.e[i]);
+  out.engine = fmt::format("{}; every {}th sample kept: a {:g} ns grid", e.engine, k, out.dt * 1e9);
+  measure_settling(out, to_samples(opt.expand.stimulus.encoding.half_bit, out.dt));
+  return out;
+}
+
 StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::PartLibrary& parts,
                                      link::Direction d, const WorstOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
@@ -426,15 +469,8 @@ StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::Par
   const long half = to_samples(opt.expand.stimulus.encoding.half_bit, opt.dt);
   // Settling of a sampled record (see EdgeResponse): true when it has settled.
   auto settled = [&](double span) {
-    const long n = static_cast<long>(out.e.size());
     out.span = span;
-    out.settle = 0;
-    out.drift = 0;
-    for (long i = n - n / 10; i < n; ++i) {
-      out.settle = std::max(out.settle, std::abs(out.e[static_cast<size_t>(i)] - out.e.back()));
-      out.drift = std::max(out.drift, std::abs(out.e[static_cast<size_t>(i)] -
-                                               out.e[static_cast<size_t>(i - half)]));
-    }
+    measure_settling(out, half);
     return out.drift <= opt.settle_tol;
   };
   auto unsettled = [&](const std::string& what, double span) {
@@ -447,6 +483,10 @@ StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::Par
   auto finite = [&](const std::string& what) {
     for (double x : out.e)
       if (!std::isfinite(x)) return Status::Error(what + ": the edge response is not finite");
+    for (const EdgeResponse::Column& c : out.more)
+      for (double x : c.e)
+        if (!std::isfinite(x))
+          return Status::Error(what + ": the edge response of " + c.probe + " is not finite");
     return Status::Ok();
   };
 
@@ -459,30 +499,42 @@ StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::Par
     ex.drive = drive;
     return link::expand_link(spec, parts, d, ex);
   };
-  auto edge_circuit = [](const link::ExpandedLink& link, Circuit& circuit) -> StatusOr<Probe> {
+  // The circuit and its probes: v(rxp,rxn), then opt.more_probes.
+  auto edge_circuit = [&](const link::ExpandedLink& link,
+                          Circuit& circuit) -> StatusOr<std::vector<Probe>> {
     for (const Card& card : link.netlist.cards)
       if (Status s = circuit.add(card); !s.ok()) return s;
     if (Status s = circuit.finalize(); !s.ok()) return s;
-    return parse_probe(circuit, "v(rxp,rxn)");
+    std::vector<Probe> probes;
+    for (size_t i = 0; i <= opt.more_probes.size(); ++i) {
+      StatusOr<Probe> p = parse_probe(circuit, i == 0 ? "v(rxp,rxn)" : opt.more_probes[i - 1]);
+      if (!p) return p.status();
+      probes.push_back(*p);
+    }
+    return probes;
   };
+  out.more.assign(opt.more_probes.size(), {});
+  for (size_t i = 0; i < out.more.size(); ++i) out.more[i].probe = opt.more_probes[i];
 
   if (opt.edge_engine == WorstOptions::EdgeEngine::Auto) {
     // The reduced model in closed form: one model, sampled on longer records until settled.
     StatusOr<link::ExpandedLink> link = edge_link(opt.max_span);
     if (!link) return link.status();
     Circuit circuit;
-    StatusOr<Probe> probe = edge_circuit(*link, circuit);
-    if (!probe) return probe.status();
+    StatusOr<std::vector<Probe>> probes = edge_circuit(*link, circuit);
+    if (!probes) return probes.status();
     for (const auto& e : circuit.elements()) e->bind_time(opt.dt, lead + opt.max_span);
     LtiOptions lo;
     lo.method = LtiOptions::Method::Reduced;
     lo.horizon = lead + opt.max_span;
     lo.reduced.start_points = opt.reduced_start_points;
     if (opt.progress) opt.progress("edge response, reduced model", 0.0);
-    StatusOr<LtiResponses> lti = LtiResponses::compute(circuit, {*probe}, lo);
+    StatusOr<LtiResponses> lti = LtiResponses::compute(circuit, *probes, lo);
     if (lti) {
       const std::vector<SourceInput> inputs = lti->netlist_inputs(lead + opt.max_span);
       out.v_idle = lti->value(0, lead - 2 * out.pre * opt.dt, inputs);
+      for (size_t i = 0; i < out.more.size(); ++i)
+        out.more[i].v_idle = lti->value(i + 1, lead - 2 * out.pre * opt.dt, inputs);
       out.e.clear();
       for (double span = 40e-6;; span *= 2) {
         // Only the samples the longer record adds: the model starts them from the edge exactly.
@@ -492,6 +544,8 @@ StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::Par
           times[static_cast<size_t>(i - from)] = lead + static_cast<double>(i - out.pre) * opt.dt;
         const std::vector<std::vector<double>> v = lti->values(inputs, times);
         for (double x : v[0]) out.e.push_back(x - out.v_idle);
+        for (size_t i = 0; i < out.more.size(); ++i)
+          for (double x : v[i + 1]) out.more[i].e.push_back(x - out.more[i].v_idle);
         if (Status s = finite(link->description); !s.ok()) return s;
         if (settled(span)) break;
         if (span * 2 > opt.max_span) return unsettled(link->description, span);
@@ -512,8 +566,8 @@ StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::Par
     StatusOr<link::ExpandedLink> link = edge_link(span);
     if (!link) return link.status();
     Circuit circuit;
-    StatusOr<Probe> probe = edge_circuit(*link, circuit);
-    if (!probe) return probe.status();
+    StatusOr<std::vector<Probe>> probes = edge_circuit(*link, circuit);
+    if (!probes) return probes.status();
     TransientOptions to;
     to.tstep = opt.dt;
     to.tstop = lead + span;
@@ -528,7 +582,7 @@ StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::Par
         opt.progress(fmt::format("edge response, {:g} us", span * 1e6), t / to.tstop);
       };
     if (Status s = to.validate(); !s.ok()) return s;
-    StatusOr<Waveform> w = run_transient(circuit, to, {*probe});
+    StatusOr<Waveform> w = run_transient(circuit, to, *probes);
     if (!w) return w.status().with_context(link->description + ", edge response");
     out.v_idle = w->value_at(0, lead - 2 * out.pre * opt.dt);
     const long n = out.pre + to_samples(span, opt.dt);
@@ -536,6 +590,14 @@ StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::Par
     for (long i = 0; i < n; ++i)
       out.e[static_cast<size_t>(i)] =
           w->value_at(0, lead + static_cast<double>(i - out.pre) * opt.dt) - out.v_idle;
+    for (size_t c = 0; c < out.more.size(); ++c) {
+      EdgeResponse::Column& col = out.more[c];
+      col.v_idle = w->value_at(c + 1, lead - 2 * out.pre * opt.dt);
+      col.e.assign(static_cast<size_t>(n), 0.0);
+      for (long i = 0; i < n; ++i)
+        col.e[static_cast<size_t>(i)] =
+            w->value_at(c + 1, lead + static_cast<double>(i - out.pre) * opt.dt) - col.v_idle;
+    }
     if (Status s = finite(link->description); !s.ok()) return s;
     if (settled(span)) break;
     if (span * 2 > opt.max_span) return unsettled(link->description, span);
@@ -595,6 +657,59 @@ Waveform synthesize(const EdgeResponse& e, const Traffic& traffic,
   return w;
 }
 
+namespace {
+
+// v = v_idle + sum dL E(. - n_edge) on [0, n) of the fine grid (resp: E, its corner at resp[pre]),
+// exactly, in two passes when every edge and the corner fall on every k-th sample (k > 1): the
+// sum on the coarse grid (every k-th sample of E, its whole record), linearly interpolated, plus
+// the sum of E's interpolation residual r (E minus the linear interpolation of its coarse
+// samples), which is non-zero only while E bends (ringing after the edge; a slow tail is almost
+// linear). r is cut where every later |r| stays below tol / 2 / sum |dL|, so the cut moves v by
+// at most tol / 2. Linear interpolation is linear, so the two passes add up to the fine sum.
+std::vector<double> superpose(const std::vector<double>& resp, long pre, double v_idle,
+                              const std::vector<std::pair<long, int>>& edges, long n, long k,
+                              double tol) {
+  std::vector<double> v(static_cast<size_t>(n), v_idle);
+  double weight = 0;
+  for (const auto& [at_, dl] : edges) weight += std::abs(dl);
+  // Before its record E is 0; the interpolation from there to resp[0] (the idle, 50 ns before the
+  // corner: 0 to rounding) is not in the residual, so it must be below tol as well.
+  if (k <= 1 || pre % k != 0 || resp.empty() || std::abs(resp[0]) * weight > tol / 2) {
+    add_response(resp, pre, edges, 0, v);
+    return v;
+  }
+  const long nc = (n + k - 1) / k + 1;  // coarse samples covering [0, n)
+  const long m = static_cast<long>(resp.size());
+  auto at = [&](long i) { return i < m ? resp[static_cast<size_t>(i)] : resp.back(); };
+  std::vector<double> coarse_resp;  // every k-th sample, up to one at or past the record's end
+  for (long i = 0; i < m + k - 1; i += k) coarse_resp.push_back(at(i));
+  std::vector<std::pair<long, int>> coarse_edges = edges;
+  for (auto& [at_, dl] : coarse_edges) at_ /= k;
+  std::vector<double> vc(static_cast<size_t>(nc), v_idle);
+  add_response(coarse_resp, pre / k, coarse_edges, 0, vc);
+  // The residual on the fine grid, 0 at the coarse samples and past the record (E constant).
+  std::vector<double> r(static_cast<size_t>(m), 0.0);
+  for (long i = 0; i < m; ++i) {
+    const long p = i % k, a = i - p;
+    if (p != 0)
+      r[static_cast<size_t>(i)] =
+          at(i) - (at(a) + (at(a + k) - at(a)) * static_cast<double>(p) / static_cast<double>(k));
+  }
+  const double cut = weight > 0 ? tol / 2 / weight : 0.0;
+  long last = m - 1;
+  while (last >= 0 && std::abs(r[static_cast<size_t>(last)]) <= cut) --last;
+  r.resize(static_cast<size_t>(last + 2), 0.0);  // ends in 0: no step after it
+  for (long i = 0; i < n; ++i) {
+    const long j = i / k, p = i % k;
+    const double a = vc[static_cast<size_t>(j)], b = vc[static_cast<size_t>(j + 1)];
+    v[static_cast<size_t>(i)] = a + (b - a) * static_cast<double>(p) / static_cast<double>(k);
+  }
+  add_response(r, pre, edges, 0, v);
+  return v;
+}
+
+}  // namespace
+
 StatusOr<Waveform> synthesize_drive(const EdgeResponse& e, const traffic::Drive& drive,
                                     double t_end) {
   // The PWL sources start at the first segment's level (the operating point) and hold the
@@ -603,6 +718,7 @@ StatusOr<Waveform> synthesize_drive(const EdgeResponse& e, const traffic::Drive&
     return Status::Error("the drive does not start idle: no edge response superposes to it");
   std::vector<std::pair<long, int>> edges;
   int level = 0;
+  long k = 4;  // the coarse grid of superpose: every 4th, 2nd or 1st sample, as the edges allow
   for (const traffic::DriveSegment& g : drive.segments) {
     if (g.level == level) continue;
     if (!on_sample(g.start, e.dt))
@@ -610,18 +726,20 @@ StatusOr<Waveform> synthesize_drive(const EdgeResponse& e, const traffic::Drive&
           "the drive changes level at {:.6g} us, off the {:g} ns grid of the edge response",
           g.start * 1e6, e.dt * 1e9));
     edges.push_back({to_samples(g.start, e.dt), g.level - level});
+    while (edges.back().first % k != 0) k /= 2;
     level = g.level;
   }
   const long n = std::max(2L, to_samples(t_end, e.dt) + 1);
   if (n > 100'000'000)
     return Status::Error(fmt::format("a {:g} us record on a {:g} ns grid is too long to synthesize",
                                      t_end * 1e6, e.dt * 1e9));
-  std::vector<double> v(static_cast<size_t>(n), e.v_idle);
-  add_edges(e, edges, 0, v);
+  constexpr double kTol = 20e-6;  // V: the most the residual's cut moves any sample
   Waveform w;
   w.time.resize(static_cast<size_t>(n));
   for (long i = 0; i < n; ++i) w.time[static_cast<size_t>(i)] = static_cast<double>(i) * e.dt;
-  w.add_column("v(rxp,rxn)", std::move(v));
+  w.add_column("v(rxp,rxn)", superpose(e.e, e.pre, e.v_idle, edges, n, k, kTol));
+  for (const EdgeResponse::Column& c : e.more)
+    w.add_column(c.probe, superpose(c.e, e.pre, c.v_idle, edges, n, k, kTol));
   return w;
 }
 

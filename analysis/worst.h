@@ -53,13 +53,21 @@ namespace isolink::analysis {
 
 // The receiver's response to one driver edge, on a uniform grid.
 struct EdgeResponse {
-  double dt = 1e-9;         // sample spacing (s)
-  long pre = 0;             // e[pre] is at the corner (the middle of the driver's ramp)
-  std::vector<double> e;    // v(rxp,rxn) after a 0 -> +1 level change, minus v_idle (V)
-  double v_idle = 0;        // v(rxp,rxn) with the line idle (V)
-  double span = 0;          // simulated time after the corner (s)
-  double settle = 0;        // max |e - e.back()| over the last 10 % of the span (V)
-  double drift = 0;         // max |E(t) - E(t - T)| over the last 10 %: a half bit's residue (V)
+  double dt = 1e-9;       // sample spacing (s)
+  long pre = 0;           // e[pre] is at the corner (the middle of the driver's ramp)
+  std::vector<double> e;  // v(rxp,rxn) after a 0 -> +1 level change, minus v_idle (V)
+  double v_idle = 0;      // v(rxp,rxn) with the line idle (V)
+  double span = 0;        // simulated time after the corner (s)
+  double settle = 0;      // max |e - e.back()| over the last 10 % of the span (V)
+  double drift = 0;       // max |E(t) - E(t - T)| over the last 10 %: a half bit's residue (V)
+  // With WorstOptions::more_probes: the same response of each of those probes (in that order),
+  // e minus v_idle of that probe, on the same grid (the spec traffic's other columns).
+  struct Column {
+    std::string probe;
+    std::vector<double> e;
+    double v_idle = 0;
+  };
+  std::vector<Column> more;
   std::string engine;       // what produced it ("reduced model, order 119 ...", "transient ...")
   std::string engine_note;  // edge_engine auto: why the reduced model was not used
   double seconds = 0;       // wall time
@@ -100,6 +108,10 @@ struct WorstOptions {
   std::vector<int> targets;
   std::vector<int> previous;
   link::ExpandOptions expand;  // driver, load, encoding (its half bit is the T above)
+  // Probes recorded besides v(rxp,rxn) (EdgeResponse::more): the sweep's fast path asks for the
+  // other columns of a run (v(rxp), v(rxn), v(txp,txn)) when its noise analysis or waveform files
+  // need them. The reduced model is then checked on these probes too.
+  std::vector<std::string> more_probes;
   // Progress for a display: what runs ("down edge response", "down search") and the fraction
   // of it done (0-1). Empty: none.
   std::function<void(const std::string& what, double fraction)> progress;
@@ -168,6 +180,12 @@ struct WorstResult {
 StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::PartLibrary& parts,
                                      link::Direction d, const WorstOptions& opt);
 
+// e on a grid k times coarser: every k-th sample counted from the corner (e.pre a multiple of
+// k), settle and drift measured again with opt's half bit; `more` dropped. The response
+// edge_response gives with dt = k e.dt, from the same model sampled at the same times (the sweep
+// synthesizes its traffic on the fine grid and searches the worst case on the coarse one).
+EdgeResponse coarsened(const EdgeResponse& e, int k, const WorstOptions& opt);
+
 // B(tau): the most that half bits older than tau (s) can move v (V). See the method above.
 double tail_bound(const EdgeResponse& e, double half_bit, double tau);
 
@@ -178,7 +196,7 @@ Waveform synthesize(const EdgeResponse& e, const Traffic& traffic,
 // v(rxp,rxn) of a whole drive (a link's own traffic, link::ExpandedLink::drive) by superposition,
 // on [0, t_end] every e.dt: exact at the samples for the link whose edge response e is. Every
 // level change must fall on the grid (within 1e-6 of a sample); an error names the first that
-// does not.
+// does not. The probes of e.more follow as further columns, each superposed the same way.
 StatusOr<Waveform> synthesize_drive(const EdgeResponse& e, const traffic::Drive& drive,
                                     double t_end);
 

@@ -16,6 +16,7 @@
 #include "base/si_number.h"
 #include "cli/capture_options.h"
 #include "cli/commands.h"
+#include "cli/common_options.h"
 #include "netlists/link/parts.h"
 #include "reports/compare_png.h"
 
@@ -139,7 +140,7 @@ void add_compare_command(CLI::App& app, int* exit_code) {
   cmd->add_flag("--json", args->json, "print one JSON object instead of the summary");
   cmd->add_option("-o,--output", args->out_dir,
                   "write compare.png, report.md and report.json to this folder");
-  cmd->add_option("--parts", args->part_dirs, "extra part-library folder (repeatable)");
+  add_parts_option(*cmd, &args->part_dirs);
   cmd->callback([args, exit_code] { *exit_code = run_compare(*args); });
 }
 

@@ -40,6 +40,7 @@ struct SweepArgs {
   bool quiet = false;
   bool list = false;
   Engine engine = Engine::Auto;
+  bool simulate = false;
 };
 
 int fail(const Status& s) {
@@ -108,6 +109,7 @@ int run_sweep_command(const SweepArgs& a) {
   opt.render_plots = reports::render_sweep_plots;
   opt.quiet = a.quiet;
   opt.point.run.engine = a.engine;
+  opt.point.simulate = a.simulate;
   if (!a.quiet && rank == 0) {
     std::fprintf(stderr, "sweep: %s: %zu points (%zu grid point%s%s)%s -> %s\n", spec->path.c_str(),
                  spec->size(), spec->grid_size(), spec->grid_size() == 1 ? "" : "s",
@@ -140,6 +142,12 @@ int run_sweep_command(const SweepArgs& a) {
         "%zu points: %zu pass, %zu fail, %zu error%s\n", out->points, out->pass, out->fail,
         out->error,
         out->skipped ? fmt::format(" ({} from the earlier run)", out->skipped).c_str() : "");
+    // Points off the fast path (analysis/README.md): how many and the first one's reason.
+    const nlohmann::ordered_json paths = sweep::path_counts(out->results);
+    if (paths["simulated"].get<size_t>() > 0)
+      std::printf("%zu simulated, not synthesized from edge responses (point %zu: %s)\n",
+                  paths["simulated"].get<size_t>(), paths["first_simulated"]["point"].get<size_t>(),
+                  paths["first_simulated"]["path"].get<std::string>().c_str());
     for (const std::string& f : out->files)
       std::printf("  %s/%s\n", opt.out_dir.c_str(), f.c_str());
   }
@@ -164,6 +172,9 @@ void add_sweep_command(CLI::App& app, int* exit_code) {
       ->check(CLI::Range(1, 4096));
   add_parts_option(*cmd, &args->part_dirs);
   add_engine_option(*cmd, &args->engine);
+  cmd->add_flag("--simulate", args->simulate,
+                "Simulate every point with the engine instead of superposing each direction's "
+                "edge response (the fast path; results.csv's path column)");
   cmd->add_flag("--resume", args->resume, "Skip the points already in DIR/results.csv");
   cmd->add_flag("--keep-waves", args->keep_waves,
                 "Write every point's waveforms to DIR/waves/point_NNNNN.csv");

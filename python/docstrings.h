@@ -109,7 +109,8 @@ Args:
 Returns:
     One dict per point, in point order, keyed by results.csv's columns: "point", the swept
     keys, "verdict", "worst_metric", "worst_margin_rel", "margin_vstart_V", "margin_vend_V",
-    "margin_width_ns", "margin_edge_ns", "decoded_ok", "fail_reason", "seconds", "error", ...
+    "margin_width_ns", "margin_edge_ns", "decoded_ok", "fail_reason", "seconds", "error", "path"
+    ("edges": the fast path, or "simulated: <why>"), ...
     None for an empty cell, bool for decoded_ok, int for point, float for numbers.)doc";
 
 inline constexpr const char* kPack =

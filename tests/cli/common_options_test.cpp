@@ -44,7 +44,7 @@ const std::vector<std::string> kEngineCommands = {
     "run " + kExamples + "/cap_2m.yaml", "sweep " + kExamples + "/sweep_cap_length.yaml",
     "sim " + kData + "/floating_cable.cir -p 'v(rxp,rxn)'"};
 const std::vector<std::string> kPartsCommands = {"run",   "worst",        "sweep", "pack",
-                                                 "noise", "export-spice", "parts"};
+                                                 "noise", "export-spice", "parts", "compare"};
 
 std::string first_word(const std::string& s) {
   return s.substr(0, s.find(' '));

@@ -253,7 +253,9 @@ TEST(SweepPackSim, ResumeSkipsThePointsAlreadyDone) {
   fs::create_directories(d + "/out");
   std::string header;
   for (const std::string& h : results_header(*s)) header += (header.empty() ? "" : ",") + h;
-  const std::string done = "0,2,pass,width,0.5,0.8,0.6,30,40,true,,99.00,,2,,0.6,0.5\n";
+  const std::string done =
+      "0,2,pass,width,0.5,0.8,0.6,30,40,true,,99.00,,simulated: a pack (every hop simulated),2,,"
+      "0.6,0.5\n";
   write(d + "/out/results.csv", header + "\n" + done);
   const std::string cmd = std::string(ISOLINK_BINARY) + " sweep " + d + "/sweep.yaml -o " + d +
                           "/out --resume -q --no-plots > " + d + "/log 2>&1";
@@ -299,9 +301,10 @@ TEST(SweepPackSim, AFailingPointIsRecordedAndTheSweepGoesOn) {
       for (size_t c = 13; c < ncol; ++c) EXPECT_EQ(r[c], "") << c;
     } else {
       EXPECT_TRUE(r[2] == "pass" || r[2] == "fail") << r[2];
-      EXPECT_TRUE(r[13] == "1" || r[13] == "2") << r[13];  // weakest_hop
-      EXPECT_NE(r[15], "");                                // hop 1's margin
-      EXPECT_NE(r[16], "");                                // hop 2's margin
+      EXPECT_EQ(r[13], "simulated: a pack (every hop simulated)");  // path
+      EXPECT_TRUE(r[14] == "1" || r[14] == "2") << r[14];           // weakest_hop
+      EXPECT_NE(r[16], "");                                         // hop 1's margin
+      EXPECT_NE(r[17], "");                                         // hop 2's margin
     }
   }
 }

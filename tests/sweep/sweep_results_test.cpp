@@ -50,6 +50,7 @@ PointResult result(size_t index, const SweepSpec& s, const std::string& verdict,
   r.worst_rel = verdict == "error" ? NAN : rel;
   if (verdict != "error") r.margin = {rel * 1.6, 0.5, 20e-9, 30e-9};
   if (verdict != "error") r.decoded_ok = verdict == "pass";
+  if (verdict != "error") r.path = "edges";
   r.seconds = 1.25;
   if (verdict == "error") r.error = "link.yaml:3:5: error: unknown part 'X, \"Y\"'";
   return r;
@@ -63,13 +64,13 @@ TEST(SweepResults, HeaderAndRowRoundTrip) {
   EXPECT_EQ(h, (std::vector<std::string>{"point", "cable.length", "rx.isolation.cap", "verdict",
                                          "worst_metric", "worst_margin_rel", "margin_vstart_V",
                                          "margin_vend_V", "margin_width_ns", "margin_edge_ns",
-                                         "decoded_ok", "fail_reason", "seconds", "error"}));
+                                         "decoded_ok", "fail_reason", "seconds", "error", "path"}));
   PointResult r = result(3, s, "fail", -0.0123456789);
   r.reason = "vstart; decode: weak bit";
   const std::string row = results_row(r);
   EXPECT_EQ(row,
             "3,2,4.7e-09,fail,vstart,-0.0123457,-0.0197531,0.5,20,30,false,vstart; decode: "
-            "weak bit,1.25,\n");
+            "weak bit,1.25,,edges\n");
   StatusOr<PointResult> back = parse_results_row(row.substr(0, row.size() - 1), shape);
   ASSERT_TRUE(back.ok()) << back.status().message();
   EXPECT_EQ(back->index, 3u);
@@ -79,13 +80,14 @@ TEST(SweepResults, HeaderAndRowRoundTrip) {
   EXPECT_DOUBLE_EQ(back->margin[2], 20e-9);
   EXPECT_EQ(back->decoded_ok, std::optional<bool>(false));
   EXPECT_EQ(back->reason, "vstart; decode: weak bit");
+  EXPECT_EQ(back->path, "edges");
   EXPECT_EQ(results_row(*back), row);  // a fixed point
   // An error row: CSV-quoted message, empty margins.
   const PointResult e = result(5, s, "error", 0);
   const std::string erow = results_row(e);
   EXPECT_EQ(erow,
             "5,5,4.7e-09,error,,,,,,,,,1.25,\"link.yaml:3:5: error: unknown part 'X, "
-            "\"\"Y\"\"'\"\n");
+            "\"\"Y\"\"'\",\n");
   StatusOr<PointResult> eback = parse_results_row(erow.substr(0, erow.size() - 1), shape);
   ASSERT_TRUE(eback.ok()) << eback.status().message();
   EXPECT_EQ(eback->error, e.error);
@@ -93,8 +95,8 @@ TEST(SweepResults, HeaderAndRowRoundTrip) {
   EXPECT_FALSE(eback->decoded_ok.has_value());
   // Malformed rows.
   EXPECT_FALSE(parse_results_row("3,2,4.7e-09,fail", shape).ok());
-  EXPECT_FALSE(parse_results_row("x,2,4.7e-09,fail,,,,,,,,,1,", shape).ok());
-  EXPECT_FALSE(parse_results_row("3,2,4.7e-09,maybe,,,,,,,,,1,", shape).ok());
+  EXPECT_FALSE(parse_results_row("x,2,4.7e-09,fail,,,,,,,,,1,,", shape).ok());
+  EXPECT_FALSE(parse_results_row("3,2,4.7e-09,maybe,,,,,,,,,1,,", shape).ok());
   EXPECT_EQ(split_csv_line("a,\"b,c\",,\"d\"\"e\""),
             (std::vector<std::string>{"a", "b,c", "", "d\"e"}));
 }
@@ -128,7 +130,8 @@ TEST(SweepResults, NoiseColumnsRoundTrip) {
                                          "noise.up.immunity_min_db",
                                          "noise.up.freq_hz",
                                          "seconds",
-                                         "error"}));
+                                         "error",
+                                         "path"}));
   PointResult r = result(3, *ns, "pass", 0.25);
   PointResult::Noise n;
   n.verdict = "fail";
@@ -140,7 +143,7 @@ TEST(SweepResults, NoiseColumnsRoundTrip) {
   const std::string row = results_row(r);
   EXPECT_EQ(row,
             "3,2,4.7e-09,pass,vstart,0.25,0.4,0.5,20,30,true,,fail,-13.5975,0.0208989,-13.5975,"
-            "8.85237e+06,,,,1.25,\n");
+            "8.85237e+06,,,,1.25,,edges\n");
   StatusOr<PointResult> back = parse_results_row(row.substr(0, row.size() - 1), shape);
   ASSERT_TRUE(back.ok()) << back.status().message();
   ASSERT_TRUE(back->noise.has_value());
@@ -155,7 +158,7 @@ TEST(SweepResults, NoiseColumnsRoundTrip) {
   EXPECT_NE(erow.find(",error,,,,,,,,,,,,,,,,,1.25,"), std::string::npos) << erow;
   EXPECT_TRUE(parse_results_row(erow.substr(0, erow.size() - 1), shape).ok());
   // A bad noise verdict is refused.
-  EXPECT_FALSE(parse_results_row("3,2,4.7e-09,pass,,,,,,,,,maybe,,,,,,,,1,", shape).ok());
+  EXPECT_FALSE(parse_results_row("3,2,4.7e-09,pass,,,,,,,,,maybe,,,,,,,,1,,", shape).ok());
   // A sweep without the family has no such columns (and reads no such row).
   EXPECT_EQ(results_header(spec()).size() + 8, h.size());
 }
@@ -168,7 +171,7 @@ TEST(SweepResults, WorstColumnsRoundTrip) {
   const std::vector<std::string> h = results_header(*ws);
   const RowShape shape = row_shape(*ws);
   EXPECT_EQ(shape.columns(), h.size());
-  ASSERT_EQ(h.size(), 14u + 8u + 13u);
+  ASSERT_EQ(h.size(), 15u + 8u + 13u);
   EXPECT_EQ(h[11], "fail_reason");
   EXPECT_EQ(h[12], "noise.verdict");
   EXPECT_EQ(
@@ -178,7 +181,7 @@ TEST(SweepResults, WorstColumnsRoundTrip) {
           "worst.down.vend_margin_V", "worst.down.width_min_margin_ns",
           "worst.down.width_max_margin_ns", "worst.down.edge_margin_ns", "worst.up.vstart_margin_V",
           "worst.up.vend_margin_V", "worst.up.width_min_margin_ns", "worst.up.width_max_margin_ns",
-          "worst.up.edge_margin_ns", "seconds", "error"}));
+          "worst.up.edge_margin_ns", "seconds", "error", "path"}));
   // Worst alone: 13 columns more than the plain sweep, in the same place.
   StatusOr<SweepSpec> wo = read_sweep_text(kSweep + "outputs: [worst]\n", "sweep.yaml");
   ASSERT_TRUE(wo.ok()) << wo.status().message();
@@ -195,7 +198,7 @@ TEST(SweepResults, WorstColumnsRoundTrip) {
   const std::string row = results_row(r);
   EXPECT_EQ(row,
             "3,2,4.7e-09,pass,vstart,0.25,0.4,0.5,20,30,true,,fail,width_min,-0.0357143,0.4,0.3,"
-            "-10,200,15,,,,,,1.25,\n");
+            "-10,200,15,,,,,,1.25,,edges\n");
   StatusOr<PointResult> back = parse_results_row(row.substr(0, row.size() - 1), row_shape(*wo));
   ASSERT_TRUE(back.ok()) << back.status().message();
   ASSERT_TRUE(back->worst.has_value());
@@ -403,7 +406,7 @@ TEST(SweepResults, ResumeKeepsGoodRowsAndDropsACutRow) {
   {
     std::ofstream out(dir + "/results.csv");
     out << header << "\n"
-        << "2,7,1e-09,pass,vstart,0.2,0.32,0.5,20,30,true,,1.25,\n";
+        << "2,7,1e-09,pass,vstart,0.2,0.32,0.5,20,30,true,,1.25,,edges\n";
   }
   StatusOr<std::unique_ptr<ResultLog>> changed = ResultLog::open(s, opt);
   ASSERT_FALSE(changed.ok());

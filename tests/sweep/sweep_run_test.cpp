@@ -102,7 +102,7 @@ TEST(SweepSim, ResultsMatchIsolinkRunPointByPoint) {
   EXPECT_EQ(csv.header, (std::vector<std::string>{
                             "point", "cable.length", "verdict", "worst_metric", "worst_margin_rel",
                             "margin_vstart_V", "margin_vend_V", "margin_width_ns", "margin_edge_ns",
-                            "decoded_ok", "fail_reason", "seconds", "error"}));
+                            "decoded_ok", "fail_reason", "seconds", "error", "path"}));
   ASSERT_EQ(csv.rows.size(), 3u);
   const std::vector<std::string> lengths = {"0.5", "1", "2"};
   bool all_pass = true;
@@ -122,11 +122,14 @@ TEST(SweepSim, ResultsMatchIsolinkRunPointByPoint) {
     all_pass = all_pass && rrc == 0;
     const nlohmann::json rep = nlohmann::json::parse(slurp(rdir + "/report.json"));
     const nlohmann::json& worst = rep["directions"][0]["check"]["summary"]["worst"];
+    // The sweep's fast path (path "edges") against `isolink run`'s simulation: within the
+    // fast path's guarantee, 1 mV and 25 ps (analysis/README.md).
+    EXPECT_EQ(r[csv.col("path")], "edges") << "point " << i;
     EXPECT_NEAR(std::stod(r[csv.col("margin_vstart_V")]), worst["vstart"]["margin"].get<double>(),
-                1e-5)
+                1e-3)
         << "point " << i;
     EXPECT_NEAR(std::stod(r[csv.col("margin_width_ns")]), worst["width"]["margin"].get<double>(),
-                1e-4)
+                0.025)
         << "point " << i;
     EXPECT_EQ(r[csv.col("decoded_ok")],
               rep["directions"][0]["check"]["verdict"] == "pass" ? "true" : "false");
@@ -171,13 +174,18 @@ sweep:
     ASSERT_TRUE(direct.ok()) << direct.status().message();
     const NoiseResult& n = direct->noise;
     ASSERT_EQ(n.directions.size(), 2u);
+    // The sweep takes the fast path (the waveform and pins superposed from edge responses),
+    // run_noise simulates: the receiver budget moves by at most 1 mV (or 25 ps of slope), a
+    // fraction of a percent of these budgets, so the immunity agrees within 1 % (0.09 dB).
+    EXPECT_EQ(r.path, "edges");
     EXPECT_EQ(r.noise->verdict, n.pass ? "pass" : "fail");
-    EXPECT_EQ(r.noise->immunity_min_db, noise_immunity_min_db(n));
+    EXPECT_NEAR(r.noise->immunity_min_db, noise_immunity_min_db(n), 0.09);
     for (const NoiseDirection& d : n.directions) {
       const size_t k = d.direction == link::Direction::kDown ? 0 : 1;
-      EXPECT_EQ(r.noise->immunity_min[k], d.immunity_min) << "point " << i << " dir " << k;
+      EXPECT_NEAR(r.noise->immunity_min[k], d.immunity_min, 0.01 * d.immunity_min)
+          << "point " << i << " dir " << k;
       EXPECT_EQ(r.noise->freq_hz[k], d.immunity_min_freq) << "point " << i << " dir " << k;
-      EXPECT_NEAR(r.noise->immunity_min_db_dir[k], 20 * std::log10(d.immunity_min / 10e-3), 1e-9);
+      EXPECT_NEAR(r.noise->immunity_min_db_dir[k], 20 * std::log10(d.immunity_min / 10e-3), 0.09);
       EXPECT_GT(d.immunity_min, 0.0);
     }
     // The overall figure is the weaker direction's.
@@ -250,6 +258,60 @@ TEST(SweepSim, WorstColumnsEqualWorstCaseOnThePointsSpec) {
   }
 }
 
+// The path column: the fast path by default, with waveform files on its grid too (the same
+// columns as a simulation's, within the LTI engine's 1 mV output grid of it); simulated, saying
+// why, with --simulate, waveform files at a step off the synthesis grid, and traffic off it.
+TEST(SweepSim, PathSaysHowEachPointWasObtained) {
+  StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
+  ASSERT_TRUE(parts.ok()) << parts.status().message();
+  const std::string dir = temp_dir("path");
+  write(dir + "/link.yaml", cap_link(1));
+  auto point = [&](const std::string& extra, const PointOptions& opt) {
+    StatusOr<SweepSpec> s = read_sweep_text(
+        "base: link.yaml\nsweep:\n  cable.length: [1]\n" + extra, dir + "/sweep.yaml");
+    EXPECT_TRUE(s.ok()) << s.status().message();
+    return s.ok() ? run_point(*s, *parts, 0, opt) : PointResult{};
+  };
+  fs::create_directories(dir + "/fast");
+  fs::create_directories(dir + "/sim");
+  const PointResult fast = point("", {.waves_dir = dir + "/fast"});
+  EXPECT_EQ(fast.path, "edges") << fast.error;
+  const PointResult sim = point("", {.waves_dir = dir + "/sim", .simulate = true});
+  EXPECT_EQ(sim.path, "simulated: --simulate") << sim.error;
+  EXPECT_EQ(fast.verdict, sim.verdict);
+  EXPECT_NEAR(fast.margin[0], sim.margin[0], 1e-3);
+  EXPECT_NEAR(fast.margin[2], sim.margin[2], 25e-12);
+  const Csv a = read_csv(dir + "/fast/point_00000.csv");
+  const Csv b = read_csv(dir + "/sim/point_00000.csv");
+  EXPECT_EQ(a.header, b.header);
+  ASSERT_EQ(a.header.size(), 5u);  // time and the four probes of the direction
+  double worst = 0;
+  for (size_t i = 0; i < std::min(a.rows.size(), b.rows.size()); ++i) {
+    EXPECT_NEAR(std::stod(a.rows[i][0]), std::stod(b.rows[i][0]), 1e-12);
+    for (size_t c = 1; c <= 3; ++c)  // the receiver's probes (v(txp,txn) is only plotted)
+      worst = std::max(worst, std::abs(std::stod(a.rows[i][c]) - std::stod(b.rows[i][c])));
+  }
+  EXPECT_LT(worst, 1e-3);
+  EXPECT_GT(a.rows.size(), 1000u);
+  EXPECT_EQ(a.rows.size(), b.rows.size());
+
+  write(dir + "/link.yaml", cap_link(1) + "sim: {tstep: 0.3n}\n");
+  EXPECT_EQ(point("", {.waves_dir = dir + "/sim"}).path,
+            "simulated: waveform files at sim.tstep 0.3 ns (not a multiple of the 0.25 ns grid of "
+            "the edge response)");
+  EXPECT_EQ(point("", {}).path, "edges");  // no files: the step does not matter
+  std::string off = cap_link(1);
+  off.replace(off.find("], direction"), 1, "], gaps: [1.0001u]");
+  write(dir + "/link.yaml", off);
+  const PointResult off_grid = point("", {});
+  EXPECT_EQ(off_grid.path,
+            "simulated: down: the drive changes level at 1.0001 us (off the 0.25 ns grid of the "
+            "edge response)")
+      << off_grid.error;
+  EXPECT_EQ(point("", {.run = {.engine = Engine::Transient}}).path,
+            "simulated: --engine transient");
+}
+
 TEST(SweepSim, AFailingPointIsRecordedAndTheSweepGoesOn) {
   const std::string dir = temp_dir("error");
   write(dir + "/sweep.yaml", R"(base:
@@ -288,8 +350,8 @@ TEST(SweepSim, ResumeSkipsThePointsAlreadyDone) {
   // Point 0 "done" by an earlier run (made-up numbers: a re-run would replace them).
   const std::string header =
       "point,cable.length,verdict,worst_metric,worst_margin_rel,margin_vstart_V,margin_vend_V,"
-      "margin_width_ns,margin_edge_ns,decoded_ok,fail_reason,seconds,error\n";
-  const std::string done = "0,1,pass,vstart,0.5,0.8,0.6,30,40,true,,99.00,\n";
+      "margin_width_ns,margin_edge_ns,decoded_ok,fail_reason,seconds,error,path\n";
+  const std::string done = "0,1,pass,vstart,0.5,0.8,0.6,30,40,true,,99.00,,edges\n";
   write(dir + "/out/results.csv", header + done);
   const int rc = run(kBinary + " sweep " + dir + "/sweep.yaml -o " + dir +
                      "/out --resume --keep-waves > " + dir + "/stdout 2> " + dir + "/stderr");
