@@ -41,7 +41,8 @@ std::vector<std::string> link_specs() {
   return out;
 }
 
-const std::vector<std::string> kLinkSpecs = {"bench/links/xfmr_12m_two_frames.yaml",
+const std::vector<std::string> kLinkSpecs = {"bench/links/bridge_xfmr_12m_two_frames.yaml",
+                                             "bench/links/xfmr_12m_two_frames.yaml",
                                              "bench/links/xfmr_20m.yaml",
                                              "bench/links/xfmr_40m.yaml",
                                              "netlists/examples/bq79606a_cap_2m.yaml",
