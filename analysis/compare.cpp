@@ -167,11 +167,45 @@ std::vector<size_t> window_samples(const std::vector<double>& t,
   return idx;
 }
 
-Residual residual_of(std::span<const double> c, std::span<const double> s) {
+// A scope's ADC clips at the ends of its range: every sample beyond lands on the end value, so
+// the record holds far more samples exactly on its extreme than on the levels just inside it
+// (a peak that is not cut holds fewer: it only touches its top). The record's maximum (minimum)
+// is taken as a rail when at least 16 samples sit exactly on it and 3 times as many as in either
+// of the two bins next to it, a bin being the quantisation step q (1/256 of the record's span
+// when it is not quantised). A peak cut only slightly does not meet this; it is then compared as
+// it is, which can only make compare stricter.
+Clipping find_clipping(const std::vector<double>& v, double q) {
+  Clipping c;
+  if (v.size() < 64) return c;
+  const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+  const double w = q > 0 ? q : (*hi - *lo) / 256;
+  if (!(w > 0)) return c;
+  auto is_rail = [&](double rail, double inward) {
+    size_t on = 0, bin1 = 0, bin2 = 0;
+    for (double x : v) {
+      const double k = (x - rail) * inward / w;  // bins inward from the rail
+      if (x == rail)
+        ++on;
+      else if (k >= 0.5 && k < 1.5)
+        ++bin1;
+      else if (k >= 1.5 && k < 2.5)
+        ++bin2;
+    }
+    return on >= 16 && on >= 3 * std::max(bin1, bin2);
+  };
+  if (is_rail(*hi, -1.0)) c.high_v = *hi;
+  if (is_rail(*lo, 1.0)) c.low_v = *lo;
+  for (double x : v)
+    if ((c.high_v && x == *c.high_v) || (c.low_v && x == *c.low_v)) ++c.samples;
+  return c;
+}
+
+Residual residual_of(std::span<const double> c, std::span<const double> s, const Clipping& clip) {
   Residual r;
   double sse = 0;
   for (size_t i = 0; i < c.size(); ++i) {
-    const double d = c[i] - s[i];
+    const double d = clip.difference(c[i], s[i]);
+    if (d == 0 && c[i] != s[i]) ++r.clipped;
     sse += d * d;
     r.max_v = std::max(r.max_v, std::abs(d));
   }
@@ -193,7 +227,8 @@ double first_edge(std::span<const double> t, std::span<const double> v) {
 // Alignment: squared error over integer lags of a 1 ns grid within +/-range of offset0, then a
 // golden-section search of the continuous offset over +/-1.5 grid steps of the best lag.
 double align(const EdgeResponse& e, const cd::EdgeList& edges, std::span<const double> ts,
-             std::span<const double> vs, double offset0, double before, double after) {
+             std::span<const double> vs, double offset0, double before, double after,
+             const Clipping& clip) {
   const double dt = 1e-9;
   // The capture on the grid offset0 + k dt inside its sample span.
   std::vector<double> cg, tg;
@@ -224,7 +259,7 @@ double align(const EdgeResponse& e, const cd::EdgeList& edges, std::span<const d
     double sse = 0;
     for (size_t j = 0; j < tg.size() && sse < best; ++j) {
       const long k = static_cast<long>(std::llround((tg[j] - tg.front()) / dt)) + la - lag;
-      const double d = cg[j] - sg[static_cast<size_t>(k)];
+      const double d = clip.difference(cg[j], sg[static_cast<size_t>(k)]);
       sse += d * d;
     }
     if (sse < best) {
@@ -236,7 +271,10 @@ double align(const EdgeResponse& e, const cd::EdgeList& edges, std::span<const d
   auto cost = [&](double off) {
     cd::synth_at(e, edges, off, ts, out);
     double sse = 0;
-    for (size_t i = 0; i < ts.size(); ++i) sse += (vs[i] - out[i]) * (vs[i] - out[i]);
+    for (size_t i = 0; i < ts.size(); ++i) {
+      const double d = clip.difference(vs[i], out[i]);
+      sse += d * d;
+    }
     return sse;
   };
   const double g = (std::sqrt(5.0) - 1) / 2;
@@ -413,6 +451,7 @@ StatusOr<CompareResult> compare_capture(const CompareInput& in, const link::Part
   r.check = std::move(*check);
   r.noise_rms_v = idle_noise(t, v, r.check);
   r.quant_step_v = quantisation_step(v);
+  r.clipping = find_clipping(v, r.quant_step_v);
   r.time = t;
   r.capture = v;
   if (no_pulses(r.check, v, r.noise_rms_v, r.quant_step_v)) {
@@ -457,7 +496,7 @@ StatusOr<CompareResult> compare_capture(const CompareInput& in, const link::Part
     r.reasons.push_back("the traffic's frames do not overlap the record");
     return r;
   }
-  r.offset_s = align(**e, *edges, ts, vs, offset0, before, after);
+  r.offset_s = align(**e, *edges, ts, vs, offset0, before, after, r.clipping);
   if (!decoded) {  // the windows follow the traffic: place them at the aligned offset
     r.windows = residual_windows(r.check, *edges, decoded, r.offset_s, t.front(), t.back());
     idx = window_samples(t, r.windows);
@@ -475,7 +514,7 @@ StatusOr<CompareResult> compare_capture(const CompareInput& in, const link::Part
   cd::synth_at(**e, *edges, r.offset_s, t, r.sim);
   std::vector<double> sw(ts.size());
   cd::synth_at(**e, *edges, r.offset_s, ts, sw);
-  r.residual = residual_of(vs, sw);
+  r.residual = residual_of(vs, sw, r.clipping);
   double peak = 0;
   for (double x : sw) peak = std::max(peak, std::abs(x));
   r.model_floor_v = opt.model_floor_rel * peak;
@@ -486,14 +525,14 @@ StatusOr<CompareResult> compare_capture(const CompareInput& in, const link::Part
 
   if (!opt.fit.empty()) {
     std::vector<double> fitted;
-    cd::FitData data{ts, vs, &*edges, r.offset_s};
+    cd::FitData data{ts, vs, &*edges, r.offset_s, &r.clipping};
     if (Status s = cd::run_fit(model, p->spec, parts, opt, data, r, fitted); !s.ok()) return s;
     StatusOr<std::shared_ptr<const EdgeResponse>> ef = model.response(opt.fit, fitted);
     if (!ef) return ef.status();
     r.sim_after_fit.resize(t.size());
     cd::synth_at(**ef, *edges, *r.offset_after_fit_s, t, r.sim_after_fit);
     cd::synth_at(**ef, *edges, *r.offset_after_fit_s, ts, sw);
-    r.residual_after_fit = residual_of(vs, sw);
+    r.residual_after_fit = residual_of(vs, sw, r.clipping);
     StatusOr<eye::CheckResult> sf = eye::check_samples(t, r.sim_after_fit, p->rules);
     if (sf) r.metrics_after_fit = metric_summaries(r.check, *sf);
   }

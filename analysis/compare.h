@@ -78,6 +78,22 @@ struct Residual {
   double rms_v = 0;
   double max_v = 0;
   size_t samples = 0;  // capture samples it is taken over
+  size_t clipped = 0;  // of those, not counted: the capture on a rail the design exceeds
+};
+
+// A scope clips at the ends of its vertical range: the record then sits on one value, noise-free,
+// for longer than it stays on any other value. Where the capture is on such a rail and the design
+// goes beyond it, the capture cannot show the difference, and it is not counted (residual 0 at
+// that sample); everywhere else, the rail included where the design stays inside it, it is.
+struct Clipping {
+  std::optional<double> high_v, low_v;  // the rails found (V)
+  size_t samples = 0;                   // capture samples on a rail (whole record)
+  // capture - simulation at one sample, 0 where the capture is on a rail the design exceeds.
+  double difference(double capture, double sim) const {
+    if (high_v && capture >= *high_v && sim > capture) return 0.0;
+    if (low_v && capture <= *low_v && sim < capture) return 0.0;
+    return capture - sim;
+  }
 };
 
 // One metric of one pulse, measured on the capture and on the simulation at the same pulse.
@@ -150,6 +166,7 @@ struct CompareResult {
   double model_floor_v = 0;    // model_floor_rel x peak |v| of the simulation
   double threshold_rms_v = 0;  // 3 noise + q / sqrt(12) + floor
   double threshold_max_v = 0;  // 6 noise + q + 5 floor
+  Clipping clipping;           // the capture's rails, if it clips
   std::vector<FitKey> fit;
   std::vector<std::string> unidentifiable;  // sentences about rank deficiency
   std::vector<Finding> findings;

@@ -346,7 +346,7 @@ Status run_fit(LinkModel& model, const link::LinkSpec& spec, const link::PartLib
     if (!e) return e.status();
     res.resize(t.size());
     synth_at(**e, *data.edges, data.offset + x[nk] * 1e-9, t, res);
-    for (size_t i = 0; i < t.size(); ++i) res[i] = v[i] - res[i];
+    for (size_t i = 0; i < t.size(); ++i) res[i] = data.clipping->difference(v[i], res[i]);
     return Status::Ok();
   };
   StatusOr<LsqResult> fit = fit_least_squares(f, t.size(), params, opt.max_iterations, opt.threads);

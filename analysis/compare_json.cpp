@@ -19,7 +19,31 @@ json num(double v) {
 }
 
 json residual_json(const Residual& r) {
-  return {{"rms_v", num(r.rms_v)}, {"max_v", num(r.max_v)}, {"samples", r.samples}};
+  return {{"rms_v", num(r.rms_v)},
+          {"max_v", num(r.max_v)},
+          {"samples", r.samples},
+          {"clipped", r.clipped}};
+}
+
+json clipping_json(const Clipping& c) {
+  json j = {{"high_v", nullptr}, {"low_v", nullptr}, {"samples", c.samples}};
+  if (c.high_v) j["high_v"] = num(*c.high_v);
+  if (c.low_v) j["low_v"] = num(*c.low_v);
+  return j;
+}
+
+// One sentence on a clipping capture, or "".
+std::string clipping_sentence(const CompareResult& r) {
+  const Clipping& c = r.clipping;
+  if (!c.high_v && !c.low_v) return "";
+  std::string rails;
+  if (c.low_v) rails = fmt::format("{:.4g} V", *c.low_v);
+  if (c.high_v) rails += fmt::format("{}{:+.4g} V", c.low_v ? " and " : "", *c.high_v);
+  return fmt::format(
+      "the capture clips at {} ({} samples on the rails): the scope's vertical range cut the "
+      "waveform, so where the design goes beyond a rail the difference is not counted ({} of the "
+      "residual's samples); widen the range to compare the peaks",
+      rails, c.samples, r.residual.clipped);
 }
 
 json metrics_json(const std::vector<MetricSummary>& ms) {
@@ -83,6 +107,7 @@ nlohmann::ordered_json compare_json(const CompareResult& r) {
                 {"model_floor_v", num(r.model_floor_v)},
                 {"threshold_rms_v", num(r.threshold_rms_v)},
                 {"threshold_max_v", num(r.threshold_max_v)}};
+  j["clipping"] = clipping_json(r.clipping);
   j["metrics"] = metrics_json(r.metrics);
   if (!r.metrics_after_fit.empty()) j["metrics_after_fit"] = metrics_json(r.metrics_after_fit);
   json windows = json::array();
@@ -115,6 +140,7 @@ std::string compare_text(const CompareResult& r) {
       "match needs rms <= {:.1f} mV and max <= {:.0f} mV\n",
       r.noise_rms_v * 1e3, r.quant_step_v * 1e3, r.model_floor_v * 1e3, r.threshold_rms_v * 1e3,
       r.threshold_max_v * 1e3);
+  if (const std::string c = clipping_sentence(r); !c.empty()) s += "  " + c + "\n";
   for (const MetricSummary& m : r.metrics)
     if (m.pulses)
       s += fmt::format("  {:<6} simulated - measured: mean {}, worst {} over {} pulses\n", m.metric,
@@ -157,6 +183,7 @@ std::string compare_markdown(const CompareResult& r) {
       "Capture noise {:.1f} mV rms (idle stretches), quantisation step {:.2f} mV, model floor "
       "{:.1f} mV; offset {:.4f} us (capture time minus drive time).\n\n",
       r.noise_rms_v * 1e3, r.quant_step_v * 1e3, r.model_floor_v * 1e3, r.offset_s * 1e6);
+  if (const std::string c = clipping_sentence(r); !c.empty()) s += "Note: " + c + ".\n\n";
   if (!r.fit.empty()) {
     s += "| key | fitted | stderr | design | bounds | tolerance | identifiable |\n";
     s += "|---|---|---|---|---|---|---|\n";

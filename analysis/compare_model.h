@@ -72,7 +72,8 @@ struct FitData {
   std::span<const double> t;  // residual samples (capture time)
   std::span<const double> v;  // capture at t
   const EdgeList* edges = nullptr;
-  double offset = 0;  // aligned offset before the fit
+  double offset = 0;                   // aligned offset before the fit
+  const Clipping* clipping = nullptr;  // the capture's rails (CompareResult::clipping)
 };
 Status run_fit(LinkModel& model, const link::LinkSpec& spec, const link::PartLibrary& parts,
                const CompareOptions& opt, const FitData& data, CompareResult& r,

@@ -193,6 +193,35 @@ TEST(Compare, NominalCaptureMatchesAndTheTriggerOffsetIsRecovered) {
   // The noise estimate: 10 mV per channel, the differential sqrt(2) x; quantised at 10 V / 256.
   EXPECT_NEAR(r.quant_step_v, 10.0 / 256, 1e-6);
   EXPECT_NEAR(r.noise_rms_v, 10e-3 * std::sqrt(2.0), 4e-3);
+  // Its peaks (about 4.5 V) stay inside the +/-5 V range: no rail.
+  EXPECT_FALSE(r.clipping.high_v || r.clipping.low_v) << compare_text(r);
+  EXPECT_EQ(r.residual.clipped, 0u);
+}
+
+// A scope range too small for the link: the ADC puts every sample beyond it on its end codes,
+// +3 V - q and -3 V (q = 6 V / 256). Those are found as rails, the design's excess over them is
+// not counted, and the nominal capture matches; the same scope on a link with five times the
+// series resistance (lower, slower pulses) stays a mismatch, and so does a narrower range that
+// cuts both captures to a third of their swing.
+TEST(Compare, ClippedCaptureMatchesWhereTheScopesRangeCutTheDesign) {
+  const std::string spec = write_spec("cap.yaml", kCapLink);
+  testing::ScopeModel scope;
+  scope.range_v = 3.0;
+  const double q = 6.0 / 256;
+  const CompareResult r = run(capture("clipped.csv", kCapLink, {}, scope), spec);
+  EXPECT_EQ(r.verdict, "match") << compare_text(r);
+  ASSERT_TRUE(r.clipping.high_v && r.clipping.low_v) << compare_text(r);
+  EXPECT_NEAR(*r.clipping.high_v, 3.0 - q, 1e-6);
+  EXPECT_NEAR(*r.clipping.low_v, -3.0, 1e-6);
+  EXPECT_GT(r.residual.clipped, 100u);
+  EXPECT_NE(compare_text(r).find("the capture clips at -3 V and +2.977 V"), std::string::npos)
+      << compare_text(r);
+  for (double range : {3.0, 1.5}) {
+    scope.range_v = range;
+    const CompareResult w =
+        run(capture("clipped_wrong.csv", kCapLink, {{"tx.series_r", "245", true}}, scope), spec);
+    EXPECT_EQ(w.verdict, "mismatch") << range << " V\n" << compare_text(w);
+  }
 }
 
 TEST(Compare, HalvedRxCapIsAMismatchAndTheFitFindsIt) {
