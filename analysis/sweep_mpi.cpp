@@ -49,13 +49,15 @@ void release_workers(int size) {
 }
 
 void worker(const SweepSpec& s, const link::PartLibrary& parts, const SweepOptions& opt) {
+  PointOptions popt = opt.point;  // each rank finds point 0's start points itself: the same
+  if (popt.start_points.empty()) popt.start_points = sweep_start_points(s, parts, popt);
   std::string row;  // empty: the first request
   for (;;) {
     MPI_Send(row.data(), static_cast<int>(row.size()), MPI_CHAR, 0, kTagResult, MPI_COMM_WORLD);
     long long index = -1;
     MPI_Recv(&index, 1, MPI_LONG_LONG, 0, kTagWork, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
     if (index < 0) return;
-    row = results_row(run_point(s, parts, static_cast<size_t>(index), opt.point));
+    row = results_row(run_point(s, parts, static_cast<size_t>(index), popt));
   }
 }
 

@@ -359,7 +359,34 @@ std::string fast_path_refused(const link::LinkSpec& spec, const PointOptions& op
   return "";
 }
 
+// The options of a point's edge responses: the run's expansion, the probes its noise analysis
+// and waveform files read, the sweep's start points.
+WorstOptions point_worst_options(const SweepSpec& s, const PointOptions& opt) {
+  WorstOptions wopt{.expand = opt.run.expand};
+  if (s.noise_outputs || !opt.waves_dir.empty())  // they read the pins (and the files the driver)
+    wopt.more_probes.assign(run_probes().begin() + 1, run_probes().end());
+  wopt.reduced_start_points_by_direction = opt.start_points;
+  return wopt;
+}
+
 }  // namespace
+
+std::map<link::Direction, std::vector<double>> sweep_start_points(const SweepSpec& s,
+                                                                  const link::PartLibrary& parts,
+                                                                  const PointOptions& opt) {
+  std::map<link::Direction, std::vector<double>> out;
+  PointOutcome po = make_point(s, 0);
+  if (!po.status.ok() || po.point.pack) return out;
+  WorstOptions fine = point_worst_options(s, opt);
+  fine.dt /= kSynthesisOversample;
+  if (!fast_path_refused(po.point.spec, opt, fine.dt).empty()) return out;
+  for (link::Direction d : po.point.spec.stimulus.directions) {
+    if (out.count(d)) continue;
+    StatusOr<EdgeResponse> e = edge_response(po.point.spec, parts, d, fine);
+    if (e && !e->expansion_points.empty()) out[d] = e->expansion_points;
+  }
+  return out;
+}
 
 nlohmann::ordered_json path_counts(const std::vector<PointResult>& results) {
   size_t edges = 0, simulated = 0;
@@ -421,11 +448,9 @@ PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t
     }
     // The fast path (analysis/README.md "The sweep's fast path"): each direction's edge
     // response gives the spec traffic's waveform and serves the worst case.
-    WorstOptions wopt{.expand = opt.run.expand};
+    const WorstOptions wopt = point_worst_options(s, opt);
     const std::string simulate_why =
         fast_path_refused(po.point.spec, opt, wopt.dt / kSynthesisOversample);
-    if (s.noise_outputs || !opt.waves_dir.empty())  // they read the pins (and the files the driver)
-      wopt.more_probes.assign(run_probes().begin() + 1, run_probes().end());
     std::vector<EdgeResponse> edges;
     StatusOr<LinkRun> run = simulate_why.empty()
                                 ? run_link_from_edges(po.point.spec, parts, opt.run, wopt, edges)
@@ -885,6 +910,8 @@ StatusOr<SweepOutcome> run_sweep(const SweepSpec& s, const link::PartLibrary& pa
   if (!log) return log.status();
   ResultLog& L = **log;
   const std::vector<size_t> todo = L.todo();
+  if (!todo.empty() && opt.point.start_points.empty())
+    opt.point.start_points = sweep_start_points(s, parts, opt.point);
   const int threads = opt.jobs > 0 ? opt.jobs : tbb::this_task_arena::max_concurrency();
   tbb::task_arena arena(threads);
   arena.initialize();  // loads oneTBB's allocator and thread-pool libraries

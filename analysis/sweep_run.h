@@ -74,6 +74,7 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -195,7 +196,17 @@ struct PointOptions {
   RunOptions run;
   std::string waves_dir;  // non-empty: write each point's waveforms there (--keep-waves)
   bool simulate = false;  // every point through run_link, off the fast path (--simulate)
+  // Hz, per direction: the expansion points that start every point's reduced model
+  // (WorstOptions::reduced_start_points_by_direction). run_sweep fills them in from point 0's
+  // edge responses before the first point, so they are the same for any thread count, across
+  // machines and on resume; each point's model still passes its full check.
+  std::map<link::Direction, std::vector<double>> start_points;
 };
+// PointOptions::start_points for a sweep: the expansion points of point 0's edge responses per
+// direction (empty where point 0 is a pack, an error, or off the fast path).
+std::map<link::Direction, std::vector<double>> sweep_start_points(const SweepSpec& s,
+                                                                  const link::PartLibrary& parts,
+                                                                  const PointOptions& opt);
 // Makes, runs and scores point `index`; never fails (errors become verdict "error").
 PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t index,
                       const PointOptions& opt);

@@ -527,7 +527,10 @@ StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::Par
     LtiOptions lo;
     lo.method = LtiOptions::Method::Reduced;
     lo.horizon = lead + opt.max_span;
-    lo.reduced.start_points = opt.reduced_start_points;
+    const auto by_direction = opt.reduced_start_points_by_direction.find(d);
+    lo.reduced.start_points = by_direction != opt.reduced_start_points_by_direction.end()
+                                  ? by_direction->second
+                                  : opt.reduced_start_points;
     if (opt.progress) opt.progress("edge response, reduced model", 0.0);
     StatusOr<LtiResponses> lti = LtiResponses::compute(circuit, *probes, lo);
     if (lti) {

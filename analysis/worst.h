@@ -37,6 +37,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -97,6 +98,9 @@ struct WorstOptions {
   // expansion_points of the same link with other part values (isolink compare's fit); the model
   // passes the same check either way.
   std::vector<double> reduced_start_points;
+  // The same per direction (a sweep's point 0, sweep::PointOptions::start_points): an entry for
+  // the direction of edge_response replaces reduced_start_points.
+  std::map<link::Direction, std::vector<double>> reduced_start_points_by_direction;
   double reltol = 1e-6;       // transient tolerance of the edge response
   double settle_tol = 20e-6;  // V: settled when a half bit's response stays below this
   double max_memory = 20e-6;  // s: longest memory searched; B there is reported as the bound

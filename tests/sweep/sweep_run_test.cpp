@@ -258,6 +258,39 @@ TEST(SweepSim, WorstColumnsEqualWorstCaseOnThePointsSpec) {
   }
 }
 
+// Every point's reduced model starts from point 0's expansion points, per direction: exactly
+// those of point 0's own edge response (so they do not depend on threads or on resume), and a
+// point started from them gives the margins of a point searched from scratch within the model's
+// accuracy (0.5 mV, 1 ps: both models pass the same check against the exact AC solution).
+TEST(SweepSim, EveryPointStartsFromPointZerosExpansionPoints) {
+  StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
+  ASSERT_TRUE(parts.ok()) << parts.status().message();
+  const std::string dir = temp_dir("start_points");
+  write(dir + "/link.yaml", cap_link(1));
+  StatusOr<SweepSpec> s =
+      read_sweep_text("base: link.yaml\nsweep:\n  cable.length: [1, 6]\n", dir + "/sweep.yaml");
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  const auto start = sweep_start_points(*s, *parts, {});
+  ASSERT_EQ(start.size(), 1u);
+  ASSERT_TRUE(start.count(link::Direction::kDown));
+  WorstOptions fine;
+  fine.dt /= kSynthesisOversample;
+  StatusOr<EdgeResponse> e0 =
+      edge_response(make_point(*s, 0).point.spec, *parts, link::Direction::kDown, fine);
+  ASSERT_TRUE(e0.ok()) << e0.status().message();
+  EXPECT_EQ(start.at(link::Direction::kDown), e0->expansion_points);
+  EXPECT_GE(e0->expansion_points.size(), 2u);
+  const PointResult scratch = run_point(*s, *parts, 1, {});
+  const PointResult warm = run_point(*s, *parts, 1, {.start_points = start});
+  ASSERT_EQ(scratch.path, "edges") << scratch.error;
+  ASSERT_EQ(warm.path, "edges") << warm.error;
+  EXPECT_EQ(warm.verdict, scratch.verdict);
+  EXPECT_NEAR(warm.margin[0], scratch.margin[0], 0.5e-3);
+  EXPECT_NEAR(warm.margin[1], scratch.margin[1], 0.5e-3);
+  EXPECT_NEAR(warm.margin[2], scratch.margin[2], 1e-12);
+  EXPECT_NEAR(warm.margin[3], scratch.margin[3], 1e-12);
+}
+
 // The path column: the fast path by default, with waveform files on its grid too (the same
 // columns as a simulation's, within the LTI engine's 1 mV output grid of it); simulated, saying
 // why, with --simulate, waveform files at a step off the synthesis grid, and traffic off it.
