@@ -3,10 +3,11 @@
 # directions, the exported netlist on `isolink sim --engine lti`, and whether the reduced model
 # passed its check (else the march ran, and its note says why).
 #   bash bench/lti_corpus.sh [FIRST] [LAST] [SEED]    # defaults 0 299 1; prints a line per direction
+# (ISOLINK=PATH runs another binary than build/cli/isolink)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 first=${1:-0} last=${2:-299} seed=${3:-1}
-bin=build/cli/isolink
+bin=${ISOLINK:-build/cli/isolink}  # ISOLINK=PATH: another binary
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 python3 tools/link_corpus.py --seed "$seed" --first "$first" --count $((last - first + 1)) \

@@ -1,13 +1,15 @@
 #!/usr/bin/env python3
 """The random link corpus (tools/link_corpus.py) on the LTI engine's reduced model (issue 28).
 
-    python3 lti_corpus_test.py ISOLINK_BINARY SOURCE_DIR WORK_DIR SEED FIRST COUNT TOL_MV
+    python3 lti_corpus_test.py ISOLINK_BINARY SOURCE_DIR WORK_DIR SEED FIRST COUNT TOL_MV [TSTOP]
 
 For specs FIRST..FIRST+COUNT-1 of the corpus drawn with SEED, in both directions: the exported
 netlist through `isolink sim --engine lti` must take the reduced model (no march: its stderr says
 "LTI engine, reduced model"), and its v(rxp,rxn) must agree with `isolink sim --engine transient
 --reltol 1e-6` within TOL_MV at every LTI row (the transient's rows, its accepted steps at
-reltol 1e-6, linearly interpolated between).
+reltol 1e-6, linearly interpolated between). With TSTOP (e.g. 20u) both runs stop there
+(`--tstop`): the first frame and its ringing, at a fraction of the reference's cost (the
+transient's steps grow with the time simulated, the reduced model's cost does not).
 Exit 0 when every direction passes, 1 otherwise (each failure named).
 """
 import bisect
@@ -19,6 +21,7 @@ import time
 
 isolink, source, work = (os.path.abspath(a) for a in sys.argv[1:4])
 seed, first, count, tol_mv = int(sys.argv[4]), int(sys.argv[5]), int(sys.argv[6]), float(sys.argv[7])
+window = ["--tstop", sys.argv[8]] if len(sys.argv) > 8 else []
 os.makedirs(work, exist_ok=True)
 subprocess.run([sys.executable, os.path.join(source, "tools", "link_corpus.py"), "--seed",
                 str(seed), "--first", str(first), "--count", str(count), "--out", work], check=True)
@@ -32,7 +35,7 @@ def load(path):
 
 def sim(netlist, out, *args):
     start = time.monotonic()
-    r = subprocess.run([isolink, "sim", netlist, "-p", "v(rxp,rxn)", "-o", out, *args],
+    r = subprocess.run([isolink, "sim", netlist, "-p", "v(rxp,rxn)", "-o", out, *window, *args],
                        capture_output=True, text=True)
     return r, time.monotonic() - start
 
