@@ -62,6 +62,23 @@ std::string engine_accuracy(const SimulationResult& r) {
         "100 m link); linear interpolation between rows within 1 mV",
         lo.step_reltol, lo.step_abstol);
   }
+  if (r.convergence && !r.convergence->deviations.empty()) {
+    const TransientConvergence& c = *r.convergence;
+    return fmt::format(
+        "transient, checked by tightening (auto's fallback): reltol {:g} -> {:g} and largest "
+        "step {:g} -> {:g} s in {} runs; the kept run is {:.3g} m from the run before it (V or "
+        "A, the probe nearest its allowance){}",
+        c.reltols.front(), c.reltols.back(), c.tmaxes.front(), c.tmaxes.back(), c.reltols.size(),
+        1e3 * c.deviations.back(),
+        c.agreed ? fmt::format(", within its allowance of {:.3g} m (5 mV or 0.1 % of the "
+                               "probe's peak): converged to about that, as the error shrinks at "
+                               "least twofold per round",
+                               1e3 * c.allowed.back())
+                 : fmt::format(", NOT within its allowance of {:.3g} m: the tightening stopped "
+                               "at reltol {:g} or at the step limit; treat small differences "
+                               "with care",
+                               1e3 * c.allowed.back(), c.reltols.back()));
+  }
   return fmt::format(
       "transient: local truncation error per step within trtol x reltol = {:.2g} of each "
       "unknown's peak (reltol {:g}); a local bound, not a global one: at reltol 1e-3 the links "
@@ -269,6 +286,15 @@ StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequ
         fmt::format("{} ({} steps: {} rows of {} values are what the 1 GB memory limit allows)",
                     wave.status().message(), opt.max_steps, opt.max_steps, probes.size() + 1));
   if (!wave) return wave.status();
+  if (req.engine == Engine::Auto && !result.engine_note.empty() && !req.reltol) {
+    // auto fell back: the run checks its own convergence (transient_check.h).
+    TransientConvergence conv;
+    wave = converge_transient(circuit, opt, probes, std::move(*wave), &result.stats, &conv);
+    result.reltol = conv.reltols.back();
+    result.convergence = std::move(conv);
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
   result.wave = std::move(*wave);
   result.engine = Engine::Transient;
   return result;

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "analysis/transient_check.h"
 #include "base/waveform.h"
 #include "netlists/spice_reader.h"
 #include "solver/lti.h"
@@ -87,6 +88,9 @@ struct SimulationResult {
   // `seconds`); 0 when it did not.
   double lti_attempt_seconds = 0.0;
   double reltol = 0.0, trtol = 0.0;  // the transient's tolerances (engine transient)
+  // auto's transient fallback: the runs at ever tighter reltol until two agree
+  // (transient_check.h); reltol above is the kept run's. Empty otherwise.
+  std::optional<TransientConvergence> convergence;
 };
 
 // The accuracy the engine that produced `r` promises, one sentence with its figures, for the

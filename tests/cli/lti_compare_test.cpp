@@ -149,6 +149,71 @@ TEST(LtiEngineChoice, AutoFallsBackOnSinAndLtiRefusesNamingTheSource) {
       << forced.status().message();
 }
 
+// auto's transient fallback tightens itself (analysis/transient_check.h). A series RLC from rest
+// (`uic`, which the LTI engine cannot take): 5 V through 1 ohm, 1 uH, 1 nF, Q = 31.6, ringing
+// for 100 periods. Closed form v(c) = 5 (1 - e^(-a t) (cos(wd t) + a / wd sin(wd t))),
+// a = R / 2L, wd = sqrt(1 / LC - a^2). At the default reltol 1e-3 the transient is more than
+// 5 mV off it (its phase drifts over the periods; 9.7 mV); auto's run tightens reltol and the
+// step until two runs agree within the allowance (0.1 % of the 9.8 V peak) and is then within it
+// of the closed form at every row, and at most half the plain run's error.
+TEST(LtiEngineChoice, AutoTransientFallbackTightensUntilTwoRunsAgree) {
+  const std::string path = ::testing::TempDir() + "/rlc_uic.cir";
+  std::ofstream(path) << "rlc\nV1 in 0 DC 5\nR1 in a 1\nL1 a c 1u\nC1 c 0 1n\n"
+                         ".tran 1n 20u uic\n.end\n";
+  auto netlist = read_spice_file(path);
+  ASSERT_TRUE(netlist.ok()) << netlist.status().message();
+  const double a = 1.0 / (2 * 1e-6), wd = std::sqrt(1.0 / (1e-6 * 1e-9) - a * a);
+  auto worst = [&](const Waveform& w) {
+    double e = 0;
+    for (size_t i = 0; i < w.samples(); ++i) {
+      const double t = w.time[i];
+      const double v = 5 * (1 - std::exp(-a * t) * (std::cos(wd * t) + a / wd * std::sin(wd * t)));
+      e = std::max(e, std::abs(w.columns[0][i] - v));
+    }
+    return e;
+  };
+  analysis::SimulationRequest req{.probes = {"v(c)"}, .engine = analysis::Engine::Transient};
+  auto plain = analysis::simulate_netlist(*netlist, req);
+  ASSERT_TRUE(plain.ok()) << plain.status().message();
+  EXPECT_FALSE(plain->convergence);  // asked for: no tightening
+  EXPECT_GT(worst(plain->wave), 5e-3);
+  req.engine = analysis::Engine::Auto;
+  auto r = analysis::simulate_netlist(*netlist, req);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_EQ(r->engine, analysis::Engine::Transient);
+  EXPECT_NE(r->engine_note.find("uic"), std::string::npos) << r->engine_note;
+  ASSERT_TRUE(r->convergence);
+  const analysis::TransientConvergence& c = *r->convergence;
+  EXPECT_TRUE(c.agreed);
+  ASSERT_GE(c.reltols.size(), 2u);
+  EXPECT_DOUBLE_EQ(c.reltols.front(), 1e-3);
+  EXPECT_NEAR(c.reltols.back(), r->reltol, 1e-18);
+  double peak = 0;
+  for (double v : r->wave.columns[0]) peak = std::max(peak, std::abs(v));
+  EXPECT_NEAR(c.allowed.back(), 1e-3 * peak, 1e-9);  // 0.1 % of the 9.8 V peak, over 5 mV
+  EXPECT_LE(c.deviations.back(), c.allowed.back());
+  EXPECT_LE(worst(r->wave), c.allowed.back());  // the promise
+  EXPECT_LT(worst(r->wave), 0.5 * worst(plain->wave));
+  EXPECT_NE(analysis::engine_accuracy(*r).find("checked by tightening"), std::string::npos);
+  // --reltol given: the user's tolerance, not tightened.
+  req.reltol = 1e-3;
+  auto given = analysis::simulate_netlist(*netlist, req);
+  ASSERT_TRUE(given.ok());
+  EXPECT_FALSE(given->convergence);
+}
+
+// max_deviation interpolates the coarse run linearly at the fine run's times: by hand, the ramp
+// 0, 1, 2 at t = 0, 1, 2 against 0, 0.6, 1.5 at t = 0, 0.5, 1.5 is 0.1 off (at t = 0.5).
+TEST(LtiEngineChoice, MaxDeviationInterpolatesTheCoarseRun) {
+  Waveform coarse, fine;
+  coarse.time = {0, 1, 2};
+  coarse.add_column("v", {0, 1, 2});
+  fine.time = {0, 0.5, 1.5};
+  fine.add_column("v", {0, 0.6, 1.5});
+  EXPECT_NEAR(analysis::max_deviation(coarse, fine), 0.1, 1e-12);
+  EXPECT_EQ(analysis::max_deviation(Waveform{}, fine), 0.0);
+}
+
 // With the march (the reduced model's fallback), auto takes the LTI engine when the responses
 // settle early in the run, and the transient when they do not settle within a quarter of it (the
 // march would then cost more than the transient). The reduced model needs no settling: auto
