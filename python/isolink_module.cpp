@@ -46,6 +46,7 @@
 #include "netlists/link/parts.h"
 #include "python/convert.h"
 #include "python/docstrings.h"
+#include "reports/compare_report.h"
 #include "reports/noise_report.h"
 #include "reports/pack_report.h"
 #include "reports/run_report.h"
@@ -383,7 +384,7 @@ py::dict compare(const std::vector<std::string>& capture, const std::string& spe
               : StatusOr<analysis::CompareResult>(parts.status());
   }
   if (!r) raise(r.status());
-  return to_python(analysis::compare_json(*r));
+  return to_python(reports::compare_json(*r));
 }
 
 py::object load_spec(const py::object& spec_obj) {
