@@ -262,114 +262,95 @@ bool parse_percent(const std::string& text, double* out) {
   return true;
 }
 
-Status read_axis(const SweepSpec& s, const YamlDoc& doc, const YAML::Node& key_node,
-                 const YAML::Node& v, Axis* axis) {
-  const std::string key = key_node.Scalar();
-  axis->key = key;
-  axis->line = doc.loc(key_node).line;
-  const std::vector<std::string> paths = expand_ends(key);
-  axis->unit = key_unit(key);
-
-  auto add_value = [&](const YAML::Node& n) -> Status {
-    AxisValue av;
-    av.line = doc.loc(n).line;
-    av.assign = assignments(paths, n);
-    std::string shown = n.IsScalar() ? "'" + n.Scalar() + "'" : "<" + config::node_kind(n) + ">";
-    if (n.IsScalar()) {
-      double x = 0;
-      if (parse_number_for(key, n.Scalar(), &x)) {
-        av.number = x;
-        av.label = num_text(x);
-      } else {
-        av.label = n.Scalar();
-      }
-    } else {
-      YAML::Emitter em;
-      em << YAML::Flow << n;
-      av.label = em.c_str();
-    }
-    if (Status st = check_value(s, doc, key, av.assign, key_node, n, shown); !st.ok()) return st;
-    axis->values.push_back(std::move(av));
-    return Status::Ok();
-  };
-
-  if (v.IsSequence()) {
-    if (v.size() == 0) return doc.error(v, fmt::format("sweep key '{}': the list is empty", key));
-    for (size_t i = 0; i < v.size(); ++i)
-      if (Status st = add_value(v[i]); !st.ok()) return st;
-    return Status::Ok();
-  }
-  if (v.IsScalar()) return add_value(v);
-  if (!v.IsMap())
-    return doc.error(key_node, fmt::format("sweep key '{}' has no values: give a list, a range "
-                                           "{{from, to, steps, scale}} or named variants",
-                                           key));
-  if (v["from"] || v["to"] || v["steps"]) {
-    // A range.
-    std::string from_text, to_text, scale = "lin";
-    int steps = 0;
-    Status st = config::read_map(
-        doc, v, "sweep." + key,
-        {
-            {"from", config::read_text(doc, &from_text)},
-            {"to", config::read_text(doc, &to_text)},
-            {"steps",
-             [&](const YAML::Node& n, const std::string& p) -> Status {
-               const std::string t = n.IsScalar() ? n.Scalar() : "";
-               char* end = nullptr;
-               const long x = std::strtol(t.c_str(), &end, 10);
-               if (t.empty() || *end != '\0' || x < 1 || x > 100000)
-                 return doc.error(n, fmt::format("key '{}': steps must be a whole number from 1 "
-                                                 "to 100000, found '{}'",
-                                                 p, config::node_text(n)));
-               steps = static_cast<int>(x);
-               return Status::Ok();
-             }},
-            {"scale", config::read_choice(doc, {"lin", "log"}, &scale)},
-        });
-    if (!st.ok()) return st;
-    for (const char* k : {"from", "to", "steps"})
-      if (!v[k])
-        return doc.error(v, fmt::format("sweep key '{}': a range needs from, to and steps "
-                                        "(missing '{}')",
-                                        key, k));
-    double from = 0, to = 0;
-    if (!parse_number_for(key, from_text, &from))
-      return doc.error(v["from"],
-                       fmt::format("sweep key '{}': from: expected a number{}, found "
-                                   "'{}'",
-                                   key,
-                                   axis->unit == Unit::kNone
-                                       ? ""
-                                       : fmt::format(" in {}", config::unit_symbol(axis->unit)),
-                                   from_text));
-    if (!parse_number_for(key, to_text, &to))
-      return doc.error(v["to"],
-                       fmt::format("sweep key '{}': to: expected a number{}, found '{}'", key,
-                                   axis->unit == Unit::kNone
-                                       ? ""
-                                       : fmt::format(" in {}", config::unit_symbol(axis->unit)),
-                                   to_text));
-    axis->log = scale == "log";
-    if (axis->log && (from <= 0 || to <= 0))
-      return doc.error(v["scale"] ? v["scale"] : v,
-                       fmt::format("sweep key '{}': a log range needs from and to > 0 (from {}, "
-                                   "to {})",
-                                   key, from_text, to_text));
-    for (double x : range_values(from, to, steps, axis->log)) {
-      AxisValue av;
+// One listed value of a swept key (a scalar, or a map or list given as it is).
+Status add_listed_value(const SweepSpec& s, const YamlDoc& doc, const YAML::Node& key_node,
+                        const std::vector<std::string>& paths, const YAML::Node& n, Axis* axis) {
+  const std::string& key = axis->key;
+  AxisValue av;
+  av.line = doc.loc(n).line;
+  av.assign = assignments(paths, n);
+  std::string shown = n.IsScalar() ? "'" + n.Scalar() + "'" : "<" + config::node_kind(n) + ">";
+  if (n.IsScalar()) {
+    double x = 0;
+    if (parse_number_for(key, n.Scalar(), &x)) {
       av.number = x;
       av.label = num_text(x);
-      const std::string text =
-          is_integer_key(key) ? fmt::format("{}", std::lround(x)) : num_text(x);
-      YAML::Node n(text);
-      av.assign = assignments(paths, n);
-      if (Status e = check_value(s, doc, key, av.assign, key_node, v, text); !e.ok()) return e;
-      axis->values.push_back(std::move(av));
+    } else {
+      av.label = n.Scalar();
     }
-    return Status::Ok();
+  } else {
+    YAML::Emitter em;
+    em << YAML::Flow << n;
+    av.label = em.c_str();
   }
-  // Named variants: NAME: {dotted.key: value, ...}.
+  if (Status st = check_value(s, doc, key, av.assign, key_node, n, shown); !st.ok()) return st;
+  axis->values.push_back(std::move(av));
+  return Status::Ok();
+}
+
+// A range {from, to, steps, scale}: steps values, linear or logarithmic.
+Status read_range(const SweepSpec& s, const YamlDoc& doc, const YAML::Node& key_node,
+                  const std::vector<std::string>& paths, const YAML::Node& v, Axis* axis) {
+  const std::string& key = axis->key;
+  std::string from_text, to_text, scale = "lin";
+  int steps = 0;
+  Status st = config::read_map(
+      doc, v, "sweep." + key,
+      {
+          {"from", config::read_text(doc, &from_text)},
+          {"to", config::read_text(doc, &to_text)},
+          {"steps",
+           [&](const YAML::Node& n, const std::string& p) -> Status {
+             const std::string t = n.IsScalar() ? n.Scalar() : "";
+             char* end = nullptr;
+             const long x = std::strtol(t.c_str(), &end, 10);
+             if (t.empty() || *end != '\0' || x < 1 || x > 100000)
+               return doc.error(n, fmt::format("key '{}': steps must be a whole number from 1 "
+                                               "to 100000, found '{}'",
+                                               p, config::node_text(n)));
+             steps = static_cast<int>(x);
+             return Status::Ok();
+           }},
+          {"scale", config::read_choice(doc, {"lin", "log"}, &scale)},
+      });
+  if (!st.ok()) return st;
+  for (const char* k : {"from", "to", "steps"})
+    if (!v[k])
+      return doc.error(v, fmt::format("sweep key '{}': a range needs from, to and steps "
+                                      "(missing '{}')",
+                                      key, k));
+  const std::string in_unit =
+      axis->unit == Unit::kNone ? "" : fmt::format(" in {}", config::unit_symbol(axis->unit));
+  double from = 0, to = 0;
+  if (!parse_number_for(key, from_text, &from))
+    return doc.error(v["from"], fmt::format("sweep key '{}': from: expected a number{}, found "
+                                            "'{}'",
+                                            key, in_unit, from_text));
+  if (!parse_number_for(key, to_text, &to))
+    return doc.error(v["to"], fmt::format("sweep key '{}': to: expected a number{}, found '{}'",
+                                          key, in_unit, to_text));
+  axis->log = scale == "log";
+  if (axis->log && (from <= 0 || to <= 0))
+    return doc.error(v["scale"] ? v["scale"] : v,
+                     fmt::format("sweep key '{}': a log range needs from and to > 0 (from {}, "
+                                 "to {})",
+                                 key, from_text, to_text));
+  for (double x : range_values(from, to, steps, axis->log)) {
+    AxisValue av;
+    av.number = x;
+    av.label = num_text(x);
+    const std::string text = is_integer_key(key) ? fmt::format("{}", std::lround(x)) : num_text(x);
+    YAML::Node n(text);
+    av.assign = assignments(paths, n);
+    if (Status e = check_value(s, doc, key, av.assign, key_node, v, text); !e.ok()) return e;
+    axis->values.push_back(std::move(av));
+  }
+  return Status::Ok();
+}
+
+// Named variants: NAME: {dotted.key: value, ...}.
+Status read_variants(const SweepSpec& s, const YamlDoc& doc, const YAML::Node& v, Axis* axis) {
+  const std::string& key = axis->key;
   axis->variants = true;
   axis->unit = Unit::kNone;
   for (auto it = v.begin(); it != v.end(); ++it) {
@@ -398,6 +379,28 @@ Status read_axis(const SweepSpec& s, const YamlDoc& doc, const YAML::Node& key_n
     axis->values.push_back(std::move(av));
   }
   return Status::Ok();
+}
+
+Status read_axis(const SweepSpec& s, const YamlDoc& doc, const YAML::Node& key_node,
+                 const YAML::Node& v, Axis* axis) {
+  const std::string key = key_node.Scalar();
+  axis->key = key;
+  axis->line = doc.loc(key_node).line;
+  const std::vector<std::string> paths = expand_ends(key);
+  axis->unit = key_unit(key);
+  if (v.IsSequence()) {
+    if (v.size() == 0) return doc.error(v, fmt::format("sweep key '{}': the list is empty", key));
+    for (size_t i = 0; i < v.size(); ++i)
+      if (Status st = add_listed_value(s, doc, key_node, paths, v[i], axis); !st.ok()) return st;
+    return Status::Ok();
+  }
+  if (v.IsScalar()) return add_listed_value(s, doc, key_node, paths, v, axis);
+  if (!v.IsMap())
+    return doc.error(key_node, fmt::format("sweep key '{}' has no values: give a list, a range "
+                                           "{{from, to, steps, scale}} or named variants",
+                                           key));
+  if (v["from"] || v["to"] || v["steps"]) return read_range(s, doc, key_node, paths, v, axis);
+  return read_variants(s, doc, v, axis);
 }
 
 Status read_tolerance(const SweepSpec& s, const YamlDoc& doc, const link::LinkSpec& base,

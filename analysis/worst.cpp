@@ -459,112 +459,146 @@ EdgeResponse coarsened(const EdgeResponse& e, int k, const WorstOptions& opt) {
   return out;
 }
 
-StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::PartLibrary& parts,
-                                     link::Direction d, const WorstOptions& opt) {
-  const auto start = std::chrono::steady_clock::now();
-  EdgeResponse out;
-  out.dt = opt.dt;
-  out.pre = to_samples(50e-9, opt.dt);
-  const double lead = kLead;
-  const long half = to_samples(opt.expand.stimulus.encoding.half_bit, opt.dt);
+namespace {
+
+// One direction's edge response (EdgeResponse): the link driven by one 0 -> +1 edge at kLead,
+// sampled from the reduced model in closed form (EdgeEngine::Auto) or from tight transients, on
+// longer records until it settles.
+class EdgeResponseBuilder {
+ public:
+  EdgeResponseBuilder(const link::LinkSpec& spec, const link::PartLibrary& parts, link::Direction d,
+                      const WorstOptions& opt, EdgeResponse& out)
+      : spec_(spec),
+        parts_(parts),
+        d_(d),
+        opt_(opt),
+        out_(out),
+        half_(to_samples(opt.expand.stimulus.encoding.half_bit, opt.dt)) {
+    out_.dt = opt.dt;
+    out_.pre = to_samples(50e-9, opt.dt);
+    out_.more.assign(opt.more_probes.size(), {});
+    for (size_t i = 0; i < out_.more.size(); ++i) out_.more[i].probe = opt.more_probes[i];
+  }
+
+  // The reduced model: one model, sampled on longer records until settled. *done false (and
+  // out.engine_note why) when the model cannot be made: the transient takes over.
+  Status from_reduced_model(bool* done);
+  // Transients of longer records until the response settles.
+  Status from_transients();
+
+ private:
   // Settling of a sampled record (see EdgeResponse): true when it has settled.
-  auto settled = [&](double span) {
-    out.span = span;
-    measure_settling(out, half);
-    return out.drift <= opt.settle_tol;
-  };
-  auto unsettled = [&](const std::string& what, double span) {
+  bool settled(double span) {
+    out_.span = span;
+    measure_settling(out_, half_);
+    return out_.drift <= opt_.settle_tol;
+  }
+  Status unsettled(const std::string& what, double span) const {
     return Status::Error(fmt::format(
         "{}: the edge response has not settled {:g} us after the edge (a half bit's response is "
         "still {:.1f} uV, more than {:.1f} uV): the link's memory is too long for the "
         "worst-case search",
-        what, span * 1e6, out.drift * 1e6, opt.settle_tol * 1e6));
-  };
-  auto finite = [&](const std::string& what) {
-    for (double x : out.e)
+        what, span * 1e6, out_.drift * 1e6, opt_.settle_tol * 1e6));
+  }
+  Status finite(const std::string& what) const {
+    for (double x : out_.e)
       if (!std::isfinite(x)) return Status::Error(what + ": the edge response is not finite");
-    for (const EdgeResponse::Column& c : out.more)
+    for (const EdgeResponse::Column& c : out_.more)
       for (double x : c.e)
         if (!std::isfinite(x))
           return Status::Error(what + ": the edge response of " + c.probe + " is not finite");
     return Status::Ok();
-  };
-
-  // The link driven by one 0 -> +1 edge at `lead`, held for `span`, and its circuit and probe.
-  auto edge_link = [&](double span) {
+  }
+  // The link driven by one 0 -> +1 edge at kLead, held for `span`.
+  StatusOr<link::ExpandedLink> edge_link(double span) const {
     traffic::Drive drive;
-    drive.encoding = opt.expand.stimulus.encoding;
-    drive.segments = {{0.0, lead, 0}, {lead, lead + span, +1}};
-    link::ExpandOptions ex = opt.expand;
+    drive.encoding = opt_.expand.stimulus.encoding;
+    drive.segments = {{0.0, kLead, 0}, {kLead, kLead + span, +1}};
+    link::ExpandOptions ex = opt_.expand;
     ex.drive = drive;
-    return link::expand_link(spec, parts, d, ex);
-  };
+    return link::expand_link(spec_, parts_, d_, ex);
+  }
   // The circuit and its probes: v(rxp,rxn), then opt.more_probes.
-  auto edge_circuit = [&](const link::ExpandedLink& link,
-                          Circuit& circuit) -> StatusOr<std::vector<Probe>> {
+  StatusOr<std::vector<Probe>> edge_circuit(const link::ExpandedLink& link,
+                                            Circuit& circuit) const {
     for (const Card& card : link.netlist.cards)
       if (Status s = circuit.add(card); !s.ok()) return s;
     if (Status s = circuit.finalize(); !s.ok()) return s;
     std::vector<Probe> probes;
-    for (size_t i = 0; i <= opt.more_probes.size(); ++i) {
-      StatusOr<Probe> p = parse_probe(circuit, i == 0 ? "v(rxp,rxn)" : opt.more_probes[i - 1]);
+    for (size_t i = 0; i <= opt_.more_probes.size(); ++i) {
+      StatusOr<Probe> p = parse_probe(circuit, i == 0 ? "v(rxp,rxn)" : opt_.more_probes[i - 1]);
       if (!p) return p.status();
       probes.push_back(*p);
     }
     return probes;
-  };
-  out.more.assign(opt.more_probes.size(), {});
-  for (size_t i = 0; i < out.more.size(); ++i) out.more[i].probe = opt.more_probes[i];
-
-  if (opt.edge_engine == WorstOptions::EdgeEngine::Auto) {
-    // The reduced model in closed form: one model, sampled on longer records until settled.
-    StatusOr<link::ExpandedLink> link = edge_link(opt.max_span);
-    if (!link) return link.status();
-    Circuit circuit;
-    StatusOr<std::vector<Probe>> probes = edge_circuit(*link, circuit);
-    if (!probes) return probes.status();
-    for (const auto& e : circuit.elements()) e->bind_time(opt.dt, lead + opt.max_span);
-    LtiOptions lo;
-    lo.method = LtiOptions::Method::Reduced;
-    lo.horizon = lead + opt.max_span;
-    const auto by_direction = opt.reduced_start_points_by_direction.find(d);
-    lo.reduced.start_points = by_direction != opt.reduced_start_points_by_direction.end()
-                                  ? by_direction->second
-                                  : opt.reduced_start_points;
-    if (opt.progress) opt.progress("edge response, reduced model", 0.0);
-    StatusOr<LtiResponses> lti = LtiResponses::compute(circuit, *probes, lo);
-    if (lti) {
-      const std::vector<SourceInput> inputs = lti->netlist_inputs(lead + opt.max_span);
-      out.v_idle = lti->value(0, lead - 2 * out.pre * opt.dt, inputs);
-      for (size_t i = 0; i < out.more.size(); ++i)
-        out.more[i].v_idle = lti->value(i + 1, lead - 2 * out.pre * opt.dt, inputs);
-      out.e.clear();
-      for (double span = 40e-6;; span *= 2) {
-        // Only the samples the longer record adds: the model starts them from the edge exactly.
-        const long from = static_cast<long>(out.e.size()), n = out.pre + to_samples(span, opt.dt);
-        std::vector<double> times(static_cast<size_t>(n - from));
-        for (long i = from; i < n; ++i)
-          times[static_cast<size_t>(i - from)] = lead + static_cast<double>(i - out.pre) * opt.dt;
-        const std::vector<std::vector<double>> v = lti->values(inputs, times);
-        for (double x : v[0]) out.e.push_back(x - out.v_idle);
-        for (size_t i = 0; i < out.more.size(); ++i)
-          for (double x : v[i + 1]) out.more[i].e.push_back(x - out.more[i].v_idle);
-        if (Status s = finite(link->description); !s.ok()) return s;
-        if (settled(span)) break;
-        if (span * 2 > opt.max_span) return unsettled(link->description, span);
-      }
-      const ReducedModelStats& m = lti->stats().model;
-      out.engine = fmt::format(
-          "reduced model (order {}, {} poles, {} expansion points, AC error {:.1e} of peak up to "
-          "3 GHz), sampled on a {:g} ns grid",
-          m.order, m.poles, m.expansion_points, m.error, opt.dt * 1e9);
-      out.expansion_points = m.points;
-      out.seconds = seconds_since(start);
-      return out;
-    }
-    out.engine_note = "reduced model not used: " + lti.status().message();
   }
+  // Samples the model on records of 40 us, doubled until the response settles.
+  Status sample_model(const LtiResponses& lti, const std::string& description);
+  // Samples a transient's waveform w (a record of `span` after the edge).
+  void sample_transient(const Waveform& w, double span);
 
+  const link::LinkSpec& spec_;
+  const link::PartLibrary& parts_;
+  const link::Direction d_;
+  const WorstOptions& opt_;
+  EdgeResponse& out_;
+  const long half_;
+};
+
+Status EdgeResponseBuilder::from_reduced_model(bool* done) {
+  StatusOr<link::ExpandedLink> link = edge_link(opt_.max_span);
+  if (!link) return link.status();
+  Circuit circuit;
+  StatusOr<std::vector<Probe>> probes = edge_circuit(*link, circuit);
+  if (!probes) return probes.status();
+  for (const auto& e : circuit.elements()) e->bind_time(opt_.dt, kLead + opt_.max_span);
+  LtiOptions lo;
+  lo.method = LtiOptions::Method::Reduced;
+  lo.horizon = kLead + opt_.max_span;
+  const auto by_direction = opt_.reduced_start_points_by_direction.find(d_);
+  lo.reduced.start_points = by_direction != opt_.reduced_start_points_by_direction.end()
+                                ? by_direction->second
+                                : opt_.reduced_start_points;
+  if (opt_.progress) opt_.progress("edge response, reduced model", 0.0);
+  StatusOr<LtiResponses> lti = LtiResponses::compute(circuit, *probes, lo);
+  if (!lti) {
+    out_.engine_note = "reduced model not used: " + lti.status().message();
+    return Status::Ok();
+  }
+  if (Status s = sample_model(*lti, link->description); !s.ok()) return s;
+  const ReducedModelStats& m = lti->stats().model;
+  out_.engine = fmt::format(
+      "reduced model (order {}, {} poles, {} expansion points, AC error {:.1e} of peak up to "
+      "3 GHz), sampled on a {:g} ns grid",
+      m.order, m.poles, m.expansion_points, m.error, opt_.dt * 1e9);
+  out_.expansion_points = m.points;
+  *done = true;
+  return Status::Ok();
+}
+
+Status EdgeResponseBuilder::sample_model(const LtiResponses& lti, const std::string& description) {
+  const std::vector<SourceInput> inputs = lti.netlist_inputs(kLead + opt_.max_span);
+  out_.v_idle = lti.value(0, kLead - 2 * out_.pre * opt_.dt, inputs);
+  for (size_t i = 0; i < out_.more.size(); ++i)
+    out_.more[i].v_idle = lti.value(i + 1, kLead - 2 * out_.pre * opt_.dt, inputs);
+  out_.e.clear();
+  for (double span = 40e-6;; span *= 2) {
+    // Only the samples the longer record adds: the model starts them from the edge exactly.
+    const long from = static_cast<long>(out_.e.size()), n = out_.pre + to_samples(span, opt_.dt);
+    std::vector<double> times(static_cast<size_t>(n - from));
+    for (long i = from; i < n; ++i)
+      times[static_cast<size_t>(i - from)] = kLead + static_cast<double>(i - out_.pre) * opt_.dt;
+    const std::vector<std::vector<double>> v = lti.values(inputs, times);
+    for (double x : v[0]) out_.e.push_back(x - out_.v_idle);
+    for (size_t i = 0; i < out_.more.size(); ++i)
+      for (double x : v[i + 1]) out_.more[i].e.push_back(x - out_.more[i].v_idle);
+    if (Status s = finite(description); !s.ok()) return s;
+    if (settled(span)) return Status::Ok();
+    if (span * 2 > opt_.max_span) return unsettled(description, span);
+  }
+}
+
+Status EdgeResponseBuilder::from_transients() {
   for (double span = 40e-6;; span *= 2) {
     StatusOr<link::ExpandedLink> link = edge_link(span);
     if (!link) return link.status();
@@ -572,41 +606,60 @@ StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::Par
     StatusOr<std::vector<Probe>> probes = edge_circuit(*link, circuit);
     if (!probes) return probes.status();
     TransientOptions to;
-    to.tstep = opt.dt;
-    to.tstop = lead + span;
+    to.tstep = opt_.dt;
+    to.tstop = kLead + span;
     // Steps up to 16 grid samples where the response is slow (the transformer's tail): the
     // reltol 1e-6 error control keeps them near the grid wherever v moves. Measured against
     // tmax = dt: the worst-case values of cap_2m and transformer_15m agree within 10 nV and 2.5 ps,
     // the same traffic wins, and the edge response of transformer_15m takes 4.7 s, not 20 s.
-    to.tmax = kEdgeTmaxSamples * opt.dt;
-    to.reltol = opt.reltol;
-    if (opt.progress)
+    to.tmax = kEdgeTmaxSamples * opt_.dt;
+    to.reltol = opt_.reltol;
+    if (opt_.progress)
       to.on_progress = [&](double t) {
-        opt.progress(fmt::format("edge response, {:g} us", span * 1e6), t / to.tstop);
+        opt_.progress(fmt::format("edge response, {:g} us", span * 1e6), t / to.tstop);
       };
     if (Status s = to.validate(); !s.ok()) return s;
     StatusOr<Waveform> w = run_transient(circuit, to, *probes);
     if (!w) return w.status().with_context(link->description + ", edge response");
-    out.v_idle = w->value_at(0, lead - 2 * out.pre * opt.dt);
-    const long n = out.pre + to_samples(span, opt.dt);
-    out.e.assign(static_cast<size_t>(n), 0.0);
-    for (long i = 0; i < n; ++i)
-      out.e[static_cast<size_t>(i)] =
-          w->value_at(0, lead + static_cast<double>(i - out.pre) * opt.dt) - out.v_idle;
-    for (size_t c = 0; c < out.more.size(); ++c) {
-      EdgeResponse::Column& col = out.more[c];
-      col.v_idle = w->value_at(c + 1, lead - 2 * out.pre * opt.dt);
-      col.e.assign(static_cast<size_t>(n), 0.0);
-      for (long i = 0; i < n; ++i)
-        col.e[static_cast<size_t>(i)] =
-            w->value_at(c + 1, lead + static_cast<double>(i - out.pre) * opt.dt) - col.v_idle;
-    }
+    sample_transient(*w, span);
     if (Status s = finite(link->description); !s.ok()) return s;
     if (settled(span)) break;
-    if (span * 2 > opt.max_span) return unsettled(link->description, span);
+    if (span * 2 > opt_.max_span) return unsettled(link->description, span);
   }
-  out.engine = fmt::format("transient, reltol {:g}, tmax {:g} ns, sampled on a {:g} ns grid",
-                           opt.reltol, kEdgeTmaxSamples * opt.dt * 1e9, opt.dt * 1e9);
+  out_.engine = fmt::format("transient, reltol {:g}, tmax {:g} ns, sampled on a {:g} ns grid",
+                            opt_.reltol, kEdgeTmaxSamples * opt_.dt * 1e9, opt_.dt * 1e9);
+  return Status::Ok();
+}
+
+void EdgeResponseBuilder::sample_transient(const Waveform& w, double span) {
+  out_.v_idle = w.value_at(0, kLead - 2 * out_.pre * opt_.dt);
+  const long n = out_.pre + to_samples(span, opt_.dt);
+  out_.e.assign(static_cast<size_t>(n), 0.0);
+  for (long i = 0; i < n; ++i)
+    out_.e[static_cast<size_t>(i)] =
+        w.value_at(0, kLead + static_cast<double>(i - out_.pre) * opt_.dt) - out_.v_idle;
+  for (size_t c = 0; c < out_.more.size(); ++c) {
+    EdgeResponse::Column& col = out_.more[c];
+    col.v_idle = w.value_at(c + 1, kLead - 2 * out_.pre * opt_.dt);
+    col.e.assign(static_cast<size_t>(n), 0.0);
+    for (long i = 0; i < n; ++i)
+      col.e[static_cast<size_t>(i)] =
+          w.value_at(c + 1, kLead + static_cast<double>(i - out_.pre) * opt_.dt) - col.v_idle;
+  }
+}
+
+}  // namespace
+
+StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::PartLibrary& parts,
+                                     link::Direction d, const WorstOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  EdgeResponse out;
+  EdgeResponseBuilder builder(spec, parts, d, opt, out);
+  bool done = false;
+  if (opt.edge_engine == WorstOptions::EdgeEngine::Auto)
+    if (Status s = builder.from_reduced_model(&done); !s.ok()) return s;
+  if (!done)
+    if (Status s = builder.from_transients(); !s.ok()) return s;
   out.seconds = seconds_since(start);
   return out;
 }
