@@ -10,6 +10,9 @@
 // rank per core plus one for the coordinator, which sleeps between messages. Waveforms
 // (--keep-waves) are written by the workers into DIR/waves (a shared folder across machines).
 // Outside mpirun (or with one rank) `isolink sweep` is the threaded run.
+//
+// Contract: as run_sweep's (sweep_run.h); every rank must call run_sweep_mpi with the same spec
+// and options, and only rank 0's outcome holds results.
 #pragma once
 
 #include "analysis/sweep_run.h"
