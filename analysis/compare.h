@@ -7,7 +7,7 @@
 //   StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
 //   StatusOr<CompareResult> r = compare_capture(in, *parts, opt);
 //   if (!r) { fputs(r.status().message().c_str(), stderr); return 2; }   // bad input
-//   std::puts(compare_json(*r).dump(2).c_str());
+//   std::puts(reports::compare_json(*r).dump(2).c_str());   // reports/compare_report.h
 //   return r->verdict == "match" ? 0 : 1;
 //
 // Contract:
@@ -184,15 +184,6 @@ struct CompareResult {
 
 StatusOr<CompareResult> compare_capture(const CompareInput& in, const link::PartLibrary& parts,
                                         const CompareOptions& opt = {});
-
-// The JSON shape (verdict, direction, offset_s, residual, fit, residual_after_fit,
-// findings) and more: noise, thresholds, metrics, input, and the capture's commands exactly as
-// `isolink check --json` gives them (commands, commands_omitted, commands_note).
-nlohmann::ordered_json compare_json(const CompareResult& r);
-// A few lines for people.
-std::string compare_text(const CompareResult& r);
-// The Markdown report body.
-std::string compare_markdown(const CompareResult& r);
 
 // The design value of a numeric key: the spec's, else the board preset's (series_r, bypass_c,
 // termination), else the transformer part's; with its tolerance band (relative) and where that

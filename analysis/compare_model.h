@@ -1,6 +1,10 @@
 // The pieces of isolink compare shared by compare.cpp (capture, alignment, verdict) and
 // compare_fit.cpp (the fit): the traffic as driver edges, the simulation at arbitrary times, the
 // spec with fitted keys set. Internal to analysis/ (compare.h is the interface).
+//
+// Contract: SI units (s, V); the helpers return a Status for a spec or traffic that does not
+// build. LinkModel keeps a reference to the part library (it must outlive the model) and is
+// safe to call from several threads (the fit's parallel Jacobian).
 #pragma once
 
 #include <atomic>

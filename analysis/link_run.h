@@ -9,6 +9,14 @@
 // names (auto: LTI where it is the cheaper engine, else the transient; analysis/simulate.h). Data
 // frames are scored with the receiving device's rule set and tones with the tone rules, each over
 // its own time windows.
+//
+// Contract:
+// - Units: SI (s, V); margins as eye/metrics.h gives them.
+// - Ownership: a LinkRun owns its expanded links, waveforms and checks; the spec and the part
+//   library are read, not kept (a run outlives them).
+// - Errors: a Status, never thrown: a spec that does not expand (the key's file:line:col), a
+//   simulation that fails (analysis/simulate.h), rules that do not validate. A link that fails
+//   its rules is a result with pass false, not an error.
 #pragma once
 
 #include <functional>

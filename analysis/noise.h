@@ -25,6 +25,15 @@
 //   - Immunity at f: the highest level at which the differential noise, at the worst phase and
 //     at the modulation's peak, stays inside the receiver budget (NoiseBudget) and every pin
 //     stays inside +/- pin_limit.
+//
+// Contract:
+// - Units: SI (Hz, A or V of noise.level, V at the pins); conversion and immunity also in dB
+//   re the test level.
+// - Ownership: a NoiseResult owns everything it holds; the NoiseDirectionInput pointers (check,
+//   rules, wave) are read during the call only and must live until it returns.
+// - Errors: a Status, never thrown: a spec that does not expand or whose noise keys do not hold,
+//   a bci or dm injection on a cable of one segment, a direction without its check or traffic,
+//   a circuit that does not build or solve. A link that fails the test level is pass false.
 #pragma once
 
 #include <complex>

@@ -136,20 +136,29 @@ StatusOr<PackTiming> pack_timing(const PackSpec& pack) {
   return t;
 }
 
-StatusOr<PackResult> run_pack(const PackSpec& pack, const link::PartLibrary& parts,
-                              const PackOptions& opt) {
-  const auto start = std::chrono::steady_clock::now();
-  PackResult out;
-  // Expand every hop in every direction it carries; keep one run per distinct circuit.
-  std::vector<std::vector<link::ExpandedLink>> own(pack.hops.size());  // per hop and direction
-  struct Distinct {
-    link::ExpandedLink link;
-    const link::LinkSpec* spec = nullptr;  // the first hop's spec with this circuit
-    link::Direction direction = link::Direction::kDown;
-    StatusOr<DirectionRun> run = Status::Error("not run");
-    StatusOr<DirectionWorst> worst = Status::Error("not run");
-  };
+namespace {
+
+// One distinct circuit of the pack: the first hop and direction that has it, and its runs.
+struct Distinct {
+  link::ExpandedLink link;
+  const link::LinkSpec* spec = nullptr;  // the first hop's spec with this circuit
+  link::Direction direction = link::Direction::kDown;
+  StatusOr<DirectionRun> run = Status::Error("not run");
+  StatusOr<DirectionWorst> worst = Status::Error("not run");
+};
+
+// The pack's circuits: per hop and direction its own expansion (names and BOM), and the
+// distinct circuits the runs are made on.
+struct PackCircuits {
+  std::vector<std::vector<link::ExpandedLink>> own;  // per hop and direction
   std::vector<Distinct> distinct;
+};
+
+// Expands every hop in every direction it carries and keeps one run per distinct circuit
+// (out->hops get their indices and runs); errors name the hop.
+Status expand_hops(const PackSpec& pack, const link::PartLibrary& parts, const PackOptions& opt,
+                   PackResult* out, PackCircuits* c) {
+  c->own.resize(pack.hops.size());
   std::map<std::string, int> by_key;
   for (const HopSpec& h : pack.hops) {
     HopResult hr;
@@ -159,19 +168,25 @@ StatusOr<PackResult> run_pack(const PackSpec& pack, const link::PartLibrary& par
     for (link::Direction d : dirs) {
       StatusOr<link::ExpandedLink> ex = link::expand_link(h.spec, parts, d, opt.run.expand);
       if (!ex) return ex.status().with_context(fmt::format("hop {}", h.index));
-      ++out.expansions;
+      ++out->expansions;
       // A symmetric hop's up direction is the same circuit as its down (node names follow the
       // roles), so it dedupes too.
       const std::string key = link::circuit_key(*ex);
-      auto [it, added] = by_key.emplace(key, static_cast<int>(distinct.size()));
-      if (added) distinct.push_back({*ex, &h.spec, d, Status::Error("not run"), Status::Error("")});
+      auto [it, added] = by_key.emplace(key, static_cast<int>(c->distinct.size()));
+      if (added)
+        c->distinct.push_back({*ex, &h.spec, d, Status::Error("not run"), Status::Error("")});
       hr.runs.push_back(it->second);
-      own[out.hops.size()].push_back(std::move(*ex));
+      c->own[out->hops.size()].push_back(std::move(*ex));
     }
-    out.hops.push_back(std::move(hr));
+    out->hops.push_back(std::move(hr));
   }
-  out.simulations = static_cast<int>(distinct.size());
+  out->simulations = static_cast<int>(c->distinct.size());
+  return Status::Ok();
+}
 
+// Runs every distinct circuit's traffic (and worst case) on opt.jobs threads; the first error.
+Status run_distinct(const link::PartLibrary& parts, const PackOptions& opt,
+                    std::vector<Distinct>& distinct) {
   const DirectionRunner runner =
       opt.runner ? opt.runner : DirectionRunner([](link::ExpandedLink x, const RunOptions& o) {
         return run_direction(std::move(x), o);
@@ -211,100 +226,127 @@ StatusOr<PackResult> run_pack(const PackSpec& pack, const link::PartLibrary& par
     if (opt.worst && !d.worst)
       return d.worst.status().with_context(d.link.description + ", worst case");
   }
-  out.worst_done = opt.worst.has_value();
-  out.worst_cases = opt.worst ? static_cast<int>(n) : 0;
+  return Status::Ok();
+}
 
-  // Per hop: its directions, verdict and worst margin.
-  out.pass = true;
+// Hop i's spec-traffic result: its directions, verdict, the hop it repeats, its worst margin.
+void score_hop(const PackCircuits& c, size_t i, PackResult* out) {
+  HopResult& hr = out->hops[i];
+  hr.run.pass = true;
+  for (size_t k = 0; k < hr.runs.size(); ++k) {
+    const int r = hr.runs[k];
+    hr.run.directions.push_back(*c.distinct[r].run);
+    hr.run.directions.back().link = c.own[i][k];  // this hop's direction, names and BOM
+    hr.run.pass = hr.run.pass && c.distinct[r].run->pass;
+    hr.run.seconds += c.distinct[r].run->sim.seconds;
+  }
+  hr.pass = hr.run.pass;
+  out->pass = out->pass && hr.pass;
+  hr.same_as = hr.index;
+  for (size_t j = 0; j < i; ++j)
+    if (out->hops[j].runs == hr.runs) {
+      hr.same_as = out->hops[j].index;
+      break;
+    }
+  for (const DirectionRun& d : hr.run.directions) {
+    LinkRun one;
+    one.pass = d.pass;
+    one.directions.push_back(d);
+    const sweep::PointResult s = sweep::score_run(one);
+    if (std::isnan(hr.worst_rel) || s.worst_rel < hr.worst_rel) {
+      hr.worst_rel = s.worst_rel;
+      hr.worst_metric = s.worst_metric;
+      hr.worst_direction = link::direction_name(d.link.direction);
+    }
+  }
+}
+
+// Hop i's worst cases, named for this hop's own directions, and its weakest worst-case margin.
+void score_hop_worst(const PackCircuits& c, size_t i, PackResult* out) {
+  HopResult& hr = out->hops[i];
+  for (size_t k = 0; k < hr.runs.size(); ++k) {
+    DirectionWorst w = *c.distinct[hr.runs[k]].worst;
+    w.direction = c.own[i][k].direction;      // a symmetric hop's up shares its down's circuit
+    w.description = c.own[i][k].description;  // this hop's direction, its device names
+    w.receiver = c.own[i][k].receiver;
+    hr.worst_pass = hr.worst_pass && w.pass;
+    std::string metric;
+    const double rel = worst_rel_of(w, &metric);
+    if (!std::isnan(rel) && (std::isnan(hr.worst_case_rel) || rel < hr.worst_case_rel)) {
+      hr.worst_case_rel = rel;
+      hr.worst_case_metric = metric;
+      hr.worst_case_direction = link::direction_name(w.direction);
+    }
+    hr.worst.push_back(std::move(w));
+  }
+  out->worst_pass = out->worst_pass && hr.worst_pass;
+}
+
+// Per hop: its directions, verdict and worst margin; the weakest hop (a failing hop is weaker
+// than any passing one), for the spec traffic and for the worst case.
+void score_hops(const PackCircuits& c, bool worst, PackResult* out) {
+  out->pass = true;
   double weakest_rel = std::numeric_limits<double>::infinity();
   double rank_worst = std::numeric_limits<double>::infinity();
-  for (size_t i = 0; i < out.hops.size(); ++i) {
-    HopResult& hr = out.hops[i];
-    hr.run.pass = true;
-    for (size_t k = 0; k < hr.runs.size(); ++k) {
-      const int r = hr.runs[k];
-      hr.run.directions.push_back(*distinct[r].run);
-      hr.run.directions.back().link = own[i][k];  // this hop's direction, names and BOM
-      hr.run.pass = hr.run.pass && distinct[r].run->pass;
-      hr.run.seconds += distinct[r].run->sim.seconds;
-    }
-    hr.pass = hr.run.pass;
-    out.pass = out.pass && hr.pass;
-    hr.same_as = hr.index;
-    for (size_t j = 0; j < i; ++j)
-      if (out.hops[j].runs == hr.runs) {
-        hr.same_as = out.hops[j].index;
-        break;
-      }
-    for (const DirectionRun& d : hr.run.directions) {
-      LinkRun one;
-      one.pass = d.pass;
-      one.directions.push_back(d);
-      const sweep::PointResult s = sweep::score_run(one);
-      if (std::isnan(hr.worst_rel) || s.worst_rel < hr.worst_rel) {
-        hr.worst_rel = s.worst_rel;
-        hr.worst_metric = s.worst_metric;
-        hr.worst_direction = link::direction_name(d.link.direction);
-      }
-    }
-    // A failing hop is weaker than any passing one.
+  for (size_t i = 0; i < out->hops.size(); ++i) {
+    score_hop(c, i, out);
+    const HopResult& hr = out->hops[i];
     const double rank = (hr.pass ? 0.0 : -1e9) + (std::isnan(hr.worst_rel) ? -1.0 : hr.worst_rel);
-    if (rank < weakest_rel) weakest_rel = rank, out.weakest = hr.index;
-
-    if (!opt.worst) continue;
-    for (size_t k = 0; k < hr.runs.size(); ++k) {
-      DirectionWorst w = *distinct[hr.runs[k]].worst;
-      w.direction = own[i][k].direction;      // a symmetric hop's up shares its down's circuit
-      w.description = own[i][k].description;  // this hop's direction, its device names
-      w.receiver = own[i][k].receiver;
-      hr.worst_pass = hr.worst_pass && w.pass;
-      std::string metric;
-      const double rel = worst_rel_of(w, &metric);
-      if (!std::isnan(rel) && (std::isnan(hr.worst_case_rel) || rel < hr.worst_case_rel)) {
-        hr.worst_case_rel = rel;
-        hr.worst_case_metric = metric;
-        hr.worst_case_direction = link::direction_name(w.direction);
-      }
-      hr.worst.push_back(std::move(w));
-    }
-    out.worst_pass = out.worst_pass && hr.worst_pass;
+    if (rank < weakest_rel) weakest_rel = rank, out->weakest = hr.index;
+    if (!worst) continue;
+    score_hop_worst(c, i, out);
     const double wrank =
         (hr.worst_pass ? 0.0 : -1e9) + (std::isnan(hr.worst_case_rel) ? -1.0 : hr.worst_case_rel);
-    if (rank_worst > wrank || out.worst_weakest == 0)
-      rank_worst = wrank, out.worst_weakest = hr.index;
+    if (rank_worst > wrank || out->worst_weakest == 0)
+      rank_worst = wrank, out->worst_weakest = hr.index;
   }
+}
 
-  // Ring breaks: every hop still carrying traffic must pass in the directions it now carries.
-  for (const BreakCase& c : ring_breaks(pack.chain_hops(), pack.ring)) {
-    BreakResult b;
-    b.c = c;
-    b.pass = true;
-    for (const BreakCase::Use& u : c.carried) {
-      const HopSpec& h = pack.hops[u.hop - 1];
-      const HopResult& hr = out.hops[u.hop - 1];
-      const link::Direction command = u.reversed ? link::Direction::kUp : link::Direction::kDown;
-      const link::Direction reply = u.reversed ? link::Direction::kDown : link::Direction::kUp;
-      for (size_t k = 0; k < hr.run.directions.size(); ++k) {
-        const DirectionRun& d = hr.run.directions[k];
-        const bool needed =
-            d.link.direction == command || (d.link.direction == reply && has_reads(h.spec));
-        if (!needed) continue;
-        const std::string what =
-            fmt::format("hop {} {} ({})", u.hop, u.reversed ? "reversed" : "normal",
-                        link::direction_name(d.link.direction));
-        if (!d.pass) {
-          b.pass = false;
-          b.failing.push_back(what);
-        }
-        if (k < hr.worst.size() && !hr.worst[k].pass) {
-          b.worst_pass = false;
-          b.worst_failing.push_back(what);
-        }
+// A ring break: every hop still carrying traffic must pass in the directions it now carries.
+BreakResult judge_break(const PackSpec& pack, const PackResult& out, const BreakCase& c) {
+  BreakResult b;
+  b.c = c;
+  b.pass = true;
+  for (const BreakCase::Use& u : c.carried) {
+    const HopSpec& h = pack.hops[u.hop - 1];
+    const HopResult& hr = out.hops[u.hop - 1];
+    const link::Direction command = u.reversed ? link::Direction::kUp : link::Direction::kDown;
+    const link::Direction reply = u.reversed ? link::Direction::kDown : link::Direction::kUp;
+    for (size_t k = 0; k < hr.run.directions.size(); ++k) {
+      const DirectionRun& d = hr.run.directions[k];
+      const bool needed =
+          d.link.direction == command || (d.link.direction == reply && has_reads(h.spec));
+      if (!needed) continue;
+      const std::string what =
+          fmt::format("hop {} {} ({})", u.hop, u.reversed ? "reversed" : "normal",
+                      link::direction_name(d.link.direction));
+      if (!d.pass) {
+        b.pass = false;
+        b.failing.push_back(what);
+      }
+      if (k < hr.worst.size() && !hr.worst[k].pass) {
+        b.worst_pass = false;
+        b.worst_failing.push_back(what);
       }
     }
-    out.breaks.push_back(std::move(b));
   }
+  return b;
+}
 
+}  // namespace
+
+StatusOr<PackResult> run_pack(const PackSpec& pack, const link::PartLibrary& parts,
+                              const PackOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  PackResult out;
+  PackCircuits circuits;
+  if (Status s = expand_hops(pack, parts, opt, &out, &circuits); !s.ok()) return s;
+  if (Status s = run_distinct(parts, opt, circuits.distinct); !s.ok()) return s;
+  out.worst_done = opt.worst.has_value();
+  out.worst_cases = opt.worst ? static_cast<int>(circuits.distinct.size()) : 0;
+  score_hops(circuits, opt.worst.has_value(), &out);
+  for (const BreakCase& c : ring_breaks(pack.chain_hops(), pack.ring))
+    out.breaks.push_back(judge_break(pack, out, c));
   StatusOr<PackTiming> timing = pack_timing(pack);
   if (!timing) return timing.status();
   out.timing = std::move(*timing);

@@ -17,6 +17,14 @@
 // verdict per hop (HopResult::worst_pass) and for the pack (PackResult::worst_pass). The spec
 // traffic's verdict (PackResult::pass) stays the pack's verdict, as in `isolink run`. Both kinds
 // of job (a circuit's spec-traffic run, a circuit's worst case) share one oneTBB loop.
+//
+// Contract:
+// - Units: SI (s for timing, V and s for margins); hops and devices numbered from 1.
+// - Ownership: a PackResult owns its hop runs and worst cases; the pack spec and the part library
+//   are read, not kept. PackOptions' runners and on_job_done are called from oneTBB threads
+//   (on_job_done under a lock) and must be thread-safe.
+// - Errors: a Status, never thrown, naming the hop ("hop 3: ..."): a hop that does not expand, a
+//   run or worst case that fails, a cable model that cannot be made. Failing hops are results.
 #pragma once
 
 #include <functional>

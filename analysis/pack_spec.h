@@ -25,6 +25,12 @@
 // its `rx` the top device. A hop spec that leaves an end's device out gets the pack's (bridge or
 // stack); one that names a different device is an error. Errors name the file, line and column
 // of the key, whether it sits in the hop spec or in the pack file.
+//
+// Contract:
+// - Units: as in link specs (SI, the config/ suffixes); timing in s.
+// - Ownership: a PackSpec owns its hop specs (each a complete link::LinkSpec); nothing refers back
+//   to the files read.
+// - Errors: a Status, never thrown, with the file, line and column of the key at fault.
 #pragma once
 
 #include <functional>

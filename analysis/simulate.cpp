@@ -109,57 +109,65 @@ Status check_transient_memory(const Netlist& netlist, const TransientOptions& op
                   static_cast<int>(row_bytes / 8), bytes / kMemoryLimitBytes));
 }
 
-StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequest& req,
-                                    SimulationResult& result) {
-  TransientOptions opt;
+// The transient options: the .tran card, the netlist's .options (unknown ones a warning), the
+// request's overrides; refused when there is nothing to simulate or the output grid is too fine.
+Status run_options(const Netlist& netlist, const SimulationRequest& req, TransientOptions* opt,
+                   SimulationResult& result) {
   if (netlist.tran) {
-    opt.tstep = netlist.tran->tstep;
-    opt.tstop = netlist.tran->tstop;
-    opt.tstart = netlist.tran->tstart;
-    opt.tmax = netlist.tran->tmax;
-    opt.uic = netlist.tran->uic;
+    opt->tstep = netlist.tran->tstep;
+    opt->tstop = netlist.tran->tstop;
+    opt->tstart = netlist.tran->tstart;
+    opt->tmax = netlist.tran->tmax;
+    opt->uic = netlist.tran->uic;
   }
   for (const auto& o : netlist.options) {
     bool known = true;
-    if (Status s = opt.set_option(o.key, o.value, &known); !s.ok()) return s;
+    if (Status s = opt->set_option(o.key, o.value, &known); !s.ok()) return s;
     if (!known)
       result.warnings.push_back(format_diagnostic(
           o.loc, "warning", "option '" + o.key + "' is not used by isolink; ignored"));
   }
-  if (req.tstop) opt.tstop = *req.tstop;
-  if (req.tstep) opt.tstep = *req.tstep;
-  if (req.tmax) opt.tmax = *req.tmax;
-  if (req.method) opt.method = *req.method;
-  if (req.reltol) opt.reltol = *req.reltol;
+  if (req.tstop) opt->tstop = *req.tstop;
+  if (req.tstep) opt->tstep = *req.tstep;
+  if (req.tmax) opt->tmax = *req.tmax;
+  if (req.method) opt->method = *req.method;
+  if (req.reltol) opt->reltol = *req.reltol;
   if (!netlist.tran && !req.tstop)
     return Status::Error("no .tran card in the netlist and no --tstop given: nothing to simulate");
-  if (opt.tstep <= 0 && opt.tstop > 0) opt.tstep = opt.tstop / 1000;
-  if (Status s = opt.validate(); !s.ok()) return s;
+  if (opt->tstep <= 0 && opt->tstop > 0) opt->tstep = opt->tstop / 1000;
+  if (Status s = opt->validate(); !s.ok()) return s;
   if (req.grid_step > 0) {
     // Refused before any work: --step 1e-30 over 5 us asks for 5e24 rows (the LTI grid and the
     // transient's resampling would both allocate them).
-    const double rows = (opt.tstop - opt.tstart) / req.grid_step + 1;
+    const double rows = (opt->tstop - opt->tstart) / req.grid_step + 1;
     if (!(rows <= static_cast<double>(kMaxGridRows)))
       return Status::Error(fmt::format(
           "--step {:g} over the {:.6g} s run asks for {:.3g} rows; the limit is {} rows (use a "
           "larger --step, or no --step for the engine's own time points)",
-          req.grid_step, opt.tstop - opt.tstart, rows, kMaxGridRows));
+          req.grid_step, opt->tstop - opt->tstart, rows, kMaxGridRows));
   }
+  return Status::Ok();
+}
 
-  Circuit circuit;
+// The circuit of the netlist's cards (its warnings into result), and the .ic nodes into opt.
+Status build_circuit(const Netlist& netlist, Circuit* circuit, TransientOptions* opt,
+                     SimulationResult& result) {
   for (const Card& card : netlist.cards)
-    if (Status s = circuit.add(card); !s.ok()) return s;
-  if (Status s = circuit.finalize(); !s.ok()) return s;
-  for (const auto& w : circuit.warnings()) result.warnings.push_back(w);
+    if (Status s = circuit->add(card); !s.ok()) return s;
+  if (Status s = circuit->finalize(); !s.ok()) return s;
+  for (const auto& w : circuit->warnings()) result.warnings.push_back(w);
   for (const InitialVoltage& ic : netlist.initial_voltages) {
-    const int node = circuit.find_node(ic.node);
+    const int node = circuit->find_node(ic.node);
     if (node <= 0)
       return error_at(ic.loc,
                       node == 0 ? "'.ic' on the ground node"
                                 : "'.ic' names node '" + ic.node + "', which no element connects");
-    opt.node_ic.emplace_back(node, ic.value);
+    opt->node_ic.emplace_back(node, ic.value);
   }
+  return Status::Ok();
+}
 
+StatusOr<std::vector<Probe>> parse_probes(const Circuit& circuit, const SimulationRequest& req) {
   std::vector<Probe> probes;
   for (const auto& text : req.probes) {
     StatusOr<Probe> p = parse_probe(circuit, text);
@@ -168,103 +176,132 @@ StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequ
   }
   if (probes.empty())
     return Status::Error("no --probe given: say what to record, e.g. --probe 'v(rxp,rxn)'");
+  return probes;
+}
 
-  // Memory (kMemoryLimitBytes): a row is the time plus every probe.
-  const double row_bytes = 8.0 * static_cast<double>(1 + probes.size());
-  if (req.grid_step > 0) {
-    const double bytes = ((opt.tstop - opt.tstart) / req.grid_step + 1) * row_bytes;
-    if (!(bytes <= kMemoryLimitBytes))
-      return Status::Error(fmt::format(
-          "--step {:g} over the {:.6g} s run with {} probes needs {:.3g} GB of rows, "
-          "over the 1 GB memory limit (use a larger --step or fewer probes)",
-          req.grid_step, opt.tstop - opt.tstart, probes.size(), bytes / kMemoryLimitBytes));
-  }
-  opt.max_steps =
-      std::min<long>(opt.max_steps, static_cast<long>(kMemoryLimitBytes / (2 * row_bytes)));
-  long sources = 0;  // time-varying: the LTI march keeps each one's response at every probe
+// The rows of a --step grid within kMemoryLimitBytes (row_bytes: the time plus every probe).
+Status check_grid_memory(const SimulationRequest& req, const TransientOptions& opt, size_t probes,
+                         double row_bytes) {
+  if (req.grid_step <= 0) return Status::Ok();
+  const double bytes = ((opt.tstop - opt.tstart) / req.grid_step + 1) * row_bytes;
+  if (!(bytes <= kMemoryLimitBytes))
+    return Status::Error(
+        fmt::format("--step {:g} over the {:.6g} s run with {} probes needs {:.3g} GB of rows, "
+                    "over the 1 GB memory limit (use a larger --step or fewer probes)",
+                    req.grid_step, opt.tstop - opt.tstart, probes, bytes / kMemoryLimitBytes));
+  return Status::Ok();
+}
+
+// Bytes per step of the LTI march: it keeps each time-varying source's response at every probe.
+double march_step_bytes(const Circuit& circuit, size_t probes) {
+  long sources = 0;
   for (const auto& e : circuit.elements())
     if (const SourceFunction* f = e->source_function(); f && f->kind() != SourceFunction::Kind::Dc)
       ++sources;
-  const double march_step_bytes =
-      8.0 * static_cast<double>(1 + 2 * sources * static_cast<long>(probes.size()));
+  return 8.0 * static_cast<double>(1 + 2 * sources * static_cast<long>(probes));
+}
 
-  result.nodes = circuit.node_count() - 1;
-  result.unknowns = circuit.unknown_count();
-  result.elements = static_cast<int>(circuit.elements().size());
+// Why the LTI engine cannot run this circuit with these options (OK: it can).
+Status lti_allowed(const Circuit& circuit, const TransientOptions& opt) {
+  if (opt.uic)
+    return Status::Error(
+        ".tran uic starts from zero, not from the DC operating point: the LTI engine needs the "
+        "operating point");
+  if (!opt.node_ic.empty())
+    return Status::Error(
+        "'.ic' holds nodes for the DC point: the LTI engine starts from the circuit's own "
+        "operating point");
+  return check_lti(circuit);
+}
 
-  const auto start = std::chrono::steady_clock::now();
-  if (req.engine != Engine::Transient) {
-    Status lti_ok = opt.uic ? Status::Error(
-                                  ".tran uic starts from zero, not from the DC operating "
-                                  "point: the LTI engine needs the operating point")
-                    : !opt.node_ic.empty()
-                        ? Status::Error(
-                              "'.ic' holds nodes for the DC point: the LTI engine starts from "
-                              "the circuit's own operating point")
-                        : check_lti(circuit);
-    if (!lti_ok.ok() && req.engine == Engine::Lti) return lti_ok;
-    if (lti_ok.ok()) {
-      for (const auto& e : circuit.elements()) e->bind_time(opt.tstep, opt.tstop);
-      LtiOptions lo;
-      lo.horizon = opt.tstop;
-      lo.method = req.lti_method;
-      if (req.progress)
-        lo.on_progress = [&](double tau) {
-          req.progress("LTI responses", std::clamp(tau / opt.tstop, 0.0, 1.0));
-        };
-      // auto: a march longer than kAutoLtiMaxSteps costs more than the transient of any example
-      // link (the longest takes 190k steps), so auto stops there and runs the transient.
-      if (req.engine == Engine::Auto) {
-        lo.max_steps = std::min(lo.max_steps, kAutoLtiMaxSteps);
-        lo.settle_by = 0.25 * opt.tstop;
-      }
-      lo.max_steps = std::min<long>(lo.max_steps,
-                                    static_cast<long>(kMemoryLimitBytes / (2 * march_step_bytes)));
-      StatusOr<LtiResponses> responses = LtiResponses::compute(circuit, probes, lo);
-      // auto: a response march that cannot meet its error control falls back to the transient
-      // engine (the cross-check) and says why; a forced `lti` reports the failure.
-      if (!responses && req.engine == Engine::Lti) return responses.status();
-      if (responses) {
-        LtiResponses::GridOptions grid;
-        grid.tstart = opt.tstart;
-        grid.tstop = opt.tstop;
-        grid.step = req.grid_step;
-        grid.grid_probes = req.grid_probes;
-        grid.max_rows =
-            std::min<long>(grid.max_rows, static_cast<long>(kMemoryLimitBytes / (4 * row_bytes)));
-        // auto: the LTI output only when it costs about what the transient would (a transient
-        // step costs about an unknown's worth of work per unknown, as does a probe evaluation).
-        if (req.engine == Engine::Auto && !responses->reduced())
-          grid.max_evaluations =
-              kAutoLtiBudget * static_cast<double>(responses->stats().steps) * result.unknowns;
-        result.wave = responses->waveform(responses->netlist_inputs(opt.tstop), grid, &result.grid);
-      }
-      if (responses && result.grid.over_budget) {
-        lti_ok = Status::Error(fmt::format(
-            "the LTI output grid would take {:.3g} probe evaluations, more than the transient "
-            "costs here ({} march steps x {} unknowns x {:g})",
-            result.grid.evaluations, responses->stats().steps, result.unknowns, kAutoLtiBudget));
-        result.grid = {};
-      } else if (responses) {
-        if (!result.grid.warning.empty())
-          result.warnings.push_back("warning: " + result.grid.warning);
-        result.lti = responses->stats();
-        result.engine = Engine::Lti;
-        result.seconds =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        return result;
-      } else {
-        // Only auto gets here (a forced lti returned the error above), and auto's own limits
-        // (settle_by, kAutoLtiMaxSteps) are the usual reason: say so, without reading the text.
-        lti_ok = Status::Error(fmt::format(
-            "the LTI response march stopped: {}; auto stops it where it would cost more than the "
-            "transient (responses not settled by a quarter of the run, or over {} steps)",
-            responses.status().message(), kAutoLtiMaxSteps));
-      }
+// What the engines share: the circuit, its probes, the options and the memory per row.
+struct EngineRun {
+  Circuit& circuit;
+  const std::vector<Probe>& probes;
+  const SimulationRequest& req;
+  TransientOptions& opt;
+  double row_bytes = 0;
+  std::chrono::steady_clock::time_point start;
+};
+
+// The LTI engine: *done when result holds its waveform; otherwise result.engine_note says why
+// not (auto falls back to the transient). Errors: a forced `lti` that cannot run.
+Status run_lti(const EngineRun& run, SimulationResult& result, bool* done) {
+  const SimulationRequest& req = run.req;
+  const TransientOptions& opt = run.opt;
+  Status lti_ok = lti_allowed(run.circuit, opt);
+  if (!lti_ok.ok() && req.engine == Engine::Lti) return lti_ok;
+  if (lti_ok.ok()) {
+    for (const auto& e : run.circuit.elements()) e->bind_time(opt.tstep, opt.tstop);
+    LtiOptions lo;
+    lo.horizon = opt.tstop;
+    lo.method = req.lti_method;
+    if (req.progress)
+      lo.on_progress = [&](double tau) {
+        req.progress("LTI responses", std::clamp(tau / opt.tstop, 0.0, 1.0));
+      };
+    // auto: a march longer than kAutoLtiMaxSteps costs more than the transient of any example
+    // link (the longest takes 190k steps), so auto stops there and runs the transient.
+    if (req.engine == Engine::Auto) {
+      lo.max_steps = std::min(lo.max_steps, kAutoLtiMaxSteps);
+      lo.settle_by = 0.25 * opt.tstop;
     }
-    result.engine_note = lti_ok.message();
+    const double march_bytes = march_step_bytes(run.circuit, run.probes.size());
+    lo.max_steps =
+        std::min<long>(lo.max_steps, static_cast<long>(kMemoryLimitBytes / (2 * march_bytes)));
+    StatusOr<LtiResponses> responses = LtiResponses::compute(run.circuit, run.probes, lo);
+    // auto: a response march that cannot meet its error control falls back to the transient
+    // engine (the cross-check) and says why; a forced `lti` reports the failure.
+    if (!responses && req.engine == Engine::Lti) return responses.status();
+    if (responses) {
+      LtiResponses::GridOptions grid;
+      grid.tstart = opt.tstart;
+      grid.tstop = opt.tstop;
+      grid.step = req.grid_step;
+      grid.grid_probes = req.grid_probes;
+      grid.max_rows =
+          std::min<long>(grid.max_rows, static_cast<long>(kMemoryLimitBytes / (4 * run.row_bytes)));
+      // auto: the LTI output only when it costs about what the transient would (a transient
+      // step costs about an unknown's worth of work per unknown, as does a probe evaluation).
+      if (req.engine == Engine::Auto && !responses->reduced())
+        grid.max_evaluations =
+            kAutoLtiBudget * static_cast<double>(responses->stats().steps) * result.unknowns;
+      result.wave = responses->waveform(responses->netlist_inputs(opt.tstop), grid, &result.grid);
+    }
+    if (responses && result.grid.over_budget) {
+      lti_ok = Status::Error(fmt::format(
+          "the LTI output grid would take {:.3g} probe evaluations, more than the transient "
+          "costs here ({} march steps x {} unknowns x {:g})",
+          result.grid.evaluations, responses->stats().steps, result.unknowns, kAutoLtiBudget));
+      result.grid = {};
+    } else if (responses) {
+      if (!result.grid.warning.empty())
+        result.warnings.push_back("warning: " + result.grid.warning);
+      result.lti = responses->stats();
+      result.engine = Engine::Lti;
+      result.seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - run.start).count();
+      *done = true;
+      return Status::Ok();
+    } else {
+      // Only auto gets here (a forced lti returned the error above), and auto's own limits
+      // (settle_by, kAutoLtiMaxSteps) are the usual reason: say so, without reading the text.
+      lti_ok = Status::Error(fmt::format(
+          "the LTI response march stopped: {}; auto stops it where it would cost more than the "
+          "transient (responses not settled by a quarter of the run, or over {} steps)",
+          responses.status().message(), kAutoLtiMaxSteps));
+    }
   }
-  if (Status s = check_transient_memory(netlist, opt, row_bytes); !s.ok()) {
+  result.engine_note = lti_ok.message();
+  return Status::Ok();
+}
+
+// The transient engine, within the memory limit (an error names the LTI engine's refusal too).
+Status run_transient_engine(const Netlist& netlist, const EngineRun& run,
+                            SimulationResult& result) {
+  const SimulationRequest& req = run.req;
+  TransientOptions& opt = run.opt;
+  if (Status s = check_transient_memory(netlist, opt, run.row_bytes); !s.ok()) {
     if (result.engine_note.empty()) return s;
     return Status::Error(s.message() + "\n(the LTI engine was not used: " + result.engine_note +
                          ")");
@@ -275,16 +312,17 @@ StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequ
     };
   if (!result.engine_note.empty())
     result.lti_attempt_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - run.start).count();
   result.reltol = opt.reltol;
   result.trtol = opt.trtol;
-  StatusOr<Waveform> wave = run_transient(circuit, opt, probes, &result.stats);
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  StatusOr<Waveform> wave = run_transient(run.circuit, opt, run.probes, &result.stats);
+  result.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - run.start).count();
   if (!wave && opt.max_steps < TransientOptions{}.max_steps &&
       result.stats.accepted + result.stats.rejected >= opt.max_steps)
     return Status::Error(
         fmt::format("{} ({} steps: {} rows of {} values are what the 1 GB memory limit allows)",
-                    wave.status().message(), opt.max_steps, opt.max_steps, probes.size() + 1));
+                    wave.status().message(), opt.max_steps, opt.max_steps, run.probes.size() + 1));
   if (!wave) return wave.status();
   if (req.engine == Engine::Auto && !result.engine_note.empty() && !req.reltol) {
     // auto fell back: the run checks its own convergence (transient_check.h).
@@ -297,6 +335,33 @@ StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequ
   }
   result.wave = std::move(*wave);
   result.engine = Engine::Transient;
+  return Status::Ok();
+}
+
+StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequest& req,
+                                    SimulationResult& result) {
+  TransientOptions opt;
+  if (Status s = run_options(netlist, req, &opt, result); !s.ok()) return s;
+  Circuit circuit;
+  if (Status s = build_circuit(netlist, &circuit, &opt, result); !s.ok()) return s;
+  StatusOr<std::vector<Probe>> probes = parse_probes(circuit, req);
+  if (!probes) return probes.status();
+  // Memory (kMemoryLimitBytes): a row is the time plus every probe.
+  const double row_bytes = 8.0 * static_cast<double>(1 + probes->size());
+  if (Status s = check_grid_memory(req, opt, probes->size(), row_bytes); !s.ok()) return s;
+  opt.max_steps =
+      std::min<long>(opt.max_steps, static_cast<long>(kMemoryLimitBytes / (2 * row_bytes)));
+  result.nodes = circuit.node_count() - 1;
+  result.unknowns = circuit.unknown_count();
+  result.elements = static_cast<int>(circuit.elements().size());
+
+  const EngineRun run{circuit, *probes, req, opt, row_bytes, std::chrono::steady_clock::now()};
+  if (req.engine != Engine::Transient) {
+    bool done = false;
+    if (Status s = run_lti(run, result, &done); !s.ok()) return s;
+    if (done) return result;
+  }
+  if (Status s = run_transient_engine(netlist, run, result); !s.ok()) return s;
   return result;
 }
 

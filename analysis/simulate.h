@@ -4,6 +4,14 @@
 //   SimulationRequest req{.probes = {"v(rxp,rxn)"}};
 //   StatusOr<SimulationResult> r = simulate_netlist(netlist, req);
 //   for (auto& w : r->warnings) print(w);
+//
+// Contract:
+// - Units: SI (s, V, A); probes as in the netlist ("v(a,b)", "i(Vname)").
+// - Ownership: the result owns its waveform and texts; the netlist is read, not kept.
+// - Errors: a Status, never thrown: a card or .ic that does not build (file:line:col), a probe
+//   that names nothing, a run over kMemoryLimitBytes or kMaxGridRows (at the .tran card), a
+//   forced `lti` the circuit does not allow, an engine that fails. simulate_netlist puts the
+//   netlist's and the circuit's warnings before the message.
 #pragma once
 
 #include <array>

@@ -4,11 +4,15 @@
 //
 // Every rank reads the sweep file and the part library itself. Rank 0 hands point indices out on
 // request (dynamic: a worker asks for the next point when it has sent its last row back), writes
-// results.csv as rows come in, then summary.json and the plots: the same files as a threaded run
-// (rows in completion order, run times aside). Each worker runs one point at a time, so start one
+// results.csv as rows come in (then the front end writes summary.json and the plots on rank 0,
+// reports/sweep_report.h): the same files as a threaded run (rows in completion order, run
+// times aside). Each worker runs one point at a time, so start one
 // rank per core plus one for the coordinator, which sleeps between messages. Waveforms
 // (--keep-waves) are written by the workers into DIR/waves (a shared folder across machines).
 // Outside mpirun (or with one rank) `isolink sweep` is the threaded run.
+//
+// Contract: as run_sweep's (sweep_run.h); every rank must call run_sweep_mpi with the same spec
+// and options, and only rank 0's outcome holds results.
 #pragma once
 
 #include "analysis/sweep_run.h"

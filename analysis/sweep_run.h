@@ -1,11 +1,15 @@
 // Running a sweep: each point through run_link (analysis/link_run.h), scored to one row of
-// results.csv; the points in parallel on all cores (oneTBB) or across MPI ranks (sweep_mpi.h);
-// then summary.json and the plots (reports/sweep_plots.h).
+// results.csv; the points in parallel on all cores (oneTBB) or across MPI ranks (sweep_mpi.h).
+// summary.json and the charts are written from the outcome by reports/sweep_report.h.
 //
 //   StatusOr<SweepSpec> s = read_sweep_file(path);
 //   StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
 //   SweepOptions opt{.out_dir = "out", .jobs = 0};
 //   StatusOr<SweepOutcome> r = run_sweep(*s, *parts, opt);   // r->fail + r->error == 0: all pass
+//   reports::write_sweep_report(*s, &*r, opt.out_dir, true);   // summary.json, the charts
+//
+// Errors (StatusOr, never thrown): a folder that cannot be created, a results.csv that cannot be
+// read (--resume) or written; a point that fails is a row with verdict "error", not an error.
 //
 // results.csv: one row per point, appended (and flushed) as points finish, so rows are in
 // completion order; `point` is the point's index (sort by it). Columns:
@@ -77,7 +81,6 @@
 #include <map>
 #include <memory>
 #include <mutex>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -212,18 +215,12 @@ PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t
                       const PointOptions& opt);
 
 struct SweepOptions {
-  std::string out_dir;      // results.csv, summary.json, PNGs (created)
+  std::string out_dir;      // results.csv (created; summary.json and the charts: reports/)
   int jobs = 0;             // threads (0: all cores)
   bool resume = false;      // skip points already in results.csv
   bool keep_waves = false;  // out_dir/waves/point_NNNNN.csv per point
-  bool plots = true;
-  // Draws the charts into out_dir and appends their names to *files (reports/sweep_report.h
-  // provides one; analysis/ draws nothing itself).
-  std::function<Status(const SweepSpec&, const std::vector<PointResult>&, const std::string& dir,
-                       std::vector<std::string>* files)>
-      render_plots;
-  bool quiet = false;  // no progress
-  PointOptions point;  // waves_dir is filled in from keep_waves
+  bool quiet = false;       // no progress
+  PointOptions point;       // waves_dir is filled in from keep_waves
   // Called once, when the thread pool is up and before the first point: the moment to start
   // background work (cli/ loads the charts' image plug-in there). Not before: the pool's first
   // start loads libraries, and a dlopen on another thread would hold it up for as long as its
@@ -231,15 +228,11 @@ struct SweepOptions {
   std::function<void()> on_pool_ready;
 };
 
-// summary.json's `paths`: {"edges": N, "simulated": M, "first_simulated": {"point", "path"} or
-// null}: how many points took the fast path, and the first that did not and why.
-nlohmann::ordered_json path_counts(const std::vector<PointResult>& results);
-
 struct SweepOutcome {
   size_t points = 0, pass = 0, fail = 0, error = 0;
   size_t skipped = 0;              // already in results.csv (--resume)
   double seconds = 0;              // wall time of this run
-  std::vector<std::string> files;  // written, relative to out_dir
+  std::vector<std::string> files;  // written, relative to out_dir (reports/ adds its own)
   // Every point's result by point index (the rows kept by --resume included): what results.csv
   // holds, for front ends that want the rows without reading the file back (python/).
   std::vector<PointResult> results;
@@ -284,12 +277,9 @@ class ResultLog {
   mutable std::mutex mu_;
 };
 
-// summary.json: counts, pass yield, the worst point, the pass/fail boundary along the first axis.
-nlohmann::ordered_json summary_json(const SweepSpec& s, const std::vector<PointResult>& results);
-// summary.json and the plots from the results (sorted by point); the files written are added to
-// out->files and the results kept in out->results.
-Status finish_sweep(const SweepSpec& s, std::vector<PointResult> results, const SweepOptions& opt,
-                    SweepOutcome* out);
+// The outcome of the results (sorted by point): the counts, results.csv among out->files, the
+// results kept in out->results.
+void finish_sweep(const SweepSpec& s, std::vector<PointResult> results, SweepOutcome* out);
 
 // The whole sweep on this machine's cores.
 StatusOr<SweepOutcome> run_sweep(const SweepSpec& s, const link::PartLibrary& parts,

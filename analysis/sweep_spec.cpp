@@ -262,114 +262,95 @@ bool parse_percent(const std::string& text, double* out) {
   return true;
 }
 
-Status read_axis(const SweepSpec& s, const YamlDoc& doc, const YAML::Node& key_node,
-                 const YAML::Node& v, Axis* axis) {
-  const std::string key = key_node.Scalar();
-  axis->key = key;
-  axis->line = doc.loc(key_node).line;
-  const std::vector<std::string> paths = expand_ends(key);
-  axis->unit = key_unit(key);
-
-  auto add_value = [&](const YAML::Node& n) -> Status {
-    AxisValue av;
-    av.line = doc.loc(n).line;
-    av.assign = assignments(paths, n);
-    std::string shown = n.IsScalar() ? "'" + n.Scalar() + "'" : "<" + config::node_kind(n) + ">";
-    if (n.IsScalar()) {
-      double x = 0;
-      if (parse_number_for(key, n.Scalar(), &x)) {
-        av.number = x;
-        av.label = num_text(x);
-      } else {
-        av.label = n.Scalar();
-      }
-    } else {
-      YAML::Emitter em;
-      em << YAML::Flow << n;
-      av.label = em.c_str();
-    }
-    if (Status st = check_value(s, doc, key, av.assign, key_node, n, shown); !st.ok()) return st;
-    axis->values.push_back(std::move(av));
-    return Status::Ok();
-  };
-
-  if (v.IsSequence()) {
-    if (v.size() == 0) return doc.error(v, fmt::format("sweep key '{}': the list is empty", key));
-    for (size_t i = 0; i < v.size(); ++i)
-      if (Status st = add_value(v[i]); !st.ok()) return st;
-    return Status::Ok();
-  }
-  if (v.IsScalar()) return add_value(v);
-  if (!v.IsMap())
-    return doc.error(key_node, fmt::format("sweep key '{}' has no values: give a list, a range "
-                                           "{{from, to, steps, scale}} or named variants",
-                                           key));
-  if (v["from"] || v["to"] || v["steps"]) {
-    // A range.
-    std::string from_text, to_text, scale = "lin";
-    int steps = 0;
-    Status st = config::read_map(
-        doc, v, "sweep." + key,
-        {
-            {"from", config::read_text(doc, &from_text)},
-            {"to", config::read_text(doc, &to_text)},
-            {"steps",
-             [&](const YAML::Node& n, const std::string& p) -> Status {
-               const std::string t = n.IsScalar() ? n.Scalar() : "";
-               char* end = nullptr;
-               const long x = std::strtol(t.c_str(), &end, 10);
-               if (t.empty() || *end != '\0' || x < 1 || x > 100000)
-                 return doc.error(n, fmt::format("key '{}': steps must be a whole number from 1 "
-                                                 "to 100000, found '{}'",
-                                                 p, config::node_text(n)));
-               steps = static_cast<int>(x);
-               return Status::Ok();
-             }},
-            {"scale", config::read_choice(doc, {"lin", "log"}, &scale)},
-        });
-    if (!st.ok()) return st;
-    for (const char* k : {"from", "to", "steps"})
-      if (!v[k])
-        return doc.error(v, fmt::format("sweep key '{}': a range needs from, to and steps "
-                                        "(missing '{}')",
-                                        key, k));
-    double from = 0, to = 0;
-    if (!parse_number_for(key, from_text, &from))
-      return doc.error(v["from"],
-                       fmt::format("sweep key '{}': from: expected a number{}, found "
-                                   "'{}'",
-                                   key,
-                                   axis->unit == Unit::kNone
-                                       ? ""
-                                       : fmt::format(" in {}", config::unit_symbol(axis->unit)),
-                                   from_text));
-    if (!parse_number_for(key, to_text, &to))
-      return doc.error(v["to"],
-                       fmt::format("sweep key '{}': to: expected a number{}, found '{}'", key,
-                                   axis->unit == Unit::kNone
-                                       ? ""
-                                       : fmt::format(" in {}", config::unit_symbol(axis->unit)),
-                                   to_text));
-    axis->log = scale == "log";
-    if (axis->log && (from <= 0 || to <= 0))
-      return doc.error(v["scale"] ? v["scale"] : v,
-                       fmt::format("sweep key '{}': a log range needs from and to > 0 (from {}, "
-                                   "to {})",
-                                   key, from_text, to_text));
-    for (double x : range_values(from, to, steps, axis->log)) {
-      AxisValue av;
+// One listed value of a swept key (a scalar, or a map or list given as it is).
+Status add_listed_value(const SweepSpec& s, const YamlDoc& doc, const YAML::Node& key_node,
+                        const std::vector<std::string>& paths, const YAML::Node& n, Axis* axis) {
+  const std::string& key = axis->key;
+  AxisValue av;
+  av.line = doc.loc(n).line;
+  av.assign = assignments(paths, n);
+  std::string shown = n.IsScalar() ? "'" + n.Scalar() + "'" : "<" + config::node_kind(n) + ">";
+  if (n.IsScalar()) {
+    double x = 0;
+    if (parse_number_for(key, n.Scalar(), &x)) {
       av.number = x;
       av.label = num_text(x);
-      const std::string text =
-          is_integer_key(key) ? fmt::format("{}", std::lround(x)) : num_text(x);
-      YAML::Node n(text);
-      av.assign = assignments(paths, n);
-      if (Status e = check_value(s, doc, key, av.assign, key_node, v, text); !e.ok()) return e;
-      axis->values.push_back(std::move(av));
+    } else {
+      av.label = n.Scalar();
     }
-    return Status::Ok();
+  } else {
+    YAML::Emitter em;
+    em << YAML::Flow << n;
+    av.label = em.c_str();
   }
-  // Named variants: NAME: {dotted.key: value, ...}.
+  if (Status st = check_value(s, doc, key, av.assign, key_node, n, shown); !st.ok()) return st;
+  axis->values.push_back(std::move(av));
+  return Status::Ok();
+}
+
+// A range {from, to, steps, scale}: steps values, linear or logarithmic.
+Status read_range(const SweepSpec& s, const YamlDoc& doc, const YAML::Node& key_node,
+                  const std::vector<std::string>& paths, const YAML::Node& v, Axis* axis) {
+  const std::string& key = axis->key;
+  std::string from_text, to_text, scale = "lin";
+  int steps = 0;
+  Status st = config::read_map(
+      doc, v, "sweep." + key,
+      {
+          {"from", config::read_text(doc, &from_text)},
+          {"to", config::read_text(doc, &to_text)},
+          {"steps",
+           [&](const YAML::Node& n, const std::string& p) -> Status {
+             const std::string t = n.IsScalar() ? n.Scalar() : "";
+             char* end = nullptr;
+             const long x = std::strtol(t.c_str(), &end, 10);
+             if (t.empty() || *end != '\0' || x < 1 || x > 100000)
+               return doc.error(n, fmt::format("key '{}': steps must be a whole number from 1 "
+                                               "to 100000, found '{}'",
+                                               p, config::node_text(n)));
+             steps = static_cast<int>(x);
+             return Status::Ok();
+           }},
+          {"scale", config::read_choice(doc, {"lin", "log"}, &scale)},
+      });
+  if (!st.ok()) return st;
+  for (const char* k : {"from", "to", "steps"})
+    if (!v[k])
+      return doc.error(v, fmt::format("sweep key '{}': a range needs from, to and steps "
+                                      "(missing '{}')",
+                                      key, k));
+  const std::string in_unit =
+      axis->unit == Unit::kNone ? "" : fmt::format(" in {}", config::unit_symbol(axis->unit));
+  double from = 0, to = 0;
+  if (!parse_number_for(key, from_text, &from))
+    return doc.error(v["from"], fmt::format("sweep key '{}': from: expected a number{}, found "
+                                            "'{}'",
+                                            key, in_unit, from_text));
+  if (!parse_number_for(key, to_text, &to))
+    return doc.error(v["to"], fmt::format("sweep key '{}': to: expected a number{}, found '{}'",
+                                          key, in_unit, to_text));
+  axis->log = scale == "log";
+  if (axis->log && (from <= 0 || to <= 0))
+    return doc.error(v["scale"] ? v["scale"] : v,
+                     fmt::format("sweep key '{}': a log range needs from and to > 0 (from {}, "
+                                 "to {})",
+                                 key, from_text, to_text));
+  for (double x : range_values(from, to, steps, axis->log)) {
+    AxisValue av;
+    av.number = x;
+    av.label = num_text(x);
+    const std::string text = is_integer_key(key) ? fmt::format("{}", std::lround(x)) : num_text(x);
+    YAML::Node n(text);
+    av.assign = assignments(paths, n);
+    if (Status e = check_value(s, doc, key, av.assign, key_node, v, text); !e.ok()) return e;
+    axis->values.push_back(std::move(av));
+  }
+  return Status::Ok();
+}
+
+// Named variants: NAME: {dotted.key: value, ...}.
+Status read_variants(const SweepSpec& s, const YamlDoc& doc, const YAML::Node& v, Axis* axis) {
+  const std::string& key = axis->key;
   axis->variants = true;
   axis->unit = Unit::kNone;
   for (auto it = v.begin(); it != v.end(); ++it) {
@@ -398,6 +379,28 @@ Status read_axis(const SweepSpec& s, const YamlDoc& doc, const YAML::Node& key_n
     axis->values.push_back(std::move(av));
   }
   return Status::Ok();
+}
+
+Status read_axis(const SweepSpec& s, const YamlDoc& doc, const YAML::Node& key_node,
+                 const YAML::Node& v, Axis* axis) {
+  const std::string key = key_node.Scalar();
+  axis->key = key;
+  axis->line = doc.loc(key_node).line;
+  const std::vector<std::string> paths = expand_ends(key);
+  axis->unit = key_unit(key);
+  if (v.IsSequence()) {
+    if (v.size() == 0) return doc.error(v, fmt::format("sweep key '{}': the list is empty", key));
+    for (size_t i = 0; i < v.size(); ++i)
+      if (Status st = add_listed_value(s, doc, key_node, paths, v[i], axis); !st.ok()) return st;
+    return Status::Ok();
+  }
+  if (v.IsScalar()) return add_listed_value(s, doc, key_node, paths, v, axis);
+  if (!v.IsMap())
+    return doc.error(key_node, fmt::format("sweep key '{}' has no values: give a list, a range "
+                                           "{{from, to, steps, scale}} or named variants",
+                                           key));
+  if (v["from"] || v["to"] || v["steps"]) return read_range(s, doc, key_node, paths, v, axis);
+  return read_variants(s, doc, v, axis);
 }
 
 Status read_tolerance(const SweepSpec& s, const YamlDoc& doc, const link::LinkSpec& base,
@@ -714,65 +717,63 @@ StatusOr<SweepSpec> read_sweep_file(const std::string& path) {
   return read_sweep_text(*text, path);
 }
 
-StatusOr<SweepSpec> read_sweep_text(const std::string& text, const std::string& name) {
-  StatusOr<YamlDoc> doc = YamlDoc::from_text(text, name);
-  if (!doc) return doc.status();
-  const YAML::Node& root = doc->root();
-  SweepSpec s;
-  s.path = name;
-  s.name = std::filesystem::path(name).stem().string();
-  if (!root.IsMap())
-    return doc->error(
-        root, "a sweep file is a YAML map with keys base, sweep, mode, monte_carlo, outputs");
+namespace {
 
-  // Keys in the order they are needed: base first, then sweep (checked against it), then Monte
-  // Carlo (its tolerances can depend on the swept keys).
-  YAML::Node base_node, sweep_node, mc_node;
+// The sweep file's own keys, kept for the steps that need what comes before them.
+struct SweepKeys {
+  YAML::Node base, sweep, monte_carlo;
+};
+
+// The top-level map: name, mode and outputs into s; base, sweep and monte_carlo kept for later.
+Status read_top_keys(const YamlDoc& doc, SweepSpec* s, SweepKeys* keys) {
+  const YAML::Node& root = doc.root();
+  if (!root.IsMap())
+    return doc.error(
+        root, "a sweep file is a YAML map with keys base, sweep, mode, monte_carlo, outputs");
   std::string mode = "grid";
   std::vector<std::string> outputs;
-  Status st = config::read_map(*doc, root, "",
+  auto keep = [](YAML::Node* into) {
+    return [into](const YAML::Node& n, const std::string&) {
+      into->reset(n);
+      return Status::Ok();
+    };
+  };
+  Status st = config::read_map(doc, root, "",
                                {
-                                   {"base",
-                                    [&](const YAML::Node& n, const std::string&) {
-                                      base_node.reset(n);
-                                      return Status::Ok();
-                                    }},
-                                   {"name", config::read_text(*doc, &s.name)},
-                                   {"sweep",
-                                    [&](const YAML::Node& n, const std::string&) {
-                                      sweep_node.reset(n);
-                                      return Status::Ok();
-                                    }},
-                                   {"mode", config::read_choice(*doc, {"grid", "zip"}, &mode)},
-                                   {"monte_carlo",
-                                    [&](const YAML::Node& n, const std::string&) {
-                                      mc_node.reset(n);
-                                      return Status::Ok();
-                                    }},
-                                   {"outputs", config::read_text_list(*doc, &outputs)},
+                                   {"base", keep(&keys->base)},
+                                   {"name", config::read_text(doc, &s->name)},
+                                   {"sweep", keep(&keys->sweep)},
+                                   {"mode", config::read_choice(doc, {"grid", "zip"}, &mode)},
+                                   {"monte_carlo", keep(&keys->monte_carlo)},
+                                   {"outputs", config::read_text_list(doc, &outputs)},
                                });
   if (!st.ok()) return st;
   for (size_t i = 0; i < outputs.size(); ++i) {
     const std::string& o = outputs[i];
     const YAML::Node on = root["outputs"];
     if (o == "noise")
-      s.noise_outputs = true;
+      s->noise_outputs = true;
     else if (o == "worst")
-      s.worst_outputs = true;
+      s->worst_outputs = true;
     else
-      return doc->error(on.IsSequence() ? YAML::Node(on[i]) : on,
-                        fmt::format("key 'outputs': '{}' is not a result family; the ones known "
-                                    "are noise (the noise-immunity columns) and worst (the worst "
-                                    "case over all legal traffic)",
-                                    o));
+      return doc.error(on.IsSequence() ? YAML::Node(on[i]) : on,
+                       fmt::format("key 'outputs': '{}' is not a result family; the ones known "
+                                   "are noise (the noise-immunity columns) and worst (the worst "
+                                   "case over all legal traffic)",
+                                   o));
   }
-  s.mode = mode == "zip" ? Mode::kZip : Mode::kGrid;
-  if (s.name.empty() || s.name.find_first_of("/\\") != std::string::npos)
-    return doc->error(root["name"], "key 'name': a non-empty name without '/'");
+  s->mode = mode == "zip" ? Mode::kZip : Mode::kGrid;
+  if (s->name.empty() || s->name.find_first_of("/\\") != std::string::npos)
+    return doc.error(root["name"], "key 'name': a non-empty name without '/'");
+  return Status::Ok();
+}
 
-  // The base spec.
+// The base spec's text: a file named relative to the sweep file, or the sweep file itself when
+// the base is inline.
+Status read_base_text(const YamlDoc& doc, const YAML::Node& base_node, const std::string& text,
+                      const std::string& name, SweepSpec* s) {
   if (!base_node.IsDefined() || base_node.IsNull())
-    return doc->error(root, "key 'base' is missing: a link spec file or an inline spec");
+    return doc.error(doc.root(), "key 'base' is missing: a link spec file or an inline spec");
   if (base_node.IsScalar()) {
     std::filesystem::path p(base_node.Scalar());
     if (p.is_relative()) p = std::filesystem::path(name).parent_path() / p;
@@ -780,116 +781,130 @@ StatusOr<SweepSpec> read_sweep_text(const std::string& text, const std::string& 
     if (!base_text) {
       const std::string& m = base_text.status().message();  // "PATH: error: REASON"
       const size_t at = m.find(": error: ");
-      return doc->error(base_node,
-                        fmt::format("key 'base': cannot read the link spec '{}': {}", p.string(),
-                                    at == std::string::npos ? m : m.substr(at + 9)));
+      return doc.error(base_node,
+                       fmt::format("key 'base': cannot read the link spec '{}': {}", p.string(),
+                                   at == std::string::npos ? m : m.substr(at + 9)));
     }
-    s.base_path = p.lexically_normal().string();
-    s.base_text = std::move(*base_text);
+    s->base_path = p.lexically_normal().string();
+    s->base_text = std::move(*base_text);
   } else if (base_node.IsMap()) {
-    s.base_path = name;
-    s.base_text = text;
-    s.base_inline = true;
+    s->base_path = name;
+    s->base_text = text;
+    s->base_inline = true;
   } else {
-    return doc->error(base_node, "key 'base': a link spec file name or an inline spec (a map)");
+    return doc.error(base_node, "key 'base': a link spec file name or an inline spec (a map)");
   }
-  StatusOr<YamlDoc> bdoc = base_doc(s);
+  return Status::Ok();
+}
+
+// The base read as a pack spec (every point a pack run; the keys address its hops) or a link
+// spec (into *base_spec); a pack refuses Monte Carlo and the result families.
+Status read_base_spec(const YamlDoc& doc, const SweepKeys& keys, const std::string& name,
+                      SweepSpec* s, link::LinkSpec* base_spec) {
+  StatusOr<YamlDoc> bdoc = base_doc(*s);
   if (!bdoc) return bdoc.status();
-  link::LinkSpec base_spec;
-  if (is_pack_spec(*bdoc)) {
-    // A pack: every point is a pack run; the keys address its hops.
-    if (s.base_inline)
-      return doc->error(base_node,
-                        "key 'base': an inline base is a link spec; give a pack spec "
-                        "as a file (base: pack.yaml)");
-    StatusOr<PackSpec> pack = read_pack_spec_text(s.base_text, s.base_path);
-    if (!pack) return pack.status().with_context(fmt::format("{}: the base pack", name));
-    s.pack = true;
-    s.pack_hops = static_cast<int>(pack->hops.size());
-    s.pack_ring = pack->ring;
-    if (mc_node.IsDefined() && !mc_node.IsNull())
-      return doc->error(mc_node,
-                        "key 'monte_carlo': not available when the base is a pack spec "
-                        "(sweep the hops' keys on a grid instead)");
-    for (const auto& [on, family] :
-         {std::pair{s.noise_outputs, "noise"}, std::pair{s.worst_outputs, "worst"}})
-      if (on)
-        return doc->error(root["outputs"],
-                          fmt::format("key 'outputs': {0} is not available when the base is a "
-                                      "pack spec (sweep a hop's own link spec with outputs: [{0}] "
-                                      "instead)",
-                                      family));
-  } else {
+  if (!is_pack_spec(*bdoc)) {
     StatusOr<link::LinkSpec> spec = link::read_link_spec(*bdoc);
     if (!spec) return spec.status().with_context(fmt::format("{}: the base spec", name));
-    base_spec = std::move(*spec);
+    *base_spec = std::move(*spec);
+    return Status::Ok();
   }
-  const link::LinkSpec* base = &base_spec;
+  if (s->base_inline)
+    return doc.error(keys.base,
+                     "key 'base': an inline base is a link spec; give a pack spec "
+                     "as a file (base: pack.yaml)");
+  StatusOr<PackSpec> pack = read_pack_spec_text(s->base_text, s->base_path);
+  if (!pack) return pack.status().with_context(fmt::format("{}: the base pack", name));
+  s->pack = true;
+  s->pack_hops = static_cast<int>(pack->hops.size());
+  s->pack_ring = pack->ring;
+  if (keys.monte_carlo.IsDefined() && !keys.monte_carlo.IsNull())
+    return doc.error(keys.monte_carlo,
+                     "key 'monte_carlo': not available when the base is a pack spec "
+                     "(sweep the hops' keys on a grid instead)");
+  for (const auto& [on, family] :
+       {std::pair{s->noise_outputs, "noise"}, std::pair{s->worst_outputs, "worst"}})
+    if (on)
+      return doc.error(doc.root()["outputs"],
+                       fmt::format("key 'outputs': {0} is not available when the base is a "
+                                   "pack spec (sweep a hop's own link spec with outputs: [{0}] "
+                                   "instead)",
+                                   family));
+  return Status::Ok();
+}
 
-  // The swept keys.
+// The swept keys (each once); in zip mode, the same number of values for each.
+Status read_swept_keys(const YamlDoc& doc, const YAML::Node& sweep_node, SweepSpec* s) {
   if (sweep_node.IsDefined() && !sweep_node.IsNull()) {
     if (!sweep_node.IsMap())
-      return doc->error(sweep_node, "key 'sweep': a map of dotted spec keys to their values");
+      return doc.error(sweep_node, "key 'sweep': a map of dotted spec keys to their values");
     for (auto it = sweep_node.begin(); it != sweep_node.end(); ++it) {
       Axis axis;
-      if (Status e = read_axis(s, *doc, it->first, it->second, &axis); !e.ok()) return e;
-      for (const Axis& other : s.axes)
+      if (Status e = read_axis(*s, doc, it->first, it->second, &axis); !e.ok()) return e;
+      for (const Axis& other : s->axes)
         if (other.key == axis.key)
-          return doc->error(it->first, fmt::format("sweep key '{}' is given twice", axis.key));
-      s.axes.push_back(std::move(axis));
+          return doc.error(it->first, fmt::format("sweep key '{}' is given twice", axis.key));
+      s->axes.push_back(std::move(axis));
     }
   }
-  if (s.mode == Mode::kZip && !s.axes.empty()) {
-    for (const Axis& a : s.axes)
-      if (a.values.size() != s.axes.front().values.size()) {
-        std::string sizes;
-        for (const Axis& b : s.axes)
-          sizes += fmt::format("{}{} has {}", sizes.empty() ? "" : ", ", b.key, b.values.size());
-        return doc->error(root["mode"] ? root["mode"] : sweep_node,
-                          fmt::format("mode zip needs the same number of values for every key: "
-                                      "{}",
-                                      sizes));
-      }
-  }
+  if (s->mode != Mode::kZip || s->axes.empty()) return Status::Ok();
+  for (const Axis& a : s->axes)
+    if (a.values.size() != s->axes.front().values.size()) {
+      std::string sizes;
+      for (const Axis& b : s->axes)
+        sizes += fmt::format("{}{} has {}", sizes.empty() ? "" : ", ", b.key, b.values.size());
+      const YAML::Node& root = doc.root();
+      return doc.error(root["mode"] ? root["mode"] : sweep_node,
+                       fmt::format("mode zip needs the same number of values for every key: "
+                                   "{}",
+                                   sizes));
+    }
+  return Status::Ok();
+}
 
-  // Monte Carlo.
-  if (mc_node.IsDefined() && !mc_node.IsNull()) {
-    YAML::Node tol_node;
-    int samples = 0, seed = 1;
-    Status e = config::read_map(
-        *doc, mc_node, "monte_carlo",
-        {
-            {"samples", config::read_int(*doc, 1, 10000000, &samples)},
-            {"seed", config::read_int(*doc, 0, std::numeric_limits<int>::max(), &seed)},
-            {"tolerances",
-             [&](const YAML::Node& n, const std::string&) {
-               tol_node.reset(n);
-               return Status::Ok();
-             }},
-        });
-    if (!e.ok()) return e;
-    if (!mc_node["samples"])
-      return doc->error(mc_node, "key 'monte_carlo.samples' is missing: how many samples");
-    if (!tol_node.IsMap() || tol_node.size() == 0)
-      return doc->error(tol_node.IsDefined() ? tol_node : mc_node,
-                        "key 'monte_carlo.tolerances': a map of dotted spec keys to tolerances "
-                        "(10%, {normal: [mean, sigma]}, {uniform: [lo, hi]})");
-    s.mc.samples = samples;
-    s.mc.seed = static_cast<uint64_t>(seed);
-    for (auto it = tol_node.begin(); it != tol_node.end(); ++it) {
-      Tolerance t;
-      if (Status te = read_tolerance(s, *doc, *base, it->first, it->second, &t); !te.ok())
-        return te;
-      for (const Tolerance& other : s.mc.tolerances)
-        if (other.key == t.key)
-          return doc->error(it->first, fmt::format("tolerance '{}' is given twice", t.key));
-      s.mc.tolerances.push_back(std::move(t));
-    }
+// The monte_carlo block: samples, seed and the tolerances (each key once), checked against the
+// base spec.
+Status read_monte_carlo(const YamlDoc& doc, const YAML::Node& mc_node, const link::LinkSpec& base,
+                        SweepSpec* s) {
+  if (!mc_node.IsDefined() || mc_node.IsNull()) return Status::Ok();
+  YAML::Node tol_node;
+  int samples = 0, seed = 1;
+  Status e = config::read_map(
+      doc, mc_node, "monte_carlo",
+      {
+          {"samples", config::read_int(doc, 1, 10000000, &samples)},
+          {"seed", config::read_int(doc, 0, std::numeric_limits<int>::max(), &seed)},
+          {"tolerances",
+           [&](const YAML::Node& n, const std::string&) {
+             tol_node.reset(n);
+             return Status::Ok();
+           }},
+      });
+  if (!e.ok()) return e;
+  if (!mc_node["samples"])
+    return doc.error(mc_node, "key 'monte_carlo.samples' is missing: how many samples");
+  if (!tol_node.IsMap() || tol_node.size() == 0)
+    return doc.error(tol_node.IsDefined() ? tol_node : mc_node,
+                     "key 'monte_carlo.tolerances': a map of dotted spec keys to tolerances "
+                     "(10%, {normal: [mean, sigma]}, {uniform: [lo, hi]})");
+  s->mc.samples = samples;
+  s->mc.seed = static_cast<uint64_t>(seed);
+  for (auto it = tol_node.begin(); it != tol_node.end(); ++it) {
+    Tolerance t;
+    if (Status te = read_tolerance(*s, doc, base, it->first, it->second, &t); !te.ok()) return te;
+    for (const Tolerance& other : s->mc.tolerances)
+      if (other.key == t.key)
+        return doc.error(it->first, fmt::format("tolerance '{}' is given twice", t.key));
+    s->mc.tolerances.push_back(std::move(t));
   }
+  return Status::Ok();
+}
+
+// Something to sweep, and a point count within kMaxSweepPoints, with overflow checks, before
+// anything is sized by it (64 two-valued axes are 2^64 points: size_t wraps to 0).
+Status check_point_count(const YamlDoc& doc, const YAML::Node& sweep_node, const SweepSpec& s) {
   if (s.axes.empty() && s.mc.samples == 0)
-    return doc->error(root, "nothing to sweep: give 'sweep' keys or 'monte_carlo'");
-  // The point count, with overflow checks, before anything is sized by it (64 two-valued axes
-  // are 2^64 points: size_t wraps to 0).
+    return doc.error(doc.root(), "nothing to sweep: give 'sweep' keys or 'monte_carlo'");
   size_t points = 1;
   bool over = false;
   if (s.mode == Mode::kZip && !s.axes.empty())
@@ -899,11 +914,32 @@ StatusOr<SweepSpec> read_sweep_text(const std::string& text, const std::string& 
       over = over || __builtin_mul_overflow(points, a.values.size(), &points);
   over = over || __builtin_mul_overflow(points, s.samples(), &points);
   if (over || points > kMaxSweepPoints)
-    return doc->error(
-        sweep_node.IsDefined() ? sweep_node : root,
+    return doc.error(
+        sweep_node.IsDefined() ? sweep_node : doc.root(),
         fmt::format("the sweep has {} points; the limit is {} (fewer values per key, "
                     "fewer keys, or fewer Monte Carlo samples)",
                     over ? std::string("2^64 or more") : std::to_string(points), kMaxSweepPoints));
+  return Status::Ok();
+}
+
+}  // namespace
+
+StatusOr<SweepSpec> read_sweep_text(const std::string& text, const std::string& name) {
+  StatusOr<YamlDoc> doc = YamlDoc::from_text(text, name);
+  if (!doc) return doc.status();
+  SweepSpec s;
+  s.path = name;
+  s.name = std::filesystem::path(name).stem().string();
+  // Keys in the order they are needed: base first, then sweep (checked against it), then Monte
+  // Carlo (its tolerances can depend on the swept keys).
+  SweepKeys keys;
+  if (Status st = read_top_keys(*doc, &s, &keys); !st.ok()) return st;
+  if (Status st = read_base_text(*doc, keys.base, text, name, &s); !st.ok()) return st;
+  link::LinkSpec base_spec;
+  if (Status st = read_base_spec(*doc, keys, name, &s, &base_spec); !st.ok()) return st;
+  if (Status st = read_swept_keys(*doc, keys.sweep, &s); !st.ok()) return st;
+  if (Status st = read_monte_carlo(*doc, keys.monte_carlo, base_spec, &s); !st.ok()) return st;
+  if (Status st = check_point_count(*doc, keys.sweep, s); !st.ok()) return st;
   return s;
 }
 

@@ -45,6 +45,13 @@
 // the spec reader applies each key's own unit rules. Every key and every listed value is checked
 // against the base spec when the file is read: unknown keys and bad values are errors at the sweep
 // file's line; combinations can still be invalid, which makes that point an error at run time.
+//
+// Contract:
+// - Units: values as the spec keys take them (SI, the config/ suffixes); AxisValue::number in SI.
+// - Ownership: a SweepSpec owns the base spec's text and every value; point specs are made from it
+//   on demand and owned by the caller.
+// - Errors: a Status, never thrown, at the file, line and column of the key (an invalid point's
+//   spec is reported by make_point, not at reading, when only that point is invalid).
 #pragma once
 
 #include <cstddef>

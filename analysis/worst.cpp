@@ -459,112 +459,146 @@ EdgeResponse coarsened(const EdgeResponse& e, int k, const WorstOptions& opt) {
   return out;
 }
 
-StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::PartLibrary& parts,
-                                     link::Direction d, const WorstOptions& opt) {
-  const auto start = std::chrono::steady_clock::now();
-  EdgeResponse out;
-  out.dt = opt.dt;
-  out.pre = to_samples(50e-9, opt.dt);
-  const double lead = kLead;
-  const long half = to_samples(opt.expand.stimulus.encoding.half_bit, opt.dt);
+namespace {
+
+// One direction's edge response (EdgeResponse): the link driven by one 0 -> +1 edge at kLead,
+// sampled from the reduced model in closed form (EdgeEngine::Auto) or from tight transients, on
+// longer records until it settles.
+class EdgeResponseBuilder {
+ public:
+  EdgeResponseBuilder(const link::LinkSpec& spec, const link::PartLibrary& parts, link::Direction d,
+                      const WorstOptions& opt, EdgeResponse& out)
+      : spec_(spec),
+        parts_(parts),
+        d_(d),
+        opt_(opt),
+        out_(out),
+        half_(to_samples(opt.expand.stimulus.encoding.half_bit, opt.dt)) {
+    out_.dt = opt.dt;
+    out_.pre = to_samples(50e-9, opt.dt);
+    out_.more.assign(opt.more_probes.size(), {});
+    for (size_t i = 0; i < out_.more.size(); ++i) out_.more[i].probe = opt.more_probes[i];
+  }
+
+  // The reduced model: one model, sampled on longer records until settled. *done false (and
+  // out.engine_note why) when the model cannot be made: the transient takes over.
+  Status from_reduced_model(bool* done);
+  // Transients of longer records until the response settles.
+  Status from_transients();
+
+ private:
   // Settling of a sampled record (see EdgeResponse): true when it has settled.
-  auto settled = [&](double span) {
-    out.span = span;
-    measure_settling(out, half);
-    return out.drift <= opt.settle_tol;
-  };
-  auto unsettled = [&](const std::string& what, double span) {
+  bool settled(double span) {
+    out_.span = span;
+    measure_settling(out_, half_);
+    return out_.drift <= opt_.settle_tol;
+  }
+  Status unsettled(const std::string& what, double span) const {
     return Status::Error(fmt::format(
         "{}: the edge response has not settled {:g} us after the edge (a half bit's response is "
         "still {:.1f} uV, more than {:.1f} uV): the link's memory is too long for the "
         "worst-case search",
-        what, span * 1e6, out.drift * 1e6, opt.settle_tol * 1e6));
-  };
-  auto finite = [&](const std::string& what) {
-    for (double x : out.e)
+        what, span * 1e6, out_.drift * 1e6, opt_.settle_tol * 1e6));
+  }
+  Status finite(const std::string& what) const {
+    for (double x : out_.e)
       if (!std::isfinite(x)) return Status::Error(what + ": the edge response is not finite");
-    for (const EdgeResponse::Column& c : out.more)
+    for (const EdgeResponse::Column& c : out_.more)
       for (double x : c.e)
         if (!std::isfinite(x))
           return Status::Error(what + ": the edge response of " + c.probe + " is not finite");
     return Status::Ok();
-  };
-
-  // The link driven by one 0 -> +1 edge at `lead`, held for `span`, and its circuit and probe.
-  auto edge_link = [&](double span) {
+  }
+  // The link driven by one 0 -> +1 edge at kLead, held for `span`.
+  StatusOr<link::ExpandedLink> edge_link(double span) const {
     traffic::Drive drive;
-    drive.encoding = opt.expand.stimulus.encoding;
-    drive.segments = {{0.0, lead, 0}, {lead, lead + span, +1}};
-    link::ExpandOptions ex = opt.expand;
+    drive.encoding = opt_.expand.stimulus.encoding;
+    drive.segments = {{0.0, kLead, 0}, {kLead, kLead + span, +1}};
+    link::ExpandOptions ex = opt_.expand;
     ex.drive = drive;
-    return link::expand_link(spec, parts, d, ex);
-  };
+    return link::expand_link(spec_, parts_, d_, ex);
+  }
   // The circuit and its probes: v(rxp,rxn), then opt.more_probes.
-  auto edge_circuit = [&](const link::ExpandedLink& link,
-                          Circuit& circuit) -> StatusOr<std::vector<Probe>> {
+  StatusOr<std::vector<Probe>> edge_circuit(const link::ExpandedLink& link,
+                                            Circuit& circuit) const {
     for (const Card& card : link.netlist.cards)
       if (Status s = circuit.add(card); !s.ok()) return s;
     if (Status s = circuit.finalize(); !s.ok()) return s;
     std::vector<Probe> probes;
-    for (size_t i = 0; i <= opt.more_probes.size(); ++i) {
-      StatusOr<Probe> p = parse_probe(circuit, i == 0 ? "v(rxp,rxn)" : opt.more_probes[i - 1]);
+    for (size_t i = 0; i <= opt_.more_probes.size(); ++i) {
+      StatusOr<Probe> p = parse_probe(circuit, i == 0 ? "v(rxp,rxn)" : opt_.more_probes[i - 1]);
       if (!p) return p.status();
       probes.push_back(*p);
     }
     return probes;
-  };
-  out.more.assign(opt.more_probes.size(), {});
-  for (size_t i = 0; i < out.more.size(); ++i) out.more[i].probe = opt.more_probes[i];
-
-  if (opt.edge_engine == WorstOptions::EdgeEngine::Auto) {
-    // The reduced model in closed form: one model, sampled on longer records until settled.
-    StatusOr<link::ExpandedLink> link = edge_link(opt.max_span);
-    if (!link) return link.status();
-    Circuit circuit;
-    StatusOr<std::vector<Probe>> probes = edge_circuit(*link, circuit);
-    if (!probes) return probes.status();
-    for (const auto& e : circuit.elements()) e->bind_time(opt.dt, lead + opt.max_span);
-    LtiOptions lo;
-    lo.method = LtiOptions::Method::Reduced;
-    lo.horizon = lead + opt.max_span;
-    const auto by_direction = opt.reduced_start_points_by_direction.find(d);
-    lo.reduced.start_points = by_direction != opt.reduced_start_points_by_direction.end()
-                                  ? by_direction->second
-                                  : opt.reduced_start_points;
-    if (opt.progress) opt.progress("edge response, reduced model", 0.0);
-    StatusOr<LtiResponses> lti = LtiResponses::compute(circuit, *probes, lo);
-    if (lti) {
-      const std::vector<SourceInput> inputs = lti->netlist_inputs(lead + opt.max_span);
-      out.v_idle = lti->value(0, lead - 2 * out.pre * opt.dt, inputs);
-      for (size_t i = 0; i < out.more.size(); ++i)
-        out.more[i].v_idle = lti->value(i + 1, lead - 2 * out.pre * opt.dt, inputs);
-      out.e.clear();
-      for (double span = 40e-6;; span *= 2) {
-        // Only the samples the longer record adds: the model starts them from the edge exactly.
-        const long from = static_cast<long>(out.e.size()), n = out.pre + to_samples(span, opt.dt);
-        std::vector<double> times(static_cast<size_t>(n - from));
-        for (long i = from; i < n; ++i)
-          times[static_cast<size_t>(i - from)] = lead + static_cast<double>(i - out.pre) * opt.dt;
-        const std::vector<std::vector<double>> v = lti->values(inputs, times);
-        for (double x : v[0]) out.e.push_back(x - out.v_idle);
-        for (size_t i = 0; i < out.more.size(); ++i)
-          for (double x : v[i + 1]) out.more[i].e.push_back(x - out.more[i].v_idle);
-        if (Status s = finite(link->description); !s.ok()) return s;
-        if (settled(span)) break;
-        if (span * 2 > opt.max_span) return unsettled(link->description, span);
-      }
-      const ReducedModelStats& m = lti->stats().model;
-      out.engine = fmt::format(
-          "reduced model (order {}, {} poles, {} expansion points, AC error {:.1e} of peak up to "
-          "3 GHz), sampled on a {:g} ns grid",
-          m.order, m.poles, m.expansion_points, m.error, opt.dt * 1e9);
-      out.expansion_points = m.points;
-      out.seconds = seconds_since(start);
-      return out;
-    }
-    out.engine_note = "reduced model not used: " + lti.status().message();
   }
+  // Samples the model on records of 40 us, doubled until the response settles.
+  Status sample_model(const LtiResponses& lti, const std::string& description);
+  // Samples a transient's waveform w (a record of `span` after the edge).
+  void sample_transient(const Waveform& w, double span);
 
+  const link::LinkSpec& spec_;
+  const link::PartLibrary& parts_;
+  const link::Direction d_;
+  const WorstOptions& opt_;
+  EdgeResponse& out_;
+  const long half_;
+};
+
+Status EdgeResponseBuilder::from_reduced_model(bool* done) {
+  StatusOr<link::ExpandedLink> link = edge_link(opt_.max_span);
+  if (!link) return link.status();
+  Circuit circuit;
+  StatusOr<std::vector<Probe>> probes = edge_circuit(*link, circuit);
+  if (!probes) return probes.status();
+  for (const auto& e : circuit.elements()) e->bind_time(opt_.dt, kLead + opt_.max_span);
+  LtiOptions lo;
+  lo.method = LtiOptions::Method::Reduced;
+  lo.horizon = kLead + opt_.max_span;
+  const auto by_direction = opt_.reduced_start_points_by_direction.find(d_);
+  lo.reduced.start_points = by_direction != opt_.reduced_start_points_by_direction.end()
+                                ? by_direction->second
+                                : opt_.reduced_start_points;
+  if (opt_.progress) opt_.progress("edge response, reduced model", 0.0);
+  StatusOr<LtiResponses> lti = LtiResponses::compute(circuit, *probes, lo);
+  if (!lti) {
+    out_.engine_note = "reduced model not used: " + lti.status().message();
+    return Status::Ok();
+  }
+  if (Status s = sample_model(*lti, link->description); !s.ok()) return s;
+  const ReducedModelStats& m = lti->stats().model;
+  out_.engine = fmt::format(
+      "reduced model (order {}, {} poles, {} expansion points, AC error {:.1e} of peak up to "
+      "3 GHz), sampled on a {:g} ns grid",
+      m.order, m.poles, m.expansion_points, m.error, opt_.dt * 1e9);
+  out_.expansion_points = m.points;
+  *done = true;
+  return Status::Ok();
+}
+
+Status EdgeResponseBuilder::sample_model(const LtiResponses& lti, const std::string& description) {
+  const std::vector<SourceInput> inputs = lti.netlist_inputs(kLead + opt_.max_span);
+  out_.v_idle = lti.value(0, kLead - 2 * out_.pre * opt_.dt, inputs);
+  for (size_t i = 0; i < out_.more.size(); ++i)
+    out_.more[i].v_idle = lti.value(i + 1, kLead - 2 * out_.pre * opt_.dt, inputs);
+  out_.e.clear();
+  for (double span = 40e-6;; span *= 2) {
+    // Only the samples the longer record adds: the model starts them from the edge exactly.
+    const long from = static_cast<long>(out_.e.size()), n = out_.pre + to_samples(span, opt_.dt);
+    std::vector<double> times(static_cast<size_t>(n - from));
+    for (long i = from; i < n; ++i)
+      times[static_cast<size_t>(i - from)] = kLead + static_cast<double>(i - out_.pre) * opt_.dt;
+    const std::vector<std::vector<double>> v = lti.values(inputs, times);
+    for (double x : v[0]) out_.e.push_back(x - out_.v_idle);
+    for (size_t i = 0; i < out_.more.size(); ++i)
+      for (double x : v[i + 1]) out_.more[i].e.push_back(x - out_.more[i].v_idle);
+    if (Status s = finite(description); !s.ok()) return s;
+    if (settled(span)) return Status::Ok();
+    if (span * 2 > opt_.max_span) return unsettled(description, span);
+  }
+}
+
+Status EdgeResponseBuilder::from_transients() {
   for (double span = 40e-6;; span *= 2) {
     StatusOr<link::ExpandedLink> link = edge_link(span);
     if (!link) return link.status();
@@ -572,41 +606,60 @@ StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::Par
     StatusOr<std::vector<Probe>> probes = edge_circuit(*link, circuit);
     if (!probes) return probes.status();
     TransientOptions to;
-    to.tstep = opt.dt;
-    to.tstop = lead + span;
+    to.tstep = opt_.dt;
+    to.tstop = kLead + span;
     // Steps up to 16 grid samples where the response is slow (the transformer's tail): the
     // reltol 1e-6 error control keeps them near the grid wherever v moves. Measured against
     // tmax = dt: the worst-case values of cap_2m and transformer_15m agree within 10 nV and 2.5 ps,
     // the same traffic wins, and the edge response of transformer_15m takes 4.7 s, not 20 s.
-    to.tmax = kEdgeTmaxSamples * opt.dt;
-    to.reltol = opt.reltol;
-    if (opt.progress)
+    to.tmax = kEdgeTmaxSamples * opt_.dt;
+    to.reltol = opt_.reltol;
+    if (opt_.progress)
       to.on_progress = [&](double t) {
-        opt.progress(fmt::format("edge response, {:g} us", span * 1e6), t / to.tstop);
+        opt_.progress(fmt::format("edge response, {:g} us", span * 1e6), t / to.tstop);
       };
     if (Status s = to.validate(); !s.ok()) return s;
     StatusOr<Waveform> w = run_transient(circuit, to, *probes);
     if (!w) return w.status().with_context(link->description + ", edge response");
-    out.v_idle = w->value_at(0, lead - 2 * out.pre * opt.dt);
-    const long n = out.pre + to_samples(span, opt.dt);
-    out.e.assign(static_cast<size_t>(n), 0.0);
-    for (long i = 0; i < n; ++i)
-      out.e[static_cast<size_t>(i)] =
-          w->value_at(0, lead + static_cast<double>(i - out.pre) * opt.dt) - out.v_idle;
-    for (size_t c = 0; c < out.more.size(); ++c) {
-      EdgeResponse::Column& col = out.more[c];
-      col.v_idle = w->value_at(c + 1, lead - 2 * out.pre * opt.dt);
-      col.e.assign(static_cast<size_t>(n), 0.0);
-      for (long i = 0; i < n; ++i)
-        col.e[static_cast<size_t>(i)] =
-            w->value_at(c + 1, lead + static_cast<double>(i - out.pre) * opt.dt) - col.v_idle;
-    }
+    sample_transient(*w, span);
     if (Status s = finite(link->description); !s.ok()) return s;
     if (settled(span)) break;
-    if (span * 2 > opt.max_span) return unsettled(link->description, span);
+    if (span * 2 > opt_.max_span) return unsettled(link->description, span);
   }
-  out.engine = fmt::format("transient, reltol {:g}, tmax {:g} ns, sampled on a {:g} ns grid",
-                           opt.reltol, kEdgeTmaxSamples * opt.dt * 1e9, opt.dt * 1e9);
+  out_.engine = fmt::format("transient, reltol {:g}, tmax {:g} ns, sampled on a {:g} ns grid",
+                            opt_.reltol, kEdgeTmaxSamples * opt_.dt * 1e9, opt_.dt * 1e9);
+  return Status::Ok();
+}
+
+void EdgeResponseBuilder::sample_transient(const Waveform& w, double span) {
+  out_.v_idle = w.value_at(0, kLead - 2 * out_.pre * opt_.dt);
+  const long n = out_.pre + to_samples(span, opt_.dt);
+  out_.e.assign(static_cast<size_t>(n), 0.0);
+  for (long i = 0; i < n; ++i)
+    out_.e[static_cast<size_t>(i)] =
+        w.value_at(0, kLead + static_cast<double>(i - out_.pre) * opt_.dt) - out_.v_idle;
+  for (size_t c = 0; c < out_.more.size(); ++c) {
+    EdgeResponse::Column& col = out_.more[c];
+    col.v_idle = w.value_at(c + 1, kLead - 2 * out_.pre * opt_.dt);
+    col.e.assign(static_cast<size_t>(n), 0.0);
+    for (long i = 0; i < n; ++i)
+      col.e[static_cast<size_t>(i)] =
+          w.value_at(c + 1, kLead + static_cast<double>(i - out_.pre) * opt_.dt) - col.v_idle;
+  }
+}
+
+}  // namespace
+
+StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::PartLibrary& parts,
+                                     link::Direction d, const WorstOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  EdgeResponse out;
+  EdgeResponseBuilder builder(spec, parts, d, opt, out);
+  bool done = false;
+  if (opt.edge_engine == WorstOptions::EdgeEngine::Auto)
+    if (Status s = builder.from_reduced_model(&done); !s.ok()) return s;
+  if (!done)
+    if (Status s = builder.from_transients(); !s.ok()) return s;
   out.seconds = seconds_since(start);
   return out;
 }
@@ -746,54 +799,46 @@ StatusOr<Waveform> synthesize_drive(const EdgeResponse& e, const traffic::Drive&
   return w;
 }
 
-StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::Rules& rules,
-                                              const WorstOptions& opt) {
-  if (Status s = opt.validate(); !s.ok()) return s;
-  const auto start = std::chrono::steady_clock::now();
-  DirectionWorst dw;
-  dw.rules = rules;
-  Search search(e, rules, opt);
-  if (Status s = search.init(); !s.ok()) return s;
-  const long half = search.half(), frame = search.frame(), pre = search.pre();
-  const double dt = e.dt;
-  const double byte_duration = static_cast<double>(frame) * dt;
+namespace {
 
-  // Memory and bounds (method items 2 and 3).
-  const std::vector<double> env = pulse_envelope(e, half);
-  long memory = 0;
-  const long max_memory = to_samples(opt.max_memory, dt);
-  while (memory < static_cast<long>(env.size()) && memory < max_memory &&
-         bound_from(env, memory, half) > opt.tail_tol)
-    memory += half;
-  dw.memory = static_cast<double>(memory) * dt;
-  dw.gap_min = opt.gap_min;
-  const long gap_min = to_samples(opt.gap_min, dt), gap_step = to_samples(opt.gap_step, dt);
-  // The previous byte's last half bit ends >= gap_min before the target, seen from the window's
-  // first sample (pre before the target); anything older is >= 2 gap_min + frame back.
-  dw.previous_bound = bound_from(env, gap_min - pre, half);
-  dw.older_bound = bound_from(env, 2 * gap_min + frame - pre, half);
-  // The previous byte matters up to the gap where it falls inside the tail tolerance.
-  long gap_max = gap_min;
-  while (gap_max < memory + pre && bound_from(env, gap_max - pre, half) > opt.tail_tol)
-    gap_max += gap_step;
+// The best score per metric so far and the traffic behind it.
+struct Best {
+  PulseScore s;
+  int target = -1, prev = -1;
+  long gap = 0;
+};
 
-  dw.gap_max = static_cast<double>(gap_max) * dt;
-  std::vector<int> targets = opt.targets, previous = opt.previous;
-  if (targets.empty())
-    for (int p = 0; p < 512; ++p) targets.push_back(p);
-  if (previous.empty())
-    for (int p = 0; p < 512; ++p) previous.push_back(p);
-  std::vector<long> gaps;
-  for (long g = gap_min; g <= gap_max; g += gap_step) gaps.push_back(g);
-  const bool history = dw.previous_bound > opt.tail_tol;
+// What the stages of one direction's search share (method items 2-5, worst.h): the window's
+// sizes, the histories to try, each metric's best so far and the failures found (in *dw).
+struct DirectionState {
+  DirectionState(const EdgeResponse& e_, const eye::Rules& rules_, const WorstOptions& opt_,
+                 Search& search_, DirectionWorst& dw_)
+      : e(e_),
+        rules(rules_),
+        opt(opt_),
+        search(search_),
+        dw(dw_),
+        half(search_.half()),
+        frame(search_.frame()),
+        pre(search_.pre()),
+        dt(e_.dt) {}
 
-  struct Best {
-    PulseScore s;
-    int target = -1, prev = -1;
-    long gap = 0;
-  };
+  const EdgeResponse& e;
+  const eye::Rules& rules;
+  const WorstOptions& opt;
+  Search& search;
+  DirectionWorst& dw;
+  const long half, frame, pre;
+  const double dt;
+  long gap_min = 0, gap_step = 0, gap_max = 0;  // samples
+  std::vector<int> targets, previous;           // patterns (byte | error bit << 8)
+  std::vector<long> gaps;                       // samples, gap_min to gap_max
   std::array<Best, kMetrics> best;
-  auto consider = [&](const Score& sc, int target, int prev, long gap) {
+  std::vector<Score> idle_scores;  // per targets entry, after idle
+  double slope_min = 0;            // V/s; 0 when unknown
+
+  // Keeps sc where it beats a metric's best; a failure adds a reason (one per kind).
+  void consider(const Score& sc, int target, int prev, long gap) {
     for (int m = 0; m < kMetrics; ++m)
       if (sc.m[m].valid() && sc.m[m].key < best[m].s.key) best[m] = {sc.m[m], target, prev, gap};
     if (!sc.pass) {
@@ -806,264 +851,379 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
         if (r.rfind(why, 0) == 0) return;
       dw.reasons.push_back(fmt::format("{} (traffic {})", sc.reason, traffic_text(t)));
     }
-  };
-
-  // Stage 1: every target pattern after idle.
-  std::vector<Score> idle_scores(targets.size());
-  std::vector<double> wave;
-  for (size_t i = 0; i < targets.size(); ++i) {
-    if (opt.progress && i % 64 == 0)
-      opt.progress("search, idle targets", static_cast<double>(i) / targets.size());
-    search.target_wave(targets[i], wave);
-    StatusOr<Score> sc = search.score(wave, targets[i]);
-    if (!sc) return sc.status();
-    idle_scores[i] = *sc;
-    consider(*sc, targets[i], -1, 0);
   }
+};
 
-  // Slowest threshold-crossing slope of the idle-history winners: a voltage change dv moves a
-  // crossing by about dv / slope (the time slack and the time bounds).
+// Memory and bounds (method items 2 and 3), then the patterns and gaps to try.
+void set_bounds_and_histories(DirectionState& st) {
+  const WorstOptions& opt = st.opt;
+  DirectionWorst& dw = st.dw;
+  const long half = st.half, pre = st.pre;
+  const std::vector<double> env = pulse_envelope(st.e, half);
+  long memory = 0;
+  const long max_memory = to_samples(opt.max_memory, st.dt);
+  while (memory < static_cast<long>(env.size()) && memory < max_memory &&
+         bound_from(env, memory, half) > opt.tail_tol)
+    memory += half;
+  dw.memory = static_cast<double>(memory) * st.dt;
+  dw.gap_min = opt.gap_min;
+  st.gap_min = to_samples(opt.gap_min, st.dt);
+  st.gap_step = to_samples(opt.gap_step, st.dt);
+  // The previous byte's last half bit ends >= gap_min before the target, seen from the window's
+  // first sample (pre before the target); anything older is >= 2 gap_min + frame back.
+  dw.previous_bound = bound_from(env, st.gap_min - pre, half);
+  dw.older_bound = bound_from(env, 2 * st.gap_min + st.frame - pre, half);
+  // The previous byte matters up to the gap where it falls inside the tail tolerance.
+  st.gap_max = st.gap_min;
+  while (st.gap_max < memory + pre && bound_from(env, st.gap_max - pre, half) > opt.tail_tol)
+    st.gap_max += st.gap_step;
+  dw.gap_max = static_cast<double>(st.gap_max) * st.dt;
+  st.targets = opt.targets;
+  st.previous = opt.previous;
+  if (st.targets.empty())
+    for (int p = 0; p < 512; ++p) st.targets.push_back(p);
+  if (st.previous.empty())
+    for (int p = 0; p < 512; ++p) st.previous.push_back(p);
+  for (long g = st.gap_min; g <= st.gap_max; g += st.gap_step) st.gaps.push_back(g);
+}
+
+// Stage 1: every target pattern after idle.
+Status search_idle_targets(DirectionState& st) {
+  st.idle_scores.assign(st.targets.size(), Score{});
+  std::vector<double> wave;
+  for (size_t i = 0; i < st.targets.size(); ++i) {
+    if (st.opt.progress && i % 64 == 0)
+      st.opt.progress("search, idle targets", static_cast<double>(i) / st.targets.size());
+    st.search.target_wave(st.targets[i], wave);
+    StatusOr<Score> sc = st.search.score(wave, st.targets[i]);
+    if (!sc) return sc.status();
+    st.idle_scores[i] = *sc;
+    st.consider(*sc, st.targets[i], -1, 0);
+  }
+  return Status::Ok();
+}
+
+// Slowest threshold-crossing slope of the idle-history winners: a voltage change dv moves a
+// crossing by about dv / slope (the time slack and the time bounds).
+Status find_slope_min(DirectionState& st) {
   double slope_min = kInf;
   for (size_t m = 0; m < kMetrics; ++m) {
-    if (best[m].target < 0) continue;
-    const std::vector<double> v = search.target_wave(best[m].target);
-    StatusOr<eye::CheckResult> c = search.check(v, best[m].target);
+    if (st.best[m].target < 0) continue;
+    const std::vector<double> v = st.search.target_wave(st.best[m].target);
+    StatusOr<eye::CheckResult> c = st.search.check(v, st.best[m].target);
     if (!c) return c.status();
     for (const eye::PulseMetrics& p : c->pulses) {
       if (p.truncated) continue;
-      slope_min =
-          std::min({slope_min, std::abs(slope_at(v, dt, p.a)), std::abs(slope_at(v, dt, p.b))});
+      slope_min = std::min(
+          {slope_min, std::abs(slope_at(v, st.dt, p.a)), std::abs(slope_at(v, st.dt, p.b))});
     }
   }
-  if (!std::isfinite(slope_min) || slope_min <= 0) slope_min = 0;
+  st.slope_min = !std::isfinite(slope_min) || slope_min <= 0 ? 0 : slope_min;
+  return Status::Ok();
+}
 
-  if (history && opt.exhaustive) {
-    for (int t : targets) {
-      const std::vector<double> base = search.target_wave(t);
-      for (int q : previous)
-        for (long g : gaps) {
-          std::vector<double> v = base;
-          search.add_previous(v, q, g);
-          StatusOr<Score> sc = search.score(v, t);
-          if (!sc) return sc.status();
-          consider(*sc, t, q, g);
-        }
-    }
-  } else if (history) {
-    // The previous byte's response per pattern bit (PatternBasis): u_q at window sample i for
-    // gap g is U_0(i - pre + frame + g) + sum_b bit_b(q) U_{1 + b}(i - pre + frame + g).
-    const PatternBasis& basis = search.basis();
-    const long reach = frame + gap_max + search.len();
-    constexpr size_t kCols = kPatternBits + 1;
-    std::array<std::vector<double>, kCols> U;  // U[b][i]: the column of bit b - 1 (0: the base)
-    for (size_t b = 0; b < kCols; ++b) {
-      std::vector<double>& u = U[b];
-      u.assign(static_cast<size_t>(reach), 0.0);
-      std::vector<std::pair<long, int>> edges;
-      level_edges(b == 0 ? basis.base : basis.bit[b - 1], 0, half, edges);
-      add_edges(e, edges, 0, u);
-    }
-    // reach_of[i] = sum_b |U_b(i)|: no previous byte moves v at U's sample i by more.
-    std::vector<double> reach_of(static_cast<size_t>(reach), 0.0);
-    for (size_t b = 0; b < kCols; ++b)
-      for (size_t i = 0; i < reach_of.size(); ++i) reach_of[i] += std::abs(U[b][i]);
-
-    // Every pattern, in order: the ranking below then enumerates the best patterns per gap
-    // instead of trying each (the `previous` index is the pattern itself).
-    bool every_pattern = previous.size() == (1u << kPatternBits);
-    for (size_t k = 0; every_pattern && k < previous.size(); ++k)
-      every_pattern = previous[k] == static_cast<int>(k);
-    const double slack_v = 2 * dw.previous_bound;
-    const double slack_t = slope_min > 0 ? slack_v / slope_min : 0;
-    // Candidates per metric: the target patterns within the slack of the best after idle.
-    std::vector<std::vector<size_t>> cands(kMetrics);
-    for (int m = 0; m < kMetrics; ++m) {
-      const double slack = m < 2 ? slack_v : slack_t;
-      std::vector<std::pair<double, size_t>> order;
-      for (size_t i = 0; i < targets.size(); ++i)
-        if (idle_scores[i].m[m].valid()) order.push_back({idle_scores[i].m[m].key, i});
-      std::sort(order.begin(), order.end());
-      for (const auto& [key, i] : order) {
-        if (static_cast<int>(cands[m].size()) >= opt.max_candidates) break;
-        if (!cands[m].empty() && key > order.front().first + slack) break;
-        cands[m].push_back(i);
-      }
-    }
-    std::vector<size_t> all;
-    for (const auto& c : cands) all.insert(all.end(), c.begin(), c.end());
-    std::sort(all.begin(), all.end());
-    all.erase(std::unique(all.begin(), all.end()), all.end());
-    const size_t ng = gaps.size();
-    std::vector<double> coef;  // one model's, per gap: kCols (constant, then per bit)
-    for (size_t n = 0; n < all.size(); ++n) {
-      const size_t ci = all[n];
-      if (opt.progress)
-        opt.progress("search, histories", static_cast<double>(n) / static_cast<double>(all.size()));
-      const int t = targets[ci];
-      const std::vector<double> base = search.target_wave(t);
-      StatusOr<eye::CheckResult> c = search.check(base, t);
-      if (!c) return c.status();
-      std::vector<Linear> lin = linearize(*c, base, rules, dt);
-      std::array<bool, kMetrics> wanted{};
-      for (int m = 0; m < kMetrics; ++m)
-        wanted[m] = std::find(cands[m].begin(), cands[m].end(), ci) != cands[m].end();
-      lin.erase(std::remove_if(lin.begin(), lin.end(),
-                               [&](const Linear& l) { return !wanted[l.metric]; }),
-                lin.end());
-      // Models in order of their key after idle, so that each metric's list below fills with
-      // low keys first and models that cannot reach it are skipped (bound below).
-      std::stable_sort(lin.begin(), lin.end(),
-                       [](const Linear& a, const Linear& b) { return a.key0 < b.key0; });
-      // Per metric, the `verify` lowest distinct histories (key, previous index, gap index), in
-      // order. A metric's key is the lowest of its models', so offering every model's values and
-      // keeping each history once, at its lowest, gives the metric's lowest histories; a value
-      // above the `verify`-th kept cannot enter (the kept one only gets lower). What is kept does
-      // not depend on the order of the offers.
-      using Entry = std::tuple<double, size_t, size_t>;
-      std::array<std::vector<Entry>, kMetrics> top;
-      auto full = [&](const std::vector<Entry>& list) {
-        return static_cast<int>(list.size()) >= opt.verify;
-      };
-      auto offer = [&](std::vector<Entry>& list, const Entry& en) {
-        for (auto it = list.begin(); it != list.end(); ++it) {
-          if (std::get<1>(*it) != std::get<1>(en) || std::get<2>(*it) != std::get<2>(en)) continue;
-          if (!(en < *it)) return;  // the same history, already as low
-          list.erase(it);
-          break;
-        }
-        if (full(list)) {
-          if (!(en < list.back())) return;
-          list.pop_back();
-        }
-        list.insert(std::upper_bound(list.begin(), list.end(), en), en);
-      };
-      // A term reads u at term.sample - pre + frame + g: the gap indices whose read falls
-      // inside the wave (0 <= at + gaps[j] < reach) are [j0, j1).
-      auto gap_range = [&](const Term& term) {
-        const long at = term.sample - pre + frame;
-        const long j0 = std::max(0L, (-at - gap_min + gap_step - 1) / gap_step);
-        const long j1 =
-            std::min(static_cast<long>(ng), (reach - at - gap_min + gap_step - 1) / gap_step);
-        return std::tuple<long, long, long>{at + gap_min, j0, j1};
-      };
-      // Per model and gap, with every pattern allowed: the lowest key sets the bits whose
-      // coefficient is negative, and the next lowest flip the bits with the smallest
-      // |coefficient|; the r-th lowest flips only bits among the r smallest (each flip adds its
-      // |coefficient|), so the subsets of the `verify` smallest hold them all.
-      const size_t r = std::min<size_t>(static_cast<size_t>(opt.verify), kPatternBits);
-      std::array<std::pair<double, int>, kPatternBits> mag;  // |coefficient|, bit
-      for (const Linear& model : lin) {
-        std::vector<Entry>& tm = top[static_cast<size_t>(model.metric)];
-        // No history moves the key below key0 - sum |coef| max_g reach(at + g): a model whose
-        // bound is above the list's last, once full, cannot enter it.
-        if (full(tm)) {
-          double drop = 0;
-          for (const Term& term : model.terms) {
-            const auto [first, j0, j1] = gap_range(term);
-            double most = 0;
-            for (long j = j0; j < j1; ++j)
-              most = std::max(most, reach_of[static_cast<size_t>(first + j * gap_step)]);
-            drop += std::abs(term.coef) * most;
-          }
-          if (model.key0 - drop > std::get<0>(tm.back())) continue;
-        }
-        // The model's predicted key for previous pattern q at gap j is affine in q's bits:
-        // c(j, 0) + sum_b bit_b(q) c(j, 1 + b), stored as cl[j * kCols + ...]; over the gap
-        // grid each term is one strided sweep of U.
-        coef.assign(kCols * ng, 0.0);
-        double* cl = coef.data();
-        for (size_t j = 0; j < ng; ++j) cl[j * kCols] = model.key0;
-        for (const Term& term : model.terms) {
-          const auto [first, j0, j1] = gap_range(term);
-          for (size_t b = 0; b < kCols; ++b) {
-            const double* u = U[b].data() + first;
-            for (long j = j0; j < j1; ++j)
-              cl[static_cast<size_t>(j) * kCols + b] += term.coef * u[j * gap_step];
-          }
-        }
-        for (size_t j = 0; j < ng; ++j) {
-          if (!every_pattern) {
-            for (size_t k = 0; k < previous.size(); ++k) {
-              double y = cl[j * kCols];
-              for (size_t b = 0; b < kPatternBits; ++b)
-                if (previous[k] >> b & 1) y += cl[j * kCols + b + 1];
-              offer(tm, {y, k, j});
-            }
-            continue;
-          }
-          double lowest = cl[j * kCols];
-          int q = 0;
-          for (int b = 0; b < kPatternBits; ++b) {
-            const double w = cl[j * kCols + static_cast<size_t>(b) + 1];
-            if (w < 0) lowest += w, q |= 1 << b;
-            mag[b] = {std::abs(w), b};
-          }
-          if (full(tm)) {
-            const double worst_kept = std::get<0>(tm.back());
-            if (lowest > worst_kept) continue;
-            // Only the best pattern itself can enter when one flip already costs too much.
-            double flip = kInf;
-            for (const auto& m2 : mag) flip = std::min(flip, m2.first);
-            if (lowest + flip > worst_kept) {
-              offer(tm, {lowest, static_cast<size_t>(q), j});
-              continue;
-            }
-          }
-          std::partial_sort(mag.begin(), mag.begin() + r, mag.end());
-          // The subsets in increasing order of their members (mag ascending): a member that
-          // pushes the key past the `verify`-th lowest ends its branch, as all later ones would.
-          auto visit = [&](auto&& self, size_t from, double key, int p) -> void {
-            offer(tm, {key, static_cast<size_t>(p), j});
-            for (size_t i = from; i < r; ++i) {
-              const double next = key + mag[i].first;
-              if (full(tm) && next > std::get<0>(tm.back())) break;
-              self(self, i + 1, next, p ^ (1 << mag[i].second));
-            }
-          };
-          visit(visit, 0, lowest, q);
-        }
-      }
-      dw.ranked += static_cast<long>(previous.size() * ng);
-      std::vector<std::pair<size_t, long>> exact;
-      for (const auto& tm : top)
-        for (const auto& [key, k, j] : tm) exact.push_back({k, gaps[j]});
-      std::sort(exact.begin(), exact.end());
-      exact.erase(std::unique(exact.begin(), exact.end()), exact.end());
-      std::vector<double> v(base.size());
-      for (const auto& [k, g] : exact) {
-        // base + u_q over the window, from the basis (the same sums add_previous makes).
-        const int q = previous[k];
-        const size_t off = static_cast<size_t>(frame + g - pre);  // window sample 0 in U
-        // One pass, a SIMD register of samples at a time, summing the base and set bits'
-        // columns in registers: a pass per column stalled on its stores (13 % of the search).
-        std::array<const double*, kCols> cols;
-        size_t nc = 0;
-        for (size_t b = 0; b < kCols; ++b)
-          if (b == 0 || (q >> (b - 1) & 1)) cols[nc++] = U[b].data() + off;
-        namespace stdx = std::experimental;
-        using V = stdx::native_simd<double>;
-        size_t i = 0;
-        for (; i + V::size() <= v.size(); i += V::size()) {
-          V sum(base.data() + i, stdx::element_aligned);
-          for (size_t col = 0; col < nc; ++col) sum += V(cols[col] + i, stdx::element_aligned);
-          sum.copy_to(v.data() + i, stdx::element_aligned);
-        }
-        for (; i < v.size(); ++i) {
-          double sum = base[i];
-          for (size_t col = 0; col < nc; ++col) sum += cols[col][i];
-          v[i] = sum;
-        }
-        StatusOr<Score> sc = search.score(v, t);
+// Every target after every previous pattern at every gap (WorstOptions::exhaustive).
+Status search_histories_exhaustively(DirectionState& st) {
+  for (int t : st.targets) {
+    const std::vector<double> base = st.search.target_wave(t);
+    for (int q : st.previous)
+      for (long g : st.gaps) {
+        std::vector<double> v = base;
+        st.search.add_previous(v, q, g);
+        StatusOr<Score> sc = st.search.score(v, t);
         if (!sc) return sc.status();
-        consider(*sc, t, q, g);
+        st.consider(*sc, t, q, g);
       }
+  }
+  return Status::Ok();
+}
+
+// Per metric, the `verify` lowest distinct histories (key, previous index, gap index), in
+// order. A metric's key is the lowest of its models', so offering every model's values and
+// keeping each history once, at its lowest, gives the metric's lowest histories; a value above
+// the `verify`-th kept cannot enter (the kept one only gets lower). What is kept does not depend
+// on the order of the offers.
+class LowestHistories {
+ public:
+  using Entry = std::tuple<double, size_t, size_t>;
+  explicit LowestHistories(int verify) : verify_(verify) {}
+  bool full() const { return static_cast<int>(list_.size()) >= verify_; }
+  double last_key() const { return std::get<0>(list_.back()); }
+  const std::vector<Entry>& entries() const { return list_; }
+  void offer(const Entry& en) {
+    for (auto it = list_.begin(); it != list_.end(); ++it) {
+      if (std::get<1>(*it) != std::get<1>(en) || std::get<2>(*it) != std::get<2>(en)) continue;
+      if (!(en < *it)) return;  // the same history, already as low
+      list_.erase(it);
+      break;
     }
+    if (full()) {
+      if (!(en < list_.back())) return;
+      list_.pop_back();
+    }
+    list_.insert(std::upper_bound(list_.begin(), list_.end(), en), en);
   }
 
-  // Results.
+ private:
+  int verify_;
+  std::vector<Entry> list_;
+};
+
+// The ranked history search: per candidate target, a first-order model of each metric's key
+// in the previous byte's bits ranks every (previous pattern, gap) history, and only the
+// `verify` lowest per metric are simulated exactly.
+class RankedHistorySearch {
+ public:
+  static constexpr size_t kCols = kPatternBits + 1;
+  explicit RankedHistorySearch(DirectionState& st);
+  Status run();
+
+ private:
+  void build_columns();
+  std::vector<std::vector<size_t>> candidates() const;
+  Status rank_target(size_t ci, const std::vector<std::vector<size_t>>& cands);
+  void rank_model(const Linear& model, LowestHistories& top);
+  void rank_every_pattern(const double* cl, size_t j, LowestHistories& top) const;
+  std::tuple<long, long, long> gap_range(const Term& term) const;
+  Status verify_exactly(const std::array<LowestHistories, kMetrics>& top, int t,
+                        const std::vector<double>& base);
+
+  DirectionState& st_;
+  long reach_ = 0;  // samples of U: the previous frame, the largest gap and the window
+  size_t ng_ = 0;   // gaps
+  // U[b][i]: the previous byte's response per pattern bit (PatternBasis), the column of bit
+  // b - 1 (0: the base); u_q at window sample i for gap g is U_0(i - pre + frame + g) +
+  // sum_b bit_b(q) U_{1 + b}(i - pre + frame + g).
+  std::array<std::vector<double>, kCols> U_;
+  std::vector<double> reach_of_;  // sum_b |U_b(i)|: no previous byte moves v at i by more
+  bool every_pattern_ = false;    // `previous` is every pattern, in order
+  std::vector<double> coef_;      // one model's, per gap: kCols (constant, then per bit)
+};
+
+RankedHistorySearch::RankedHistorySearch(DirectionState& st)
+    : st_(st), reach_(st.frame + st.gap_max + st.search.len()), ng_(st.gaps.size()) {}
+
+Status RankedHistorySearch::run() {
+  build_columns();
+  // Every pattern, in order: the ranking then enumerates the best patterns per gap instead of
+  // trying each (the `previous` index is the pattern itself).
+  every_pattern_ = st_.previous.size() == (1u << kPatternBits);
+  for (size_t k = 0; every_pattern_ && k < st_.previous.size(); ++k)
+    every_pattern_ = st_.previous[k] == static_cast<int>(k);
+  const std::vector<std::vector<size_t>> cands = candidates();
+  std::vector<size_t> all;
+  for (const auto& c : cands) all.insert(all.end(), c.begin(), c.end());
+  std::sort(all.begin(), all.end());
+  all.erase(std::unique(all.begin(), all.end()), all.end());
+  for (size_t n = 0; n < all.size(); ++n) {
+    if (st_.opt.progress)
+      st_.opt.progress("search, histories",
+                       static_cast<double>(n) / static_cast<double>(all.size()));
+    if (Status s = rank_target(all[n], cands); !s.ok()) return s;
+  }
+  return Status::Ok();
+}
+
+void RankedHistorySearch::build_columns() {
+  const PatternBasis& basis = st_.search.basis();
+  for (size_t b = 0; b < kCols; ++b) {
+    std::vector<double>& u = U_[b];
+    u.assign(static_cast<size_t>(reach_), 0.0);
+    std::vector<std::pair<long, int>> edges;
+    level_edges(b == 0 ? basis.base : basis.bit[b - 1], 0, st_.half, edges);
+    add_edges(st_.e, edges, 0, u);
+  }
+  reach_of_.assign(static_cast<size_t>(reach_), 0.0);
+  for (size_t b = 0; b < kCols; ++b)
+    for (size_t i = 0; i < reach_of_.size(); ++i) reach_of_[i] += std::abs(U_[b][i]);
+}
+
+// Candidates per metric: the target patterns within the slack of the best after idle.
+std::vector<std::vector<size_t>> RankedHistorySearch::candidates() const {
+  const double slack_v = 2 * st_.dw.previous_bound;
+  const double slack_t = st_.slope_min > 0 ? slack_v / st_.slope_min : 0;
+  std::vector<std::vector<size_t>> cands(kMetrics);
+  for (int m = 0; m < kMetrics; ++m) {
+    const double slack = m < 2 ? slack_v : slack_t;
+    std::vector<std::pair<double, size_t>> order;
+    for (size_t i = 0; i < st_.targets.size(); ++i)
+      if (st_.idle_scores[i].m[m].valid()) order.push_back({st_.idle_scores[i].m[m].key, i});
+    std::sort(order.begin(), order.end());
+    for (const auto& [key, i] : order) {
+      if (static_cast<int>(cands[m].size()) >= st_.opt.max_candidates) break;
+      if (!cands[m].empty() && key > order.front().first + slack) break;
+      cands[m].push_back(i);
+    }
+  }
+  return cands;
+}
+
+Status RankedHistorySearch::rank_target(size_t ci, const std::vector<std::vector<size_t>>& cands) {
+  const int t = st_.targets[ci];
+  const std::vector<double> base = st_.search.target_wave(t);
+  StatusOr<eye::CheckResult> c = st_.search.check(base, t);
+  if (!c) return c.status();
+  std::vector<Linear> lin = linearize(*c, base, st_.rules, st_.dt);
+  std::array<bool, kMetrics> wanted{};
+  for (int m = 0; m < kMetrics; ++m)
+    wanted[m] = std::find(cands[m].begin(), cands[m].end(), ci) != cands[m].end();
+  lin.erase(
+      std::remove_if(lin.begin(), lin.end(), [&](const Linear& l) { return !wanted[l.metric]; }),
+      lin.end());
+  // Models in order of their key after idle, so that each metric's list fills with low keys
+  // first and models that cannot reach it are skipped (bound in rank_model).
+  std::stable_sort(lin.begin(), lin.end(),
+                   [](const Linear& a, const Linear& b) { return a.key0 < b.key0; });
+  std::array<LowestHistories, kMetrics> top{
+      LowestHistories(st_.opt.verify), LowestHistories(st_.opt.verify),
+      LowestHistories(st_.opt.verify), LowestHistories(st_.opt.verify),
+      LowestHistories(st_.opt.verify)};
+  for (const Linear& model : lin) rank_model(model, top[static_cast<size_t>(model.metric)]);
+  st_.dw.ranked += static_cast<long>(st_.previous.size() * ng_);
+  return verify_exactly(top, t, base);
+}
+
+// A term reads u at term.sample - pre + frame + g: the gap indices whose read falls inside the
+// wave (0 <= at + gaps[j] < reach) are [j0, j1); returns (at + gap_min, j0, j1).
+std::tuple<long, long, long> RankedHistorySearch::gap_range(const Term& term) const {
+  const long at = term.sample - st_.pre + st_.frame;
+  const long gap_min = st_.gap_min, gap_step = st_.gap_step;
+  const long j0 = std::max(0L, (-at - gap_min + gap_step - 1) / gap_step);
+  const long j1 =
+      std::min(static_cast<long>(ng_), (reach_ - at - gap_min + gap_step - 1) / gap_step);
+  return std::tuple<long, long, long>{at + gap_min, j0, j1};
+}
+
+void RankedHistorySearch::rank_model(const Linear& model, LowestHistories& top) {
+  const long gap_step = st_.gap_step;
+  // No history moves the key below key0 - sum |coef| max_g reach(at + g): a model whose bound
+  // is above the list's last, once full, cannot enter it.
+  if (top.full()) {
+    double drop = 0;
+    for (const Term& term : model.terms) {
+      const auto [first, j0, j1] = gap_range(term);
+      double most = 0;
+      for (long j = j0; j < j1; ++j)
+        most = std::max(most, reach_of_[static_cast<size_t>(first + j * gap_step)]);
+      drop += std::abs(term.coef) * most;
+    }
+    if (model.key0 - drop > top.last_key()) return;
+  }
+  // The model's predicted key for previous pattern q at gap j is affine in q's bits:
+  // c(j, 0) + sum_b bit_b(q) c(j, 1 + b), stored as cl[j * kCols + ...]; over the gap grid
+  // each term is one strided sweep of U.
+  coef_.assign(kCols * ng_, 0.0);
+  double* cl = coef_.data();
+  for (size_t j = 0; j < ng_; ++j) cl[j * kCols] = model.key0;
+  for (const Term& term : model.terms) {
+    const auto [first, j0, j1] = gap_range(term);
+    for (size_t b = 0; b < kCols; ++b) {
+      const double* u = U_[b].data() + first;
+      for (long j = j0; j < j1; ++j)
+        cl[static_cast<size_t>(j) * kCols + b] += term.coef * u[j * gap_step];
+    }
+  }
+  for (size_t j = 0; j < ng_; ++j) {
+    if (every_pattern_) {
+      rank_every_pattern(cl + j * kCols, j, top);
+      continue;
+    }
+    for (size_t k = 0; k < st_.previous.size(); ++k) {
+      double y = cl[j * kCols];
+      for (size_t b = 0; b < kPatternBits; ++b)
+        if (st_.previous[k] >> b & 1) y += cl[j * kCols + b + 1];
+      top.offer({y, k, j});
+    }
+  }
+}
+
+// Gap j's lowest keys with every pattern allowed (cl: its kCols coefficients): the lowest key
+// sets the bits whose coefficient is negative, and the next lowest flip the bits with the
+// smallest |coefficient|; the r-th lowest flips only bits among the r smallest (each flip adds
+// its |coefficient|), so the subsets of the `verify` smallest hold them all.
+void RankedHistorySearch::rank_every_pattern(const double* cl, size_t j,
+                                             LowestHistories& top) const {
+  const size_t r = std::min<size_t>(static_cast<size_t>(st_.opt.verify), kPatternBits);
+  std::array<std::pair<double, int>, kPatternBits> mag;  // |coefficient|, bit
+  double lowest = cl[0];
+  int q = 0;
+  for (int b = 0; b < kPatternBits; ++b) {
+    const double w = cl[static_cast<size_t>(b) + 1];
+    if (w < 0) lowest += w, q |= 1 << b;
+    mag[b] = {std::abs(w), b};
+  }
+  if (top.full()) {
+    const double worst_kept = top.last_key();
+    if (lowest > worst_kept) return;
+    // Only the best pattern itself can enter when one flip already costs too much.
+    double flip = kInf;
+    for (const auto& m2 : mag) flip = std::min(flip, m2.first);
+    if (lowest + flip > worst_kept) {
+      top.offer({lowest, static_cast<size_t>(q), j});
+      return;
+    }
+  }
+  std::partial_sort(mag.begin(), mag.begin() + r, mag.end());
+  // The subsets in increasing order of their members (mag ascending): a member that pushes the
+  // key past the `verify`-th lowest ends its branch, as all later ones would.
+  auto visit = [&](auto&& self, size_t from, double key, int p) -> void {
+    top.offer({key, static_cast<size_t>(p), j});
+    for (size_t i = from; i < r; ++i) {
+      const double next = key + mag[i].first;
+      if (top.full() && next > top.last_key()) break;
+      self(self, i + 1, next, p ^ (1 << mag[i].second));
+    }
+  };
+  visit(visit, 0, lowest, q);
+}
+
+// Simulates the kept histories exactly: base + u_q over the window, from the basis (the same
+// sums add_previous makes).
+Status RankedHistorySearch::verify_exactly(const std::array<LowestHistories, kMetrics>& top, int t,
+                                           const std::vector<double>& base) {
+  std::vector<std::pair<size_t, long>> exact;
+  for (const LowestHistories& tm : top)
+    for (const auto& [key, k, j] : tm.entries()) exact.push_back({k, st_.gaps[j]});
+  std::sort(exact.begin(), exact.end());
+  exact.erase(std::unique(exact.begin(), exact.end()), exact.end());
+  std::vector<double> v(base.size());
+  for (const auto& [k, g] : exact) {
+    const int q = st_.previous[k];
+    const size_t off = static_cast<size_t>(st_.frame + g - st_.pre);  // window sample 0 in U
+    // One pass, a SIMD register of samples at a time, summing the base and set bits' columns
+    // in registers: a pass per column stalled on its stores (13 % of the search).
+    std::array<const double*, kCols> cols;
+    size_t nc = 0;
+    for (size_t b = 0; b < kCols; ++b)
+      if (b == 0 || (q >> (b - 1) & 1)) cols[nc++] = U_[b].data() + off;
+    namespace stdx = std::experimental;
+    using V = stdx::native_simd<double>;
+    size_t i = 0;
+    for (; i + V::size() <= v.size(); i += V::size()) {
+      V sum(base.data() + i, stdx::element_aligned);
+      for (size_t col = 0; col < nc; ++col) sum += V(cols[col] + i, stdx::element_aligned);
+      sum.copy_to(v.data() + i, stdx::element_aligned);
+    }
+    for (; i < v.size(); ++i) {
+      double sum = base[i];
+      for (size_t col = 0; col < nc; ++col) sum += cols[col][i];
+      v[i] = sum;
+    }
+    StatusOr<Score> sc = st_.search.score(v, t);
+    if (!sc) return sc.status();
+    st_.consider(*sc, t, q, g);
+  }
+  return Status::Ok();
+}
+
+// Results: each metric's best as a WorstMetric with the traffic that replays it and the bound on
+// what older traffic could add; a metric past its limit fails the direction.
+void assemble_metrics(const DirectionState& st) {
+  DirectionWorst& dw = st.dw;
+  const double byte_duration = static_cast<double>(st.frame) * st.dt;
   dw.pass = dw.reasons.empty();
   for (int m = 0; m < kMetrics; ++m) {
-    const Best& b = best[m];
+    const Best& b = st.best[m];
     if (b.target < 0) continue;
     WorstMetric wm;
     wm.name = kNames[m];
@@ -1074,17 +1234,18 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
     wm.role = b.s.role;
     if (b.prev >= 0) {
       wm.traffic.frames = {pattern_frame(b.prev), pattern_frame(b.target)};
-      wm.traffic.gaps = {kLead, static_cast<double>(b.gap) * dt};
+      wm.traffic.gaps = {kLead, static_cast<double>(b.gap) * st.dt};
     } else {
       wm.traffic.frames = {pattern_frame(b.target)};
       wm.traffic.gaps = {kLead};
     }
     const double target_start = wm.traffic.frame_start(wm.traffic.frames.size() - 1, byte_duration);
-    wm.pulse_time = target_start - static_cast<double>(pre) * dt + b.s.a;
+    wm.pulse_time = target_start - static_cast<double>(st.pre) * st.dt + b.s.a;
     wm.record = target_start + byte_duration + 5e-6;
     // Older traffic moves v by at most older_bound, each of a width's or an edge's two crossings
     // by about that over its slope.
-    wm.bound = m < 2 ? dw.older_bound : (slope_min > 0 ? 2 * dw.older_bound / slope_min : 0.0);
+    wm.bound =
+        m < 2 ? dw.older_bound : (st.slope_min > 0 ? 2 * dw.older_bound / st.slope_min : 0.0);
     if (wm.margin < 0) {
       dw.pass = false;
       dw.reasons.push_back(fmt::format("{} {:.4g} breaks its limit {:.4g} (traffic {})", wm.name,
@@ -1092,6 +1253,27 @@ StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::
     }
     dw.metrics.push_back(std::move(wm));
   }
+}
+
+}  // namespace
+
+StatusOr<DirectionWorst> worst_case_direction(const EdgeResponse& e, const eye::Rules& rules,
+                                              const WorstOptions& opt) {
+  if (Status s = opt.validate(); !s.ok()) return s;
+  const auto start = std::chrono::steady_clock::now();
+  DirectionWorst dw;
+  dw.rules = rules;
+  Search search(e, rules, opt);
+  if (Status s = search.init(); !s.ok()) return s;
+  DirectionState st(e, rules, opt, search, dw);
+  set_bounds_and_histories(st);
+  if (Status s = search_idle_targets(st); !s.ok()) return s;
+  if (Status s = find_slope_min(st); !s.ok()) return s;
+  if (dw.previous_bound > opt.tail_tol) {
+    Status s = opt.exhaustive ? search_histories_exhaustively(st) : RankedHistorySearch(st).run();
+    if (!s.ok()) return s;
+  }
+  assemble_metrics(st);
   dw.scored = search.scored_;
   dw.seconds = seconds_since(start);
   return dw;

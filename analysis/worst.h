@@ -33,6 +33,15 @@
 //    each predicted change is too: per gap the ranking reads each metric's best previous bytes
 //    off the per-bit coefficients rather than trying all 512. With `exhaustive`, every
 //    combination is scored (brute force; the tests check the search against it).
+//
+// Contract:
+// - Units: SI (s, V); WorstMetric value, limit and margin in the metric's unit (V for vstart and
+//   vend, s for widths and edges); EdgeResponse samples on its grid of dt seconds.
+// - Ownership: results own their traffic and records; an EdgeResponse is a value (copy it freely).
+//   WorstOptions::progress is called on the calling thread.
+// - Errors: a Status, never thrown: options that do not hold (WorstOptions::validate), a spec that
+//   does not expand, an edge response that does not settle within max_span or is not finite, an
+//   encoding whose frames are not affine in their bits. A failing worst case is pass false.
 #pragma once
 
 #include <cstdint>

@@ -19,6 +19,7 @@
 #include "cli/common_options.h"
 #include "netlists/link/parts.h"
 #include "reports/compare_png.h"
+#include "reports/compare_report.h"
 
 namespace isolink::cli {
 namespace {
@@ -64,11 +65,11 @@ int write_outputs(const analysis::CompareResult& r, const std::string& dir) {
   if (ec) return fail(fmt::format("{}: error: cannot create the folder: {}", dir, ec.message()));
   if (Status s = reports::write_compare_png(r, dir + "/compare.png"); !s.ok())
     return fail(s.message());
-  if (Status s = write_file_atomic(dir + "/report.json", analysis::compare_json(r).dump(2) + "\n");
+  if (Status s = write_file_atomic(dir + "/report.json", reports::compare_json(r).dump(2) + "\n");
       !s.ok())
     return fail(s.message());
   if (Status s = write_file_atomic(dir + "/report.md",
-                                   analysis::compare_markdown(r) + "\n![compare](compare.png)\n");
+                                   reports::compare_markdown(r) + "\n![compare](compare.png)\n");
       !s.ok())
     return fail(s.message());
   return 0;
@@ -103,9 +104,9 @@ int run_compare(const CompareArgs& a) {
   if (!a.out_dir.empty())
     if (int rc = write_outputs(*r, a.out_dir); rc != 0) return rc;
   if (a.json)
-    std::printf("%s\n", analysis::compare_json(*r).dump(2).c_str());
+    std::printf("%s\n", reports::compare_json(*r).dump(2).c_str());
   else
-    std::fputs(analysis::compare_text(*r).c_str(), stdout);
+    std::fputs(reports::compare_text(*r).c_str(), stdout);
   return r->verdict == "match" ? 0 : 1;
 }
 

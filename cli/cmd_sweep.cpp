@@ -105,8 +105,6 @@ int run_sweep_command(const SweepArgs& a) {
   opt.jobs = a.jobs;
   opt.resume = a.resume;
   opt.keep_waves = a.keep_waves;
-  opt.plots = !a.no_plots;
-  opt.render_plots = reports::render_sweep_plots;
   opt.quiet = a.quiet;
   opt.point.run.engine = a.engine;
   opt.point.simulate = a.simulate;
@@ -124,7 +122,8 @@ int run_sweep_command(const SweepArgs& a) {
   // it), at normal priority: at the lowest it got no core until the points were done and the
   // charts waited for it (64 points on 2 cores: 4.9 s at nice 19, 4.75 s at 0).
   std::jthread plugin_loader;  // joined when the command returns
-  if (opt.plots && rank == 0)
+  const bool plots = !a.no_plots;
+  if (plots && rank == 0)
     opt.on_pool_ready = [&plugin_loader] {
       plugin_loader = std::jthread([] { reports::load_image_plugin(); });
     };
@@ -137,13 +136,15 @@ int run_sweep_command(const SweepArgs& a) {
     out = sweep::run_sweep(*spec, *parts, opt);
   if (!out) return report(out.status());
   if (rank != 0) return 0;
+  if (Status st = reports::write_sweep_report(*spec, &*out, opt.out_dir, plots); !st.ok())
+    return fail(st);
   if (!a.quiet) {
     std::printf(
         "%zu points: %zu pass, %zu fail, %zu error%s\n", out->points, out->pass, out->fail,
         out->error,
         out->skipped ? fmt::format(" ({} from the earlier run)", out->skipped).c_str() : "");
     // Points off the fast path (analysis/README.md): how many and the first one's reason.
-    const nlohmann::ordered_json paths = sweep::path_counts(out->results);
+    const nlohmann::ordered_json paths = reports::sweep_path_counts(out->results);
     if (paths["simulated"].get<size_t>() > 0)
       std::printf("%zu simulated, not synthesized from edge responses (point %zu: %s)\n",
                   paths["simulated"].get<size_t>(), paths["first_simulated"]["point"].get<size_t>(),

@@ -138,10 +138,11 @@ size_t first_unordered(std::span<const double> t, std::span<const double> v) {
       t[0] * 0.0 + v[0] * 0.0 == 0.0 && stdx::all_of(probe == 0.0) && stdx::all_of(step > 0.0);
   return ok ? i : 0;
 }
-}  // namespace
 
-StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const double> v,
-                                    const Rules& rules, const CheckOptions& opt) {
+// The input's errors: samples not finite or time not increasing, rules that do not validate, a
+// command idle that is not a time.
+Status validate_input(std::span<const double> t, std::span<const double> v, const Rules& rules,
+                      const CheckOptions& opt) {
   if (t.size() != v.size())
     return Status::Error(fmt::format("{} time samples but {} values", t.size(), v.size()));
   if (t.size() < 2) return Status::Error("a waveform needs at least two samples");
@@ -156,151 +157,167 @@ StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const d
   if (!(opt.command_idle >= 0) || !std::isfinite(opt.command_idle))
     return Status::Error(
         fmt::format("command idle {:g} s is not a finite time >= 0", opt.command_idle));
+  return Status::Ok();
+}
 
-  CheckResult r;
-  r.rules = rules.name;
-  r.rules_source = rules.source;
-  r.tone = rules.tone;
-  r.frame_format = rules.frame;
-  if (opt.sof) r.frame_format.sof = *opt.sof;
-  if (opt.sof_value) r.frame_format.sof_value = *opt.sof_value;
-  if (opt.bit_order) r.frame_format.bit_order = *opt.bit_order;
-  if (r.frame_format.sof_value != 0 && r.frame_format.sof_value != 1)
-    return Status::Error(fmt::format("SOF value {} is neither 0 nor 1", r.frame_format.sof_value));
-  r.samples = t.size();
-  r.t_begin = t.front();
-  r.t_end = t.back();
+// The result's header: the rule set, the frame format (the rules' with opt's overrides), the
+// record's span; an error when the SOF value is neither 0 nor 1.
+Status start_result(std::span<const double> t, const Rules& rules, const CheckOptions& opt,
+                    CheckResult* r) {
+  r->rules = rules.name;
+  r->rules_source = rules.source;
+  r->tone = rules.tone;
+  r->frame_format = rules.frame;
+  if (opt.sof) r->frame_format.sof = *opt.sof;
+  if (opt.sof_value) r->frame_format.sof_value = *opt.sof_value;
+  if (opt.bit_order) r->frame_format.bit_order = *opt.bit_order;
+  if (r->frame_format.sof_value != 0 && r->frame_format.sof_value != 1)
+    return Status::Error(fmt::format("SOF value {} is neither 0 nor 1", r->frame_format.sof_value));
+  r->samples = t.size();
+  r->t_begin = t.front();
+  r->t_end = t.back();
+  return Status::Ok();
+}
 
-  Segmentation seg = segment(t, v, segment_params(rules));
-  if (!rules.tone) {
-    // Rule 8.4a: when a run's half bits make whole frames up to its second-last pulse, its last
-    // pulse is the line's kickback after the postamble (AC coupling swinging back past the
-    // threshold when the driver goes idle), not the start of a frame: the receiver blanks it
-    // (tblank), and joining it would stretch the postamble's width to the kickback's start.
-    const size_t frame_len = r.frame_format.half_bits();
-    std::vector<size_t> tails;
-    for (const FrameSpan& fs : seg.frames) {
-      size_t acc = 0;
-      for (size_t p = fs.first; p < fs.last; ++p) acc += pulse_half_bits(seg, p, rules);
-      if (fs.last > fs.first && acc % frame_len == 0) tails.push_back(fs.last);
-    }
-    for (auto it = tails.rbegin(); it != tails.rend(); ++it) drop_frame_tail(&seg, *it);
+// Rule 8.4a: when a run's half bits make whole frames up to its second-last pulse, its last
+// pulse is the line's kickback after the postamble (AC coupling swinging back past the threshold
+// when the driver goes idle), not the start of a frame: the receiver blanks it (tblank), and
+// joining it would stretch the postamble's width to the kickback's start.
+void drop_kickback_tails(const Rules& rules, size_t frame_len, Segmentation* seg) {
+  std::vector<size_t> tails;
+  for (const FrameSpan& fs : seg->frames) {
+    size_t acc = 0;
+    for (size_t p = fs.first; p < fs.last; ++p) acc += pulse_half_bits(*seg, p, rules);
+    if (fs.last > fs.first && acc % frame_len == 0) tails.push_back(fs.last);
   }
-  r.pulses = measure_pulses(t, v, seg, rules, opt.warning_texts);
-  r.ringing = seg.ringing;
-  r.idle = find_idle_undershoots(t, v, seg, rules);
-  const FrameFormat& fmt_ = r.frame_format;
+  for (auto it = tails.rbegin(); it != tails.rend(); ++it) drop_frame_tail(seg, *it);
+}
 
-  // Rule 8.12: decode each run of joined pulses.
+// What decoding found beyond the frames: the hints and the verdict read these.
+struct DecodeCounts {
   size_t structural = 0;  // frames whose couplets form a byte (metrics aside)
   size_t inverted = 0;    // runs that decode only with every sign flipped (P and N swapped?)
-  for (const FrameSpan& fs : seg.frames) {
-    std::vector<int> hb;
-    std::vector<size_t> hb_pulse;
-    std::vector<int> hb_off;
-    for (size_t p = fs.first; p <= fs.last; ++p)
-      for (int k = 0; k < r.pulses[p].half_bits; ++k) {
-        hb.push_back(r.pulses[p].sign);
-        hb_pulse.push_back(p);
-        hb_off.push_back(k);
-      }
-    std::vector<DecodedByte> decoded;
-    if (rules.tone) {
-      DecodedByte d;
-      d.half_count = hb.size();
-      decoded.push_back(d);
-    } else {
-      decoded = decode_half_bits(hb, fmt_);
-      const size_t ok = static_cast<size_t>(std::count_if(
-          decoded.begin(), decoded.end(), [](const DecodedByte& d) { return d.byte.has_value(); }));
-      structural += ok;
-      if (ok == 0) {
-        std::vector<int> flipped(hb.size());
-        std::transform(hb.begin(), hb.end(), flipped.begin(), [](int x) { return -x; });
-        const std::vector<DecodedByte> alt = decode_half_bits(flipped, fmt_);
-        if (!alt.empty() && alt.front().byte) ++inverted;
-      }
+};
+
+// The first fault of a decoded frame's pulses, in the order a receiver meets them: a pulse the
+// record cuts, a timing failure, the decoder's own fault, a weak bit; none leaves fr's fault empty.
+void set_frame_fault(const std::vector<PulseMetrics>& pulses, const DecodedByte& d,
+                     FrameResult* fr) {
+  const PulseMetrics* trunc = nullptr;
+  const PulseMetrics* timing = nullptr;
+  const PulseMetrics* weak = nullptr;
+  for (size_t p = fr->first_pulse; p <= fr->last_pulse; ++p) {
+    const PulseMetrics& pm = pulses[p];
+    if (pm.truncated && !trunc) trunc = &pm;
+    if (pm.timing_fail && !timing) timing = &pm;
+    if (pm.weak_fail && !weak) weak = &pm;
+  }
+  auto first_fail = [](const PulseMetrics& pm, const char* a, const char* b) {
+    for (const std::string& f : pm.fails)
+      if (f.rfind(a, 0) == 0 || (b && f.rfind(b, 0) == 0)) return f;
+    return pm.fails.empty() ? std::string() : pm.fails.front();
+  };
+  if (trunc) {
+    fr->fault = "truncated";
+    fr->detail = "the record cuts " + place(*trunc);
+  } else if (timing) {
+    fr->fault = "timing";
+    fr->detail = place(*timing) + ": " + first_fail(*timing, "width", "edge");
+  } else if (!d.fault.empty()) {
+    fr->fault = d.fault;
+    fr->detail = d.detail;
+  } else if (weak) {
+    fr->fault = "weak bit";
+    fr->detail = place(*weak) + ": " + first_fail(*weak, "vstart", "vend");
+  }
+}
+
+// Rule 8.12: decodes one run of joined pulses into r's frames (and bytes), marking each pulse's
+// frame and role.
+void decode_run(const FrameSpan& fs, const Rules& rules, CheckResult* r, DecodeCounts* counts) {
+  const FrameFormat& format = r->frame_format;
+  std::vector<int> hb;
+  std::vector<size_t> hb_pulse;
+  std::vector<int> hb_off;
+  for (size_t p = fs.first; p <= fs.last; ++p)
+    for (int k = 0; k < r->pulses[p].half_bits; ++k) {
+      hb.push_back(r->pulses[p].sign);
+      hb_pulse.push_back(p);
+      hb_off.push_back(k);
     }
-    for (const DecodedByte& d : decoded) {
-      FrameResult fr;
-      const size_t h0 = d.first_half, h1 = d.first_half + d.half_count - 1;
-      fr.first_pulse = hb_pulse[h0];
-      fr.last_pulse = hb_pulse[h1];
-      fr.start = r.pulses[fr.first_pulse].a + hb_off[h0] * rules.pulse_time;
-      fr.error_bit = d.error_bit;
-      const int idx = static_cast<int>(r.frames.size());
-      for (size_t h = h0; h <= h1; ++h) {
-        PulseMetrics& p = r.pulses[hb_pulse[h]];
-        const std::string role = rules.tone ? "" : half_bit_role(h - h0, fmt_);
-        if (p.frame != idx) {
-          p.frame = idx;
-          p.role = role;
-        } else if (!role.empty() && role != p.role) {
-          p.role += "/" + role;
-        }
-      }
-      const PulseMetrics* trunc = nullptr;
-      const PulseMetrics* timing = nullptr;
-      const PulseMetrics* weak = nullptr;
-      for (size_t p = fr.first_pulse; p <= fr.last_pulse; ++p) {
-        const PulseMetrics& pm = r.pulses[p];
-        if (pm.truncated && !trunc) trunc = &pm;
-        if (pm.timing_fail && !timing) timing = &pm;
-        if (pm.weak_fail && !weak) weak = &pm;
-      }
-      auto first_fail = [](const PulseMetrics& pm, const char* a, const char* b) {
-        for (const std::string& f : pm.fails)
-          if (f.rfind(a, 0) == 0 || (b && f.rfind(b, 0) == 0)) return f;
-        return pm.fails.empty() ? std::string() : pm.fails.front();
-      };
-      if (trunc) {
-        fr.fault = "truncated";
-        fr.detail = "the record cuts " + place(*trunc);
-      } else if (timing) {
-        fr.fault = "timing";
-        fr.detail = place(*timing) + ": " + first_fail(*timing, "width", "edge");
-      } else if (!d.fault.empty()) {
-        fr.fault = d.fault;
-        fr.detail = d.detail;
-      } else if (weak) {
-        fr.fault = "weak bit";
-        fr.detail = place(*weak) + ": " + first_fail(*weak, "vstart", "vend");
-      }
-      if (fr.fault.empty() && d.byte) {
-        fr.byte = d.byte;
-        r.bytes.push_back(*d.byte);
-      }
-      r.frames.push_back(std::move(fr));
+  std::vector<DecodedByte> decoded;
+  if (rules.tone) {
+    DecodedByte d;
+    d.half_count = hb.size();
+    decoded.push_back(d);
+  } else {
+    decoded = decode_half_bits(hb, format);
+    const size_t ok = static_cast<size_t>(std::count_if(
+        decoded.begin(), decoded.end(), [](const DecodedByte& d) { return d.byte.has_value(); }));
+    counts->structural += ok;
+    if (ok == 0) {
+      std::vector<int> flipped(hb.size());
+      std::transform(hb.begin(), hb.end(), flipped.begin(), [](int x) { return -x; });
+      const std::vector<DecodedByte> alt = decode_half_bits(flipped, format);
+      if (!alt.empty() && alt.front().byte) ++counts->inverted;
     }
   }
-
-  if (opt.expect) {
-    r.expect = opt.expect;
-    const auto& e = *opt.expect;
-    for (size_t i = 0; i < std::max(e.size(), r.bytes.size()); ++i) {
-      if (i >= e.size() || i >= r.bytes.size()) {
-        r.expect_match = false;
-        r.expect_detail = fmt::format("expected {} bytes, decoded {}", e.size(), r.bytes.size());
-        break;
-      }
-      if (e[i] != r.bytes[i]) {
-        r.expect_match = false;
-        r.expect_detail = fmt::format("byte {}: expected {}, decoded {}", i, byte_hex(e[i]),
-                                      byte_hex(r.bytes[i]));
-        break;
+  for (const DecodedByte& d : decoded) {
+    FrameResult fr;
+    const size_t h0 = d.first_half, h1 = d.first_half + d.half_count - 1;
+    fr.first_pulse = hb_pulse[h0];
+    fr.last_pulse = hb_pulse[h1];
+    fr.start = r->pulses[fr.first_pulse].a + hb_off[h0] * rules.pulse_time;
+    fr.error_bit = d.error_bit;
+    const int idx = static_cast<int>(r->frames.size());
+    for (size_t h = h0; h <= h1; ++h) {
+      PulseMetrics& p = r->pulses[hb_pulse[h]];
+      const std::string role = rules.tone ? "" : half_bit_role(h - h0, format);
+      if (p.frame != idx) {
+        p.frame = idx;
+        p.role = role;
+      } else if (!role.empty() && role != p.role) {
+        p.role += "/" + role;
       }
     }
+    set_frame_fault(r->pulses, d, &fr);
+    if (fr.fault.empty() && d.byte) {
+      fr.byte = d.byte;
+      r->bytes.push_back(*d.byte);
+    }
+    r->frames.push_back(std::move(fr));
   }
+}
 
-  r.worst = worst_margins(r.pulses);
+// The decoded bytes against opt.expect: expect_match false and expect_detail on the first
+// difference.
+void compare_expected(const CheckOptions& opt, CheckResult* r) {
+  if (!opt.expect) return;
+  r->expect = opt.expect;
+  const auto& e = *opt.expect;
+  for (size_t i = 0; i < std::max(e.size(), r->bytes.size()); ++i) {
+    if (i >= e.size() || i >= r->bytes.size()) {
+      r->expect_match = false;
+      r->expect_detail = fmt::format("expected {} bytes, decoded {}", e.size(), r->bytes.size());
+      break;
+    }
+    if (e[i] != r->bytes[i]) {
+      r->expect_match = false;
+      r->expect_detail =
+          fmt::format("byte {}: expected {}, decoded {}", i, byte_hex(e[i]), byte_hex(r->bytes[i]));
+      break;
+    }
+  }
+}
 
-  // Rule 8.11: the verdict (eye/verdict.h): failures measured on the link, then what keeps the
-  // record from showing that the link works (no verdict of pass without it).
-  const double peak = largest_magnitude(v);
+// Rule 8.11: the verdict (eye/verdict.h): failures measured on the link, then what keeps the
+// record from showing that the link works (no verdict of pass without it).
+Verdict judge(const CheckResult& r, const Rules& rules, double peak, size_t runs,
+              const DecodeCounts& counts) {
   VerdictFacts facts;
   facts.peak = peak;
-  facts.decodes = rules.tone || structural > 0;
-  facts.runs = seg.frames.size();
+  facts.decodes = rules.tone || counts.structural > 0;
+  facts.runs = runs;
   if (size_t nf = r.failing())
     facts.failures.push_back(fmt::format("{} of {} pulses fail", nf, r.pulses.size()));
   for (size_t i = 0; i < r.frames.size(); ++i)
@@ -318,44 +335,65 @@ StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const d
         place(*std::find_if(r.pulses.begin(), r.pulses.end(),
                             [](const PulseMetrics& p) { return p.truncated; })),
         cut == 1 ? "it is" : "they are"));
-  const Verdict verdict = decide_verdict(r.pulses, rules, facts);
+  return decide_verdict(r.pulses, rules, facts);
+}
 
-  // Hints: the samples look like the wrong units, the wrong column or swapped P and N.
-  const bool decoded_nothing = !rules.tone && structural == 0;
+// Hints: the samples look like the wrong units, the wrong column or swapped P and N.
+void add_hints(const Rules& rules, double peak, const DecodeCounts& counts, CheckResult* r) {
+  const bool decoded_nothing = !rules.tone && counts.structural == 0;
   if (peak > kImplausibleVth * rules.vth)
-    r.hints.push_back(fmt::format(
+    r->hints.push_back(fmt::format(
         "|v| reaches {:.4g} V, over {:g}x the {:g} V threshold: a column in mV read as volts? "
         "(a units row such as \"s,mV\" under the names sets the scale)",
         peak, kImplausibleVth, rules.vth));
-  else if (r.pulses.empty() && peak > 0 && peak < rules.vth / 100)
-    r.hints.push_back(fmt::format(
+  else if (r->pulses.empty() && peak > 0 && peak < rules.vth / 100)
+    r->hints.push_back(fmt::format(
         "|v| stays under {:.4g} V, 1/100 of the threshold: the wrong column (an idle channel, a "
         "trigger or math trace), or volts read as kV?",
         peak));
-  else if (r.pulses.empty() && peak < rules.vth)
-    r.hints.push_back(
+  else if (r->pulses.empty() && peak < rules.vth)
+    r->hints.push_back(
         fmt::format("|v| peaks at {:.4g} V, under the {:g} V threshold: the wrong column, a probe "
                     "attenuation not applied, or one leg (P or N) alone instead of P - N?",
                     peak, rules.vth));
-  if (decoded_nothing && !r.pulses.empty()) {
-    std::vector<double> widths;
-    for (const PulseMetrics& p : r.pulses)
-      if (!p.truncated) widths.push_back(p.b - p.a);
-    if (!widths.empty()) {
-      std::nth_element(widths.begin(), widths.begin() + widths.size() / 2, widths.end());
-      const double w = widths[widths.size() / 2];
-      if (w > 20 * rules.pulse_time || w < rules.pulse_time / 20)
-        r.hints.push_back(fmt::format(
-            "the median pulse lasts {:.4g} s against a {:g} ns half bit: time in us or ms read "
-            "as seconds (or the reverse)? A units row such as \"(us)\" sets the scale",
-            w, ns(rules.pulse_time)));
-    }
-    if (inverted > 0)
-      r.hints.push_back(fmt::format(
-          "{} run{} decode{} with the signs flipped: P and N swapped (or the probe inverted)?",
-          inverted, inverted == 1 ? "" : "s", inverted == 1 ? "s" : ""));
+  if (!decoded_nothing || r->pulses.empty()) return;
+  std::vector<double> widths;
+  for (const PulseMetrics& p : r->pulses)
+    if (!p.truncated) widths.push_back(p.b - p.a);
+  if (!widths.empty()) {
+    std::nth_element(widths.begin(), widths.begin() + widths.size() / 2, widths.end());
+    const double w = widths[widths.size() / 2];
+    if (w > 20 * rules.pulse_time || w < rules.pulse_time / 20)
+      r->hints.push_back(fmt::format(
+          "the median pulse lasts {:.4g} s against a {:g} ns half bit: time in us or ms read "
+          "as seconds (or the reverse)? A units row such as \"(us)\" sets the scale",
+          w, ns(rules.pulse_time)));
   }
+  if (counts.inverted > 0)
+    r->hints.push_back(fmt::format(
+        "{} run{} decode{} with the signs flipped: P and N swapped (or the probe inverted)?",
+        counts.inverted, counts.inverted == 1 ? "" : "s", counts.inverted == 1 ? "s" : ""));
+}
 
+}  // namespace
+
+StatusOr<CheckResult> check_samples(std::span<const double> t, std::span<const double> v,
+                                    const Rules& rules, const CheckOptions& opt) {
+  if (Status s = validate_input(t, v, rules, opt); !s.ok()) return s;
+  CheckResult r;
+  if (Status s = start_result(t, rules, opt, &r); !s.ok()) return s;
+  Segmentation seg = segment(t, v, segment_params(rules));
+  if (!rules.tone) drop_kickback_tails(rules, r.frame_format.half_bits(), &seg);
+  r.pulses = measure_pulses(t, v, seg, rules, opt.warning_texts);
+  r.ringing = seg.ringing;
+  r.idle = find_idle_undershoots(t, v, seg, rules);
+  DecodeCounts counts;
+  for (const FrameSpan& fs : seg.frames) decode_run(fs, rules, &r, &counts);
+  compare_expected(opt, &r);
+  r.worst = worst_margins(r.pulses);
+  const double peak = largest_magnitude(v);
+  const Verdict verdict = judge(r, rules, peak, seg.frames.size(), counts);
+  add_hints(rules, peak, counts, &r);
   r.reasons = verdict.reasons;
   r.pass = verdict.kind == VerdictKind::kPass;
   r.inconclusive = verdict.kind == VerdictKind::kInconclusive;

@@ -167,11 +167,80 @@ class Parser {
   StatusOr<Rules> parse(std::string_view yaml_text);
 
  private:
+  // key 'base': the shipped rule set the file's keys override, into *r.
+  Status read_base(const YAML::Node& base, Rules* r);
+  // key 'width': the list of {class, min, max} windows (each names all three keys).
+  Status read_width(const YAML::Node& n, const std::string& key, Rules* r);
+  // key 'amplitude': the rule first (it decides which keys exist), then its levels.
+  Status read_amplitude(const YAML::Node& n, const std::string& key, Rules* r);
+
   std::string source_;
   const config::YamlDoc* doc_ = nullptr;
   std::map<std::string, YAML::Node> nodes_;  // dotted key path -> its key node, for errors
   bool has_base_ = false;
 };
+
+Status Parser::read_base(const YAML::Node& base, Rules* r) {
+  const std::string base_name = base.IsScalar() ? base.Scalar() : "";
+  std::string_view base_text = builtin_rule_text(base_name);
+  if (base_text.empty()) {
+    std::string names;
+    for (const auto& n : builtin_rule_names()) names += (names.empty() ? "" : ", ") + n;
+    return doc_->error(
+        base, fmt::format("key 'base': '{}' is not a shipped rule set ({})", base_name, names));
+  }
+  StatusOr<Rules> b = Parser("eye/rules/" + base_name + ".yaml").parse(base_text);
+  if (!b) return b.status();
+  *r = *b;
+  r->name = std::filesystem::path(source_).stem().string();
+  has_base_ = true;
+  return Status::Ok();
+}
+
+Status Parser::read_width(const YAML::Node& n, const std::string& key, Rules* r) {
+  if (!n.IsSequence())
+    return doc_->error(n, fmt::format("key '{}': expected a list of {{class, min, max}}, "
+                                      "found a {}",
+                                      key, config::node_kind(n)));
+  r->width.clear();
+  const bool had_base = has_base_;
+  has_base_ = false;  // every window names all three keys
+  for (size_t i = 0; i < n.size(); ++i) {
+    WidthWindow w;
+    const std::string path = fmt::format("{}[{}]", key, i);
+    nodes_[path] = n[i];
+    Status s = section(
+        n[i], path, {{"class", integer(&w.k)}, {"min", seconds(&w.min)}, {"max", seconds(&w.max)}});
+    if (!s.ok()) {
+      has_base_ = had_base;
+      return s;
+    }
+    r->width.push_back(w);
+  }
+  has_base_ = had_base;
+  return Status::Ok();
+}
+
+Status Parser::read_amplitude(const YAML::Node& n, const std::string& key, Rules* r) {
+  if (n.IsMap())
+    if (const YAML::Node rn = n["rule"]) {
+      if (Status s = choice(&r->amplitude,
+                            {std::pair{std::string("bq7961x"), AmplitudeRule::kBq7961x},
+                             {std::string("bridge"), AmplitudeRule::kBridge}})(rn, key + ".rule");
+          !s.ok())
+        return s;
+    }
+  std::vector<Field> fields = {
+      {"rule", [](const YAML::Node&, const std::string&) { return Status::Ok(); }},
+      {"vend_min", volts(&r->vend_min)},
+      {"vstart_min", volts(&r->vstart_min)},
+      {"droop_max", volts(&r->droop_max)}};
+  if (r->amplitude == AmplitudeRule::kBq7961x) {
+    fields.push_back({"vend_knee", volts(&r->vend_knee)});
+    fields.push_back({"vstart_min_low_vend", volts(&r->vstart_min_low_vend)});
+  }
+  return section(n, key, fields);
+}
 
 StatusOr<Rules> Parser::parse(std::string_view yaml_text) {
   StatusOr<config::YamlDoc> loaded = config::YamlDoc::from_text(std::string(yaml_text), source_);
@@ -183,50 +252,13 @@ StatusOr<Rules> Parser::parse(std::string_view yaml_text) {
     return doc.error(root, "a rule file is a YAML map of keys (name, vth, timing, ...)");
 
   Rules r;
-  if (const YAML::Node base = root["base"]) {
-    const std::string base_name = base.IsScalar() ? base.Scalar() : "";
-    std::string_view base_text = builtin_rule_text(base_name);
-    if (base_text.empty()) {
-      std::string names;
-      for (const auto& n : builtin_rule_names()) names += (names.empty() ? "" : ", ") + n;
-      return doc.error(
-          base, fmt::format("key 'base': '{}' is not a shipped rule set ({})", base_name, names));
-    }
-    StatusOr<Rules> b = Parser("eye/rules/" + base_name + ".yaml").parse(base_text);
-    if (!b) return b.status();
-    r = *b;
-    r.name = std::filesystem::path(source_).stem().string();
-    has_base_ = true;
-  }
+  if (const YAML::Node base = root["base"])
+    if (Status s = read_base(base, &r); !s.ok()) return s;
   r.source = source_;
 
   std::string kind_name = r.tone ? "tone" : "data";
   bool decode_seen = false;
   YAML::Node decode_node;
-  auto width_handler = [this, &r](const YAML::Node& n, const std::string& key) -> Status {
-    if (!n.IsSequence())
-      return doc_->error(n, fmt::format("key '{}': expected a list of {{class, min, max}}, "
-                                        "found a {}",
-                                        key, config::node_kind(n)));
-    r.width.clear();
-    const bool had_base = has_base_;
-    has_base_ = false;  // every window names all three keys
-    for (size_t i = 0; i < n.size(); ++i) {
-      WidthWindow w;
-      const std::string path = fmt::format("{}[{}]", key, i);
-      nodes_[path] = n[i];
-      Status s =
-          section(n[i], path,
-                  {{"class", integer(&w.k)}, {"min", seconds(&w.min)}, {"max", seconds(&w.max)}});
-      if (!s.ok()) {
-        has_base_ = had_base;
-        return s;
-      }
-      r.width.push_back(w);
-    }
-    has_base_ = had_base;
-    return Status::Ok();
-  };
   auto timing = [this, &r](const YAML::Node& n, const std::string& key) {
     return section(n, key,
                    {{"pulse_time", seconds(&r.pulse_time)},
@@ -235,27 +267,6 @@ StatusOr<Rules> Parser::parse(std::string_view yaml_text) {
                     {"transition_gap", seconds(&r.transition_gap)},
                     {"edge_max", seconds(&r.edge_max)},
                     {"vend_offset", seconds(&r.vend_offset)}});
-  };
-  auto amplitude = [&, this](const YAML::Node& n, const std::string& key) -> Status {
-    // the rule decides which keys exist, so read it first
-    if (n.IsMap())
-      if (const YAML::Node rn = n["rule"]) {
-        if (Status s = choice(&r.amplitude,
-                              {std::pair{std::string("bq7961x"), AmplitudeRule::kBq7961x},
-                               {std::string("bridge"), AmplitudeRule::kBridge}})(rn, key + ".rule");
-            !s.ok())
-          return s;
-      }
-    std::vector<Field> fields = {
-        {"rule", [](const YAML::Node&, const std::string&) { return Status::Ok(); }},
-        {"vend_min", volts(&r.vend_min)},
-        {"vstart_min", volts(&r.vstart_min)},
-        {"droop_max", volts(&r.droop_max)}};
-    if (r.amplitude == AmplitudeRule::kBq7961x) {
-      fields.push_back({"vend_knee", volts(&r.vend_knee)});
-      fields.push_back({"vstart_min_low_vend", volts(&r.vstart_min_low_vend)});
-    }
-    return section(n, key, fields);
   };
   auto idle = [this, &r](const YAML::Node& n, const std::string& key) {
     return section(n, key, {{"level", volts(&r.idle_level)}, {"tblank", seconds(&r.tblank)}});
@@ -271,19 +282,21 @@ StatusOr<Rules> Parser::parse(std::string_view yaml_text) {
                                                  {std::string("msb"), BitOrder::kMsbFirst}})}});
   };
   const bool base_given = has_base_;
-  Status s =
-      section(root, "",
-              {{"base", [](const YAML::Node&, const std::string&) { return Status::Ok(); }},
-               {"name", text(&r.name)},
-               {"description", text(&r.description)},
-               {"kind", choice(&kind_name, {std::pair{std::string("data"), std::string("data")},
-                                            {std::string("tone"), std::string("tone")}})},
-               {"vth", volts(&r.vth)},
-               {"timing", timing},
-               {"width", width_handler},
-               {"amplitude", amplitude},
-               {"idle", idle},
-               {"decode", decode}});
+  Status s = section(
+      root, "",
+      {{"base", [](const YAML::Node&, const std::string&) { return Status::Ok(); }},
+       {"name", text(&r.name)},
+       {"description", text(&r.description)},
+       {"kind", choice(&kind_name, {std::pair{std::string("data"), std::string("data")},
+                                    {std::string("tone"), std::string("tone")}})},
+       {"vth", volts(&r.vth)},
+       {"timing", timing},
+       {"width",
+        [this, &r](const YAML::Node& n, const std::string& key) { return read_width(n, key, &r); }},
+       {"amplitude", [this, &r](const YAML::Node& n,
+                                const std::string& key) { return read_amplitude(n, key, &r); }},
+       {"idle", idle},
+       {"decode", decode}});
   if (!s.ok()) return s;
   r.tone = kind_name == "tone";
   if (r.tone && decode_seen)

@@ -604,10 +604,20 @@ StatusOr<std::vector<BinaryTrace>> read_lecroy(BinFile& f) {
 
 // ---- Tektronix .wfm (WFM#001/#002/#003) ----
 
-StatusOr<std::vector<BinaryTrace>> read_tek_wfm(BinFile& f) {
+// The static file information: its byte order, the version (1-3), bytes per point and where the
+// curve buffer starts; one record only (no FastFrame).
+struct TekStatic {
+  Fields s;
+  int version = 0;
+  uint64_t bpp = 0;
+  int64_t curve_buf = 0;
+};
+
+StatusOr<TekStatic> read_tek_static(BinFile& f) {
   StatusOr<Fields> st0 = f.fields(0, 78, false, "the 78-byte static file information");
   if (!st0) return st0.status();
-  Fields& s = *st0;
+  TekStatic out;
+  Fields& s = out.s = std::move(*st0);
   if (s.b[0] == 0x0F && s.b[1] == 0x0F) {
     s.big = false;
   } else if (s.b[0] == 0xF0 && s.b[1] == 0xF0) {
@@ -619,20 +629,104 @@ StatusOr<std::vector<BinaryTrace>> read_tek_wfm(BinFile& f) {
   }
   const std::string ver = s.text(2, 8);
   const size_t at = ver.find("WFM#00");
-  const int version = at != std::string::npos && at + 6 < ver.size() ? ver[at + 6] - '0' : 0;
-  if (version < 1 || version > 3)
+  out.version = at != std::string::npos && at + 6 < ver.size() ? ver[at + 6] - '0' : 0;
+  if (out.version < 1 || out.version > 3)
     return f.error(2, fmt::format("version '{}': expected :WFM#001, :WFM#002 or :WFM#003", ver));
-  const uint64_t bpp = s.u(15, 1);
-  const int64_t curve_buf = s.s(16, 4);
+  out.bpp = s.u(15, 1);
+  out.curve_buf = s.s(16, 4);
   const uint64_t frames = s.u(72, 4);
   if (frames != 0)
     return f.error(72, fmt::format("{} FastFrame frames: one record is read; save a single "
                                    "frame",
                                    frames + 1));
+  return out;
+}
+
+// The sample type of a curve format code (WFM#003 adds uint8 and int8); none for the others.
+std::optional<Sample> tek_sample_kind(int64_t format, int version) {
+  switch (format) {
+    case 0:
+      return Sample::kI16;
+    case 1:
+      return Sample::kI32;
+    case 2:
+      return Sample::kU32;
+    case 4:
+      return Sample::kF32;
+    case 5:
+      return Sample::kF64;
+    case 6:
+      if (version == 3) return Sample::kU8;
+      break;
+    case 7:
+      if (version == 3) return Sample::kI8;
+      break;
+    default:
+      break;
+  }
+  return std::nullopt;
+}
+
+// The waveform's dimensions: vertical (explicit dimension 1) and time (implicit dimension 1),
+// scaled to volts and seconds.
+struct TekDims {
+  Sample kind = Sample::kI16;
+  double vscale = 0, voffset = 0, ys = 1;  // v = (raw * vscale + voffset) * ys
+  double tscale = 0, toffset = 0, xs = 1;  // t = (toffset + i * tscale) * xs
+};
+
+StatusOr<TekDims> read_tek_dims(BinFile& f, const Fields& h, const TekStatic& st, size_t exp1,
+                                size_t imp1) {
+  TekDims d;
+  d.vscale = h.f64(exp1);
+  d.voffset = h.f64(exp1 + 8);
+  const std::string vunit = h.text(exp1 + 20, 20);
+  const int64_t format = h.s(exp1 + 72, 4), storage = h.s(exp1 + 76, 4);
+  d.tscale = h.f64(imp1);
+  d.toffset = h.f64(imp1 + 8);
+  const std::string tunit = h.text(imp1 + 20, 20);
+  std::optional<Sample> kind = tek_sample_kind(format, st.version);
+  if (!kind)
+    return f.error(exp1 + 72, fmt::format("curve format {}: expected int16 (0), int32 (1), uint32 "
+                                          "(2), fp32 (4), fp64 (5), or in WFM#003 uint8 (6), "
+                                          "int8 (7)",
+                                          format));
+  d.kind = *kind;
+  if (width_of(*kind) != st.bpp)
+    return f.error(15, fmt::format("{} bytes per point, but curve format {} has {}", st.bpp, format,
+                                   width_of(*kind)));
+  if (storage != 0)
+    return f.error(exp1 + 76, fmt::format("storage type {} (1 min/max, 2/3 histograms, 4/5 row or "
+                                          "column order): only samples (0) are read",
+                                          storage));
+  std::optional<double> ys = scale_to(vunit, UnitKind::kVolt);
+  if (!ys)
+    return f.error(exp1 + 20, fmt::format("vertical units '{}': only volts are read", vunit));
+  std::optional<double> xs = scale_to(tunit, UnitKind::kTime);
+  if (!xs) return f.error(imp1 + 20, fmt::format("horizontal units '{}': expected seconds", tunit));
+  d.ys = *ys;
+  d.xs = *xs;
+  if (!std::isfinite(d.vscale) || d.vscale == 0 || !std::isfinite(d.voffset))
+    return f.error(exp1, fmt::format("vertical scale {:g}, offset {:g}: expected finite numbers "
+                                     "and a scale that is not 0",
+                                     d.vscale, d.voffset));
+  if (!(d.tscale > 0) || !std::isfinite(d.tscale) || !std::isfinite(d.toffset))
+    return f.error(imp1, fmt::format("horizontal scale {:g}, offset {:g}: expected a positive "
+                                     "scale and a finite offset",
+                                     d.tscale, d.toffset));
+  return d;
+}
+
+StatusOr<std::vector<BinaryTrace>> read_tek_wfm(BinFile& f) {
+  StatusOr<TekStatic> st = read_tek_static(f);
+  if (!st) return st.status();
+  const Fields& s = st->s;
+  const uint64_t bpp = st->bpp;
+  const int64_t curve_buf = st->curve_buf;
   // Offsets of the waveform header's parts (WFM#001 lacks the summary frame type; WFM#003's
   // point density is 8 bytes, not 4).
-  const size_t base = version == 1 ? 166 : 168;
-  const size_t exp_size = version == 3 ? 160 : 156, imp_size = version == 3 ? 136 : 132;
+  const size_t base = st->version == 1 ? 166 : 168;
+  const size_t exp_size = st->version == 3 ? 160 : 156, imp_size = st->version == 3 ? 136 : 132;
   const size_t exp1 = base, imp1 = base + 2 * exp_size;
   const size_t update = imp1 + 2 * imp_size + 12 + 12;  // after the two time base blocks
   const size_t curve = update + 24;
@@ -647,62 +741,9 @@ StatusOr<std::vector<BinaryTrace>> read_tek_wfm(BinFile& f) {
     return f.error(122, fmt::format("data type {}: only a vector waveform (2, YT) is read, not "
                                     "scalars, pixel maps or waveform databases",
                                     type));
-  const double vscale = h.f64(exp1), voffset = h.f64(exp1 + 8);
-  const std::string vunit = h.text(exp1 + 20, 20);
-  const int64_t format = h.s(exp1 + 72, 4), storage = h.s(exp1 + 76, 4);
-  const double tscale = h.f64(imp1), toffset = h.f64(imp1 + 8);
-  const std::string tunit = h.text(imp1 + 20, 20);
-  std::optional<Sample> kind;
-  switch (format) {
-    case 0:
-      kind = Sample::kI16;
-      break;
-    case 1:
-      kind = Sample::kI32;
-      break;
-    case 2:
-      kind = Sample::kU32;
-      break;
-    case 4:
-      kind = Sample::kF32;
-      break;
-    case 5:
-      kind = Sample::kF64;
-      break;
-    case 6:
-      if (version == 3) kind = Sample::kU8;
-      break;
-    case 7:
-      if (version == 3) kind = Sample::kI8;
-      break;
-    default:
-      break;
-  }
-  if (!kind)
-    return f.error(exp1 + 72, fmt::format("curve format {}: expected int16 (0), int32 (1), uint32 "
-                                          "(2), fp32 (4), fp64 (5), or in WFM#003 uint8 (6), "
-                                          "int8 (7)",
-                                          format));
-  if (width_of(*kind) != bpp)
-    return f.error(15, fmt::format("{} bytes per point, but curve format {} has {}", bpp, format,
-                                   width_of(*kind)));
-  if (storage != 0)
-    return f.error(exp1 + 76, fmt::format("storage type {} (1 min/max, 2/3 histograms, 4/5 row or "
-                                          "column order): only samples (0) are read",
-                                          storage));
-  std::optional<double> ys = scale_to(vunit, UnitKind::kVolt);
-  if (!ys)
-    return f.error(exp1 + 20, fmt::format("vertical units '{}': only volts are read", vunit));
-  std::optional<double> xs = scale_to(tunit, UnitKind::kTime);
-  if (!xs) return f.error(imp1 + 20, fmt::format("horizontal units '{}': expected seconds", tunit));
-  if (!std::isfinite(vscale) || vscale == 0 || !std::isfinite(voffset))
-    return f.error(exp1, fmt::format("vertical scale {:g}, offset {:g}: expected finite numbers "
-                                     "and a scale that is not 0",
-                                     vscale, voffset));
-  if (!(tscale > 0) || !std::isfinite(tscale) || !std::isfinite(toffset))
-    return f.error(imp1, fmt::format("horizontal scale {:g}, offset {:g}: expected a positive "
-                                     "scale and a finite offset",
-                                     tscale, toffset));
+  StatusOr<TekDims> dims = read_tek_dims(f, h, *st, exp1, imp1);
+  if (!dims) return dims.status();
+  const TekDims& d = *dims;
   const uint64_t data_start = h.u(curve + 14, 4), post_start = h.u(curve + 18, 4);
   if (curve_buf < static_cast<int64_t>(curve + 30))
     return f.error(16, fmt::format("curve buffer at byte {}: inside the header (which ends at "
@@ -723,17 +764,17 @@ StatusOr<std::vector<BinaryTrace>> read_tek_wfm(BinFile& f) {
   tr.name = s.text(40, 32);
   if (tr.name.empty()) tr.name = "waveform";
   tr.y_unit = "V";
-  if (Status st2 = f.samples(static_cast<uint64_t>(curve_buf) + data_start, n, *kind, s.big,
-                             vscale * *ys, voffset * *ys, &tr.v, "the curve buffer's data");
+  if (Status st2 = f.samples(static_cast<uint64_t>(curve_buf) + data_start, n, d.kind, s.big,
+                             d.vscale * d.ys, d.voffset * d.ys, &tr.v, "the curve buffer's data");
       !st2.ok())
     return st2;
   // The first point after the precharge is at imp_dim1.offset (Tektronix's own reader,
   // tekwfm.py of Programmatic-Control-Examples, which also adds the TT offset).
-  const double t_first = (toffset + tt * tscale) * *xs;
-  uniform_time(&tr, t_first, tscale * *xs);
+  const double t_first = (d.toffset + tt * d.tscale) * d.xs;
+  uniform_time(&tr, t_first, d.tscale * d.xs);
   tr.time_from =
       fmt::format("t = imp_dim1.offset + (TT offset + i) * imp_dim1.scale ({:g} + i * {:g} s)",
-                  t_first, tscale * *xs);
+                  t_first, d.tscale * d.xs);
   return one_trace(std::move(tr));
 }
 

@@ -78,18 +78,22 @@ std::vector<std::pair<std::string, std::string>> rs_sibling_header(const std::st
   return out;
 }
 
+Status error_at(const std::string& source, int line, const std::string& msg) {
+  return Status::Error(line > 0 ? fmt::format("{}:{}: error: {}", source, line, msg)
+                                : fmt::format("{}: error: {}", source, msg));
+}
+
+std::string describe_column(const ScopeLayout& l, size_t k) {
+  return fmt::format("column {} ('{}')", l.columns[k].field + 1, l.columns[k].name);
+}
+
 // Resolves the P/N/diff references against the layout; refuses time columns, Start/Increment,
 // non-volt units and P = N.
 Status pick_terms(const ScopeLayout& l, const std::vector<Term>& terms, const std::string& source,
                   std::vector<size_t>* picked_out, std::vector<double>* sign_out,
                   std::vector<std::string>* how_out, std::vector<std::string>* notes) {
-  auto err = [&](int line, const std::string& msg) {
-    return Status::Error(line > 0 ? fmt::format("{}:{}: error: {}", source, line, msg)
-                                  : fmt::format("{}: error: {}", source, msg));
-  };
-  auto describe = [&](size_t k) {
-    return fmt::format("column {} ('{}')", l.columns[k].field + 1, l.columns[k].name);
-  };
+  auto err = [&](int line, const std::string& msg) { return error_at(source, line, msg); };
+  auto describe = [&](size_t k) { return describe_column(l, k); };
   std::vector<size_t>& picked = *picked_out;
   std::vector<double>& sign = *sign_out;
   std::vector<std::string>& how = *how_out;
@@ -135,15 +139,198 @@ Status pick_terms(const ScopeLayout& l, const std::vector<Term>& terms, const st
   return Status::Ok();
 }
 
+// Resolves --time against the layout (none given: the layout's own time column stays).
+Status pick_time_column(const std::string& time_ref, const std::string& source, ScopeLayout* l,
+                        std::vector<std::string>* notes) {
+  if (time_ref.empty()) return Status::Ok();
+  StatusOr<ColumnPick> p = pick_column(*l, time_ref, "time column", source);
+  if (!p) return p.status();
+  if (!p->note.empty()) notes->push_back(p->note);
+  l->time = static_cast<int>(p->column);
+  l->time_is_index = l->columns[p->column].unit.kind == UnitKind::kIndex && l->dt > 0;
+  l->columns[p->column].time_like = true;
+  l->time_from = "--time " + describe_column(*l, p->column);
+  return Status::Ok();
+}
+
+// The data rows of one file, one line at a time: time (read, or from t0 and dt) and the signed,
+// scaled sum of the picked columns; footers end the data, and the first bad row stops it with
+// an error at its line.
+class RowReader {
+ public:
+  RowReader(const ScopeLayout& l, const std::vector<size_t>& picked,
+            const std::vector<double>& sign, const std::string& source)
+      : l_(l), source_(source), steps_(picked.size()) {
+    tcol_ = l.time;
+    tfield_ = tcol_ >= 0 ? l.columns[static_cast<size_t>(tcol_)].field : 0;
+    tscale_ = tcol_ >= 0 && !l.time_is_index ? l.columns[static_cast<size_t>(tcol_)].unit.scale : 1;
+    for (size_t i = 0; i < picked.size(); ++i) {
+      vfield_.push_back(l.columns[picked[i]].field);
+      vscale_.push_back(sign[i] * l.columns[picked[i]].unit.scale);
+    }
+    need_ = tcol_ >= 0 ? tfield_ + 1 : 0;
+    for (size_t f : vfield_) need_ = std::max(need_, f + 1);
+    probed_ = std::any_of(picked.begin(), picked.end(),
+                          [&](size_t k) { return l.columns[k].probe_factor > 0; });
+  }
+
+  // Reserves from the file's size and the first data rows' length: no doubling past the file.
+  void reserve(const std::vector<std::string>& head, uint64_t file_size) {
+    size_t bytes = 0, rows = 0;
+    for (size_t i = static_cast<size_t>(l_.data_line - 1); i < head.size() && rows < 64; ++i)
+      if (!trim_cell(head[i]).empty()) {
+        bytes += head[i].size() + 1;
+        ++rows;
+      }
+    if (rows > 0 && file_size > 0) {
+      const size_t est = static_cast<size_t>(static_cast<double>(file_size) /
+                                             (static_cast<double>(bytes) / rows) * 1.02) +
+                         16;
+      out_.t.reserve(est);
+      out_.v.reserve(est);
+    }
+  }
+
+  // Takes line `number`; false (and error() says why) at a bad row.
+  bool take(std::string_view text, int number) {
+    if (trim_cell(text).empty()) return true;
+    split_fields(text, l_.delim, &f_);
+    double x = 0;
+    bool any = false;
+    for (auto s : f_)
+      if (parse_cell(s, l_.decimal_comma, &x)) {
+        any = true;
+        break;
+      }
+    if (!any) {  // a footer (",,", "End of data"): the data end here
+      if (!footer_line_) {
+        footer_line_ = number;
+        footer_text_ = std::string(trim_cell(text).substr(0, 40));
+      }
+      return true;
+    }
+    if (footer_line_)
+      return fail(number, fmt::format("data after line {} ('{}'), which is no data row: expected "
+                                      "the data to end there (a footer) or to go on as numbers",
+                                      footer_line_, footer_text_));
+    if (f_.size() != l_.data_fields || f_.size() < need_) {
+      const bool like_header = l_.header_line > 0 && l_.columns.size() == l_.data_fields;
+      return fail(number,
+                  fmt::format("expected {} fields like {} (line {}), found {}", l_.data_fields,
+                              like_header ? "the header" : "the first data row",
+                              like_header ? l_.header_line : l_.data_line, f_.size()));
+    }
+    double t = 0;
+    if (tcol_ >= 0) {
+      if (!get(tfield_, number, &t)) return false;
+      t = l_.time_is_index ? l_.t0 + t * l_.dt : t * tscale_;
+    } else {
+      t = l_.t0 + static_cast<double>(row_) * l_.dt;
+    }
+    double v = 0;
+    for (size_t i = 0; i < vfield_.size(); ++i) {
+      if (!get(vfield_[i], number, &x)) return false;
+      v += vscale_[i] * x;
+      if (probed_) {  // the smallest step between values, for check_probe_step
+        ValueStep& s = steps_[i];
+        const double d = std::abs(x - s.prev);
+        if (row_ > 0 && d > 0 && (s.min == 0 || d < s.min)) s.min = d;
+        s.prev = x;
+      }
+    }
+    if (!out_.t.empty() && !(t > out_.t.back()))
+      return fail(number, fmt::format("time {:g} is not after {:g} on line {}: time must increase "
+                                      "from row to row",
+                                      t, out_.t.back(), prev_row_line_));
+    out_.t.push_back(t);
+    out_.v.push_back(v);
+    prev_row_line_ = number;
+    ++row_;
+    return true;
+  }
+
+  const Status& error() const { return bad_; }
+  bool probed() const { return probed_; }
+  double tscale() const { return tscale_; }
+  // The smallest step between two values of picked column i (probed() only; 0: none seen).
+  double min_step(size_t i) const { return steps_[i].min; }
+  OneFile& out() { return out_; }
+
+ private:
+  struct ValueStep {
+    double prev = 0, min = 0;
+  };
+
+  bool fail(int number, const std::string& msg) {
+    bad_ = error_at(source_, number, msg);
+    return false;
+  }
+  // Field `field` of the row as a number; an overrange marker or a word is an error.
+  bool get(size_t field, int number, double* y) {
+    if (parse_cell(f_[field], l_.decimal_comma, y)) {
+      if (std::abs(*y) < kOverrange) return true;
+      return fail(number, fmt::format("field {}: {} is the scope's overrange marker: the "
+                                      "channel clipped; capture again with more volts/div",
+                                      field + 1, std::string(trim_cell(f_[field]))));
+    }
+    std::string name = fmt::format("column {}", field + 1);
+    for (const ScopeColumn& c : l_.columns)
+      if (c.field == field) name = c.name;
+    return fail(number, fmt::format("column {} ('{}'): expected a number, found '{}'", field + 1,
+                                    name, std::string(trim_cell(f_[field]))));
+  }
+
+  const ScopeLayout& l_;
+  const std::string& source_;
+  int tcol_ = -1;
+  size_t tfield_ = 0, need_ = 0;
+  double tscale_ = 1;
+  std::vector<size_t> vfield_;
+  std::vector<double> vscale_;
+  bool probed_ = false;
+  std::vector<ValueStep> steps_;
+  std::vector<std::string_view> f_;
+  int prev_row_line_ = 0, footer_line_ = 0;
+  std::string footer_text_;
+  size_t row_ = 0;
+  Status bad_ = Status::Ok();
+  OneFile out_;
+};
+
+// What was read: the file, its layout, and each column taken, with its unit and how it was
+// chosen; notes for columns without a unit.
+void record_capture(const ScopeLayout& l, const std::string& source, const std::string& time_ref,
+                    const std::vector<Term>& terms, const std::vector<size_t>& picked,
+                    const std::vector<std::string>& how, double tscale,
+                    const std::vector<std::string>& notes, CaptureInfo* info) {
+  info->files.push_back(source);
+  info->layouts.push_back(l.name);
+  if (info->time_from.empty()) info->time_from = l.time_from;
+  if (l.time >= 0 && info->columns.empty()) {
+    const ScopeColumn& c = l.columns[static_cast<size_t>(l.time)];
+    const bool assumed = c.unit.kind == UnitKind::kNone;
+    info->columns.push_back({"time", source, c.name, c.channel, c.field + 1,
+                             time_ref.empty() ? "default" : "by --time", assumed ? "" : c.unit.text,
+                             l.time_is_index ? l.dt : tscale});
+    if (assumed && !l.time_is_index)
+      info->notes.push_back(
+          fmt::format("{}: no unit for the time column: read as seconds", source));
+  }
+  for (size_t i = 0; i < picked.size(); ++i) {
+    const ScopeColumn& c = l.columns[picked[i]];
+    info->columns.push_back(
+        {terms[i].role, source, c.name, c.channel, c.field + 1, how[i], c.unit.text, c.unit.scale});
+    if (c.unit.kind == UnitKind::kNone)
+      info->notes.push_back(
+          fmt::format("{}: no unit for {} ('{}'): read as volts", source, terms[i].role, c.name));
+  }
+  info->notes.insert(info->notes.end(), notes.begin(), notes.end());
+}
+
 StatusOr<OneFile> read_one(LineReader& in, const std::string& source, const std::string& time_ref,
-                           const std::vector<Term>& terms, const std::string& other_file_p,
+                           const std::vector<Term>& terms,
                            const std::vector<std::pair<std::string, std::string>>& extra,
                            CaptureInfo* info) {
-  auto err = [&](int line, const std::string& msg) {
-    return Status::Error(line > 0 ? fmt::format("{}:{}: error: {}", source, line, msg)
-                                  : fmt::format("{}: error: {}", source, msg));
-  };
-  (void)other_file_p;
   std::vector<std::string> head;
   std::string_view line;
   bool more = false;
@@ -154,192 +341,39 @@ StatusOr<OneFile> read_one(LineReader& in, const std::string& source, const std:
       break;
     }
   }
-  if (!in.error().empty()) return err(0, in.error());
+  if (!in.error().empty()) return error_at(source, 0, in.error());
   StatusOr<ScopeLayout> lay = detect_layout(head, source, more, extra);
   if (!lay) return lay.status();
   ScopeLayout& l = *lay;
   std::vector<std::string> notes;
-
-  // Columns.
-  auto describe = [&](size_t k) {
-    return fmt::format("column {} ('{}')", l.columns[k].field + 1, l.columns[k].name);
-  };
-  if (!time_ref.empty()) {
-    StatusOr<ColumnPick> p = pick_column(l, time_ref, "time column", source);
-    if (!p) return p.status();
-    if (!p->note.empty()) notes.push_back(p->note);
-    l.time = static_cast<int>(p->column);
-    l.time_is_index = l.columns[p->column].unit.kind == UnitKind::kIndex && l.dt > 0;
-    l.columns[p->column].time_like = true;
-    l.time_from = "--time " + describe(p->column);
-  }
+  if (Status st = pick_time_column(time_ref, source, &l, &notes); !st.ok()) return st;
   std::vector<size_t> picked;
   std::vector<double> sign;
   std::vector<std::string> how;
   if (Status st = pick_terms(l, terms, source, &picked, &sign, &how, &notes); !st.ok()) return st;
 
-  // Fields to read and their scales.
-  const int tcol = l.time;
-  const size_t tfield = tcol >= 0 ? l.columns[static_cast<size_t>(tcol)].field : 0;
-  const double tscale =
-      tcol >= 0 && !l.time_is_index ? l.columns[static_cast<size_t>(tcol)].unit.scale : 1;
-  std::vector<size_t> vfield;
-  std::vector<double> vscale;
-  for (size_t i = 0; i < picked.size(); ++i) {
-    vfield.push_back(l.columns[picked[i]].field);
-    vscale.push_back(sign[i] * l.columns[picked[i]].unit.scale);
-  }
-  size_t need = tcol >= 0 ? tfield + 1 : 0;
-  for (size_t f : vfield) need = std::max(need, f + 1);
-
-  // Rows.
-  OneFile out;
-  {
-    // reserve from the file's size and the first data rows' length: no doubling past the file
-    size_t bytes = 0, rows = 0;
-    for (size_t i = static_cast<size_t>(l.data_line - 1); i < head.size() && rows < 64; ++i)
-      if (!trim_cell(head[i]).empty()) {
-        bytes += head[i].size() + 1;
-        ++rows;
-      }
-    if (rows > 0 && in.size() > 0) {
-      const size_t est = static_cast<size_t>(static_cast<double>(in.size()) /
-                                             (static_cast<double>(bytes) / rows) * 1.02) +
-                         16;
-      out.t.reserve(est);
-      out.v.reserve(est);
-    }
-  }
-  std::vector<std::string_view> f;
-  int prev_row_line = 0, footer_line = 0;
-  std::string footer_text;
-  size_t row = 0;
-  Status bad = Status::Ok();
-  struct ValueStep {
-    double prev = 0, min = 0;
-  };
-  std::vector<ValueStep> steps(picked.size());
-  const bool probed = std::any_of(picked.begin(), picked.end(),
-                                  [&](size_t k) { return l.columns[k].probe_factor > 0; });
-  auto take = [&](std::string_view text, int number) -> bool {
-    if (trim_cell(text).empty()) return true;
-    split_fields(text, l.delim, &f);
-    double x;
-    bool any = false;
-    for (auto s : f)
-      if (parse_cell(s, l.decimal_comma, &x)) {
-        any = true;
-        break;
-      }
-    if (!any) {  // a footer (",,", "End of data"): the data end here
-      if (!footer_line) {
-        footer_line = number;
-        footer_text = std::string(trim_cell(text).substr(0, 40));
-      }
-      return true;
-    }
-    if (footer_line) {
-      bad = err(number, fmt::format("data after line {} ('{}'), which is no data row: expected "
-                                    "the data to end there (a footer) or to go on as numbers",
-                                    footer_line, footer_text));
-      return false;
-    }
-    if (f.size() != l.data_fields || f.size() < need) {
-      const bool like_header = l.header_line > 0 && l.columns.size() == l.data_fields;
-      bad = err(number, fmt::format("expected {} fields like {} (line {}), found {}", l.data_fields,
-                                    like_header ? "the header" : "the first data row",
-                                    like_header ? l.header_line : l.data_line, f.size()));
-      return false;
-    }
-    auto get = [&](size_t field, size_t col_hint, double* y) -> bool {
-      if (parse_cell(f[field], l.decimal_comma, y)) {
-        if (std::abs(*y) < kOverrange) return true;
-        bad = err(number, fmt::format("field {}: {} is the scope's overrange marker: the "
-                                      "channel clipped; capture again with more volts/div",
-                                      field + 1, std::string(trim_cell(f[field]))));
-        return false;
-      }
-      std::string name = fmt::format("column {}", field + 1);
-      for (const ScopeColumn& c : l.columns)
-        if (c.field == field) name = c.name;
-      (void)col_hint;
-      bad = err(number, fmt::format("column {} ('{}'): expected a number, found '{}'", field + 1,
-                                    name, std::string(trim_cell(f[field]))));
-      return false;
-    };
-    double t = 0;
-    if (tcol >= 0) {
-      if (!get(tfield, 0, &t)) return false;
-      t = l.time_is_index ? l.t0 + t * l.dt : t * tscale;
-    } else {
-      t = l.t0 + static_cast<double>(row) * l.dt;
-    }
-    double v = 0;
-    for (size_t i = 0; i < vfield.size(); ++i) {
-      if (!get(vfield[i], i, &x)) return false;
-      v += vscale[i] * x;
-      if (probed) {  // the smallest step between values, for check_probe_step
-        ValueStep& s = steps[i];
-        const double d = std::abs(x - s.prev);
-        if (row > 0 && d > 0 && (s.min == 0 || d < s.min)) s.min = d;
-        s.prev = x;
-      }
-    }
-    if (!out.t.empty() && !(t > out.t.back())) {
-      bad = err(number, fmt::format("time {:g} is not after {:g} on line {}: time must increase "
-                                    "from row to row",
-                                    t, out.t.back(), prev_row_line));
-      return false;
-    }
-    out.t.push_back(t);
-    out.v.push_back(v);
-    prev_row_line = number;
-    ++row;
-    return true;
-  };
+  RowReader rows(l, picked, sign, source);
+  rows.reserve(head, in.size());
   for (size_t i = static_cast<size_t>(l.data_line - 1); i < head.size(); ++i)
-    if (!take(head[i], static_cast<int>(i) + 1)) return bad;
+    if (!rows.take(head[i], static_cast<int>(i) + 1)) return rows.error();
   if (more)
     while (in.next(&line))
-      if (!take(line, in.number())) return bad;
-  if (!in.error().empty()) return err(0, in.error());
+      if (!rows.take(line, in.number())) return rows.error();
+  if (!in.error().empty()) return error_at(source, 0, in.error());
+  OneFile& out = rows.out();
   if (out.t.size() < 2)
-    return err(l.data_line,
-               fmt::format("fewer than two samples in the data from line {}", l.data_line));
-  for (size_t i = 0; i < picked.size() && probed; ++i) {
-    StatusOr<std::string> note = check_probe_step(l, l.columns[picked[i]], steps[i].min, source);
+    return error_at(source, l.data_line,
+                    fmt::format("fewer than two samples in the data from line {}", l.data_line));
+  for (size_t i = 0; i < picked.size() && rows.probed(); ++i) {
+    StatusOr<std::string> note =
+        check_probe_step(l, l.columns[picked[i]], rows.min_step(i), source);
     if (!note) return note.status();
     if (!note->empty()) notes.push_back(*note);
   }
-
-  // What was read.
-  if (info) {
-    info->files.push_back(source);
-    info->layouts.push_back(l.name);
-    if (info->time_from.empty()) info->time_from = l.time_from;
-    if (tcol >= 0 && info->columns.empty()) {
-      const ScopeColumn& c = l.columns[static_cast<size_t>(tcol)];
-      const bool assumed = c.unit.kind == UnitKind::kNone;
-      info->columns.push_back({"time", source, c.name, c.channel, c.field + 1,
-                               time_ref.empty() ? "default" : "by --time",
-                               assumed ? "" : c.unit.text, l.time_is_index ? l.dt : tscale});
-      if (assumed && !l.time_is_index)
-        info->notes.push_back(
-            fmt::format("{}: no unit for the time column: read as seconds", source));
-    }
-    for (size_t i = 0; i < picked.size(); ++i) {
-      const ScopeColumn& c = l.columns[picked[i]];
-      info->columns.push_back({terms[i].role, source, c.name, c.channel, c.field + 1, how[i],
-                               c.unit.text, c.unit.scale});
-      if (c.unit.kind == UnitKind::kNone)
-        info->notes.push_back(
-            fmt::format("{}: no unit for {} ('{}'): read as volts", source, terms[i].role, c.name));
-    }
-    info->notes.insert(info->notes.end(), notes.begin(), notes.end());
-  }
+  if (info) record_capture(l, source, time_ref, terms, picked, how, rows.tscale(), notes, info);
   out.name = l.columns[picked[0]].name;
   if (picked.size() == 2) out.name += "-" + l.columns[picked[1]].name;
-  return out;
+  return std::move(out);
 }
 
 void finish_info(const Waveform& w, CaptureInfo* info) {
@@ -444,7 +478,7 @@ StatusOr<OneFile> read_path(const std::string& path, const std::string& time_ref
           "file (their headers are checked against its length); save it to a file first",
           path, *kind));
     LineReader in(*text);
-    return read_one(in, path, time_ref, terms, "", {}, info);
+    return read_one(in, path, time_ref, terms, {}, info);
   }
   if (std::optional<std::string> kind = binary_kind(path)) {
     if (!time_ref.empty())
@@ -456,7 +490,7 @@ StatusOr<OneFile> read_path(const std::string& path, const std::string& time_ref
   }
   StatusOr<LineReader> in = LineReader::open(path);
   if (!in) return in.status();
-  return read_one(*in, path, time_ref, terms, "", rs_sibling_header(path), info);
+  return read_one(*in, path, time_ref, terms, rs_sibling_header(path), info);
 }
 
 Waveform to_waveform(OneFile&& one, CaptureInfo* info) {
@@ -474,7 +508,7 @@ StatusOr<Waveform> parse_differential_csv(std::string_view text, const std::stri
   StatusOr<std::vector<Term>> terms = terms_for(cols, source);
   if (!terms) return terms.status();
   LineReader in(text);
-  StatusOr<OneFile> one = read_one(in, source, cols.time, *terms, "", {}, info);
+  StatusOr<OneFile> one = read_one(in, source, cols.time, *terms, {}, info);
   if (!one) return one.status();
   return to_waveform(std::move(*one), info);
 }

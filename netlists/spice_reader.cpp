@@ -650,10 +650,8 @@ class Reader {
     return Status::Ok();
   }
 
-  Status element(const Line& line, const Ctx& ctx) {
-    if (!line.word(0))
-      return error_at(line.at(0), "expected an element name, got '" + describe(line.toks[0]) + "'");
-    std::string local = lower(line.toks[0].text);
+  // The element kind of the card's first letter; an error for refused and unknown letters.
+  StatusOr<const ElementKind*> element_kind(const Line& line, const std::string& local) {
     const char letter = local[0];
     for (const RefusedLetter& r : kRefusedLetters)
       if (r.letter == letter)
@@ -666,108 +664,142 @@ class Reader {
       return error_at(line.at(0), "unknown element letter '" + std::string(1, letter) + "' in '" +
                                       local + "' (known: " + known + "x)");
     }
-    local = unflatten_name(local);
-    Card card;
-    card.letter = letter;
-    card.name = ctx.prefix + local;
-    card.loc = line.at(0);
-    const std::size_t n = line.toks.size();
-    std::size_t i = 1;
+    return kind;
+  }
+
+  // The kind's nodes and element names (K's inductors) from token *i on.
+  Status read_nodes_and_refs(const Line& line, const Ctx& ctx, const ElementKind& kind,
+                             const std::string& local, Card& card, std::size_t* i) {
     auto plain_word = [&](std::size_t k) {
       return line.word(k) && !line.kind(k + 1, TokenKind::Equals) &&
              !line.kind(k + 1, TokenKind::LParen);
     };
-    for (int k = 0; k < kind->node_count; ++k, ++i) {
-      if (!plain_word(i))
-        return error_at(line.at_or_end(i), "too few nodes: " + std::string(kind->name) + " '" +
-                                               local + "' needs " +
-                                               std::to_string(kind->node_count) +
-                                               " nodes (usage: " + kind->usage + ")");
-      card.nodes.push_back(node(line.toks[i].text, ctx));
-      card.node_locs.push_back(line.at(i));
+    for (int k = 0; k < kind.node_count; ++k, ++*i) {
+      if (!plain_word(*i))
+        return error_at(line.at_or_end(*i),
+                        "too few nodes: " + std::string(kind.name) + " '" + local + "' needs " +
+                            std::to_string(kind.node_count) + " nodes (usage: " + kind.usage + ")");
+      card.nodes.push_back(node(line.toks[*i].text, ctx));
+      card.node_locs.push_back(line.at(*i));
     }
-    for (int k = 0; k < kind->ref_count; ++k, ++i) {
-      if (!plain_word(i))
-        return error_at(line.at_or_end(i), "too few element names: " + std::string(kind->name) +
-                                               " '" + local + "' needs " +
-                                               std::to_string(kind->ref_count) +
-                                               " (usage: " + kind->usage + ")");
-      card.refs.push_back(ctx.prefix + unflatten_name(lower(line.toks[i].text)));
-      card.ref_locs.push_back(line.at(i));
+    for (int k = 0; k < kind.ref_count; ++k, ++*i) {
+      if (!plain_word(*i))
+        return error_at(line.at_or_end(*i), "too few element names: " + std::string(kind.name) +
+                                                " '" + local + "' needs " +
+                                                std::to_string(kind.ref_count) +
+                                                " (usage: " + kind.usage + ")");
+      card.refs.push_back(ctx.prefix + unflatten_name(lower(line.toks[*i].text)));
+      card.ref_locs.push_back(line.at(*i));
     }
-    // V and I: dc=, ac= (acmag=, acphase=) may stand among the positional values, as in
-    // "V1 a 0 dc = 2 AC 1"; dc= reads as DC, the ac ones are dropped as AC is.
+    return Status::Ok();
+  }
+
+  // A source function without parentheses ("SIN 0 1 1K") from token *i: its numbers up to the
+  // next word that is not one.
+  Status read_bare_source_call(const Line& line, const Ctx& ctx, const std::string& w, Card& card,
+                               std::size_t* i) {
+    const std::size_t n = line.toks.size();
+    CardArg a;
+    a.kind = CardArg::Kind::Call;
+    a.word = w;
+    a.loc = line.at((*i)++);
+    while (*i < n && !line.assignment(*i) &&
+           (line.kind(*i, TokenKind::Expr) ||
+            (line.word(*i) && !line.kind(*i + 1, TokenKind::LParen) &&
+             !is_source_function(lower(line.toks[*i].text)) && lower(line.toks[*i].text) != "dc" &&
+             lower(line.toks[*i].text) != "ac"))) {
+      auto v = number(line, line.toks[*i], *ctx.scope);
+      if (!v) return v.status();
+      a.call.push_back(*v);
+      ++*i;
+    }
+    card.args.push_back(std::move(a));
+    return Status::Ok();
+  }
+
+  // The positional values from token *i up to the key=value parameters. V and I: dc=, ac=
+  // (acmag=, acphase=) may stand among them, as in "V1 a 0 dc = 2 AC 1"; dc= reads as DC, the
+  // ac ones are dropped as AC is.
+  Status read_positional(const Line& line, const Ctx& ctx, Card& card, std::size_t* i) {
+    const std::size_t n = line.toks.size();
+    const char letter = card.letter;
     auto source_key = [&](std::size_t k) {
       if ((letter != 'v' && letter != 'i') || !line.assignment(k)) return std::string();
       const std::string w = lower(line.toks[k].text);
       return w == "dc" || w == "ac" || w == "acmag" || w == "acphase" ? w : std::string();
     };
-    while (i < n && (!line.assignment(i) || !source_key(i).empty())) {
-      if (const std::string key = source_key(i); !key.empty()) {
-        if (i + 2 >= n) return error_at(line.at_or_end(i + 2), "missing value for '" + key + "'");
+    while (*i < n && (!line.assignment(*i) || !source_key(*i).empty())) {
+      if (const std::string key = source_key(*i); !key.empty()) {
+        if (*i + 2 >= n) return error_at(line.at_or_end(*i + 2), "missing value for '" + key + "'");
         if (key == "dc") {
           CardArg a;
           a.kind = CardArg::Kind::Word;
           a.word = key;
-          a.loc = line.at(i);
+          a.loc = line.at(*i);
           card.args.push_back(std::move(a));
-          i += 2;
-          auto v = value(line, i, *ctx.scope, false);
+          *i += 2;
+          auto v = value(line, *i, *ctx.scope, false);
           if (!v) return v.status();
           card.args.push_back(std::move(*v));
         } else {
-          warn_once("ac", line.at(i), "AC specification ignored (isolink runs transient analyses)");
-          i += 3;
+          warn_once("ac", line.at(*i),
+                    "AC specification ignored (isolink runs transient analyses)");
+          *i += 3;
         }
         continue;
       }
-      const Token& t = line.toks[i];
+      const Token& t = line.toks[*i];
       if (t.kind != TokenKind::Word && t.kind != TokenKind::Expr)
-        return error_at(line.at(i), "unexpected '" + describe(t) + "'");
-      if (t.kind == TokenKind::Word && !line.kind(i + 1, TokenKind::LParen)) {
+        return error_at(line.at(*i), "unexpected '" + describe(t) + "'");
+      if (t.kind == TokenKind::Word && !line.kind(*i + 1, TokenKind::LParen)) {
         const std::string w = lower(t.text);
         if (is_source_function(w) && !ctx.scope->find(w)) {  // "SIN 0 1 1K": no parentheses
-          CardArg a;
-          a.kind = CardArg::Kind::Call;
-          a.word = w;
-          a.loc = line.at(i++);
-          while (i < n && !line.assignment(i) &&
-                 (line.kind(i, TokenKind::Expr) ||
-                  (line.word(i) && !line.kind(i + 1, TokenKind::LParen) &&
-                   !is_source_function(lower(line.toks[i].text)) &&
-                   lower(line.toks[i].text) != "dc" && lower(line.toks[i].text) != "ac"))) {
-            auto v = number(line, line.toks[i], *ctx.scope);
-            if (!v) return v.status();
-            a.call.push_back(*v);
-            ++i;
-          }
-          card.args.push_back(std::move(a));
+          if (Status s = read_bare_source_call(line, ctx, w, card, i); !s.ok()) return s;
           continue;
         }
         if (w == "dc") {
           CardArg a;
           a.kind = CardArg::Kind::Word;
           a.word = w;
-          a.loc = line.at(i++);
+          a.loc = line.at((*i)++);
           card.args.push_back(std::move(a));
           continue;
         }
         if (w == "ac") {
-          warn_once("ac", line.at(i), "AC specification ignored (isolink runs transient analyses)");
-          ++i;
-          for (int k = 0; k < 2 && i < n && !line.assignment(i) &&
-                          (line.kind(i, TokenKind::Expr) ||
-                           (line.word(i) && !line.kind(i + 1, TokenKind::LParen) &&
-                            number(line, line.toks[i], *ctx.scope)));
+          warn_once("ac", line.at(*i),
+                    "AC specification ignored (isolink runs transient analyses)");
+          ++*i;
+          for (int k = 0; k < 2 && *i < n && !line.assignment(*i) &&
+                          (line.kind(*i, TokenKind::Expr) ||
+                           (line.word(*i) && !line.kind(*i + 1, TokenKind::LParen) &&
+                            number(line, line.toks[*i], *ctx.scope)));
                ++k)
-            ++i;
+            ++*i;
           continue;
         }
       }
-      auto a = value(line, i, *ctx.scope, false);
+      auto a = value(line, *i, *ctx.scope, false);
       if (!a) return a.status();
       card.args.push_back(std::move(*a));
     }
+    return Status::Ok();
+  }
+
+  Status element(const Line& line, const Ctx& ctx) {
+    if (!line.word(0))
+      return error_at(line.at(0), "expected an element name, got '" + describe(line.toks[0]) + "'");
+    std::string local = lower(line.toks[0].text);
+    StatusOr<const ElementKind*> kind = element_kind(line, local);
+    if (!kind) return kind.status();
+    const char letter = local[0];
+    local = unflatten_name(local);
+    Card card;
+    card.letter = letter;
+    card.name = ctx.prefix + local;
+    card.loc = line.at(0);
+    std::size_t i = 1;
+    if (Status s = read_nodes_and_refs(line, ctx, **kind, local, card, &i); !s.ok()) return s;
+    if (Status s = read_positional(line, ctx, card, &i); !s.ok()) return s;
     if (Status s = key_values(line, i, *ctx.scope, card.params); !s.ok()) return s;
     if (Status s = claim_name(card.name, card.loc); !s.ok()) return s;
     out_.cards.push_back(std::move(card));

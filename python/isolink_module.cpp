@@ -46,9 +46,11 @@
 #include "netlists/link/parts.h"
 #include "python/convert.h"
 #include "python/docstrings.h"
+#include "reports/compare_report.h"
 #include "reports/noise_report.h"
 #include "reports/pack_report.h"
 #include "reports/run_report.h"
+#include "reports/sweep_report.h"
 #include "reports/worst_report.h"
 
 namespace isolink::python {
@@ -245,7 +247,6 @@ py::list sweep(const py::object& sweep_obj, const std::optional<std::string>& ou
   analysis::sweep::SweepOptions opt;
   opt.point.run.engine = take(analysis::parse_engine(engine));
   opt.jobs = jobs;
-  opt.plots = false;  // analysis/ draws nothing; charts are the CLI's (reports/)
   opt.quiet = true;
   std::string tmp;
   if (out) {
@@ -270,6 +271,9 @@ py::list sweep(const py::object& sweep_obj, const std::optional<std::string>& ou
       r = analysis::sweep::run_sweep(*sp, *p, opt);
     else
       r = p.status();
+    // summary.json beside results.csv; the charts are the CLI's.
+    if (r)
+      if (Status st = reports::write_sweep_report(*sp, &*r, opt.out_dir, false); !st.ok()) r = st;
     if (sp) s = std::move(*sp);
     if (!tmp.empty()) {
       std::error_code ec;
@@ -380,7 +384,7 @@ py::dict compare(const std::vector<std::string>& capture, const std::string& spe
               : StatusOr<analysis::CompareResult>(parts.status());
   }
   if (!r) raise(r.status());
-  return to_python(analysis::compare_json(*r));
+  return to_python(reports::compare_json(*r));
 }
 
 py::object load_spec(const py::object& spec_obj) {

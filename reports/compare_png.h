@@ -5,6 +5,10 @@
 //
 //   StatusOr<analysis::CompareResult> r = analysis::compare_capture(in, parts, opt);
 //   Status s = write_compare_png(*r, dir + "/compare.png");   // temp file + rename
+//
+// Contract: the inputs are read during the call only. Errors: a Status naming the file (the
+// image plug-in or its fonts not found, a write that fails); the PNG is written to a temporary
+// name and renamed, so a failure leaves no file.
 #pragma once
 
 #include <string>

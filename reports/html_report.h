@@ -9,6 +9,9 @@
 //                                .values = *w.column("v(rxp,rxn)")}};
 //   std::string page = run_report_html(report_json, waves, eye_png_bytes);
 //   Status s = write_file_atomic(dir + "/report.html", page);
+//
+// Contract: the page builders are pure functions of their arguments (no I/O, no errors); the
+// caller writes the page (write_file_atomic).
 #pragma once
 
 #include <cstdint>

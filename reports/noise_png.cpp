@@ -86,16 +86,11 @@ void line_series(Canvas& c, const PlotArea& a, const std::vector<double>& x,
 
 }  // namespace
 
-Status write_noise_png(const analysis::NoiseResult& r, const std::string& title,
-                       const std::string& path) {
-  StatusOr<Canvas> cv = Canvas::create(kW, kH);
-  if (!cv) return cv.status();
-  Canvas& c = *cv;
-  const link::NoiseSpec& n = r.spec;
-  const char* unit = n.level_unit();
-  const double flo = std::log10(n.f_start), fhi = std::log10(n.f_stop);
+namespace {
 
-  // Title and verdict.
+// The title with the verdict, and the test level's line.
+void draw_noise_title(Canvas& c, const analysis::NoiseResult& r, const std::string& title) {
+  const link::NoiseSpec& n = r.spec;
   const std::string what = n.injection == "bci"  ? "BCI (CM current into both wires)"
                            : n.injection == "dm" ? "DM current"
                                                  : "ground shift (CM voltage between grounds)";
@@ -106,14 +101,22 @@ Status write_noise_png(const analysis::NoiseResult& r, const std::string& title,
   c.text(40, 90,
          fmt::format("test level {} RMS {} (peak x{:.2f}), worst corner of the part tolerances; "
                      "solid: worst case, dashed: nominal",
-                     link::format_si(n.level, unit), n.modulation == "am" ? "AM 80 % 1 kHz" : "CW",
-                     r.peak_factor),
+                     link::format_si(n.level, n.level_unit()),
+                     n.modulation == "am" ? "AM 80 % 1 kHz" : "CW", r.peak_factor),
          kFont, kMuted, FontFace::kSans, HAlign::kLeft, VAlign::kTop);
+}
 
-  const int x0 = 150, x1 = 1400;
-  const Rect r1{x0, 150, x1, 580}, r2{x0, 660, x1, 1060}, r3{x0, 1140, x1, 1560};
-  std::vector<LegendEntry> legend;
+// The three panels over log frequency and the ranges of the two log panels (log10 of V and of
+// the level's unit).
+struct NoisePanels {
+  Panel conversion, pins, immunity;
+  double v_lo = 0, v_hi = 0, i_lo = 0, i_hi = 0;
+};
 
+NoisePanels make_noise_panels(Canvas& c, const analysis::NoiseResult& r, const Rect& r1,
+                              const Rect& r2, const Rect& r3) {
+  const link::NoiseSpec& n = r.spec;
+  const double flo = std::log10(n.f_start), fhi = std::log10(n.f_stop);
   // Panel 1: conversion.
   std::vector<double> all;
   for (const auto& d : r.directions)
@@ -140,65 +143,93 @@ Status write_noise_png(const analysis::NoiseResult& r, const std::string& title,
   auto [i_lo, i_hi] = range_of(all, true, 2);
   i_lo = std::max(i_lo, std::log10(n.level) - 5);
   i_hi = std::min(i_hi, std::log10(n.level) + 5);
-  Panel p3 = make_panel(r3, flo, fhi, i_lo, i_hi, true, unit);
+  Panel p3 = make_panel(r3, flo, fhi, i_lo, i_hi, true, n.level_unit());
   draw_grid(c, p3.area, p3.xt, p3.yt);
+  return {p1, p2, p3, v_lo, v_hi, i_lo, i_hi};
+}
 
-  for (size_t k = 0; k < r.directions.size(); ++k) {
-    const analysis::NoiseDirection& d = r.directions[k];
-    const Color col = kDirColor[k % 2];
-    std::vector<double> f, worst, nom, pin, imm;
-    for (const auto& p : d.points) {
-      f.push_back(std::log10(p.freq_hz));
-      worst.push_back(p.cm_to_dm_db);
-      nom.push_back(p.cm_to_dm_nominal_db);
-      pin.push_back(std::log10(std::max(p.pin_cm_v, 1e-30)));
-      imm.push_back(std::log10(std::max(p.immunity, 1e-30)));
+// Direction k's curves in the three panels, its failing frequencies shaded and its weakest point
+// marked; returns its legend entry.
+LegendEntry draw_noise_direction(Canvas& c, const NoisePanels& P, const analysis::NoiseResult& r,
+                                 size_t k) {
+  const link::NoiseSpec& n = r.spec;
+  const char* unit = n.level_unit();
+  const analysis::NoiseDirection& d = r.directions[k];
+  const Color col = kDirColor[k % 2];
+  std::vector<double> f, worst, nom, pin, imm;
+  for (const auto& p : d.points) {
+    f.push_back(std::log10(p.freq_hz));
+    worst.push_back(p.cm_to_dm_db);
+    nom.push_back(p.cm_to_dm_nominal_db);
+    pin.push_back(std::log10(std::max(p.pin_cm_v, 1e-30)));
+    imm.push_back(std::log10(std::max(p.immunity, 1e-30)));
+  }
+  // Failing frequencies: shaded in panel 3.
+  for (size_t i = 0; i < d.points.size(); ++i)
+    if (d.points[i].immunity < n.level) {
+      const double a = i > 0 ? (f[i - 1] + f[i]) / 2 : f[i];
+      const double b = i + 1 < f.size() ? (f[i] + f[i + 1]) / 2 : f[i];
+      c.fill_rect(P.immunity.area.data_rect(a, b, P.i_lo, std::log10(n.level)),
+                  kFail.with_alpha(0.12f));
     }
-    // Failing frequencies: shaded in panel 3.
-    for (size_t i = 0; i < d.points.size(); ++i)
-      if (d.points[i].immunity < n.level) {
-        const double a = i > 0 ? (f[i - 1] + f[i]) / 2 : f[i];
-        const double b = i + 1 < f.size() ? (f[i] + f[i + 1]) / 2 : f[i];
-        c.fill_rect(p3.area.data_rect(a, b, i_lo, std::log10(n.level)), kFail.with_alpha(0.12f));
-      }
-    line_series(c, p1.area, f, worst, {.color = col, .width = 3});
-    line_series(c, p1.area, f, nom, {.color = col, .width = 2, .dash = 10, .gap = 7});
-    line_series(c, p2.area, f, pin, {.color = col, .width = 3});
-    line_series(c, p3.area, f, imm, {.color = col, .width = 3});
-    // The weakest point.
-    const double xm = p3.area.px(std::log10(d.immunity_min_freq));
-    const double ym =
-        p3.area.py(std::clamp(std::log10(std::max(d.immunity_min, 1e-30)), i_lo, i_hi));
-    c.stroke_rect(Rect{static_cast<int>(xm) - 7, static_cast<int>(ym) - 7, static_cast<int>(xm) + 8,
-                       static_cast<int>(ym) + 8},
-                  d.pass ? col : kFail, 3);
-    draw_label(c, xm + 12, ym + 10,
-               fmt::format("{} min {} at {}", link::direction_name(d.direction),
-                           link::format_si(d.immunity_min, unit),
-                           link::format_si(d.immunity_min_freq, "Hz")),
-               kFont - 2, d.pass ? kInk : kFail, HAlign::kLeft, VAlign::kTop);
-    legend.push_back({d.description, {.color = col, .width = 3}});
-  }
-  // Limits.
-  for (double s : {1.0}) {
-    const double y = std::log10(n.pin_limit) * s;
-    if (y >= v_lo && y <= v_hi)
-      c.hline(p2.area.py(y), p2.area.rect.x0, p2.area.rect.x1,
-              {.color = kLimit, .width = 3, .dash = 14, .gap = 8});
-  }
+  line_series(c, P.conversion.area, f, worst, {.color = col, .width = 3});
+  line_series(c, P.conversion.area, f, nom, {.color = col, .width = 2, .dash = 10, .gap = 7});
+  line_series(c, P.pins.area, f, pin, {.color = col, .width = 3});
+  line_series(c, P.immunity.area, f, imm, {.color = col, .width = 3});
+  // The weakest point.
+  const double xm = P.immunity.area.px(std::log10(d.immunity_min_freq));
+  const double ym =
+      P.immunity.area.py(std::clamp(std::log10(std::max(d.immunity_min, 1e-30)), P.i_lo, P.i_hi));
+  c.stroke_rect(Rect{static_cast<int>(xm) - 7, static_cast<int>(ym) - 7, static_cast<int>(xm) + 8,
+                     static_cast<int>(ym) + 8},
+                d.pass ? col : kFail, 3);
+  draw_label(c, xm + 12, ym + 10,
+             fmt::format("{} min {} at {}", link::direction_name(d.direction),
+                         link::format_si(d.immunity_min, unit),
+                         link::format_si(d.immunity_min_freq, "Hz")),
+             kFont - 2, d.pass ? kInk : kFail, HAlign::kLeft, VAlign::kTop);
+  return {d.description, {.color = col, .width = 3}};
+}
+
+// The pin limit (panel 2) and the test level (panel 3), dashed and labelled.
+void draw_noise_limits(Canvas& c, const NoisePanels& P, const link::NoiseSpec& n) {
+  const Panel &p2 = P.pins, &p3 = P.immunity;
+  const double y = std::log10(n.pin_limit);
+  if (y >= P.v_lo && y <= P.v_hi)
+    c.hline(p2.area.py(y), p2.area.rect.x0, p2.area.rect.x1,
+            {.color = kLimit, .width = 3, .dash = 14, .gap = 8});
   c.hline(p3.area.py(std::log10(n.level)), p3.area.rect.x0, p3.area.rect.x1,
           {.color = kLimit, .width = 3, .dash = 14, .gap = 8});
   draw_label(c, p2.area.rect.x1 - 8,
-             p2.area.py(std::clamp(std::log10(n.pin_limit), v_lo, v_hi)) - 4,
+             p2.area.py(std::clamp(std::log10(n.pin_limit), P.v_lo, P.v_hi)) - 4,
              fmt::format("pin limit +/-{:g} V", n.pin_limit), kFont - 2, kLimit, HAlign::kRight,
              VAlign::kBottom);
   draw_label(c, p3.area.rect.x1 - 8, p3.area.py(std::log10(n.level)) - 4,
-             fmt::format("test level {}", link::format_si(n.level, unit)), kFont - 2, kLimit,
-             HAlign::kRight, VAlign::kBottom);
+             fmt::format("test level {}", link::format_si(n.level, n.level_unit())), kFont - 2,
+             kLimit, HAlign::kRight, VAlign::kBottom);
+}
 
-  draw_axes(c, p1.area, p1.xt, p1.yt, "frequency", "CM -> DM at the receiver pins", kFont);
-  draw_axes(c, p2.area, p2.xt, p2.yt, "frequency", "pin common mode at the test level", kFont);
-  draw_axes(c, p3.area, p3.xt, p3.yt, "frequency",
+}  // namespace
+
+Status write_noise_png(const analysis::NoiseResult& r, const std::string& title,
+                       const std::string& path) {
+  StatusOr<Canvas> cv = Canvas::create(kW, kH);
+  if (!cv) return cv.status();
+  Canvas& c = *cv;
+  const link::NoiseSpec& n = r.spec;
+  draw_noise_title(c, r, title);
+  const int x0 = 150, x1 = 1400;
+  const Rect r1{x0, 150, x1, 580}, r2{x0, 660, x1, 1060}, r3{x0, 1140, x1, 1560};
+  const NoisePanels P = make_noise_panels(c, r, r1, r2, r3);
+  std::vector<LegendEntry> legend;
+  for (size_t k = 0; k < r.directions.size(); ++k)
+    legend.push_back(draw_noise_direction(c, P, r, k));
+  draw_noise_limits(c, P, n);
+  draw_axes(c, P.conversion.area, P.conversion.xt, P.conversion.yt, "frequency",
+            "CM -> DM at the receiver pins", kFont);
+  draw_axes(c, P.pins.area, P.pins.xt, P.pins.yt, "frequency", "pin common mode at the test level",
+            kFont);
+  draw_axes(c, P.immunity.area, P.immunity.xt, P.immunity.yt, "frequency",
             fmt::format("immunity (highest {} level)",
                         n.injection == "ground_shift" ? "voltage" : "current"),
             kFont);

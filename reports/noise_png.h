@@ -4,6 +4,10 @@
 // curve with the test level drawn; one colour per direction, failing frequencies shaded red.
 //
 //   Status s = write_noise_png(result, spec.name, dir + "/noise.png");   // temp file + rename
+//
+// Contract: the inputs are read during the call only. Errors: a Status naming the file (the
+// image plug-in or its fonts not found, a write that fails); the PNG is written to a temporary
+// name and renamed, so a failure leaves no file.
 #pragma once
 
 #include <string>

@@ -1,6 +1,9 @@
 #pragma once
 // The noise analysis's reports (analysis/noise.h computes it): the JSON of `isolink noise --json`
 // and of report.json's `noise`, and the report.md section. Pure functions of a NoiseResult.
+//
+// Contract: pure functions of their arguments, which they only read: no I/O, no errors. Units
+// are SI, named in the JSON keys (`_s`, `_V`, `_ns`) and the Markdown text.
 
 #include <nlohmann/json.hpp>
 #include <string>

@@ -6,6 +6,10 @@
 //   PackDiagram d{.title = "pack-16", .verdict = "PASS", .devices = 16, .ring = true};
 //   d.hops.push_back({.index = 1, .pass = true, .margin = 0.31, .length = 0.3, .isolation =
 //   "cap"}); Status s = draw_pack_png(d, "out/pack.png");
+//
+// Contract: the inputs are read during the call only. Errors: a Status naming the file (the
+// image plug-in or its fonts not found, a write that fails); the PNG is written to a temporary
+// name and renamed, so a failure leaves no file.
 #pragma once
 
 #include <string>

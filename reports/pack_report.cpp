@@ -172,9 +172,11 @@ nlohmann::ordered_json pack_report_json(const PackSpec& pack, const PackResult& 
       {"timing", timing}};
 }
 
-std::string pack_report_markdown(const PackSpec& pack, const PackResult& r,
-                                 const std::string& diagram,
-                                 const std::vector<std::string>& hop_dirs) {
+namespace {
+
+// The title, the verdicts (spec traffic and worst case), the weakest hops and the diagram.
+std::string verdict_markdown(const PackSpec& pack, const PackResult& r,
+                             const std::string& diagram) {
   std::string md;
   md += fmt::format("# isolink pack report: {}\n\n", pack.name);
   int failing = 0;
@@ -201,7 +203,52 @@ std::string pack_report_markdown(const PackSpec& pack, const PackResult& r,
     md += fmt::format("Weakest hop over all traffic: **hop {}** ({}).\n\n", r.worst_weakest,
                       hop_devices(pack, pack.hops[r.worst_weakest - 1]));
   if (!diagram.empty()) md += fmt::format("![pack diagram]({})\n\n", diagram);
+  return md;
+}
 
+// One row of the hops table: hop i's devices, parts, verdict, margins (and worst case), images.
+std::string hop_row_markdown(const PackSpec& pack, const PackResult& r,
+                             const std::vector<std::string>& hop_dirs, size_t i) {
+  std::string md;
+  const HopResult& h = r.hops[i];
+  const HopSpec& s = pack.hops[i];
+  const analysis::sweep::PointResult p = analysis::sweep::score_run(h.run);
+  const bool weakest = h.index == r.weakest;
+  const std::string b = weakest ? "**" : "";
+  std::string worst =
+      std::isfinite(h.worst_rel)
+          ? fmt::format("{:+.1f} % {} ({})", h.worst_rel * 100, h.worst_metric, h.worst_direction)
+          : "-";
+  std::string images = i < hop_dirs.size() && !hop_dirs[i].empty()
+                           ? fmt::format("[eye]({0}/eye.png), [wave]({0}/wave.png)", hop_dirs[i])
+                           : "-";
+  if (h.same_as != h.index) images += fmt::format(" (same circuit as hop {})", h.same_as);
+  md += fmt::format("| {b}{}{}{b} | {} | {} / {} | {} | {} | {b}{}{b} | {} | {} | {} | {} |",
+                    h.index, weakest ? " (weakest)" : "", hop_devices(pack, s),
+                    isolation_short(s.spec.tx.isolation), isolation_short(s.spec.rx.isolation),
+                    fmt::format("{:g} m {}", s.spec.cable.length, s.spec.cable.material),
+                    h.pass ? "pass" : "**FAIL**", worst, margin_text(p.margin[0], 1, "V"),
+                    margin_text(p.margin[1], 1, "V"), margin_text(p.margin[2], 1e9, "ns"),
+                    margin_text(p.margin[3], 1e9, "ns"), fmt::arg("b", b));
+  if (r.worst_done) {
+    const std::array<double, 4> wc = worst_case_margins(h);
+    const std::string wb = h.index == r.worst_weakest ? "**" : "";
+    md += fmt::format(
+        " {} | {wb}{}{wb} | {} | {} | {} | {} |", h.worst_pass ? "pass" : "**FAIL**",
+        std::isfinite(h.worst_case_rel) ? fmt::format("{:+.1f} % {} ({})", h.worst_case_rel * 100,
+                                                      h.worst_case_metric, h.worst_case_direction)
+                                        : "-",
+        margin_text(wc[0], 1, "V"), margin_text(wc[1], 1, "V"), margin_text(wc[2], 1e9, "ns"),
+        margin_text(wc[3], 1e9, "ns"), fmt::arg("wb", wb));
+  }
+  md += fmt::format(" {} |\n", images);
+  return md;
+}
+
+// The hops table: its explanation, header and one row per hop.
+std::string hops_markdown(const PackSpec& pack, const PackResult& r,
+                          const std::vector<std::string>& hop_dirs) {
+  std::string md;
   md +=
       "## Hops\n\nMargins are the worst over the hop's directions (positive = inside the "
       "limit); the relative margin is margin / |limit| of the worst metric.\n\n";
@@ -219,41 +266,14 @@ std::string pack_report_markdown(const PackSpec& pack, const PackResult& r,
   md += " images |\n|---|---|---|---|---|---|---|---|---|---|";
   if (r.worst_done) md += "---|---|---|---|---|---|";
   md += "---|\n";
-  for (size_t i = 0; i < r.hops.size(); ++i) {
-    const HopResult& h = r.hops[i];
-    const HopSpec& s = pack.hops[i];
-    const analysis::sweep::PointResult p = analysis::sweep::score_run(h.run);
-    const bool weakest = h.index == r.weakest;
-    const std::string b = weakest ? "**" : "";
-    std::string worst =
-        std::isfinite(h.worst_rel)
-            ? fmt::format("{:+.1f} % {} ({})", h.worst_rel * 100, h.worst_metric, h.worst_direction)
-            : "-";
-    std::string images = i < hop_dirs.size() && !hop_dirs[i].empty()
-                             ? fmt::format("[eye]({0}/eye.png), [wave]({0}/wave.png)", hop_dirs[i])
-                             : "-";
-    if (h.same_as != h.index) images += fmt::format(" (same circuit as hop {})", h.same_as);
-    md += fmt::format("| {b}{}{}{b} | {} | {} / {} | {} | {} | {b}{}{b} | {} | {} | {} | {} |",
-                      h.index, weakest ? " (weakest)" : "", hop_devices(pack, s),
-                      isolation_short(s.spec.tx.isolation), isolation_short(s.spec.rx.isolation),
-                      fmt::format("{:g} m {}", s.spec.cable.length, s.spec.cable.material),
-                      h.pass ? "pass" : "**FAIL**", worst, margin_text(p.margin[0], 1, "V"),
-                      margin_text(p.margin[1], 1, "V"), margin_text(p.margin[2], 1e9, "ns"),
-                      margin_text(p.margin[3], 1e9, "ns"), fmt::arg("b", b));
-    if (r.worst_done) {
-      const std::array<double, 4> wc = worst_case_margins(h);
-      const std::string wb = h.index == r.worst_weakest ? "**" : "";
-      md += fmt::format(
-          " {} | {wb}{}{wb} | {} | {} | {} | {} |", h.worst_pass ? "pass" : "**FAIL**",
-          std::isfinite(h.worst_case_rel) ? fmt::format("{:+.1f} % {} ({})", h.worst_case_rel * 100,
-                                                        h.worst_case_metric, h.worst_case_direction)
-                                          : "-",
-          margin_text(wc[0], 1, "V"), margin_text(wc[1], 1, "V"), margin_text(wc[2], 1e9, "ns"),
-          margin_text(wc[3], 1e9, "ns"), fmt::arg("wb", wb));
-    }
-    md += fmt::format(" {} |\n", images);
-  }
+  for (size_t i = 0; i < r.hops.size(); ++i) md += hop_row_markdown(pack, r, hop_dirs, i);
   md += "\n";
+  return md;
+}
+
+// Why each failing hop fails (spec traffic, then worst case), once per distinct circuit.
+std::string hop_failures_markdown(const PackResult& r) {
+  std::string md;
   for (size_t i = 0; i < r.hops.size(); ++i) {
     const HopResult& h = r.hops[i];
     if (h.pass || h.same_as != h.index) continue;
@@ -271,7 +291,12 @@ std::string pack_report_markdown(const PackSpec& pack, const PackResult& r,
     md +=
         fmt::format("Hop {} fails its worst case{}{}.\n\n", h.index, why.empty() ? "" : ": ", why);
   }
+  return md;
+}
 
+// The ring and cable breaks table: who is reached which way, the hops in use, the verdict.
+std::string breaks_markdown(const PackSpec& pack, const PackResult& r) {
+  std::string md;
   md += "## Ring and cable breaks\n\n";
   md += pack.ring ? "The top device's COMH is wired back to the bridge's COML. After a break the "
                     "host reverses direction for the devices above it and reaches them through the "
@@ -301,7 +326,12 @@ std::string pack_report_markdown(const PackSpec& pack, const PackResult& r,
                       devices_text(b.c.unreached), used.empty() ? "-" : used, verdict);
   }
   md += "\n(`5r`: hop 5 reversed.)\n\n";
+  return md;
+}
 
+// When each device has a command and the responses are back at the host.
+std::string timing_markdown(const PackSpec& pack, const PackResult& r) {
+  std::string md;
   md += "## Command timing\n\n";
   const TimingSpec& t = pack.timing;
   md += fmt::format(
@@ -347,6 +377,15 @@ std::string pack_report_markdown(const PackSpec& pack, const PackResult& r,
     md += fmt::format("\n(for `{}`)\n", c.command);
   }
   return md;
+}
+
+}  // namespace
+
+std::string pack_report_markdown(const PackSpec& pack, const PackResult& r,
+                                 const std::string& diagram,
+                                 const std::vector<std::string>& hop_dirs) {
+  return verdict_markdown(pack, r, diagram) + hops_markdown(pack, r, hop_dirs) +
+         hop_failures_markdown(r) + breaks_markdown(pack, r) + timing_markdown(pack, r);
 }
 
 PackDiagram pack_diagram(const PackSpec& pack, const PackResult& r) {

@@ -3,6 +3,9 @@
 //
 //   nlohmann::ordered_json j = pack_report_json(pack, result);
 //   std::string md = pack_report_markdown(pack, result, "pack.png", hop_dirs);
+//
+// Contract: pure functions of their arguments, which they only read: no I/O, no errors. Units
+// are SI, named in the JSON keys (`_s`, `_V`, `_ns`) and the Markdown text.
 #pragma once
 
 #include <nlohmann/json.hpp>

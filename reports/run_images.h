@@ -1,5 +1,9 @@
 // The images of the `isolink run` bundle: eye.png and wave.png, one panel per direction, drawn
 // by reports/ from each direction's waveform and check.
+//
+// Contract: the inputs are read during the call only. Errors: a Status naming the file (the
+// image plug-in or its fonts not found, a write that fails); the PNG is written to a temporary
+// name and renamed, so a failure leaves no file.
 #pragma once
 
 #include <string>

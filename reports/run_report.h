@@ -5,6 +5,9 @@
 //   std::string md = run_report_markdown(spec, run, {"eye.png", "wave.png"});
 //   Waveform w = run_waveforms(run);          // every direction's probes on one time axis
 //   Status s = write_file_atomic(dir + "/report.md", md);
+//
+// Contract: pure functions of their arguments (no I/O, no errors; units SI, named in the JSON
+// keys); the caller writes the files (base/file_io.h write_file_atomic).
 #pragma once
 
 #include <nlohmann/json.hpp>

@@ -205,100 +205,90 @@ MarginLayout margin_layout(const SweepPlotData& d) {
   return L;
 }
 
-Status render_margin_png(const SweepPlotData& d, const std::string& path) {
-  if (d.axes.empty()) return Status::Error(path + ": error: the margin plot needs a swept key");
-  StatusOr<Canvas> cv = Canvas::create(kW, kH);
-  if (!cv) return cv.status().with_context(path);
-  Canvas& c = *cv;
-  const MarginLayout L = margin_layout(d);
-  const PlotArea& a = L.plot;
+namespace {
+
+// A failing point's reason, where its label goes (pixels).
+struct FailReason {
+  double x, y;
+  std::string text;
+};
+
+// The margin plot's x ticks: nice numbers on a linear numeric axis, else one label per value,
+// leaving out those that would overlap.
+AxisTicks margin_x_ticks(Canvas& c, const PlotArea& a, const SweepPlotData& d) {
+  const SweepPlotAxis& ax = d.axes[0];
+  const UnitScale xs = axis_scale(ax);
+  AxisTicks xt;
+  if (ax.numeric() && !ax.log) return make_ticks(a.x, xs, 10);
+  xt.unit = xs;
+  for (size_t i = 0; i < ax.labels.size(); ++i)
+    xt.ticks.push_back({margin_x(d, i), value_label(ax, i, xs)});
+  style::LabelRow row;
+  std::vector<Tick> kept;
+  for (size_t i : axis_order(ax)) {
+    const Tick& t = xt.ticks[i];
+    const double w = c.measure(t.label, kFont).width;
+    if (row.fits(a.px(t.value) - w / 2, a.px(t.value) + w / 2, 12)) kept.push_back(t);
+  }
+  xt.ticks = kept;
+  return xt;
+}
+
+// The line of axis-1 value iy, points in axis-0 order, failing points ringed; their reasons and
+// the error points' x go to *reasons and *errors. Returns the line's legend entry.
+LegendEntry draw_margin_line(Canvas& c, const PlotArea& a, const SweepPlotData& d,
+                             const std::vector<Cell>& cells, size_t iy,
+                             std::vector<std::pair<double, double>>* errors,
+                             std::vector<FailReason>* reasons) {
   const SweepPlotAxis& ax = d.axes[0];
   const bool lines = d.axes.size() >= 2;
   const size_t nx = ax.labels.size();
-  const size_t ny = lines ? d.axes[1].labels.size() : 1;
-  draw_header(c, "Worst margin vs " + ax.name, d, aggregation_note(d, lines ? 2 : 1));
-
-  // Pass side shaded, grid, ticks.
-  c.fill_rect(a.data_rect(a.x.lo, a.x.hi, 0, a.y.hi), kPassShade);
-  const UnitScale xs = axis_scale(ax);
-  AxisTicks xt;
-  if (ax.numeric() && !ax.log) {
-    xt = make_ticks(a.x, xs, 10);
-  } else {
-    xt.unit = xs;
-    for (size_t i = 0; i < nx; ++i) xt.ticks.push_back({margin_x(d, i), value_label(ax, i, xs)});
-    // Drop labels that would overlap.
-    style::LabelRow row;
-    std::vector<Tick> kept;
-    for (size_t i : axis_order(ax)) {
-      const Tick& t = xt.ticks[i];
-      const double w = c.measure(t.label, kFont).width;
-      if (row.fits(a.px(t.value) - w / 2, a.px(t.value) + w / 2, 12)) kept.push_back(t);
-    }
-    xt.ticks = kept;
-  }
-  const AxisTicks yt = make_ticks(a.y, UnitScale{100, "%"}, 10);
-  draw_grid(c, a, xt, yt);
-  // The limit.
-  c.hline(a.row(0.0), a.rect.x0, a.rect.x1, {.color = kLimitLine, .width = 3});
-  draw_label(c, a.rect.x0 + 10, a.row(0.0) - 4, "limit: margin 0 (below fails)", kFont, kLimitLine,
-             HAlign::kLeft, VAlign::kBottom, kPassShade.with_alpha(0.85f));
-
-  // One line per axis-1 value, points in axis-0 order.
-  const std::vector<Cell> cells = cells_2d(d, nx, ny);
   const std::vector<size_t> xo = axis_order(ax);
-  std::vector<LegendEntry> legend;
-  std::vector<std::pair<double, double>> errors;
-  struct Reason {
-    double x, y;
-    std::string text;
+  const Color col = sweep_series_color(iy);
+  const LineStyle s{.color = col, .width = 3};
+  std::vector<double> px, py;
+  auto flush = [&] {
+    if (px.size() >= 2) c.polyline(px, py, s, a.rect);
+    px.clear();
+    py.clear();
   };
-  std::vector<Reason> reasons;
-  for (size_t iy = 0; iy < ny; ++iy) {
-    const Color col = sweep_series_color(iy);
-    const LineStyle s{.color = col, .width = 3};
-    std::vector<double> px, py;
-    auto flush = [&] {
-      if (px.size() >= 2) c.polyline(px, py, s, a.rect);
-      px.clear();
-      py.clear();
-    };
-    for (size_t ix : xo) {
-      const Cell& cell = cells[iy * nx + ix];
-      if (!cell.any) continue;
-      if (std::isnan(cell.margin)) {
-        if (cell.verdict == "error") errors.push_back({a.px(margin_x(d, ix)), 0});
-        flush();
-        continue;
-      }
-      px.push_back(a.px(margin_x(d, ix)));
-      py.push_back(a.py(cell.margin));
+  for (size_t ix : xo) {
+    const Cell& cell = cells[iy * nx + ix];
+    if (!cell.any) continue;
+    if (std::isnan(cell.margin)) {
+      if (cell.verdict == "error") errors->push_back({a.px(margin_x(d, ix)), 0});
+      flush();
+      continue;
     }
-    flush();
-    for (size_t ix : xo) {
-      const Cell& cell = cells[iy * nx + ix];
-      if (!cell.any || std::isnan(cell.margin)) continue;
-      const double x = a.px(margin_x(d, ix)), y = a.py(cell.margin);
-      fill_circle(c, x, y, 7, col);
-      if (cell.verdict != "pass") {
-        ring(c, x, y, 11, 3, kFail);
-        if (!cell.reason.empty()) reasons.push_back({x, y, cell.reason});
-      }
+    px.push_back(a.px(margin_x(d, ix)));
+    py.push_back(a.py(cell.margin));
+  }
+  flush();
+  for (size_t ix : xo) {
+    const Cell& cell = cells[iy * nx + ix];
+    if (!cell.any || std::isnan(cell.margin)) continue;
+    const double x = a.px(margin_x(d, ix)), y = a.py(cell.margin);
+    fill_circle(c, x, y, 7, col);
+    if (cell.verdict != "pass") {
+      ring(c, x, y, 11, 3, kFail);
+      if (!cell.reason.empty()) reasons->push_back({x, y, cell.reason});
     }
-    const std::string label =
-        lines
-            ? fmt::format(
+  }
+  const std::string label =
+      lines ? fmt::format(
                   "{} = {}", d.axes[1].name,
                   value_label(d.axes[1], iy, axis_scale(d.axes[1])) +
                       (axis_scale(d.axes[1]).unit.empty() ? "" : " " + axis_scale(d.axes[1]).unit))
             : "worst margin";
-    legend.push_back({label, s});
-  }
-  // Why points fail: one label per distinct reason, at its lowest point, left of the points in the
-  // right third of the plot; a label that would cover another one is left out (the red rings
-  // still mark every failing point).
+  return {label, s};
+}
+
+// Why points fail: one label per distinct reason, at its lowest point, left of the points in the
+// right third of the plot; a label that would cover another one is left out (the red rings
+// still mark every failing point).
+void draw_fail_reasons(Canvas& c, const PlotArea& a, std::vector<FailReason> reasons) {
   std::sort(reasons.begin(), reasons.end(),
-            [](const Reason& p, const Reason& q) { return p.y > q.y; });
+            [](const FailReason& p, const FailReason& q) { return p.y > q.y; });
   std::vector<Rect> placed;
   for (size_t i = 0; i < reasons.size(); ++i) {
     bool shown = false;
@@ -318,6 +308,41 @@ Status render_margin_png(const SweepPlotData& d, const std::string& path) {
     draw_label(c, lx, ly, reasons[i].text, kFont - 2, kFail, left ? HAlign::kRight : HAlign::kLeft,
                VAlign::kTop, kWhite.with_alpha(0.8f), 2);
   }
+}
+
+}  // namespace
+
+Status render_margin_png(const SweepPlotData& d, const std::string& path) {
+  if (d.axes.empty()) return Status::Error(path + ": error: the margin plot needs a swept key");
+  StatusOr<Canvas> cv = Canvas::create(kW, kH);
+  if (!cv) return cv.status().with_context(path);
+  Canvas& c = *cv;
+  const MarginLayout L = margin_layout(d);
+  const PlotArea& a = L.plot;
+  const SweepPlotAxis& ax = d.axes[0];
+  const bool lines = d.axes.size() >= 2;
+  const size_t nx = ax.labels.size();
+  const size_t ny = lines ? d.axes[1].labels.size() : 1;
+  draw_header(c, "Worst margin vs " + ax.name, d, aggregation_note(d, lines ? 2 : 1));
+
+  // Pass side shaded, grid, ticks.
+  c.fill_rect(a.data_rect(a.x.lo, a.x.hi, 0, a.y.hi), kPassShade);
+  const AxisTicks xt = margin_x_ticks(c, a, d);
+  const AxisTicks yt = make_ticks(a.y, UnitScale{100, "%"}, 10);
+  draw_grid(c, a, xt, yt);
+  // The limit.
+  c.hline(a.row(0.0), a.rect.x0, a.rect.x1, {.color = kLimitLine, .width = 3});
+  draw_label(c, a.rect.x0 + 10, a.row(0.0) - 4, "limit: margin 0 (below fails)", kFont, kLimitLine,
+             HAlign::kLeft, VAlign::kBottom, kPassShade.with_alpha(0.85f));
+
+  // One line per axis-1 value, points in axis-0 order.
+  const std::vector<Cell> cells = cells_2d(d, nx, ny);
+  std::vector<LegendEntry> legend;
+  std::vector<std::pair<double, double>> errors;
+  std::vector<FailReason> reasons;
+  for (size_t iy = 0; iy < ny; ++iy)
+    legend.push_back(draw_margin_line(c, a, d, cells, iy, &errors, &reasons));
+  draw_fail_reasons(c, a, std::move(reasons));
   for (const auto& [x, unused] : errors) {
     cross(c, x, a.rect.y1 - 22, 9, kMuted);
     c.text(x, a.rect.y1 - 38, "error", kFont, kMuted, FontFace::kSans, HAlign::kCenter,
@@ -371,18 +396,17 @@ HeatmapLayout heatmap_layout(const SweepPlotData& d) {
   return L;
 }
 
-Status render_heatmap_png(const SweepPlotData& d, const std::string& path) {
-  if (d.axes.size() < 2) return Status::Error(path + ": error: the heatmap needs two swept keys");
-  StatusOr<Canvas> cv = Canvas::create(kW, kH);
-  if (!cv) return cv.status().with_context(path);
-  Canvas& c = *cv;
-  const HeatmapLayout L = heatmap_layout(d);
-  const HeatmapCells h = heatmap_cells(d);
-  const PlotArea& a = L.plot;
-  const SweepPlotAxis &ax = d.axes[0], &ay = d.axes[1];
-  draw_header(c, "Pass/fail map: " + ay.name + " vs " + ax.name, d, aggregation_note(d, 2));
+namespace {
 
-  auto at = [&](int ix, int iy) { return static_cast<size_t>(iy * h.nx + ix); };
+size_t cell_index(const HeatmapCells& h, int ix, int iy) {
+  return static_cast<size_t>(iy * h.nx + ix);
+}
+
+// The cells coloured by margin (grey when empty or an error), white separators, failing cells
+// hatched (a point can fail with every margin positive: a dip, a frame that does not decode).
+void draw_heatmap_cells(Canvas& c, const PlotArea& a, const HeatmapLayout& L,
+                        const HeatmapCells& h) {
+  auto at = [&](int ix, int iy) { return cell_index(h, ix, iy); };
   fill_cells(c, a, h.nx, h.ny, [&](int ix, int iy) -> std::optional<Color> {
     const std::string& v = h.verdict[at(ix, iy)];
     if (v.empty()) return kEmptyCell;
@@ -394,9 +418,7 @@ Status render_heatmap_png(const SweepPlotData& d, const std::string& path) {
     c.vline(a.col(ix), a.rect.y0, a.rect.y1, {.color = kWhite, .width = 1});
   for (int iy = 1; iy < h.ny; ++iy)
     c.hline(a.row(iy), a.rect.x0, a.rect.x1, {.color = kWhite, .width = 1});
-
-  // Failing cells hatched (a point can fail with every margin positive: a dip, a frame that does
-  // not decode), then labels where there is room.
+  // Failing cells hatched.
   for (int iy = 0; iy < h.ny; ++iy)
     for (int ix = 0; ix < h.nx; ++ix) {
       if (h.verdict[at(ix, iy)] != "fail") continue;
@@ -405,6 +427,12 @@ Status render_heatmap_png(const SweepPlotData& d, const std::string& path) {
       for (int k = -cell.height(); k < cell.width(); k += 18)
         c.line(cell.x0 + k, cell.y1, cell.x0 + k + cell.height(), cell.y0, hatch, cell);
     }
+}
+
+// Each cell's margin (and a failing cell's reason) where the cells have room for text.
+void draw_heatmap_labels(Canvas& c, const PlotArea& a, const HeatmapLayout& L,
+                         const HeatmapCells& h) {
+  auto at = [&](int ix, int iy) { return cell_index(h, ix, iy); };
   const double cw = a.rect.width() / static_cast<double>(h.nx);
   const double ch = a.rect.height() / static_cast<double>(h.ny);
   const int fs = cw >= 110 && ch >= 48 ? 20 : cw >= 80 && ch >= 36 ? 16 : 0;
@@ -429,9 +457,12 @@ Status render_heatmap_png(const SweepPlotData& d, const std::string& path) {
                      kFail.with_alpha(0.85f), 3, FontFace::kBold);
         }
       }
+}
 
-  // The boundary: every cell edge between a passing cell and a failing (or error) one.
-  const LineStyle b{.color = kBoundary, .width = 5};
+// The boundary: every cell edge between a passing cell and a failing (or error) one.
+void draw_heatmap_boundary(Canvas& c, const PlotArea& a, const HeatmapCells& h,
+                           const LineStyle& b) {
+  auto at = [&](int ix, int iy) { return cell_index(h, ix, iy); };
   auto passes = [&](int ix, int iy) { return h.verdict[at(ix, iy)] == "pass"; };
   auto known = [&](int ix, int iy) { return !h.verdict[at(ix, iy)].empty(); };
   for (int iy = 0; iy < h.ny; ++iy)
@@ -442,8 +473,12 @@ Status render_heatmap_png(const SweepPlotData& d, const std::string& path) {
       if (iy + 1 < h.ny && known(ix, iy + 1) && passes(ix, iy) != passes(ix, iy + 1))
         c.hline(a.row(iy + 1), a.col(ix) - 2, a.col(ix + 1) + 3, b);
     }
+}
 
-  // Axes: a tick per value at the cell centres.
+// Axes: a tick per value at the cell centres, labels that would overlap left out.
+void draw_heatmap_axes(Canvas& c, const PlotArea& a, const SweepPlotData& d,
+                       const HeatmapCells& h) {
+  const SweepPlotAxis &ax = d.axes[0], &ay = d.axes[1];
   const UnitScale xs = axis_scale(ax), ys = axis_scale(ay);
   const std::vector<size_t> xo = axis_order(ax), yo = axis_order(ay);
   AxisTicks xt, yt;
@@ -464,8 +499,11 @@ Status render_heatmap_png(const SweepPlotData& d, const std::string& path) {
     yt.ticks.push_back({iy + 0.5, value_label(ay, yo[static_cast<size_t>(iy)], ys)});
   }
   draw_axes(c, a, xt, yt, ax.name, ay.name, kFont);
+}
 
-  // Colour bar.
+// The colour bar (each half on its own scale) and the legend.
+void draw_heatmap_key(Canvas& c, const HeatmapLayout& L, const HeatmapCells& h,
+                      const LineStyle& b) {
   const Rect& cb = L.colorbar;
   for (int y = cb.y0; y < cb.y1; ++y) {
     const double t = 1.0 - 2.0 * (y + 0.5 - cb.y0) / cb.height();
@@ -497,6 +535,26 @@ Status render_heatmap_png(const SweepPlotData& d, const std::string& path) {
   if (any_error) legend.push_back({"could not be simulated", {.color = kErrorCell}, true});
   if (any_empty) legend.push_back({"not run", {.color = kEmptyCell}, true});
   draw_legend(c, cb.x0 - 20, cb.y1 + 40, legend, kFont);
+}
+
+}  // namespace
+
+Status render_heatmap_png(const SweepPlotData& d, const std::string& path) {
+  if (d.axes.size() < 2) return Status::Error(path + ": error: the heatmap needs two swept keys");
+  StatusOr<Canvas> cv = Canvas::create(kW, kH);
+  if (!cv) return cv.status().with_context(path);
+  Canvas& c = *cv;
+  const HeatmapLayout L = heatmap_layout(d);
+  const HeatmapCells h = heatmap_cells(d);
+  const PlotArea& a = L.plot;
+  const SweepPlotAxis &ax = d.axes[0], &ay = d.axes[1];
+  draw_header(c, "Pass/fail map: " + ay.name + " vs " + ax.name, d, aggregation_note(d, 2));
+  draw_heatmap_cells(c, a, L, h);
+  draw_heatmap_labels(c, a, L, h);
+  const LineStyle b{.color = kBoundary, .width = 5};
+  draw_heatmap_boundary(c, a, h, b);
+  draw_heatmap_axes(c, a, d, h);
+  draw_heatmap_key(c, L, h, b);
   return c.write_png(path);
 }
 

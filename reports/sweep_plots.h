@@ -10,6 +10,10 @@
 // grid cell holds several points (Monte Carlo samples, or keys beyond the ones drawn) the chart
 // shows the worst of them, and a cell passes only when all of them pass. The *_layout functions
 // give the mappings the images are drawn with (tests read pixels back through them).
+//
+// Contract: the inputs are read during the call only. Errors: a Status naming the file (the
+// image plug-in or its fonts not found, a write that fails); the PNG is written to a temporary
+// name and renamed, so a failure leaves no file.
 #pragma once
 
 #include <optional>

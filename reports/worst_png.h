@@ -6,6 +6,10 @@
 // Each image is one wave.png panel (wave_png.h) of the replayed record (superposition of the edge
 // response, the same waveform the search scored), titled with the metric, its value and margin,
 // and the reproduce stimulus as the second title line.
+//
+// Contract: the inputs are read during the call only. Errors: a Status naming the file (the
+// image plug-in or its fonts not found, a write that fails); the PNG is written to a temporary
+// name and renamed, so a failure leaves no file.
 #pragma once
 
 #include <string>

@@ -5,6 +5,9 @@
 //
 //   StatusOr<analysis::WorstResult> w = analysis::worst_case(spec, parts);
 //   std::puts(worst_json(*w).dump(2).c_str());
+//
+// Contract: pure functions of their arguments, which they only read: no I/O, no errors. Units
+// are SI, named in the JSON keys (`_s`, `_V`, `_ns`) and the Markdown text.
 
 #include <nlohmann/json.hpp>
 #include <string>

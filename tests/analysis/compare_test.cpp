@@ -23,6 +23,7 @@
 #include "analysis/compare_model.h"
 #include "analysis/worst.h"
 #include "base/file_io.h"
+#include "reports/compare_report.h"
 #include "tests/analysis/synthetic_capture.h"
 
 namespace isolink::analysis {
@@ -185,7 +186,7 @@ TEST(Compare, NominalCaptureMatchesAndTheTriggerOffsetIsRecovered) {
   const std::string spec = write_spec("cap.yaml", kCapLink);
   testing::ScopeModel scope;  // 2.5 GS/s, 300 MHz, 10 mV, 8 bits over +/-5 V, 3.3 us
   const CompareResult r = run(capture("nominal.csv", kCapLink, {}, scope), spec);
-  EXPECT_EQ(r.verdict, "match") << compare_text(r);
+  EXPECT_EQ(r.verdict, "match") << reports::compare_text(r);
   EXPECT_TRUE(r.findings.empty());
   EXPECT_EQ(r.traffic_from, "capture: 9 frames decoded");
   // Drive time t is capture time t + trigger, plus the bandwidth limit's delay (tau = 0.53 ns).
@@ -194,7 +195,7 @@ TEST(Compare, NominalCaptureMatchesAndTheTriggerOffsetIsRecovered) {
   EXPECT_NEAR(r.quant_step_v, 10.0 / 256, 1e-6);
   EXPECT_NEAR(r.noise_rms_v, 10e-3 * std::sqrt(2.0), 4e-3);
   // Its peaks (about 4.5 V) stay inside the +/-5 V range: no rail.
-  EXPECT_FALSE(r.clipping.high_v || r.clipping.low_v) << compare_text(r);
+  EXPECT_FALSE(r.clipping.high_v || r.clipping.low_v) << reports::compare_text(r);
   EXPECT_EQ(r.residual.clipped, 0u);
 }
 
@@ -209,18 +210,19 @@ TEST(Compare, ClippedCaptureMatchesWhereTheScopesRangeCutTheDesign) {
   scope.range_v = 3.0;
   const double q = 6.0 / 256;
   const CompareResult r = run(capture("clipped.csv", kCapLink, {}, scope), spec);
-  EXPECT_EQ(r.verdict, "match") << compare_text(r);
-  ASSERT_TRUE(r.clipping.high_v && r.clipping.low_v) << compare_text(r);
+  EXPECT_EQ(r.verdict, "match") << reports::compare_text(r);
+  ASSERT_TRUE(r.clipping.high_v && r.clipping.low_v) << reports::compare_text(r);
   EXPECT_NEAR(*r.clipping.high_v, 3.0 - q, 1e-6);
   EXPECT_NEAR(*r.clipping.low_v, -3.0, 1e-6);
   EXPECT_GT(r.residual.clipped, 100u);
-  EXPECT_NE(compare_text(r).find("the capture clips at -3 V and +2.977 V"), std::string::npos)
-      << compare_text(r);
+  EXPECT_NE(reports::compare_text(r).find("the capture clips at -3 V and +2.977 V"),
+            std::string::npos)
+      << reports::compare_text(r);
   for (double range : {3.0, 1.5}) {
     scope.range_v = range;
     const CompareResult w =
         run(capture("clipped_wrong.csv", kCapLink, {{"tx.series_r", "245", true}}, scope), spec);
-    EXPECT_EQ(w.verdict, "mismatch") << range << " V\n" << compare_text(w);
+    EXPECT_EQ(w.verdict, "mismatch") << range << " V\n" << reports::compare_text(w);
   }
 }
 
@@ -242,7 +244,7 @@ TEST(Compare, HalvedRxCapIsAMismatchAndTheFitFindsIt) {
   const CompareResult r = run(cap, spec, opt, cols);
   EXPECT_EQ(r.verdict, "mismatch");
   ASSERT_EQ(r.fit.size(), 1u);
-  EXPECT_NEAR(r.fit[0].value, 1.1e-9, 0.1 * 1.1e-9) << compare_text(r);
+  EXPECT_NEAR(r.fit[0].value, 1.1e-9, 0.1 * 1.1e-9) << reports::compare_text(r);
   EXPECT_DOUBLE_EQ(r.fit[0].initial, 2.2e-9);
   EXPECT_NEAR(r.fit[0].low, 0.44e-9, 1e-15);
   EXPECT_NEAR(r.fit[0].high, 11e-9, 1e-15);
@@ -263,8 +265,8 @@ TEST(Compare, CableLengthAndTerminationAreRecovered) {
   opt.fit = {"cable.length", "rx.termination"};
   const CompareResult r = run(cap, spec, opt);
   ASSERT_EQ(r.fit.size(), 2u);
-  EXPECT_NEAR(r.fit[0].value, 3.2, 0.32) << compare_text(r);
-  EXPECT_NEAR(r.fit[1].value, 1300, 260) << compare_text(r);
+  EXPECT_NEAR(r.fit[0].value, 3.2, 0.32) << reports::compare_text(r);
+  EXPECT_NEAR(r.fit[1].value, 1300, 260) << reports::compare_text(r);
   EXPECT_EQ(r.verdict, "mismatch");  // both are outside their 10 % bands
   EXPECT_EQ(r.findings.size(), 2u);
 }
@@ -300,13 +302,13 @@ void expect_recovered(const std::string& key, const std::string& truth, double t
   opt.fit = {key};
   const CompareResult r = run(cap, spec, opt, columns_of(scope));
   ASSERT_EQ(r.fit.size(), 1u);
-  EXPECT_NEAR(r.fit[0].value, truth_si, 0.2 * truth_si) << compare_text(r);
-  EXPECT_TRUE(r.fit[0].identifiable) << compare_text(r);
-  ASSERT_EQ(r.findings.size(), 1u) << compare_text(r);
+  EXPECT_NEAR(r.fit[0].value, truth_si, 0.2 * truth_si) << reports::compare_text(r);
+  EXPECT_TRUE(r.fit[0].identifiable) << reports::compare_text(r);
+  ASSERT_EQ(r.findings.size(), 1u) << reports::compare_text(r);
   EXPECT_EQ(r.findings[0].key, key);
   EXPECT_EQ(r.verdict, "mismatch");
   ASSERT_TRUE(r.residual_after_fit);
-  EXPECT_LT(r.residual_after_fit->rms_v, r.threshold_rms_v) << compare_text(r);
+  EXPECT_LT(r.residual_after_fit->rms_v, r.threshold_rms_v) << reports::compare_text(r);
   ASSERT_TRUE(r.offset_after_fit_s);
   EXPECT_NEAR(*r.offset_after_fit_s, scope.trigger, 2e-9);
 }
@@ -329,7 +331,7 @@ TEST(Compare, TransformerCaptureAgainstACapSpecStaysAMismatch) {
   CompareOptions opt;
   opt.fit = {"cable.length"};
   const CompareResult r = run(cap, spec, opt);
-  EXPECT_EQ(r.verdict, "mismatch") << compare_text(r);
+  EXPECT_EQ(r.verdict, "mismatch") << reports::compare_text(r);
   ASSERT_TRUE(r.residual_after_fit);
   EXPECT_GT(r.residual_after_fit->rms_v, r.threshold_rms_v);
 }
@@ -347,7 +349,7 @@ TEST(Compare, BrokenLinkThatDecodesNothingIsFittedFromTheSpecStimulus) {
   EXPECT_EQ(r.traffic_from, "spec stimulus (nothing decoded)");
   EXPECT_EQ(r.verdict, "mismatch");
   ASSERT_EQ(r.fit.size(), 1u);
-  EXPECT_NEAR(r.fit[0].value, 47e-12, 4.7e-12) << compare_text(r);
+  EXPECT_NEAR(r.fit[0].value, 47e-12, 4.7e-12) << reports::compare_text(r);
   ASSERT_TRUE(r.offset_after_fit_s);
   EXPECT_NEAR(*r.offset_after_fit_s, 3.3e-6, 1.5e-9);  // the trigger, as made
   EXPECT_LT(r.noise_rms_v, 0.03);  // the traffic's windows are not taken for idle

@@ -8,6 +8,7 @@
 
 #include "analysis/sweep_run.h"
 #include "analysis/sweep_spec.h"
+#include "reports/sweep_report.h"
 
 namespace isolink::analysis::sweep {
 namespace {
@@ -268,14 +269,14 @@ TEST(SweepResults, ResumeReadsTheWorstColumns) {
     (*log)->add(result(4, *ws, "error", 0));  // no worst cells: padded
     EXPECT_TRUE((*log)->results()[1].worst.has_value());
     // summary.json: the worst-case verdicts and the point with the smallest worst.margin_rel.
-    const nlohmann::ordered_json j = summary_json(*ws, (*log)->results());
+    const nlohmann::ordered_json j = reports::sweep_summary_json(*ws, (*log)->results());
     EXPECT_EQ(j["worst_case"]["pass"], 1);
     EXPECT_EQ(j["worst_case"]["fail"], 1);
     EXPECT_EQ(j["worst_case"]["worst"]["point"], 2);
     EXPECT_EQ(j["worst_case"]["worst"]["worst_metric"], "vend");
     EXPECT_DOUBLE_EQ(j["worst_case"]["worst"]["margin_rel"].get<double>(), -0.05);
     EXPECT_EQ(j["worst"]["point"], 6);  // the spec traffic's worst point is another
-    EXPECT_FALSE(summary_json(spec(), (*log)->results()).contains("worst_case"));
+    EXPECT_FALSE(reports::sweep_summary_json(spec(), (*log)->results()).contains("worst_case"));
   }
   const std::string all = slurp(dir + "/results.csv");
   EXPECT_NE(all.find("\n4,5,1e-09,error,,,,,,,,,,,,,,,,,,,,,,"), std::string::npos) << all;
@@ -348,7 +349,7 @@ TEST(SweepResults, SummaryCountsYieldAndBoundary) {
     if (i != 3) rs.push_back(result(2 * i + 1, s, m2[i] >= 0 ? "pass" : "fail", m2[i]));
   }
   rs.push_back(result(7, s, "error", 0));
-  const nlohmann::ordered_json j = summary_json(s, rs);
+  const nlohmann::ordered_json j = reports::sweep_summary_json(s, rs);
   EXPECT_EQ(j["points"], 8);
   EXPECT_EQ(j["done"], 8);
   EXPECT_EQ(j["pass"], 5);

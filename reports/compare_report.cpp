@@ -1,15 +1,23 @@
-// isolink compare's result as JSON (issue 29's shape and more), text and Markdown.
+#include "reports/compare_report.h"
+
 #include <fmt/format.h>
 
 #include <cmath>
 
-#include "analysis/compare.h"
 #include "analysis/sweep_spec.h"
 #include "eye/commands.h"
 #include "netlists/link/cards.h"
 
-namespace isolink::analysis {
+namespace isolink::reports {
 namespace {
+
+using analysis::Clipping;
+using analysis::CompareResult;
+using analysis::Finding;
+using analysis::FitKey;
+using analysis::MetricSummary;
+using analysis::Residual;
+namespace sweep = analysis::sweep;
 
 using json = nlohmann::ordered_json;
 
@@ -214,4 +222,4 @@ std::string compare_markdown(const CompareResult& r) {
   return s;
 }
 
-}  // namespace isolink::analysis
+}  // namespace isolink::reports
