@@ -327,11 +327,11 @@ Status run_transient_engine(const Netlist& netlist, const EngineRun& run,
   if (req.engine == Engine::Auto && !result.engine_note.empty() && !req.reltol) {
     // auto fell back: the run checks its own convergence (transient_check.h).
     TransientConvergence conv;
-    wave = converge_transient(circuit, opt, probes, std::move(*wave), &result.stats, &conv);
+    wave = converge_transient(run.circuit, opt, run.probes, std::move(*wave), &result.stats, &conv);
     result.reltol = conv.reltols.back();
     result.convergence = std::move(conv);
     result.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - run.start).count();
   }
   result.wave = std::move(*wave);
   result.engine = Engine::Transient;
