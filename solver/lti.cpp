@@ -10,6 +10,7 @@
 #include <functional>
 
 #include "solver/mna_system.h"
+#include "solver/step_control.h"
 
 namespace isolink {
 
@@ -221,18 +222,15 @@ StatusOr<LtiResponses> LtiResponses::compute(const Circuit& circuit,
   const double hmax = opt.max_step > 0 ? std::min(opt.max_step, horizon) : horizon / 64;
   const double h0 = opt.first_step > 0 ? opt.first_step : std::min(1e-12, horizon * 1e-9);
   const double hmin = std::max(1e-18, horizon * 1e-14);
-  auto ladder = [&](double h) {  // largest hmax / 2^k not above h
-    if (h >= hmax) return hmax;
-    const int e = static_cast<int>(std::ceil(std::log2(hmax / h) - 1e-9));
-    return std::ldexp(hmax, -e);
-  };
+  // The truncation error per unit time is O(h^2).
+  const StepControl control{.hmax = hmax, .hmin = hmin, .error_order = 2};
 
   std::vector<std::vector<double>> x(nk, std::vector<double>(n + 1, 0.0)), xdot = x, xnew = x,
                                                                            hist_part = x;
   MarchHistory hist;
   for (auto& s : hist.states) s = x;
   hist.push(0.0, x);
-  double tau = 0.0, h = ladder(h0);
+  double tau = 0.0, h = control.ladder(h0);
   int worst_unknown = 0;
   // Largest |chord slope| of each probe's response so far: no settling before it has arrived.
   std::vector<std::vector<double>> probe_peak(nk, std::vector<double>(np, 0.0));
@@ -282,13 +280,13 @@ StatusOr<LtiResponses> LtiResponses::compute(const Circuit& circuit,
     }
     if (ratio > 1.0) {
       ++r.stats_.rejected;
-      h = step * std::max(0.25, 0.9 * std::sqrt(1.0 / ratio));
+      h = control.shrink(step, ratio);
       if (h < hmin)
         return Status::Error(fmt::format(
             "LTI march: step too small at {:g} s (h={:g} s): the truncation error of {} does not "
             "converge",
             tau, h, circuit.unknown_name(worst_unknown)));
-      h = ladder(h);
+      h = control.ladder(h);
       continue;
     }
 
@@ -314,9 +312,7 @@ StatusOr<LtiResponses> LtiResponses::compute(const Circuit& circuit,
         const double chord = (R.back() - R[R.size() - 2]) / step;
         probe_peak[k][p] = std::max(probe_peak[k][p], std::fabs(chord));
       }
-    // Error per unit time scales as h^2: grow by sqrt, at most 2x.
-    const double grow = ratio > 0 ? std::min(2.0, 0.9 * std::sqrt(1.0 / ratio)) : 2.0;
-    h = ladder(std::max(step * std::max(grow, 0.5), hmin));
+    h = control.grow(step, ratio);
 
     // Settling (see lti.h), checked whenever the step count or the time has grown by 10 %.
     const size_t i = r.tau_.size() - 1;

@@ -9,6 +9,7 @@
 #include "solver/klu_solver.h"
 #include "solver/mna.h"
 #include "solver/mna_system.h"
+#include "solver/step_control.h"
 
 namespace isolink {
 
@@ -188,19 +189,14 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
   // History since the last breakpoint: up to 3 points, oldest first (fixed storage).
   History hist(n, x);
 
-  auto ladder = [&](double h) {  // largest hmax / 2^k not above h (up to rounding)
-    if (h >= hmax) return hmax;
-    // h of 0 (or below hmax * 2^-1074) makes log2 infinite; converting that to int was UB
-    // (UBSan: negation of INT_MIN). Clamp to the double range: the step-size floor then reports.
-    const double k = std::ceil(std::log2(hmax / h) - 1e-9);
-    return std::ldexp(hmax, k < 1100 ? -static_cast<int>(k) : -1100);
-  };
+  // Local truncation error of a second-order method: O(h^3).
+  const StepControl control{.hmax = hmax, .hmin = hmin, .error_order = 3};
 
   double t = 0.0;
   size_t next_bp = 0;
-  double h = ladder(0.1 * std::min(hmax, bps[0]));
+  double h = control.ladder(0.1 * std::min(hmax, bps[0]));
   // The UIC step that puts the capacitors' ic= charge in place is not error-checked: keep it short.
-  if (!uic_dq.empty()) h = ladder(1e-3 * h);
+  if (!uic_dq.empty()) h = control.ladder(1e-3 * h);
   double last_regular_h = hmax;
   bool after_bp = true;  // the next step is the first after a breakpoint (or t = 0)
   int worst_unknown = 0;
@@ -295,7 +291,8 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
       if (ratio1 > 1.0) {
         stats.rejected += 2;
         --stats.accepted;
-        const double h_retry = h1 * std::max(0.1, 0.9 * std::sqrt(1.0 / ratio1));
+        // Backward Euler's error is O(h^2).
+        const double h_retry = StepControl::shrink_by_order(h1, ratio1, 2, 0.1);
         if (h_retry < hmin)
           return Status::Error(fmt::format(
               "time step too small at t={:g} s (h={:g} s): the truncation error of {} does not "
@@ -309,20 +306,20 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
         std::copy(x0.begin(), x0.end(), x.begin());
         hist.reset(t0, x);
         after_bp = true;
-        h = ladder(h_retry);
+        h = control.ladder(h_retry);
         continue;
       }
     }
 
     if (ratio > 1.0) {
       ++stats.rejected;
-      h = step * std::max(0.25, 0.9 * std::cbrt(1.0 / ratio));
+      h = control.shrink(step, ratio);
       if (h < hmin)
         return Status::Error(fmt::format(
             "time step too small at t={:g} s (h={:g} s): the truncation error of {} does not "
             "converge",
             t, h, circuit.unknown_name(worst_unknown)));
-      h = ladder(h);
+      h = control.ladder(h);
       continue;
     }
 
@@ -339,9 +336,8 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
       if (a > peak[k]) peak[k] = a, inv_tol[k] = 1.0 / (rel_tol * a + abs_tol[k]);
     }
 
-    const double grow = ratio > 0 ? std::min(2.0, 0.9 * std::cbrt(1.0 / ratio)) : 2.0;
     if (!lands) last_regular_h = step;
-    h = ladder(std::max(step * std::max(grow, 0.5), hmin));
+    h = control.grow(step, ratio);
     after_bp = false;
     if (!uic_dq.empty()) {
       // The UIC step moved the capacitors' charge to their ic=: restart the formula from here,
@@ -353,8 +349,8 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
     if (lands) {
       // Restart the formula at the corner: small Euler step, fresh history.
       after_bp = true;
-      h = ladder(0.1 * std::min(last_regular_h,
-                                (next_bp + 1 < bps.size() ? bps[next_bp + 1] : tstop) - t));
+      h = control.ladder(0.1 * std::min(last_regular_h,
+                                        (next_bp + 1 < bps.size() ? bps[next_bp + 1] : tstop) - t));
       hist.reset(t, x);
     }
   }
