@@ -36,16 +36,11 @@ struct MnaSystem {
 
   Status build(const Circuit& circuit) {
     n = circuit.unknown_count();
-    pattern = MnaPattern(n);
-    auto& elements = const_cast<Circuit&>(circuit).elements();
-    for (auto& e : elements) e->declare(pattern);
-    pattern.finalize();
-    for (auto& e : elements) e->declare(pattern);
-    g.assign(pattern.value_count(), 0.0);
-    c.assign(pattern.value_count(), 0.0);
-    for (auto& e : elements) e->stamp(g.data(), c.data());
-    for (int node : circuit.floating_nodes()) g[pattern.slot(node, node)] += Circuit::kFloatingTie;
-    for (const auto& e : elements)
+    MnaMatrices m = assemble_mna(circuit);
+    pattern = std::move(m.pattern);
+    g = std::move(m.g);
+    c = std::move(m.c);
+    for (const auto& e : circuit.elements())
       if (e->has_excitation()) sources.push_back(e.get());
     const auto& cp = pattern.col_start();
     const auto& ri = pattern.row_index();

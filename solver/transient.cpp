@@ -106,11 +106,11 @@ StatusOr<std::vector<double>> dc_operating_point(const Circuit& circuit) {
   return x;
 }
 
-StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions& opt,
+StatusOr<Waveform> run_transient(Circuit& circuit, const TransientOptions& opt,
                                  const std::vector<Probe>& probes, TransientStats* stats_out) {
   if (Status s = opt.validate(); !s.ok()) return s;
   TransientStats stats;
-  for (const auto& e : circuit.elements()) const_cast<Element&>(*e).bind_time(opt.tstep, opt.tstop);
+  for (const auto& e : circuit.elements()) e->bind_time(opt.tstep, opt.tstop);
 
   MnaSystem sys;
   if (Status s = sys.build(circuit); !s.ok()) return s;

@@ -73,7 +73,7 @@ struct TransientStats {
 // DC operating point: the full unknown vector (index 0 = ground). Errors name the node.
 StatusOr<std::vector<double>> dc_operating_point(const Circuit& circuit);
 
-StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions& options,
+StatusOr<Waveform> run_transient(Circuit& circuit, const TransientOptions& options,
                                  const std::vector<Probe>& probes, TransientStats* stats = nullptr);
 
 }  // namespace isolink
