@@ -10,7 +10,6 @@
 #include <functional>
 
 #include "solver/mna_system.h"
-#include "solver/step_control.h"
 
 namespace isolink {
 
@@ -66,22 +65,6 @@ Status check_lti(const Circuit& circuit) {
 }
 
 namespace {
-
-// The last accepted points of the march, oldest first: times and the full state of each source.
-struct MarchHistory {
-  std::array<double, 3> times{};
-  std::array<std::vector<std::vector<double>>, 3> states;  // [slot][source][unknown]
-  int first = 0, count = 0;
-  double t(int i) const { return times[(first + i) % 3]; }
-  const std::vector<double>& x(int i, size_t k) const { return states[(first + i) % 3][k]; }
-  void push(double t1, const std::vector<std::vector<double>>& x1) {
-    if (count == 3) first = (first + 1) % 3, --count;
-    const int slot = (first + count) % 3;
-    times[slot] = t1;
-    states[slot] = x1;
-    ++count;
-  }
-};
 
 // e^x, phi1(x) = (e^x - 1) / x and phi2(x) = (e^x - 1 - x) / x^2: a mode x' = p x + u(t) moves
 // over a step h, with u = b + g t on it, to e^{ph} x + h phi1(ph) b + h^2 phi2(ph) g.
@@ -140,248 +123,84 @@ StatusOr<LtiResponses> LtiResponses::compute(const Circuit& circuit,
     r.labels_.push_back(p.label);
     r.is_current_.push_back(p.label.rfind("i(", 0) == 0);
   }
-
   MnaSystem sys;
   if (Status s = sys.build(circuit); !s.ok()) return s;
-  const int n = sys.n;
+  const std::vector<std::vector<double>> unit = r.collect_sources(circuit, sys.n);
+  std::vector<std::vector<double>> dc_solutions;  // per source: G^-1 e_k
+  if (Status s = r.solve_dc(circuit, sys, probes, unit, dc_solutions); !s.ok()) return s;
+  if (opt.method != LtiOptions::Method::March && !r.sources_.empty()) {
+    StatusOr<bool> reduced = r.try_reduced_model(circuit, probes, unit, dc_solutions, opt);
+    if (!reduced) return reduced.status();
+    if (*reduced) return r;
+  }
+  if (Status s = r.march(circuit, sys, probes, unit, opt); !s.ok()) return s;
+  return r;
+}
+
+std::vector<std::vector<double>> LtiResponses::collect_sources(const Circuit& circuit, int n) {
   std::vector<std::vector<double>> unit;  // per source: its unit excitation (n + 1)
   for (const auto& e : circuit.elements()) {
     const SourceFunction* f = e->source_function();
     if (!f || f->kind() == SourceFunction::Kind::Dc) continue;
-    r.sources_.push_back({e->name(), f, f->value(0.0)});
+    sources_.push_back({e->name(), f, f->value(0.0)});
     unit.emplace_back(n + 1, 0.0);
     e->stamp_unit(unit.back().data());
     unit.back()[0] = 0.0;
   }
-  const size_t nk = r.sources_.size(), np = probes.size();
+  return unit;
+}
 
-  // DC: the operating point of the netlist's sources at t = 0, and each source's DC gain.
-  std::vector<std::vector<double>> dc_solutions;  // per source: G^-1 e_k
-  {
-    KluSolver dc_klu;
-    if (Status s = sys.factor_dc(circuit, dc_klu); !s.ok())
-      return s.with_context("DC operating point");
-    std::vector<double> x(n + 1);
-    sys.rhs(0.0, x);
+// The operating point of the netlist's sources at t = 0, and each source's DC gain.
+Status LtiResponses::solve_dc(const Circuit& circuit, const MnaSystem& sys,
+                              const std::vector<Probe>& probes,
+                              const std::vector<std::vector<double>>& unit,
+                              std::vector<std::vector<double>>& dc_solutions) {
+  KluSolver dc_klu;
+  if (Status s = sys.factor_dc(circuit, dc_klu); !s.ok())
+    return s.with_context("DC operating point");
+  std::vector<double> x(sys.n + 1);
+  sys.rhs(0.0, x);
+  if (Status s = dc_klu.solve(x.data() + 1); !s.ok()) return s;
+  x[0] = 0.0;
+  for (const Probe& p : probes) y_dc_.push_back(p.value(x.data()));
+  for (size_t k = 0; k < unit.size(); ++k) {
+    x = unit[k];
     if (Status s = dc_klu.solve(x.data() + 1); !s.ok()) return s;
     x[0] = 0.0;
-    for (const Probe& p : probes) r.y_dc_.push_back(p.value(x.data()));
-    for (size_t k = 0; k < nk; ++k) {
-      x = unit[k];
-      if (Status s = dc_klu.solve(x.data() + 1); !s.ok()) return s;
-      x[0] = 0.0;
-      r.gain_.emplace_back();
-      for (const Probe& p : probes) r.gain_[k].push_back(p.value(x.data()));
-      dc_solutions.push_back(x);
-    }
-    r.stats_.factorizations = 1;
+    gain_.emplace_back();
+    for (const Probe& p : probes) gain_[k].push_back(p.value(x.data()));
+    dc_solutions.push_back(x);
   }
+  stats_.factorizations = 1;
+  return Status::Ok();
+}
 
-  if (opt.method != LtiOptions::Method::March && nk > 0) {
-    ReducedModelOptions ro = opt.reduced;
-    ro.horizon = opt.horizon;
-    std::vector<const SourceFunction*> functions;
-    for (const Source& src : r.sources_) functions.push_back(src.function);
-    ro.edge_time = opt.edge_time > 0 ? opt.edge_time : shortest_edge(functions, opt.horizon);
-    const auto started = std::chrono::steady_clock::now();
-    StatusOr<ReducedModel> model = reduce_circuit(circuit, unit, dc_solutions, probes, ro);
-    r.stats_.model_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    if (model) {
-      r.stats_.method = "reduced model";
-      r.stats_.model = model->stats;
-      r.stats_.factorizations += model->stats.factorizations;
-      r.stats_.settled_at = opt.horizon;
-      r.model_ = std::move(*model);
-      r.tau_.push_back(0.0);
-      return r;
-    }
-    if (opt.method == LtiOptions::Method::Reduced) return model.status();
-    r.stats_.note = model.status().message();
+StatusOr<bool> LtiResponses::try_reduced_model(const Circuit& circuit,
+                                               const std::vector<Probe>& probes,
+                                               const std::vector<std::vector<double>>& unit,
+                                               const std::vector<std::vector<double>>& dc_solutions,
+                                               const LtiOptions& opt) {
+  ReducedModelOptions ro = opt.reduced;
+  ro.horizon = opt.horizon;
+  std::vector<const SourceFunction*> functions;
+  for (const Source& src : sources_) functions.push_back(src.function);
+  ro.edge_time = opt.edge_time > 0 ? opt.edge_time : shortest_edge(functions, opt.horizon);
+  const auto started = std::chrono::steady_clock::now();
+  StatusOr<ReducedModel> model = reduce_circuit(circuit, unit, dc_solutions, probes, ro);
+  stats_.model_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  if (model) {
+    stats_.method = "reduced model";
+    stats_.model = model->stats;
+    stats_.factorizations += model->stats.factorizations;
+    stats_.settled_at = opt.horizon;
+    model_ = std::move(*model);
+    tau_.push_back(0.0);
+    return true;
   }
-  r.stats_.method = "march";
-  const auto march_started = std::chrono::steady_clock::now();
-
-  r.tau_.push_back(0.0);
-  r.r_.assign(nk, std::vector<std::vector<double>>(np, std::vector<double>{0.0}));
-  r.s_.assign(nk, std::vector<std::vector<double>>(np, std::vector<double>{0.0}));
-  if (nk == 0) return r;
-
-  // Watched states and their absolute tolerances, as the transient's error control.
-  std::vector<int> watched;
-  for (int u = 1; u <= n; ++u) {
-    const bool has_c = sys.c[sys.pattern.slot(u, u)] != 0.0;
-    if ((circuit.unknown_is_node(u) && has_c) || circuit.unknown_is_state(u)) watched.push_back(u);
-  }
-  // peak |S| per source and watched state, and 1 / tolerance (recomputed when a peak grows).
-  std::vector<std::vector<double>> peak(nk, std::vector<double>(watched.size(), 0.0));
-  std::vector<std::vector<double>> inv_tol(
-      nk, std::vector<double>(watched.size(), 1.0 / opt.step_abstol));
-
-  const double horizon = opt.horizon;
-  const double hmax = opt.max_step > 0 ? std::min(opt.max_step, horizon) : horizon / 64;
-  const double h0 = opt.first_step > 0 ? opt.first_step : std::min(1e-12, horizon * 1e-9);
-  const double hmin = std::max(1e-18, horizon * 1e-14);
-  // The truncation error per unit time is O(h^2).
-  const StepControl control{.hmax = hmax, .hmin = hmin, .error_order = 2};
-
-  std::vector<std::vector<double>> x(nk, std::vector<double>(n + 1, 0.0)), xdot = x, xnew = x,
-                                                                           hist_part = x;
-  MarchHistory hist;
-  for (auto& s : hist.states) s = x;
-  hist.push(0.0, x);
-  double tau = 0.0, h = control.ladder(h0);
-  int worst_unknown = 0;
-  // Largest |chord slope| of each probe's response so far: no settling before it has arrived.
-  std::vector<std::vector<double>> probe_peak(nk, std::vector<double>(np, 0.0));
-  size_t next_check = 16;  // settle checks at geometrically spaced march points and times
-  double next_check_tau = 0.0;
-
-  while (tau < horizon * (1 - 1e-12)) {
-    if (r.stats_.steps + r.stats_.rejected >= opt.max_steps)
-      return Status::Error(fmt::format("LTI march gave up at {:g} s after {} steps (max_steps)",
-                                       tau, opt.max_steps));
-    if (opt.settle_by > 0 && tau > opt.settle_by)
-      return Status::Error(
-          fmt::format("the responses have not settled by {:g} s (settle_by)", opt.settle_by));
-    double step = std::min(h, horizon - tau);
-    const bool euler = hist.count < 2;
-    const double a0 = euler ? 1.0 / step : 2.0 / step;
-    if (Status s = sys.select_or_factor(circuit, a0); !s.ok())
-      return s.with_context(fmt::format("LTI march at {:g} s", tau + step));
-    const double t1 = tau + step;
-    for (size_t k = 0; k < nk; ++k) {
-      auto& hp = hist_part[k];
-      for (int u = 1; u <= n; ++u) hp[u] = euler ? -x[k][u] / step : -a0 * x[k][u] - xdot[k][u];
-      auto& b = xnew[k];
-      for (int u = 0; u <= n; ++u) b[u] = unit[k][u] * t1;  // unit ramp: u(t) = t
-      sys.sub_c_times(hp.data(), b.data());
-      if (Status s = sys.solve(b); !s.ok()) return s;
-    }
-
-    // Truncation error per unit time against step_reltol * peak|S| + step_abstol.
-    double ratio = 0.0;
-    if (hist.count == 3) {
-      const double t0 = hist.t(2), tm1 = hist.t(1), tm2 = hist.t(0);
-      const double ia = 1.0 / (t1 - t0), ib = 1.0 / (t0 - tm1), ic = 1.0 / (tm1 - tm2);
-      const double ie = 1.0 / (t1 - tm1), iff = 1.0 / (t0 - tm2), ig = 1.0 / (t1 - tm2);
-      const double h2 = step * step * 0.5 * ig;  // h^3 * (1/12) * 6 / h
-      const double w1 = h2 * ie * ia, w2 = -h2 * ib * (ie + iff), w3 = h2 * iff * ic;
-      for (size_t k = 0; k < nk; ++k) {
-        const auto &x0 = hist.x(2, k), &xm1 = hist.x(1, k), &xm2 = hist.x(0, k);
-        const auto& xn = xnew[k];
-        for (size_t w = 0; w < watched.size(); ++w) {
-          const int u = watched[w];
-          const double e = inv_tol[k][w] * std::fabs(w1 * (xn[u] - x0[u]) + w2 * (x0[u] - xm1[u]) +
-                                                     w3 * (xm1[u] - xm2[u]));
-          if (e > ratio) ratio = e, worst_unknown = u;
-        }
-      }
-    }
-    if (ratio > 1.0) {
-      ++r.stats_.rejected;
-      h = control.shrink(step, ratio);
-      if (h < hmin)
-        return Status::Error(fmt::format(
-            "LTI march: step too small at {:g} s (h={:g} s): the truncation error of {} does not "
-            "converge",
-            tau, h, circuit.unknown_name(worst_unknown)));
-      h = control.ladder(h);
-      continue;
-    }
-
-    ++r.stats_.steps;
-    tau = t1;
-    if (opt.on_progress && (r.stats_.steps & 1023) == 0) opt.on_progress(tau);
-    for (size_t k = 0; k < nk; ++k) {
-      for (int u = 1; u <= n; ++u) xdot[k][u] = a0 * xnew[k][u] + hist_part[k][u];
-      std::swap(x[k], xnew[k]);
-      for (size_t w = 0; w < watched.size(); ++w) {
-        const double a = std::fabs(xdot[k][watched[w]]);
-        if (a > peak[k][w])
-          peak[k][w] = a, inv_tol[k][w] = 1.0 / (opt.step_reltol * a + opt.step_abstol);
-      }
-    }
-    hist.push(tau, x);
-    r.tau_.push_back(tau);
-    for (size_t k = 0; k < nk; ++k)
-      for (size_t p = 0; p < np; ++p) {
-        auto &R = r.r_[k][p], &S = r.s_[k][p];
-        R.push_back(probes[p].value(x[k].data()));
-        S.push_back(probes[p].value(xdot[k].data()));
-        const double chord = (R.back() - R[R.size() - 2]) / step;
-        probe_peak[k][p] = std::max(probe_peak[k][p], std::fabs(chord));
-      }
-    h = control.grow(step, ratio);
-
-    // Settling (see lti.h), checked whenever the step count or the time has grown by 10 %.
-    const size_t i = r.tau_.size() - 1;
-    if (i >= next_check || (i >= 16 && tau >= next_check_tau)) {
-      next_check = static_cast<size_t>(static_cast<double>(i) * 1.1) + 1;
-      next_check_tau = tau * 1.1;
-      bool settled = true;
-      const size_t from = static_cast<size_t>(
-          std::lower_bound(r.tau_.begin(), r.tau_.end(), 0.5 * tau) - r.tau_.begin());
-      // On chord slopes (R_j - R_j-1) / h_j, the mean of S over each step: the trapezoidal rule's
-      // derivative S carries a +-delta alternation that never damps, its chords do not.
-      auto chord = [&](const std::vector<double>& R, size_t j) {
-        return (R[j] - R[j - 1]) / (r.tau_[j] - r.tau_[j - 1]);
-      };
-      for (size_t k = 0; k < nk && settled; ++k)
-        for (size_t p = 0; p < np && settled; ++p) {
-          const auto& R = r.r_[k][p];
-          const double last = chord(R, i);
-          const double slope = (last - chord(R, i - 1)) / (0.5 * (r.tau_[i] - r.tau_[i - 2]));
-          if (probe_peak[k][p] < 100 * opt.settle_tol ||
-              std::fabs(slope) * (horizon - tau) > opt.settle_tol ||
-              std::fabs(last - r.gain_[k][p]) > opt.settle_tol) {
-            settled = false;
-            break;
-          }
-          for (size_t j = std::max<size_t>(from, 1); j < i; ++j)
-            if (std::fabs(chord(R, j) - last) > opt.settle_tol) {
-              settled = false;
-              break;
-            }
-        }
-      if (settled) {
-        r.stats_.settled = true;
-        break;
-      }
-    }
-  }
-  r.stats_.settled_at = tau;
-  // S at the march points from R alone: the slope at tau_i of the parabola through the points
-  // i-1, i, i+1 (second order on any spacing; one-sided at the ends). Not the trapezoidal
-  // derivative xdot: its error from the first (Euler) step alternates in sign and never damps,
-  // and the Hermite interpolant would carry it into the output.
-  const size_t m = r.tau_.size();
-  for (size_t k = 0; k < nk; ++k)
-    for (size_t p = 0; p < np; ++p) {
-      const auto& R = r.r_[k][p];
-      auto& S = r.s_[k][p];
-      auto chord = [&](size_t j) { return (R[j] - R[j - 1]) / (r.tau_[j] - r.tau_[j - 1]); };
-      for (size_t i = 1; i + 1 < m; ++i) {
-        const double hp = r.tau_[i] - r.tau_[i - 1], hn = r.tau_[i + 1] - r.tau_[i];
-        S[i] = (hn * chord(i) + hp * chord(i + 1)) / (hp + hn);
-      }
-      if (m >= 3) {
-        const double h1 = r.tau_[1], h2 = r.tau_[2] - r.tau_[1];
-        S[0] = chord(1) - h1 * (chord(2) - chord(1)) / (h1 + h2);
-        const double hl = r.tau_[m - 1] - r.tau_[m - 2], hq = r.tau_[m - 2] - r.tau_[m - 3];
-        S[m - 1] = chord(m - 1) + hl * (chord(m - 1) - chord(m - 2)) / (hl + hq);
-      }
-    }
-  // Beyond the march R continues with the last chord slope (see the settle check).
-  const size_t e = r.tau_.size() - 1;
-  r.end_slope_.assign(nk, std::vector<double>(np, 0.0));
-  for (size_t k = 0; k < nk; ++k)
-    for (size_t p = 0; p < np; ++p)
-      r.end_slope_[k][p] = (r.r_[k][p][e] - r.r_[k][p][e - 1]) / (r.tau_[e] - r.tau_[e - 1]);
-  r.stats_.factorizations += sys.klu.factorizations();
-  r.stats_.march_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - march_started).count();
-  return r;
+  if (opt.method == LtiOptions::Method::Reduced) return model.status();
+  stats_.note = model.status().message();
+  return false;
 }
 
 int LtiResponses::find_source(const std::string& name) const {

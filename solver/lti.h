@@ -55,6 +55,8 @@
 
 namespace isolink {
 
+struct MnaSystem;
+
 struct LtiOptions {
   // How the responses are computed: `march` (above), `reduced` (a reduced model in closed form,
   // solver/reduced_model.h: no march, no settling, any lag at the same cost), or `auto`: the
@@ -210,9 +212,25 @@ class LtiResponses {
 
   struct Source {
     std::string name;
+    // The circuit's own source function (Element::source_function): the circuit must outlive
+    // this LtiResponses (netlist_inputs reads it).
     const SourceFunction* function = nullptr;
     double initial = 0.0;  // the netlist's value at t = 0
   };
+  friend class LtiMarch;  // lti_march.cpp: fills tau_, r_, s_, end_slope_
+  // compute's pieces: the time-varying sources and their unit excitations (per source, n + 1
+  // entries); the DC point and gains; the reduced model (true: built and kept; false: failed
+  // under Method::Auto, the reason in stats_.note); the march.
+  std::vector<std::vector<double>> collect_sources(const Circuit& circuit, int n);
+  Status solve_dc(const Circuit& circuit, const MnaSystem& sys, const std::vector<Probe>& probes,
+                  const std::vector<std::vector<double>>& unit,
+                  std::vector<std::vector<double>>& dc_solutions);
+  StatusOr<bool> try_reduced_model(const Circuit& circuit, const std::vector<Probe>& probes,
+                                   const std::vector<std::vector<double>>& unit,
+                                   const std::vector<std::vector<double>>& dc_solutions,
+                                   const LtiOptions& opt);
+  Status march(const Circuit& circuit, MnaSystem& sys, const std::vector<Probe>& probes,
+               const std::vector<std::vector<double>>& unit, const LtiOptions& opt);
   // Adds sum of the inputs' ramps into out[p][i] for t_i = t0 + i dt, i < count.
   void superpose(const std::vector<SourceInput>& inputs, double t0, double dt, long count,
                  std::vector<std::vector<double>>& out) const;
