@@ -115,10 +115,16 @@ struct LtiStats {
 // piecewise linear), naming the element and its netlist location; Ok when it can.
 Status check_lti(const Circuit& circuit);
 
+// Lifetime: an LtiResponses owns its response tables (or reduced model) but points to the
+// circuit's source functions (netlist_inputs reads them): the circuit must outlive it, unmoved
+// (the elements are held by unique_ptr, so moving the Circuit object itself is fine). All const
+// methods are thread-safe.
 class LtiResponses {
  public:
   // The DC solves and the march. The circuit must be finalized (and bound to the analysis times:
-  // Element::bind_time, as for the transient) and pass check_lti.
+  // Element::bind_time, as for the transient) and pass check_lti. Errors: invalid options,
+  // check_lti's, a singular DC point, the reduced model's failure (Method::Reduced only), the
+  // march's (max_steps, settle_by passed, a step below the floor naming the unknown).
   static StatusOr<LtiResponses> compute(const Circuit& circuit, const std::vector<Probe>& probes,
                                         const LtiOptions& options);
 
