@@ -555,12 +555,10 @@ std::vector<std::vector<double>> LtiResponses::values(const std::vector<SourceIn
                                                       const std::vector<double>& times) const {
   const size_t np = labels_.size();
   std::vector<std::vector<double>> out(np, std::vector<double>(times.size(), 0.0));
+  const std::vector<double> base = base_values(inputs);
   for (size_t p = 0; p < np; ++p) {
-    double base = y_dc_[p];
-    for (size_t k = 0; k < sources_.size() && k < inputs.size(); ++k)
-      base += (inputs[k].initial - sources_[k].initial) * gain_[k][p];
     if (model_)
-      std::fill(out[p].begin(), out[p].end(), base);
+      std::fill(out[p].begin(), out[p].end(), base[p]);
     else
       for (size_t j = 0; j < times.size(); ++j) out[p][j] = value(p, times[j], inputs);
   }
@@ -740,180 +738,240 @@ Waveform LtiResponses::modal_waveform(const std::vector<SourceInput>& inputs,
   return w;
 }
 
-Waveform LtiResponses::waveform(const std::vector<SourceInput>& inputs, const GridOptions& grid,
-                                GridInfo* info) const {
-  const size_t np = labels_.size();
-  GridInfo local;
-  GridInfo& gi = info ? *info : local;
-  gi = GridInfo{};
-  for (const SourceInput& in : inputs) gi.corners += static_cast<long>(in.ramps.size());
-  std::vector<double> base(np);
-  for (size_t p = 0; p < np; ++p) {
+std::vector<double> LtiResponses::base_values(const std::vector<SourceInput>& inputs) const {
+  std::vector<double> base(labels_.size());
+  for (size_t p = 0; p < base.size(); ++p) {
     base[p] = y_dc_[p];
     for (size_t k = 0; k < sources_.size() && k < inputs.size(); ++k)
       base[p] += (inputs[k].initial - sources_[k].initial) * gain_[k][p];
   }
-  if (model_) return modal_waveform(inputs, grid, base, gi);
-  const double span = grid.tstop - grid.tstart;
+  return base;
+}
+
+// waveform() on the march's responses: GridOptions' rule by uniform halving, the corners as rows
+// of their own.
+class MarchGrid {
+ public:
+  MarchGrid(const LtiResponses& r, const std::vector<SourceInput>& inputs,
+            const LtiResponses::GridOptions& grid, const std::vector<double>& base,
+            LtiResponses::GridInfo& gi);
+  Waveform build();
+
+ private:
+  // Probe p at time t in O(ramps inside the march window): the ramps older than the march's
+  // end respond affinely, summed from prefix sums of slope and slope * time.
+  double value_at(size_t p, double t) const;
+  Rows rows_at(double t0, double dt, long count) const {
+    Rows v(np_, std::vector<double>(count, 0.0));
+    for (size_t p = 0; p < np_; ++p) std::fill(v[p].begin(), v[p].end(), base_[p]);
+    r_.superpose(inputs_, t0, dt, count, v);
+    return v;
+  }
+  // Counts the probe evaluations of a level at `step`; true when over max_evaluations.
+  bool over_budget(double step) {
+    const double evaluations = static_cast<double>(np_) * reach_ / step;
+    gi_.evaluations += evaluations;
+    if (grid_.max_evaluations > 0 && evaluations > grid_.max_evaluations) gi_.over_budget = true;
+    return gi_.over_budget;
+  }
+  // The level's worst interpolation error at the cells' midpoints, over the grid probes.
+  double level_error(const Rows& rows, const Rows& mids, double dt, long count) const;
+  // Halves the grid until the rule holds (or max_rows stops it, with a warning); false when the
+  // evaluation budget stops it.
+  bool refine(Rows& rows, double& dt, long& count);
+  Waveform assemble(const Rows& rows, double dt, long count) const;
+
+  const LtiResponses& r_;
+  const std::vector<SourceInput>& inputs_;
+  const LtiResponses::GridOptions& grid_;
+  const std::vector<double>& base_;
+  LtiResponses::GridInfo& gi_;
+  const size_t np_;
+  const double end_;             // s, the march's end
+  std::vector<double> corners_;  // source corners strictly inside the span, sorted, unique
+  std::vector<std::vector<double>> sum_s_, sum_st_;  // [k][j]: prefix sums of slope, slope * t
+  double reach_ = 0.0;  // s, the rows each ramp is evaluated on (inside its march window), summed
+};
+
+MarchGrid::MarchGrid(const LtiResponses& r, const std::vector<SourceInput>& inputs,
+                     const LtiResponses::GridOptions& grid, const std::vector<double>& base,
+                     LtiResponses::GridInfo& gi)
+    : r_(r),
+      inputs_(inputs),
+      grid_(grid),
+      base_(base),
+      gi_(gi),
+      np_(r.labels_.size()),
+      end_(r.tau_.back()) {
   // Source corners strictly inside the span: rows of their own, so that a probe on a driven node
   // is exact between rows too (not with a given step: the caller asked for that grid).
-  std::vector<double> corners;
   for (const SourceInput& in : inputs)
     for (const Ramp& ramp : in.ramps)
-      if (grid.step <= 0 && ramp.t > grid.tstart && ramp.t < grid.tstop) corners.push_back(ramp.t);
-  std::sort(corners.begin(), corners.end());
-  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
-  // Any probe at any time in O(ramps inside the march window): the ramps older than the march's
-  // end respond affinely, summed from prefix sums of slope and slope * time.
-  const double end = tau_.back();
-  std::vector<std::vector<double>> sum_s(inputs.size()), sum_st(inputs.size());
+      if (grid.step <= 0 && ramp.t > grid.tstart && ramp.t < grid.tstop) corners_.push_back(ramp.t);
+  std::sort(corners_.begin(), corners_.end());
+  corners_.erase(std::unique(corners_.begin(), corners_.end()), corners_.end());
+  sum_s_.resize(inputs.size());
+  sum_st_.resize(inputs.size());
   for (size_t k = 0; k < inputs.size(); ++k) {
-    sum_s[k].assign(inputs[k].ramps.size() + 1, 0.0);
-    sum_st[k].assign(inputs[k].ramps.size() + 1, 0.0);
+    sum_s_[k].assign(inputs[k].ramps.size() + 1, 0.0);
+    sum_st_[k].assign(inputs[k].ramps.size() + 1, 0.0);
     for (size_t j = 0; j < inputs[k].ramps.size(); ++j) {
-      sum_s[k][j + 1] = sum_s[k][j] + inputs[k].ramps[j].slope;
-      sum_st[k][j + 1] = sum_st[k][j] + inputs[k].ramps[j].slope * inputs[k].ramps[j].t;
+      sum_s_[k][j + 1] = sum_s_[k][j] + inputs[k].ramps[j].slope;
+      sum_st_[k][j + 1] = sum_st_[k][j] + inputs[k].ramps[j].slope * inputs[k].ramps[j].t;
     }
   }
-  auto value_at = [&](size_t p, double t) {
-    double y = base[p];
-    for (size_t k = 0; k < sources_.size() && k < inputs.size(); ++k) {
-      const auto& ramps = inputs[k].ramps;
-      auto before = [&](double x) {  // ramps with t_j < x
-        return static_cast<size_t>(
-            std::lower_bound(ramps.begin(), ramps.end(), x,
-                             [](const Ramp& r, double v) { return r.t < v; }) -
-            ramps.begin());
-      };
-      const size_t hi = before(t), lo = std::min(hi, before(t - end));
-      const double rend = r_[k][p].back(), send = end_slope_[k][p];
-      y += (rend - send * end) * sum_s[k][lo] + send * (t * sum_s[k][lo] - sum_st[k][lo]);
-      for (size_t j = lo; j < hi; ++j) y += ramps[j].slope * ramp_response(k, p, t - ramps[j].t);
-    }
-    return y;
-  };
-  auto rows_at = [&](double t0, double dt, long count) {
-    std::vector<std::vector<double>> v(np, std::vector<double>(count, 0.0));
-    for (size_t p = 0; p < np; ++p) std::fill(v[p].begin(), v[p].end(), base[p]);
-    superpose(inputs, t0, dt, count, v);
-    return v;
-  };
-
   // The superposition's cost at a step: each ramp is evaluated on the rows inside its march window
   // (beyond it the response is affine and costs nothing per row).
-  double reach = 0.0;
   for (const SourceInput& in : inputs)
     for (const Ramp& ramp : in.ramps)
-      if (ramp.t < grid.tstop) reach += std::min(grid.tstop - std::max(ramp.t, grid.tstart), end);
-  auto over_budget = [&](double step) {
-    const double evaluations = static_cast<double>(np) * reach / step;
-    gi.evaluations += evaluations;
-    if (grid.max_evaluations > 0 && evaluations > grid.max_evaluations) gi.over_budget = true;
-    return gi.over_budget;
-  };
+      if (ramp.t < grid.tstop) reach_ += std::min(grid.tstop - std::max(ramp.t, grid.tstart), end_);
+}
 
-  double dt = grid.step;
-  std::vector<std::vector<double>> rows;
+double MarchGrid::value_at(size_t p, double t) const {
+  double y = base_[p];
+  for (size_t k = 0; k < r_.sources_.size() && k < inputs_.size(); ++k) {
+    const auto& ramps = inputs_[k].ramps;
+    auto before = [&](double x) {  // ramps with t_j < x
+      return static_cast<size_t>(std::lower_bound(ramps.begin(), ramps.end(), x,
+                                                  [](const Ramp& r, double v) { return r.t < v; }) -
+                                 ramps.begin());
+    };
+    const size_t hi = before(t), lo = std::min(hi, before(t - end_));
+    const double rend = r_.r_[k][p].back(), send = r_.end_slope_[k][p];
+    y += (rend - send * end_) * sum_s_[k][lo] + send * (t * sum_s_[k][lo] - sum_st_[k][lo]);
+    for (size_t j = lo; j < hi; ++j) y += ramps[j].slope * r_.ramp_response(k, p, t - ramps[j].t);
+  }
+  return y;
+}
+
+double MarchGrid::level_error(const Rows& rows, const Rows& mids, double dt, long count) const {
+  double worst = 0.0;
+  // Cells holding a source corner are skipped: the corner becomes a row of its own below.
+  std::vector<char> has_corner(count, 0);
+  for (double c : corners_) {
+    const long i = static_cast<long>(std::floor((c - grid_.tstart) / dt));
+    if (i >= 0 && i < count) has_corner[i] = 1;
+  }
+  for (size_t p = 0; p < np_; ++p) {
+    if (!grid_.grid_probes.empty() && (p >= grid_.grid_probes.size() || !grid_.grid_probes[p]))
+      continue;
+    const double scale = r_.is_current_[p] ? 1e3 : 1.0;  // 1 mV -> 1 uA
+    for (long i = 0; i + 1 < count; ++i)
+      if (!has_corner[i])
+        worst =
+            std::max(worst, scale * std::fabs(mids[p][i] - 0.5 * (rows[p][i] + rows[p][i + 1])));
+    // A cell holding corners is tested piece by piece between them (the corners are rows of
+    // their own): a fast response just after a corner is as visible as anywhere else.
+    for (size_t c = 0; c < corners_.size();) {
+      const long i = static_cast<long>(std::floor((corners_[c] - grid_.tstart) / dt));
+      if (i < 0 || i + 1 >= count) {
+        ++c;
+        continue;
+      }
+      double a = grid_.tstart + static_cast<double>(i) * dt, ya = rows[p][i];
+      for (; c < corners_.size() && corners_[c] < a + dt; ++c) {
+        const double yc = value_at(p, corners_[c]);
+        const double ym = value_at(p, 0.5 * (a + corners_[c]));
+        worst = std::max(worst, scale * std::fabs(ym - 0.5 * (ya + yc)));
+        a = corners_[c], ya = yc;
+      }
+      const double b = grid_.tstart + static_cast<double>(i + 1) * dt;
+      const double ym = value_at(p, 0.5 * (a + b));
+      worst = std::max(worst, scale * std::fabs(ym - 0.5 * (ya + rows[p][i + 1])));
+    }
+  }
+  return worst;
+}
+
+bool MarchGrid::refine(Rows& rows, double& dt, long& count) {
+  while (true) {
+    if (over_budget(dt)) return false;
+    const Rows mids = rows_at(grid_.tstart + 0.5 * dt, dt, count - 1);
+    const double worst = level_error(rows, mids, dt, count);
+    if (worst <= 0.5 * grid_.interp_tol) return true;
+    // Budgeted: a smooth response's interpolation error falls as dt^2, so the step that meets
+    // the tolerance is about dt sqrt(tol / worst); when even that level would be over budget,
+    // stop now instead of computing the levels on the way (a kink needs finer still).
+    if (grid_.max_evaluations > 0) {
+      const double final_dt = dt * std::sqrt(0.5 * grid_.interp_tol / worst);
+      const double predicted = static_cast<double>(np_) * reach_ / final_dt;
+      if (predicted > grid_.max_evaluations) {
+        gi_.evaluations += predicted;
+        gi_.over_budget = true;
+        return false;
+      }
+    }
+    if (2 * count - 1 > grid_.max_rows) {
+      gi_.warning = fmt::format(
+          "LTI output grid stopped at {} rows (step {:g} s): linear interpolation between rows "
+          "may be off by up to {:.3g} mV, over the {:g} mV target",
+          count, dt, 2e3 * worst, 1e3 * grid_.interp_tol);
+      return true;
+    }
+    // Interleave: the midpoints are the finer grid's odd rows.
+    for (size_t p = 0; p < np_; ++p) {
+      std::vector<double> fine(2 * count - 1);
+      for (long i = 0; i < count; ++i) fine[2 * i] = rows[p][i];
+      for (long i = 0; i + 1 < count; ++i) fine[2 * i + 1] = mids[p][i];
+      rows[p].swap(fine);
+    }
+    count = 2 * count - 1;
+    dt *= 0.5;
+  }
+}
+
+Waveform MarchGrid::assemble(const Rows& rows, double dt, long count) const {
+  Waveform w;
+  Rows cols(np_);
+  const double tiny = dt * 1e-6;
+  size_t c = 0;
+  for (long i = 0; i < count; ++i) {
+    const double t = grid_.tstart + static_cast<double>(i) * dt;
+    for (; c < corners_.size() && corners_[c] < t; ++c) {
+      if (corners_[c] <= t - tiny && (w.time.empty() || corners_[c] >= w.time.back() + tiny)) {
+        w.time.push_back(corners_[c]);
+        for (size_t p = 0; p < np_; ++p) cols[p].push_back(value_at(p, corners_[c]));
+      }
+    }
+    if (!w.time.empty() && t <= w.time.back()) continue;
+    w.time.push_back(t);
+    for (size_t p = 0; p < np_; ++p) cols[p].push_back(rows[p][i]);
+  }
+  for (size_t p = 0; p < np_; ++p) w.add_column(r_.labels_[p], std::move(cols[p]));
+  gi_.rows = static_cast<long>(w.time.size());
+  gi_.step = dt;
+  return w;
+}
+
+Waveform MarchGrid::build() {
+  const double span = grid_.tstop - grid_.tstart;
+  double dt = grid_.step;
+  Rows rows;
   long count = 0;
   if (dt > 0) {
     count = static_cast<long>(std::floor(span / dt * (1 + 1e-12))) + 1;
     if (over_budget(dt)) return Waveform{};
-    rows = rows_at(grid.tstart, dt, count);
+    rows = rows_at(grid_.tstart, dt, count);
   } else {
     dt = span;
     while (dt > coarsest_grid_step(span)) dt *= 0.5;
     count = static_cast<long>(std::llround(span / dt)) + 1;
     if (over_budget(dt)) return Waveform{};
-    rows = rows_at(grid.tstart, dt, count);
-    while (true) {
-      if (over_budget(dt)) return Waveform{};
-      auto mids = rows_at(grid.tstart + 0.5 * dt, dt, count - 1);
-      double worst = 0.0;
-      // Cells holding a source corner are skipped: the corner becomes a row of its own below.
-      std::vector<char> has_corner(count, 0);
-      for (double c : corners) {
-        const long i = static_cast<long>(std::floor((c - grid.tstart) / dt));
-        if (i >= 0 && i < count) has_corner[i] = 1;
-      }
-      for (size_t p = 0; p < np; ++p) {
-        if (!grid.grid_probes.empty() && (p >= grid.grid_probes.size() || !grid.grid_probes[p]))
-          continue;
-        const double scale = is_current_[p] ? 1e3 : 1.0;  // 1 mV -> 1 uA
-        for (long i = 0; i + 1 < count; ++i)
-          if (!has_corner[i])
-            worst = std::max(worst,
-                             scale * std::fabs(mids[p][i] - 0.5 * (rows[p][i] + rows[p][i + 1])));
-        // A cell holding corners is tested piece by piece between them (the corners are rows of
-        // their own): a fast response just after a corner is as visible as anywhere else.
-        for (size_t c = 0; c < corners.size();) {
-          const long i = static_cast<long>(std::floor((corners[c] - grid.tstart) / dt));
-          if (i < 0 || i + 1 >= count) {
-            ++c;
-            continue;
-          }
-          double a = grid.tstart + static_cast<double>(i) * dt, ya = rows[p][i];
-          for (; c < corners.size() && corners[c] < a + dt; ++c) {
-            const double yc = value_at(p, corners[c]);
-            const double ym = value_at(p, 0.5 * (a + corners[c]));
-            worst = std::max(worst, scale * std::fabs(ym - 0.5 * (ya + yc)));
-            a = corners[c], ya = yc;
-          }
-          const double b = grid.tstart + static_cast<double>(i + 1) * dt;
-          const double ym = value_at(p, 0.5 * (a + b));
-          worst = std::max(worst, scale * std::fabs(ym - 0.5 * (ya + rows[p][i + 1])));
-        }
-      }
-      if (worst <= 0.5 * grid.interp_tol) break;
-      // Budgeted: a smooth response's interpolation error falls as dt^2, so the step that meets
-      // the tolerance is about dt sqrt(tol / worst); when even that level would be over budget,
-      // stop now instead of computing the levels on the way (a kink needs finer still).
-      if (grid.max_evaluations > 0) {
-        const double final_dt = dt * std::sqrt(0.5 * grid.interp_tol / worst);
-        const double predicted = static_cast<double>(np) * reach / final_dt;
-        if (predicted > grid.max_evaluations) {
-          gi.evaluations += predicted;
-          gi.over_budget = true;
-          return Waveform{};
-        }
-      }
-      if (2 * count - 1 > grid.max_rows) {
-        gi.warning = fmt::format(
-            "LTI output grid stopped at {} rows (step {:g} s): linear interpolation between rows "
-            "may be off by up to {:.3g} mV, over the {:g} mV target",
-            count, dt, 2e3 * worst, 1e3 * grid.interp_tol);
-        break;
-      }
-      // Interleave: the midpoints are the finer grid's odd rows.
-      for (size_t p = 0; p < np; ++p) {
-        std::vector<double> fine(2 * count - 1);
-        for (long i = 0; i < count; ++i) fine[2 * i] = rows[p][i];
-        for (long i = 0; i + 1 < count; ++i) fine[2 * i + 1] = mids[p][i];
-        rows[p].swap(fine);
-      }
-      count = 2 * count - 1;
-      dt *= 0.5;
-    }
+    rows = rows_at(grid_.tstart, dt, count);
+    if (!refine(rows, dt, count)) return Waveform{};
   }
-  Waveform w;
-  std::vector<std::vector<double>> cols(np);
-  const double tiny = dt * 1e-6;
-  size_t c = 0;
-  for (long i = 0; i < count; ++i) {
-    const double t = grid.tstart + static_cast<double>(i) * dt;
-    for (; c < corners.size() && corners[c] < t; ++c) {
-      if (corners[c] <= t - tiny && (w.time.empty() || corners[c] >= w.time.back() + tiny)) {
-        w.time.push_back(corners[c]);
-        for (size_t p = 0; p < np; ++p) cols[p].push_back(value_at(p, corners[c]));
-      }
-    }
-    if (!w.time.empty() && t <= w.time.back()) continue;
-    w.time.push_back(t);
-    for (size_t p = 0; p < np; ++p) cols[p].push_back(rows[p][i]);
-  }
-  for (size_t p = 0; p < np; ++p) w.add_column(labels_[p], std::move(cols[p]));
-  gi.rows = static_cast<long>(w.time.size());
-  gi.step = dt;
-  return w;
+  return assemble(rows, dt, count);
+}
+
+Waveform LtiResponses::waveform(const std::vector<SourceInput>& inputs, const GridOptions& grid,
+                                GridInfo* info) const {
+  GridInfo local;
+  GridInfo& gi = info ? *info : local;
+  gi = GridInfo{};
+  for (const SourceInput& in : inputs) gi.corners += static_cast<long>(in.ramps.size());
+  const std::vector<double> base = base_values(inputs);
+  if (model_) return modal_waveform(inputs, grid, base, gi);
+  return MarchGrid(*this, inputs, grid, base, gi).build();
 }
 
 }  // namespace isolink

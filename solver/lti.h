@@ -223,7 +223,10 @@ class LtiResponses {
     const SourceFunction* function = nullptr;
     double initial = 0.0;  // the netlist's value at t = 0
   };
-  friend class LtiMarch;  // lti_march.cpp: fills tau_, r_, s_, end_slope_
+  friend class LtiMarch;   // lti_march.cpp: fills tau_, r_, s_, end_slope_
+  friend class MarchGrid;  // lti.cpp: waveform() on the march's responses
+  // Per probe: the DC point moved by the inputs' initial values through the DC gains.
+  std::vector<double> base_values(const std::vector<SourceInput>& inputs) const;
   // compute's pieces: the time-varying sources and their unit excitations (per source, n + 1
   // entries); the DC point and gains; the reduced model (true: built and kept; false: failed
   // under Method::Auto, the reason in stats_.note); the march.
