@@ -19,7 +19,8 @@ struct AcAnalysis::Impl {
   const Circuit* circuit = nullptr;
   MnaPattern pattern{0};
   std::vector<double> g, c;
-  std::vector<double> a;  // interleaved re, im of G + j w C, pattern (CSC) order
+  std::vector<int> ap, ai;  // the pattern's CSC arrays, for KLU (int*)
+  std::vector<double> a;    // interleaved re, im of G + j w C, pattern (CSC) order
   klu_common common{};
   klu_symbolic* symbolic = nullptr;
   klu_numeric* numeric = nullptr;
@@ -41,23 +42,19 @@ StatusOr<AcAnalysis> AcAnalysis::create(const Circuit& circuit) {
   m.circuit = &circuit;
   const int n = circuit.unknown_count();
   if (n == 0) return Status::Error("ac analysis: the circuit has no unknowns");
-  m.pattern = MnaPattern(n);
-  auto& elements = const_cast<Circuit&>(circuit).elements();
-  for (auto& e : elements) e->declare(m.pattern);
-  m.pattern.finalize();
-  for (auto& e : elements) e->declare(m.pattern);
-  m.g.assign(m.pattern.value_count(), 0.0);
-  m.c.assign(m.pattern.value_count(), 0.0);
-  for (auto& e : elements) e->stamp(m.g.data(), m.c.data());
-  for (int node : circuit.floating_nodes())
-    m.g[m.pattern.slot(node, node)] += Circuit::kFloatingTie;
+  MnaMatrices mna = assemble_mna(circuit);
+  m.pattern = std::move(mna.pattern);
+  m.g = std::move(mna.g);
+  m.c = std::move(mna.c);
+  // KLU's C interface takes the pattern as int*, never writing it: its own copies.
+  m.ap = m.pattern.col_start();
+  m.ai = m.pattern.row_index();
 
   klu_defaults(&m.common);
   // COLAMD, not KLU's default AMD: on a 40 m link (2732 unknowns) AMD's pivoted LU held 230k
   // entries (17 ms a refactorization), COLAMD's 34k.
   m.common.ordering = 1;
-  m.symbolic = klu_analyze(n, const_cast<int*>(m.pattern.col_start().data()),
-                           const_cast<int*>(m.pattern.row_index().data()), &m.common);
+  m.symbolic = klu_analyze(n, m.ap.data(), m.ai.data(), &m.common);
   if (m.symbolic == nullptr)
     return Status::Error(
         fmt::format("ac analysis: KLU symbolic analysis failed (status {})", m.common.status));
@@ -110,8 +107,8 @@ Status AcAnalysis::factor(double frequency) {
   const double w = 2 * std::numbers::pi * frequency;
   for (int k = 0; k < m.pattern.nonzeros(); ++k) m.a[2 * k] = m.g[k], m.a[2 * k + 1] = w * m.c[k];
   m.frequency = -1;
-  int* ap = const_cast<int*>(m.pattern.col_start().data());
-  int* ai = const_cast<int*>(m.pattern.row_index().data());
+  int* ap = m.ap.data();
+  int* ai = m.ai.data();
   // Refactor on the previous pivots when there is one (fast), a full factor otherwise or when
   // the refactorization's pivots have become poor.
   bool ok = false;

@@ -8,6 +8,13 @@
 // Solves (G + j 2 pi f C) x = b with KLU's complex LU; the G and C stamps are the ones the
 // transient engine uses, floating nodes tied as there. Used for impedances, attenuation and
 // filter responses (cable and part-library checks), not for time-domain results.
+//
+// Units: frequencies in Hz; solutions in V (nodes) and A (branches) per unit source amplitude.
+// Lifetime: the analysis keeps a pointer to the circuit (names, sources): the circuit must
+// outlive it. It owns its pattern, stamps and KLU factorization; moving it is cheap.
+// Errors: create (no unknowns, KLU's symbolic analysis failed), factor (a negative or non-finite
+// frequency, a singular matrix with KLU's status), solve / add_excitation (no such source, or not
+// a V or I source). solve_factored and solve_transposed need a successful factor() first.
 #pragma once
 
 #include <complex>

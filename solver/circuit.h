@@ -5,7 +5,16 @@
 //   for (const Card& card : netlist.cards) if (Status s = c.add(card); !s.ok()) return s;
 //   if (Status s = c.finalize(); !s.ok()) return s;   // unknowns, links, DC topology checks
 //   for (auto& w : c.warnings()) print(w);             // e.g. nodes tied for lack of a DC path
-// Unknown 0 is ground; 1..node_count()-1 are node voltages; then one per branch current.
+// Unknown 0 is ground; 1..node_count()-1 are node voltages (V); then one per branch current (A).
+//
+// Ownership: the Circuit owns its elements. After finalize() the engines only read it
+// (`const Circuit&`: MnaSystem, AcAnalysis, LtiResponses, the reduced model), except
+// run_transient and the LTI engine's caller, which bind the sources' time defaults
+// (Element::bind_time). LtiResponses and AcAnalysis keep pointers into the circuit: it must
+// outlive them. Probes hold unknown indices of this circuit only.
+// Errors: add() names the card's location (unknown kind, bad value, duplicate name, added after
+// finalize); finalize() names the element (a reference to a missing inductor, a loop of voltage
+// sources and inductors, a current source into a node without a DC path).
 #pragma once
 
 #include <memory>

@@ -157,7 +157,8 @@ struct KluSolver::Impl {
   const char* ordering = "amd";
   std::list<Factors> cache;  // most recently used first
   const Factors* current = nullptr;
-  std::vector<double> y;  // solve workspace
+  std::vector<double> y;   // solve workspace
+  std::vector<double> ax;  // the values being factored: KLU's C interface takes double*
 
   ~Impl() {
     if (symbolic) klu_free_symbolic(&symbolic, &common);
@@ -176,7 +177,8 @@ struct KluSolver::Impl {
 
   // Factors with sym and copies the result into f. False when KLU fails (status in common).
   bool factor_into(klu_symbolic* sym, const double* values, Factors& f) {
-    klu_numeric* num = klu_factor(ap.data(), ai.data(), const_cast<double*>(values), sym, &common);
+    ax.assign(values, values + ap[n]);
+    klu_numeric* num = klu_factor(ap.data(), ai.data(), ax.data(), sym, &common);
     if (!num) return false;
     if (common.status == KLU_SINGULAR) {
       klu_free_numeric(&num, &common);

@@ -6,6 +6,10 @@
 //   klu.solve(x);                                // in place, x has pattern.size() entries
 // The key identifies a matrix (the engines use alpha, the coefficient of C): when a step size
 // comes back, its factorization is reused instead of refactored.
+// Ownership: the solver copies the pattern's arrays at analyze() (the pattern need not outlive
+// it) and owns every cached factorization (at most kCacheSize, least recently used dropped).
+// Errors: analyze (no unknowns, KLU's symbolic analysis failed), factor (a singular matrix,
+// naming the column; another KLU failure with its status), solve (no factorization selected).
 //
 // A transient step is one solve, so the solve is what counts, and for circuit matrices its time
 // is set less by the number of entries than by the longest chain of dependent updates (each

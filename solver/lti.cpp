@@ -66,22 +66,6 @@ Status check_lti(const Circuit& circuit) {
 
 namespace {
 
-// The last accepted points of the march, oldest first: times and the full state of each source.
-struct MarchHistory {
-  std::array<double, 3> times{};
-  std::array<std::vector<std::vector<double>>, 3> states;  // [slot][source][unknown]
-  int first = 0, count = 0;
-  double t(int i) const { return times[(first + i) % 3]; }
-  const std::vector<double>& x(int i, size_t k) const { return states[(first + i) % 3][k]; }
-  void push(double t1, const std::vector<std::vector<double>>& x1) {
-    if (count == 3) first = (first + 1) % 3, --count;
-    const int slot = (first + count) % 3;
-    times[slot] = t1;
-    states[slot] = x1;
-    ++count;
-  }
-};
-
 // e^x, phi1(x) = (e^x - 1) / x and phi2(x) = (e^x - 1 - x) / x^2: a mode x' = p x + u(t) moves
 // over a step h, with u = b + g t on it, to e^{ph} x + h phi1(ph) b + h^2 phi2(ph) g.
 struct Phi {
@@ -139,253 +123,84 @@ StatusOr<LtiResponses> LtiResponses::compute(const Circuit& circuit,
     r.labels_.push_back(p.label);
     r.is_current_.push_back(p.label.rfind("i(", 0) == 0);
   }
-
   MnaSystem sys;
   if (Status s = sys.build(circuit); !s.ok()) return s;
-  const int n = sys.n;
+  const std::vector<std::vector<double>> unit = r.collect_sources(circuit, sys.n);
+  std::vector<std::vector<double>> dc_solutions;  // per source: G^-1 e_k
+  if (Status s = r.solve_dc(circuit, sys, probes, unit, dc_solutions); !s.ok()) return s;
+  if (opt.method != LtiOptions::Method::March && !r.sources_.empty()) {
+    StatusOr<bool> reduced = r.try_reduced_model(circuit, probes, unit, dc_solutions, opt);
+    if (!reduced) return reduced.status();
+    if (*reduced) return r;
+  }
+  if (Status s = r.march(circuit, sys, probes, unit, opt); !s.ok()) return s;
+  return r;
+}
+
+std::vector<std::vector<double>> LtiResponses::collect_sources(const Circuit& circuit, int n) {
   std::vector<std::vector<double>> unit;  // per source: its unit excitation (n + 1)
   for (const auto& e : circuit.elements()) {
     const SourceFunction* f = e->source_function();
     if (!f || f->kind() == SourceFunction::Kind::Dc) continue;
-    r.sources_.push_back({e->name(), f, f->value(0.0)});
+    sources_.push_back({e->name(), f, f->value(0.0)});
     unit.emplace_back(n + 1, 0.0);
     e->stamp_unit(unit.back().data());
     unit.back()[0] = 0.0;
   }
-  const size_t nk = r.sources_.size(), np = probes.size();
+  return unit;
+}
 
-  // DC: the operating point of the netlist's sources at t = 0, and each source's DC gain.
-  std::vector<std::vector<double>> dc_solutions;  // per source: G^-1 e_k
-  {
-    KluSolver dc_klu;
-    if (Status s = sys.factor_dc(circuit, dc_klu); !s.ok())
-      return s.with_context("DC operating point");
-    std::vector<double> x(n + 1);
-    sys.rhs(0.0, x);
+// The operating point of the netlist's sources at t = 0, and each source's DC gain.
+Status LtiResponses::solve_dc(const Circuit& circuit, const MnaSystem& sys,
+                              const std::vector<Probe>& probes,
+                              const std::vector<std::vector<double>>& unit,
+                              std::vector<std::vector<double>>& dc_solutions) {
+  KluSolver dc_klu;
+  if (Status s = sys.factor_dc(circuit, dc_klu); !s.ok())
+    return s.with_context("DC operating point");
+  std::vector<double> x(sys.n + 1);
+  sys.rhs(0.0, x);
+  if (Status s = dc_klu.solve(x.data() + 1); !s.ok()) return s;
+  x[0] = 0.0;
+  for (const Probe& p : probes) y_dc_.push_back(p.value(x.data()));
+  for (size_t k = 0; k < unit.size(); ++k) {
+    x = unit[k];
     if (Status s = dc_klu.solve(x.data() + 1); !s.ok()) return s;
     x[0] = 0.0;
-    for (const Probe& p : probes) r.y_dc_.push_back(p.value(x.data()));
-    for (size_t k = 0; k < nk; ++k) {
-      x = unit[k];
-      if (Status s = dc_klu.solve(x.data() + 1); !s.ok()) return s;
-      x[0] = 0.0;
-      r.gain_.emplace_back();
-      for (const Probe& p : probes) r.gain_[k].push_back(p.value(x.data()));
-      dc_solutions.push_back(x);
-    }
-    r.stats_.factorizations = 1;
+    gain_.emplace_back();
+    for (const Probe& p : probes) gain_[k].push_back(p.value(x.data()));
+    dc_solutions.push_back(x);
   }
+  stats_.factorizations = 1;
+  return Status::Ok();
+}
 
-  if (opt.method != LtiOptions::Method::March && nk > 0) {
-    ReducedModelOptions ro = opt.reduced;
-    ro.horizon = opt.horizon;
-    std::vector<const SourceFunction*> functions;
-    for (const Source& src : r.sources_) functions.push_back(src.function);
-    ro.edge_time = opt.edge_time > 0 ? opt.edge_time : shortest_edge(functions, opt.horizon);
-    const auto started = std::chrono::steady_clock::now();
-    StatusOr<ReducedModel> model = reduce_circuit(circuit, unit, dc_solutions, probes, ro);
-    r.stats_.model_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    if (model) {
-      r.stats_.method = "reduced model";
-      r.stats_.model = model->stats;
-      r.stats_.factorizations += model->stats.factorizations;
-      r.stats_.settled_at = opt.horizon;
-      r.model_ = std::move(*model);
-      r.tau_.push_back(0.0);
-      return r;
-    }
-    if (opt.method == LtiOptions::Method::Reduced) return model.status();
-    r.stats_.note = model.status().message();
+StatusOr<bool> LtiResponses::try_reduced_model(const Circuit& circuit,
+                                               const std::vector<Probe>& probes,
+                                               const std::vector<std::vector<double>>& unit,
+                                               const std::vector<std::vector<double>>& dc_solutions,
+                                               const LtiOptions& opt) {
+  ReducedModelOptions ro = opt.reduced;
+  ro.horizon = opt.horizon;
+  std::vector<const SourceFunction*> functions;
+  for (const Source& src : sources_) functions.push_back(src.function);
+  ro.edge_time = opt.edge_time > 0 ? opt.edge_time : shortest_edge(functions, opt.horizon);
+  const auto started = std::chrono::steady_clock::now();
+  StatusOr<ReducedModel> model = reduce_circuit(circuit, unit, dc_solutions, probes, ro);
+  stats_.model_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  if (model) {
+    stats_.method = "reduced model";
+    stats_.model = model->stats;
+    stats_.factorizations += model->stats.factorizations;
+    stats_.settled_at = opt.horizon;
+    model_ = std::move(*model);
+    tau_.push_back(0.0);
+    return true;
   }
-  r.stats_.method = "march";
-  const auto march_started = std::chrono::steady_clock::now();
-
-  r.tau_.push_back(0.0);
-  r.r_.assign(nk, std::vector<std::vector<double>>(np, std::vector<double>{0.0}));
-  r.s_.assign(nk, std::vector<std::vector<double>>(np, std::vector<double>{0.0}));
-  if (nk == 0) return r;
-
-  // Watched states and their absolute tolerances, as the transient's error control.
-  std::vector<int> watched;
-  for (int u = 1; u <= n; ++u) {
-    const bool has_c = sys.c[sys.pattern.slot(u, u)] != 0.0;
-    if ((circuit.unknown_is_node(u) && has_c) || circuit.unknown_is_state(u)) watched.push_back(u);
-  }
-  // peak |S| per source and watched state, and 1 / tolerance (recomputed when a peak grows).
-  std::vector<std::vector<double>> peak(nk, std::vector<double>(watched.size(), 0.0));
-  std::vector<std::vector<double>> inv_tol(
-      nk, std::vector<double>(watched.size(), 1.0 / opt.step_abstol));
-
-  const double horizon = opt.horizon;
-  const double hmax = opt.max_step > 0 ? std::min(opt.max_step, horizon) : horizon / 64;
-  const double h0 = opt.first_step > 0 ? opt.first_step : std::min(1e-12, horizon * 1e-9);
-  const double hmin = std::max(1e-18, horizon * 1e-14);
-  auto ladder = [&](double h) {  // largest hmax / 2^k not above h
-    if (h >= hmax) return hmax;
-    const int e = static_cast<int>(std::ceil(std::log2(hmax / h) - 1e-9));
-    return std::ldexp(hmax, -e);
-  };
-
-  std::vector<std::vector<double>> x(nk, std::vector<double>(n + 1, 0.0)), xdot = x, xnew = x,
-                                                                           hist_part = x;
-  MarchHistory hist;
-  for (auto& s : hist.states) s = x;
-  hist.push(0.0, x);
-  double tau = 0.0, h = ladder(h0);
-  int worst_unknown = 0;
-  // Largest |chord slope| of each probe's response so far: no settling before it has arrived.
-  std::vector<std::vector<double>> probe_peak(nk, std::vector<double>(np, 0.0));
-  size_t next_check = 16;  // settle checks at geometrically spaced march points and times
-  double next_check_tau = 0.0;
-
-  while (tau < horizon * (1 - 1e-12)) {
-    if (r.stats_.steps + r.stats_.rejected >= opt.max_steps)
-      return Status::Error(fmt::format("LTI march gave up at {:g} s after {} steps (max_steps)",
-                                       tau, opt.max_steps));
-    if (opt.settle_by > 0 && tau > opt.settle_by)
-      return Status::Error(
-          fmt::format("the responses have not settled by {:g} s (settle_by)", opt.settle_by));
-    double step = std::min(h, horizon - tau);
-    const bool euler = hist.count < 2;
-    const double a0 = euler ? 1.0 / step : 2.0 / step;
-    if (Status s = sys.select_or_factor(circuit, a0); !s.ok())
-      return s.with_context(fmt::format("LTI march at {:g} s", tau + step));
-    const double t1 = tau + step;
-    for (size_t k = 0; k < nk; ++k) {
-      auto& hp = hist_part[k];
-      for (int u = 1; u <= n; ++u) hp[u] = euler ? -x[k][u] / step : -a0 * x[k][u] - xdot[k][u];
-      auto& b = xnew[k];
-      for (int u = 0; u <= n; ++u) b[u] = unit[k][u] * t1;  // unit ramp: u(t) = t
-      sys.sub_c_times(hp.data(), b.data());
-      if (Status s = sys.solve(b); !s.ok()) return s;
-    }
-
-    // Truncation error per unit time against step_reltol * peak|S| + step_abstol.
-    double ratio = 0.0;
-    if (hist.count == 3) {
-      const double t0 = hist.t(2), tm1 = hist.t(1), tm2 = hist.t(0);
-      const double ia = 1.0 / (t1 - t0), ib = 1.0 / (t0 - tm1), ic = 1.0 / (tm1 - tm2);
-      const double ie = 1.0 / (t1 - tm1), iff = 1.0 / (t0 - tm2), ig = 1.0 / (t1 - tm2);
-      const double h2 = step * step * 0.5 * ig;  // h^3 * (1/12) * 6 / h
-      const double w1 = h2 * ie * ia, w2 = -h2 * ib * (ie + iff), w3 = h2 * iff * ic;
-      for (size_t k = 0; k < nk; ++k) {
-        const auto &x0 = hist.x(2, k), &xm1 = hist.x(1, k), &xm2 = hist.x(0, k);
-        const auto& xn = xnew[k];
-        for (size_t w = 0; w < watched.size(); ++w) {
-          const int u = watched[w];
-          const double e = inv_tol[k][w] * std::fabs(w1 * (xn[u] - x0[u]) + w2 * (x0[u] - xm1[u]) +
-                                                     w3 * (xm1[u] - xm2[u]));
-          if (e > ratio) ratio = e, worst_unknown = u;
-        }
-      }
-    }
-    if (ratio > 1.0) {
-      ++r.stats_.rejected;
-      h = step * std::max(0.25, 0.9 * std::sqrt(1.0 / ratio));
-      if (h < hmin)
-        return Status::Error(fmt::format(
-            "LTI march: step too small at {:g} s (h={:g} s): the truncation error of {} does not "
-            "converge",
-            tau, h, circuit.unknown_name(worst_unknown)));
-      h = ladder(h);
-      continue;
-    }
-
-    ++r.stats_.steps;
-    tau = t1;
-    if (opt.on_progress && (r.stats_.steps & 1023) == 0) opt.on_progress(tau);
-    for (size_t k = 0; k < nk; ++k) {
-      for (int u = 1; u <= n; ++u) xdot[k][u] = a0 * xnew[k][u] + hist_part[k][u];
-      std::swap(x[k], xnew[k]);
-      for (size_t w = 0; w < watched.size(); ++w) {
-        const double a = std::fabs(xdot[k][watched[w]]);
-        if (a > peak[k][w])
-          peak[k][w] = a, inv_tol[k][w] = 1.0 / (opt.step_reltol * a + opt.step_abstol);
-      }
-    }
-    hist.push(tau, x);
-    r.tau_.push_back(tau);
-    for (size_t k = 0; k < nk; ++k)
-      for (size_t p = 0; p < np; ++p) {
-        auto &R = r.r_[k][p], &S = r.s_[k][p];
-        R.push_back(probes[p].value(x[k].data()));
-        S.push_back(probes[p].value(xdot[k].data()));
-        const double chord = (R.back() - R[R.size() - 2]) / step;
-        probe_peak[k][p] = std::max(probe_peak[k][p], std::fabs(chord));
-      }
-    // Error per unit time scales as h^2: grow by sqrt, at most 2x.
-    const double grow = ratio > 0 ? std::min(2.0, 0.9 * std::sqrt(1.0 / ratio)) : 2.0;
-    h = ladder(std::max(step * std::max(grow, 0.5), hmin));
-
-    // Settling (see lti.h), checked whenever the step count or the time has grown by 10 %.
-    const size_t i = r.tau_.size() - 1;
-    if (i >= next_check || (i >= 16 && tau >= next_check_tau)) {
-      next_check = static_cast<size_t>(static_cast<double>(i) * 1.1) + 1;
-      next_check_tau = tau * 1.1;
-      bool settled = true;
-      const size_t from = static_cast<size_t>(
-          std::lower_bound(r.tau_.begin(), r.tau_.end(), 0.5 * tau) - r.tau_.begin());
-      // On chord slopes (R_j - R_j-1) / h_j, the mean of S over each step: the trapezoidal rule's
-      // derivative S carries a +-delta alternation that never damps, its chords do not.
-      auto chord = [&](const std::vector<double>& R, size_t j) {
-        return (R[j] - R[j - 1]) / (r.tau_[j] - r.tau_[j - 1]);
-      };
-      for (size_t k = 0; k < nk && settled; ++k)
-        for (size_t p = 0; p < np && settled; ++p) {
-          const auto& R = r.r_[k][p];
-          const double last = chord(R, i);
-          const double slope = (last - chord(R, i - 1)) / (0.5 * (r.tau_[i] - r.tau_[i - 2]));
-          if (probe_peak[k][p] < 100 * opt.settle_tol ||
-              std::fabs(slope) * (horizon - tau) > opt.settle_tol ||
-              std::fabs(last - r.gain_[k][p]) > opt.settle_tol) {
-            settled = false;
-            break;
-          }
-          for (size_t j = std::max<size_t>(from, 1); j < i; ++j)
-            if (std::fabs(chord(R, j) - last) > opt.settle_tol) {
-              settled = false;
-              break;
-            }
-        }
-      if (settled) {
-        r.stats_.settled = true;
-        break;
-      }
-    }
-  }
-  r.stats_.settled_at = tau;
-  // S at the march points from R alone: the slope at tau_i of the parabola through the points
-  // i-1, i, i+1 (second order on any spacing; one-sided at the ends). Not the trapezoidal
-  // derivative xdot: its error from the first (Euler) step alternates in sign and never damps,
-  // and the Hermite interpolant would carry it into the output.
-  const size_t m = r.tau_.size();
-  for (size_t k = 0; k < nk; ++k)
-    for (size_t p = 0; p < np; ++p) {
-      const auto& R = r.r_[k][p];
-      auto& S = r.s_[k][p];
-      auto chord = [&](size_t j) { return (R[j] - R[j - 1]) / (r.tau_[j] - r.tau_[j - 1]); };
-      for (size_t i = 1; i + 1 < m; ++i) {
-        const double hp = r.tau_[i] - r.tau_[i - 1], hn = r.tau_[i + 1] - r.tau_[i];
-        S[i] = (hn * chord(i) + hp * chord(i + 1)) / (hp + hn);
-      }
-      if (m >= 3) {
-        const double h1 = r.tau_[1], h2 = r.tau_[2] - r.tau_[1];
-        S[0] = chord(1) - h1 * (chord(2) - chord(1)) / (h1 + h2);
-        const double hl = r.tau_[m - 1] - r.tau_[m - 2], hq = r.tau_[m - 2] - r.tau_[m - 3];
-        S[m - 1] = chord(m - 1) + hl * (chord(m - 1) - chord(m - 2)) / (hl + hq);
-      }
-    }
-  // Beyond the march R continues with the last chord slope (see the settle check).
-  const size_t e = r.tau_.size() - 1;
-  r.end_slope_.assign(nk, std::vector<double>(np, 0.0));
-  for (size_t k = 0; k < nk; ++k)
-    for (size_t p = 0; p < np; ++p)
-      r.end_slope_[k][p] = (r.r_[k][p][e] - r.r_[k][p][e - 1]) / (r.tau_[e] - r.tau_[e - 1]);
-  r.stats_.factorizations += sys.klu.factorizations();
-  r.stats_.march_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - march_started).count();
-  return r;
+  if (opt.method == LtiOptions::Method::Reduced) return model.status();
+  stats_.note = model.status().message();
+  return false;
 }
 
 int LtiResponses::find_source(const std::string& name) const {
@@ -740,12 +555,10 @@ std::vector<std::vector<double>> LtiResponses::values(const std::vector<SourceIn
                                                       const std::vector<double>& times) const {
   const size_t np = labels_.size();
   std::vector<std::vector<double>> out(np, std::vector<double>(times.size(), 0.0));
+  const std::vector<double> base = base_values(inputs);
   for (size_t p = 0; p < np; ++p) {
-    double base = y_dc_[p];
-    for (size_t k = 0; k < sources_.size() && k < inputs.size(); ++k)
-      base += (inputs[k].initial - sources_[k].initial) * gain_[k][p];
     if (model_)
-      std::fill(out[p].begin(), out[p].end(), base);
+      std::fill(out[p].begin(), out[p].end(), base[p]);
     else
       for (size_t j = 0; j < times.size(); ++j) out[p][j] = value(p, times[j], inputs);
   }
@@ -925,180 +738,240 @@ Waveform LtiResponses::modal_waveform(const std::vector<SourceInput>& inputs,
   return w;
 }
 
-Waveform LtiResponses::waveform(const std::vector<SourceInput>& inputs, const GridOptions& grid,
-                                GridInfo* info) const {
-  const size_t np = labels_.size();
-  GridInfo local;
-  GridInfo& gi = info ? *info : local;
-  gi = GridInfo{};
-  for (const SourceInput& in : inputs) gi.corners += static_cast<long>(in.ramps.size());
-  std::vector<double> base(np);
-  for (size_t p = 0; p < np; ++p) {
+std::vector<double> LtiResponses::base_values(const std::vector<SourceInput>& inputs) const {
+  std::vector<double> base(labels_.size());
+  for (size_t p = 0; p < base.size(); ++p) {
     base[p] = y_dc_[p];
     for (size_t k = 0; k < sources_.size() && k < inputs.size(); ++k)
       base[p] += (inputs[k].initial - sources_[k].initial) * gain_[k][p];
   }
-  if (model_) return modal_waveform(inputs, grid, base, gi);
-  const double span = grid.tstop - grid.tstart;
+  return base;
+}
+
+// waveform() on the march's responses: GridOptions' rule by uniform halving, the corners as rows
+// of their own.
+class MarchGrid {
+ public:
+  MarchGrid(const LtiResponses& r, const std::vector<SourceInput>& inputs,
+            const LtiResponses::GridOptions& grid, const std::vector<double>& base,
+            LtiResponses::GridInfo& gi);
+  Waveform build();
+
+ private:
+  // Probe p at time t in O(ramps inside the march window): the ramps older than the march's
+  // end respond affinely, summed from prefix sums of slope and slope * time.
+  double value_at(size_t p, double t) const;
+  Rows rows_at(double t0, double dt, long count) const {
+    Rows v(np_, std::vector<double>(count, 0.0));
+    for (size_t p = 0; p < np_; ++p) std::fill(v[p].begin(), v[p].end(), base_[p]);
+    r_.superpose(inputs_, t0, dt, count, v);
+    return v;
+  }
+  // Counts the probe evaluations of a level at `step`; true when over max_evaluations.
+  bool over_budget(double step) {
+    const double evaluations = static_cast<double>(np_) * reach_ / step;
+    gi_.evaluations += evaluations;
+    if (grid_.max_evaluations > 0 && evaluations > grid_.max_evaluations) gi_.over_budget = true;
+    return gi_.over_budget;
+  }
+  // The level's worst interpolation error at the cells' midpoints, over the grid probes.
+  double level_error(const Rows& rows, const Rows& mids, double dt, long count) const;
+  // Halves the grid until the rule holds (or max_rows stops it, with a warning); false when the
+  // evaluation budget stops it.
+  bool refine(Rows& rows, double& dt, long& count);
+  Waveform assemble(const Rows& rows, double dt, long count) const;
+
+  const LtiResponses& r_;
+  const std::vector<SourceInput>& inputs_;
+  const LtiResponses::GridOptions& grid_;
+  const std::vector<double>& base_;
+  LtiResponses::GridInfo& gi_;
+  const size_t np_;
+  const double end_;             // s, the march's end
+  std::vector<double> corners_;  // source corners strictly inside the span, sorted, unique
+  std::vector<std::vector<double>> sum_s_, sum_st_;  // [k][j]: prefix sums of slope, slope * t
+  double reach_ = 0.0;  // s, the rows each ramp is evaluated on (inside its march window), summed
+};
+
+MarchGrid::MarchGrid(const LtiResponses& r, const std::vector<SourceInput>& inputs,
+                     const LtiResponses::GridOptions& grid, const std::vector<double>& base,
+                     LtiResponses::GridInfo& gi)
+    : r_(r),
+      inputs_(inputs),
+      grid_(grid),
+      base_(base),
+      gi_(gi),
+      np_(r.labels_.size()),
+      end_(r.tau_.back()) {
   // Source corners strictly inside the span: rows of their own, so that a probe on a driven node
   // is exact between rows too (not with a given step: the caller asked for that grid).
-  std::vector<double> corners;
   for (const SourceInput& in : inputs)
     for (const Ramp& ramp : in.ramps)
-      if (grid.step <= 0 && ramp.t > grid.tstart && ramp.t < grid.tstop) corners.push_back(ramp.t);
-  std::sort(corners.begin(), corners.end());
-  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
-  // Any probe at any time in O(ramps inside the march window): the ramps older than the march's
-  // end respond affinely, summed from prefix sums of slope and slope * time.
-  const double end = tau_.back();
-  std::vector<std::vector<double>> sum_s(inputs.size()), sum_st(inputs.size());
+      if (grid.step <= 0 && ramp.t > grid.tstart && ramp.t < grid.tstop) corners_.push_back(ramp.t);
+  std::sort(corners_.begin(), corners_.end());
+  corners_.erase(std::unique(corners_.begin(), corners_.end()), corners_.end());
+  sum_s_.resize(inputs.size());
+  sum_st_.resize(inputs.size());
   for (size_t k = 0; k < inputs.size(); ++k) {
-    sum_s[k].assign(inputs[k].ramps.size() + 1, 0.0);
-    sum_st[k].assign(inputs[k].ramps.size() + 1, 0.0);
+    sum_s_[k].assign(inputs[k].ramps.size() + 1, 0.0);
+    sum_st_[k].assign(inputs[k].ramps.size() + 1, 0.0);
     for (size_t j = 0; j < inputs[k].ramps.size(); ++j) {
-      sum_s[k][j + 1] = sum_s[k][j] + inputs[k].ramps[j].slope;
-      sum_st[k][j + 1] = sum_st[k][j] + inputs[k].ramps[j].slope * inputs[k].ramps[j].t;
+      sum_s_[k][j + 1] = sum_s_[k][j] + inputs[k].ramps[j].slope;
+      sum_st_[k][j + 1] = sum_st_[k][j] + inputs[k].ramps[j].slope * inputs[k].ramps[j].t;
     }
   }
-  auto value_at = [&](size_t p, double t) {
-    double y = base[p];
-    for (size_t k = 0; k < sources_.size() && k < inputs.size(); ++k) {
-      const auto& ramps = inputs[k].ramps;
-      auto before = [&](double x) {  // ramps with t_j < x
-        return static_cast<size_t>(
-            std::lower_bound(ramps.begin(), ramps.end(), x,
-                             [](const Ramp& r, double v) { return r.t < v; }) -
-            ramps.begin());
-      };
-      const size_t hi = before(t), lo = std::min(hi, before(t - end));
-      const double rend = r_[k][p].back(), send = end_slope_[k][p];
-      y += (rend - send * end) * sum_s[k][lo] + send * (t * sum_s[k][lo] - sum_st[k][lo]);
-      for (size_t j = lo; j < hi; ++j) y += ramps[j].slope * ramp_response(k, p, t - ramps[j].t);
-    }
-    return y;
-  };
-  auto rows_at = [&](double t0, double dt, long count) {
-    std::vector<std::vector<double>> v(np, std::vector<double>(count, 0.0));
-    for (size_t p = 0; p < np; ++p) std::fill(v[p].begin(), v[p].end(), base[p]);
-    superpose(inputs, t0, dt, count, v);
-    return v;
-  };
-
   // The superposition's cost at a step: each ramp is evaluated on the rows inside its march window
   // (beyond it the response is affine and costs nothing per row).
-  double reach = 0.0;
   for (const SourceInput& in : inputs)
     for (const Ramp& ramp : in.ramps)
-      if (ramp.t < grid.tstop) reach += std::min(grid.tstop - std::max(ramp.t, grid.tstart), end);
-  auto over_budget = [&](double step) {
-    const double evaluations = static_cast<double>(np) * reach / step;
-    gi.evaluations += evaluations;
-    if (grid.max_evaluations > 0 && evaluations > grid.max_evaluations) gi.over_budget = true;
-    return gi.over_budget;
-  };
+      if (ramp.t < grid.tstop) reach_ += std::min(grid.tstop - std::max(ramp.t, grid.tstart), end_);
+}
 
-  double dt = grid.step;
-  std::vector<std::vector<double>> rows;
+double MarchGrid::value_at(size_t p, double t) const {
+  double y = base_[p];
+  for (size_t k = 0; k < r_.sources_.size() && k < inputs_.size(); ++k) {
+    const auto& ramps = inputs_[k].ramps;
+    auto before = [&](double x) {  // ramps with t_j < x
+      return static_cast<size_t>(std::lower_bound(ramps.begin(), ramps.end(), x,
+                                                  [](const Ramp& r, double v) { return r.t < v; }) -
+                                 ramps.begin());
+    };
+    const size_t hi = before(t), lo = std::min(hi, before(t - end_));
+    const double rend = r_.r_[k][p].back(), send = r_.end_slope_[k][p];
+    y += (rend - send * end_) * sum_s_[k][lo] + send * (t * sum_s_[k][lo] - sum_st_[k][lo]);
+    for (size_t j = lo; j < hi; ++j) y += ramps[j].slope * r_.ramp_response(k, p, t - ramps[j].t);
+  }
+  return y;
+}
+
+double MarchGrid::level_error(const Rows& rows, const Rows& mids, double dt, long count) const {
+  double worst = 0.0;
+  // Cells holding a source corner are skipped: the corner becomes a row of its own below.
+  std::vector<char> has_corner(count, 0);
+  for (double c : corners_) {
+    const long i = static_cast<long>(std::floor((c - grid_.tstart) / dt));
+    if (i >= 0 && i < count) has_corner[i] = 1;
+  }
+  for (size_t p = 0; p < np_; ++p) {
+    if (!grid_.grid_probes.empty() && (p >= grid_.grid_probes.size() || !grid_.grid_probes[p]))
+      continue;
+    const double scale = r_.is_current_[p] ? 1e3 : 1.0;  // 1 mV -> 1 uA
+    for (long i = 0; i + 1 < count; ++i)
+      if (!has_corner[i])
+        worst =
+            std::max(worst, scale * std::fabs(mids[p][i] - 0.5 * (rows[p][i] + rows[p][i + 1])));
+    // A cell holding corners is tested piece by piece between them (the corners are rows of
+    // their own): a fast response just after a corner is as visible as anywhere else.
+    for (size_t c = 0; c < corners_.size();) {
+      const long i = static_cast<long>(std::floor((corners_[c] - grid_.tstart) / dt));
+      if (i < 0 || i + 1 >= count) {
+        ++c;
+        continue;
+      }
+      double a = grid_.tstart + static_cast<double>(i) * dt, ya = rows[p][i];
+      for (; c < corners_.size() && corners_[c] < a + dt; ++c) {
+        const double yc = value_at(p, corners_[c]);
+        const double ym = value_at(p, 0.5 * (a + corners_[c]));
+        worst = std::max(worst, scale * std::fabs(ym - 0.5 * (ya + yc)));
+        a = corners_[c], ya = yc;
+      }
+      const double b = grid_.tstart + static_cast<double>(i + 1) * dt;
+      const double ym = value_at(p, 0.5 * (a + b));
+      worst = std::max(worst, scale * std::fabs(ym - 0.5 * (ya + rows[p][i + 1])));
+    }
+  }
+  return worst;
+}
+
+bool MarchGrid::refine(Rows& rows, double& dt, long& count) {
+  while (true) {
+    if (over_budget(dt)) return false;
+    const Rows mids = rows_at(grid_.tstart + 0.5 * dt, dt, count - 1);
+    const double worst = level_error(rows, mids, dt, count);
+    if (worst <= 0.5 * grid_.interp_tol) return true;
+    // Budgeted: a smooth response's interpolation error falls as dt^2, so the step that meets
+    // the tolerance is about dt sqrt(tol / worst); when even that level would be over budget,
+    // stop now instead of computing the levels on the way (a kink needs finer still).
+    if (grid_.max_evaluations > 0) {
+      const double final_dt = dt * std::sqrt(0.5 * grid_.interp_tol / worst);
+      const double predicted = static_cast<double>(np_) * reach_ / final_dt;
+      if (predicted > grid_.max_evaluations) {
+        gi_.evaluations += predicted;
+        gi_.over_budget = true;
+        return false;
+      }
+    }
+    if (2 * count - 1 > grid_.max_rows) {
+      gi_.warning = fmt::format(
+          "LTI output grid stopped at {} rows (step {:g} s): linear interpolation between rows "
+          "may be off by up to {:.3g} mV, over the {:g} mV target",
+          count, dt, 2e3 * worst, 1e3 * grid_.interp_tol);
+      return true;
+    }
+    // Interleave: the midpoints are the finer grid's odd rows.
+    for (size_t p = 0; p < np_; ++p) {
+      std::vector<double> fine(2 * count - 1);
+      for (long i = 0; i < count; ++i) fine[2 * i] = rows[p][i];
+      for (long i = 0; i + 1 < count; ++i) fine[2 * i + 1] = mids[p][i];
+      rows[p].swap(fine);
+    }
+    count = 2 * count - 1;
+    dt *= 0.5;
+  }
+}
+
+Waveform MarchGrid::assemble(const Rows& rows, double dt, long count) const {
+  Waveform w;
+  Rows cols(np_);
+  const double tiny = dt * 1e-6;
+  size_t c = 0;
+  for (long i = 0; i < count; ++i) {
+    const double t = grid_.tstart + static_cast<double>(i) * dt;
+    for (; c < corners_.size() && corners_[c] < t; ++c) {
+      if (corners_[c] <= t - tiny && (w.time.empty() || corners_[c] >= w.time.back() + tiny)) {
+        w.time.push_back(corners_[c]);
+        for (size_t p = 0; p < np_; ++p) cols[p].push_back(value_at(p, corners_[c]));
+      }
+    }
+    if (!w.time.empty() && t <= w.time.back()) continue;
+    w.time.push_back(t);
+    for (size_t p = 0; p < np_; ++p) cols[p].push_back(rows[p][i]);
+  }
+  for (size_t p = 0; p < np_; ++p) w.add_column(r_.labels_[p], std::move(cols[p]));
+  gi_.rows = static_cast<long>(w.time.size());
+  gi_.step = dt;
+  return w;
+}
+
+Waveform MarchGrid::build() {
+  const double span = grid_.tstop - grid_.tstart;
+  double dt = grid_.step;
+  Rows rows;
   long count = 0;
   if (dt > 0) {
     count = static_cast<long>(std::floor(span / dt * (1 + 1e-12))) + 1;
     if (over_budget(dt)) return Waveform{};
-    rows = rows_at(grid.tstart, dt, count);
+    rows = rows_at(grid_.tstart, dt, count);
   } else {
     dt = span;
     while (dt > coarsest_grid_step(span)) dt *= 0.5;
     count = static_cast<long>(std::llround(span / dt)) + 1;
     if (over_budget(dt)) return Waveform{};
-    rows = rows_at(grid.tstart, dt, count);
-    while (true) {
-      if (over_budget(dt)) return Waveform{};
-      auto mids = rows_at(grid.tstart + 0.5 * dt, dt, count - 1);
-      double worst = 0.0;
-      // Cells holding a source corner are skipped: the corner becomes a row of its own below.
-      std::vector<char> has_corner(count, 0);
-      for (double c : corners) {
-        const long i = static_cast<long>(std::floor((c - grid.tstart) / dt));
-        if (i >= 0 && i < count) has_corner[i] = 1;
-      }
-      for (size_t p = 0; p < np; ++p) {
-        if (!grid.grid_probes.empty() && (p >= grid.grid_probes.size() || !grid.grid_probes[p]))
-          continue;
-        const double scale = is_current_[p] ? 1e3 : 1.0;  // 1 mV -> 1 uA
-        for (long i = 0; i + 1 < count; ++i)
-          if (!has_corner[i])
-            worst = std::max(worst,
-                             scale * std::fabs(mids[p][i] - 0.5 * (rows[p][i] + rows[p][i + 1])));
-        // A cell holding corners is tested piece by piece between them (the corners are rows of
-        // their own): a fast response just after a corner is as visible as anywhere else.
-        for (size_t c = 0; c < corners.size();) {
-          const long i = static_cast<long>(std::floor((corners[c] - grid.tstart) / dt));
-          if (i < 0 || i + 1 >= count) {
-            ++c;
-            continue;
-          }
-          double a = grid.tstart + static_cast<double>(i) * dt, ya = rows[p][i];
-          for (; c < corners.size() && corners[c] < a + dt; ++c) {
-            const double yc = value_at(p, corners[c]);
-            const double ym = value_at(p, 0.5 * (a + corners[c]));
-            worst = std::max(worst, scale * std::fabs(ym - 0.5 * (ya + yc)));
-            a = corners[c], ya = yc;
-          }
-          const double b = grid.tstart + static_cast<double>(i + 1) * dt;
-          const double ym = value_at(p, 0.5 * (a + b));
-          worst = std::max(worst, scale * std::fabs(ym - 0.5 * (ya + rows[p][i + 1])));
-        }
-      }
-      if (worst <= 0.5 * grid.interp_tol) break;
-      // Budgeted: a smooth response's interpolation error falls as dt^2, so the step that meets
-      // the tolerance is about dt sqrt(tol / worst); when even that level would be over budget,
-      // stop now instead of computing the levels on the way (a kink needs finer still).
-      if (grid.max_evaluations > 0) {
-        const double final_dt = dt * std::sqrt(0.5 * grid.interp_tol / worst);
-        const double predicted = static_cast<double>(np) * reach / final_dt;
-        if (predicted > grid.max_evaluations) {
-          gi.evaluations += predicted;
-          gi.over_budget = true;
-          return Waveform{};
-        }
-      }
-      if (2 * count - 1 > grid.max_rows) {
-        gi.warning = fmt::format(
-            "LTI output grid stopped at {} rows (step {:g} s): linear interpolation between rows "
-            "may be off by up to {:.3g} mV, over the {:g} mV target",
-            count, dt, 2e3 * worst, 1e3 * grid.interp_tol);
-        break;
-      }
-      // Interleave: the midpoints are the finer grid's odd rows.
-      for (size_t p = 0; p < np; ++p) {
-        std::vector<double> fine(2 * count - 1);
-        for (long i = 0; i < count; ++i) fine[2 * i] = rows[p][i];
-        for (long i = 0; i + 1 < count; ++i) fine[2 * i + 1] = mids[p][i];
-        rows[p].swap(fine);
-      }
-      count = 2 * count - 1;
-      dt *= 0.5;
-    }
+    rows = rows_at(grid_.tstart, dt, count);
+    if (!refine(rows, dt, count)) return Waveform{};
   }
-  Waveform w;
-  std::vector<std::vector<double>> cols(np);
-  const double tiny = dt * 1e-6;
-  size_t c = 0;
-  for (long i = 0; i < count; ++i) {
-    const double t = grid.tstart + static_cast<double>(i) * dt;
-    for (; c < corners.size() && corners[c] < t; ++c) {
-      if (corners[c] <= t - tiny && (w.time.empty() || corners[c] >= w.time.back() + tiny)) {
-        w.time.push_back(corners[c]);
-        for (size_t p = 0; p < np; ++p) cols[p].push_back(value_at(p, corners[c]));
-      }
-    }
-    if (!w.time.empty() && t <= w.time.back()) continue;
-    w.time.push_back(t);
-    for (size_t p = 0; p < np; ++p) cols[p].push_back(rows[p][i]);
-  }
-  for (size_t p = 0; p < np; ++p) w.add_column(labels_[p], std::move(cols[p]));
-  gi.rows = static_cast<long>(w.time.size());
-  gi.step = dt;
-  return w;
+  return assemble(rows, dt, count);
+}
+
+Waveform LtiResponses::waveform(const std::vector<SourceInput>& inputs, const GridOptions& grid,
+                                GridInfo* info) const {
+  GridInfo local;
+  GridInfo& gi = info ? *info : local;
+  gi = GridInfo{};
+  for (const SourceInput& in : inputs) gi.corners += static_cast<long>(in.ramps.size());
+  const std::vector<double> base = base_values(inputs);
+  if (model_) return modal_waveform(inputs, grid, base, gi);
+  return MarchGrid(*this, inputs, grid, base, gi).build();
 }
 
 }  // namespace isolink

@@ -55,6 +55,8 @@
 
 namespace isolink {
 
+struct MnaSystem;
+
 struct LtiOptions {
   // How the responses are computed: `march` (above), `reduced` (a reduced model in closed form,
   // solver/reduced_model.h: no march, no settling, any lag at the same cost), or `auto`: the
@@ -113,10 +115,16 @@ struct LtiStats {
 // piecewise linear), naming the element and its netlist location; Ok when it can.
 Status check_lti(const Circuit& circuit);
 
+// Lifetime: an LtiResponses owns its response tables (or reduced model) but points to the
+// circuit's source functions (netlist_inputs reads them): the circuit must outlive it, unmoved
+// (the elements are held by unique_ptr, so moving the Circuit object itself is fine). All const
+// methods are thread-safe.
 class LtiResponses {
  public:
   // The DC solves and the march. The circuit must be finalized (and bound to the analysis times:
-  // Element::bind_time, as for the transient) and pass check_lti.
+  // Element::bind_time, as for the transient) and pass check_lti. Errors: invalid options,
+  // check_lti's, a singular DC point, the reduced model's failure (Method::Reduced only), the
+  // march's (max_steps, settle_by passed, a step below the floor naming the unknown).
   static StatusOr<LtiResponses> compute(const Circuit& circuit, const std::vector<Probe>& probes,
                                         const LtiOptions& options);
 
@@ -210,9 +218,28 @@ class LtiResponses {
 
   struct Source {
     std::string name;
+    // The circuit's own source function (Element::source_function): the circuit must outlive
+    // this LtiResponses (netlist_inputs reads it).
     const SourceFunction* function = nullptr;
     double initial = 0.0;  // the netlist's value at t = 0
   };
+  friend class LtiMarch;   // lti_march.cpp: fills tau_, r_, s_, end_slope_
+  friend class MarchGrid;  // lti.cpp: waveform() on the march's responses
+  // Per probe: the DC point moved by the inputs' initial values through the DC gains.
+  std::vector<double> base_values(const std::vector<SourceInput>& inputs) const;
+  // compute's pieces: the time-varying sources and their unit excitations (per source, n + 1
+  // entries); the DC point and gains; the reduced model (true: built and kept; false: failed
+  // under Method::Auto, the reason in stats_.note); the march.
+  std::vector<std::vector<double>> collect_sources(const Circuit& circuit, int n);
+  Status solve_dc(const Circuit& circuit, const MnaSystem& sys, const std::vector<Probe>& probes,
+                  const std::vector<std::vector<double>>& unit,
+                  std::vector<std::vector<double>>& dc_solutions);
+  StatusOr<bool> try_reduced_model(const Circuit& circuit, const std::vector<Probe>& probes,
+                                   const std::vector<std::vector<double>>& unit,
+                                   const std::vector<std::vector<double>>& dc_solutions,
+                                   const LtiOptions& opt);
+  Status march(const Circuit& circuit, MnaSystem& sys, const std::vector<Probe>& probes,
+               const std::vector<std::vector<double>>& unit, const LtiOptions& opt);
   // Adds sum of the inputs' ramps into out[p][i] for t_i = t0 + i dt, i < count.
   void superpose(const std::vector<SourceInput>& inputs, double t0, double dt, long count,
                  std::vector<std::vector<double>>& out) const;

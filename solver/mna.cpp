@@ -2,13 +2,15 @@
 
 #include <algorithm>
 
+#include "solver/circuit.h"
+
 namespace isolink {
 
-Slot MnaPattern::slot(int row, int col) {
-  if (!finalized_) {
-    if (row > 0 && col > 0) entries_.emplace_back(col - 1, row - 1);
-    return 0;
-  }
+void MnaPattern::declare(int row, int col) {
+  if (row > 0 && col > 0) entries_.emplace_back(col - 1, row - 1);
+}
+
+Slot MnaPattern::slot(int row, int col) const {
   if (row <= 0 || col <= 0) return trash();
   const int c = col - 1, r = row - 1;
   auto begin = row_index_.begin() + col_start_[c];
@@ -33,6 +35,21 @@ void MnaPattern::finalize() {
   entries_.clear();
   entries_.shrink_to_fit();
   finalized_ = true;
+}
+
+MnaMatrices assemble_mna(const Circuit& circuit) {
+  MnaMatrices m;
+  m.pattern = MnaPattern(circuit.unknown_count());
+  MnaStamp collect(m.pattern);
+  for (const auto& e : circuit.elements()) e->stamp(collect);
+  m.pattern.finalize();
+  m.g.assign(m.pattern.value_count(), 0.0);
+  m.c.assign(m.pattern.value_count(), 0.0);
+  MnaStamp values(m.pattern, m.g.data(), m.c.data());
+  for (const auto& e : circuit.elements()) e->stamp(values);
+  for (int node : circuit.floating_nodes())
+    m.g[m.pattern.slot(node, node)] += Circuit::kFloatingTie;
+  return m;
 }
 
 }  // namespace isolink

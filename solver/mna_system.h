@@ -5,6 +5,12 @@
 //   if (Status s = sys.build(circuit); !s.ok()) return s;   // stamps G, C; KLU symbolic analysis
 //   sys.dc(circuit, x);                                       // DC operating point
 //   sys.select_or_factor(circuit, alpha); sys.solve(b);      // (G + alpha C) x = b
+// Ownership: the system owns its pattern, G and C (assemble_mna) and the KLU factorizations. It
+// keeps pointers to the circuit's source elements (rhs): the circuit must outlive it; the
+// methods that report errors take the circuit again, for its unknown names. alpha is in 1/s
+// (the integration coefficient of C); right-hand sides and solutions index unknowns, [0] ground.
+// Errors: build (KLU's analysis), select_or_factor and factor_dc (a singular matrix, naming the
+// unknown), dc and check_finite (a non-finite solution, naming the unknown and the likely cause).
 #pragma once
 
 #include <fmt/format.h>
@@ -36,16 +42,11 @@ struct MnaSystem {
 
   Status build(const Circuit& circuit) {
     n = circuit.unknown_count();
-    pattern = MnaPattern(n);
-    auto& elements = const_cast<Circuit&>(circuit).elements();
-    for (auto& e : elements) e->declare(pattern);
-    pattern.finalize();
-    for (auto& e : elements) e->declare(pattern);
-    g.assign(pattern.value_count(), 0.0);
-    c.assign(pattern.value_count(), 0.0);
-    for (auto& e : elements) e->stamp(g.data(), c.data());
-    for (int node : circuit.floating_nodes()) g[pattern.slot(node, node)] += Circuit::kFloatingTie;
-    for (const auto& e : elements)
+    MnaMatrices m = assemble_mna(circuit);
+    pattern = std::move(m.pattern);
+    g = std::move(m.g);
+    c = std::move(m.c);
+    for (const auto& e : circuit.elements())
       if (e->has_excitation()) sources.push_back(e.get());
     const auto& cp = pattern.col_start();
     const auto& ri = pattern.row_index();

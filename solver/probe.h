@@ -3,6 +3,8 @@
 //
 //   StatusOr<Probe> p = parse_probe(circuit, "v(rxp,rxn)");
 //   double value = p->value(x);   // x: the full unknown vector, x[0] = ground = 0
+// Units: V for v(...), A for i(...). A Probe holds unknown indices of the circuit it was parsed
+// on (no reference to it): valid for that circuit, or one built from the same cards.
 #pragma once
 
 #include <string>

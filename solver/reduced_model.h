@@ -128,6 +128,8 @@ struct ReducedModel {
 
 // excitations: per source, its unit excitation indexed by unknown ([0] ground, ignored).
 // dc_solutions: per source, G^-1 e_k (same indexing), from the caller's DC solve.
+// The circuit is read during the call only; the model owns its numbers (poles in 1/s, inputs
+// and outputs per unit of source: V or A; direct terms V/V or A/V).
 // Errors: the check not met within max_points / max_order (with the error reached), a growing
 // mode, a singular projection.
 StatusOr<ReducedModel> reduce_circuit(const Circuit& circuit,

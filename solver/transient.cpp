@@ -5,10 +5,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 
 #include "solver/klu_solver.h"
 #include "solver/mna.h"
 #include "solver/mna_system.h"
+#include "solver/step_control.h"
 
 namespace isolink {
 
@@ -105,21 +107,10 @@ StatusOr<std::vector<double>> dc_operating_point(const Circuit& circuit) {
   return x;
 }
 
-StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions& opt,
-                                 const std::vector<Probe>& probes, TransientStats* stats_out) {
-  if (Status s = opt.validate(); !s.ok()) return s;
-  TransientStats stats;
-  for (const auto& e : circuit.elements()) const_cast<Element&>(*e).bind_time(opt.tstep, opt.tstop);
+namespace {
 
-  MnaSystem sys;
-  if (Status s = sys.build(circuit); !s.ok()) return s;
-  const int n = sys.n;
-  const double tstop = opt.tstop;
-  const double hmax = opt.effective_tmax();
-  const double hmin = std::max(1e-18, tstop * 1e-13);
-  const double tiny = tstop * 1e-12;  // breakpoints closer than this merge
-
-  // Breakpoints: every source corner, and tstop.
+// Every source corner in (tiny, tstop], and tstop, sorted; corners closer than tiny merge.
+std::vector<double> merged_breakpoints(const Circuit& circuit, double tstop, double tiny) {
   std::vector<double> bps;
   for (const auto& e : circuit.elements()) e->breakpoints(tstop, bps);
   bps.push_back(tstop);
@@ -127,241 +118,335 @@ StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions&
   std::vector<double> merged;
   for (double t : bps)
     if (t > tiny && (merged.empty() || t - merged.back() > tiny)) merged.push_back(t);
-  bps.swap(merged);
-  stats.breakpoints = static_cast<int>(bps.size());
+  return merged;
+}
 
-  // Initial state.
-  std::vector<double> x(n + 1, 0.0), xdot(n + 1, 0.0), hist_part(n + 1, 0.0), xnew(n + 1);
-  for (const auto& [node, v] : opt.node_ic)
-    if (node > n) return Status::Error(fmt::format("node_ic: unknown {} is out of range", node));
-  // UIC: the charge the capacitors' ic= add beyond C x0, applied on the first step only.
-  std::vector<double> uic_dq;
-  if (!opt.uic) {
-    if (Status s = sys.dc(circuit, x, opt.node_ic); !s.ok())
-      return s.with_context("DC operating point");
-    ++stats.solves;
-    ++stats.factorizations;
-  } else {
-    for (const auto& [node, v] : opt.node_ic) x[node] = v;
-    for (const auto& e : circuit.elements()) e->uic_state(x.data());
-    uic_dq.assign(n + 1, 0.0);
-    for (const auto& e : circuit.elements()) e->uic_charge(x.data(), uic_dq.data());
-    uic_dq[0] = 0.0;
-    if (std::all_of(uic_dq.begin(), uic_dq.end(), [](double v) { return v == 0.0; }))
-      uic_dq.clear();
-  }
+// Which unknowns the error control watches, and 1 / tolerance of each (trtol folded in).
+// As SPICE does, only states count: nodes with capacitance (C diagonal) and inductor currents;
+// a node without capacitance is algebraic and follows the states.
+// The relative part scales with the largest |x| the unknown has had so far (its own, since
+// t = 0), not with its value now: an oscillating current passes through zero twice a period,
+// and a tolerance relative to its value there would hold the step down for nothing (that made
+// the cable's ringing currents set most steps of the 15 m example).
+// inv_tol = 1 / tolerance, recomputed only when a peak grows (rarely, once the signals have
+// had their first full swing), so the error loop has no division.
+struct WatchedStates {
+  std::vector<int> unknowns;
+  std::vector<double> abs_tol, peak, inv_tol;
+  double rel_tol = 0.0;
 
-  Waveform w;
-  for (const auto& p : probes) w.add_column(p.label, {});
-  auto record = [&](double t, const std::vector<double>& v) {
-    if (t < opt.tstart - tiny) return;
-    w.time.push_back(t);
-    for (size_t k = 0; k < probes.size(); ++k) w.columns[k].push_back(probes[k].value(v.data()));
-  };
-  record(0.0, x);
-
-  // Which unknowns the error control watches, and their tolerances (trtol folded in).
-  // As SPICE does, only states count: nodes with capacitance (C diagonal) and inductor currents;
-  // a node without capacitance is algebraic and follows the states.
-  std::vector<int> watched;
-  std::vector<double> abs_tol;
-  for (int u = 1; u <= n; ++u) {
-    const bool has_c = sys.c[sys.pattern.slot(u, u)] != 0.0;
-    if ((circuit.unknown_is_node(u) && has_c) || circuit.unknown_is_state(u)) {
-      watched.push_back(u);
-      abs_tol.push_back(opt.trtol * (circuit.unknown_is_node(u) ? opt.vntol : opt.abstol));
+  WatchedStates(const Circuit& circuit, const MnaSystem& sys, const TransientOptions& opt,
+                const std::vector<double>& x0) {
+    for (int u = 1; u <= sys.n; ++u) {
+      const bool has_c = sys.c[sys.pattern.slot(u, u)] != 0.0;
+      if ((circuit.unknown_is_node(u) && has_c) || circuit.unknown_is_state(u)) {
+        unknowns.push_back(u);
+        abs_tol.push_back(opt.trtol * (circuit.unknown_is_node(u) ? opt.vntol : opt.abstol));
+      }
+    }
+    rel_tol = opt.trtol * opt.reltol;
+    peak.assign(unknowns.size(), 0.0);
+    inv_tol.assign(unknowns.size(), 0.0);
+    for (size_t k = 0; k < unknowns.size(); ++k) {
+      peak[k] = std::fabs(x0[unknowns[k]]);
+      inv_tol[k] = 1.0 / (rel_tol * peak[k] + abs_tol[k]);
     }
   }
-  const double rel_tol = opt.trtol * opt.reltol;
-  // The relative part scales with the largest |x| the unknown has had so far (its own, since
-  // t = 0), not with its value now: an oscillating current passes through zero twice a period,
-  // and a tolerance relative to its value there would hold the step down for nothing (that made
-  // the cable's ringing currents set most steps of the 15 m example).
-  // inv_tol = 1 / tolerance, recomputed only when a peak grows (rarely, once the signals have
-  // had their first full swing), so the error loop has no division.
-  std::vector<double> peak(watched.size(), 0.0), inv_tol(watched.size(), 0.0);
-  for (size_t k = 0; k < watched.size(); ++k) {
-    peak[k] = std::fabs(x[watched[k]]);
-    inv_tol[k] = 1.0 / (rel_tol * peak[k] + abs_tol[k]);
+  // After an accepted step: the peaks, and the tolerances of those that grew.
+  void track(const std::vector<double>& x) {
+    for (size_t k = 0; k < unknowns.size(); ++k) {
+      const double a = std::fabs(x[unknowns[k]]);
+      if (a > peak[k]) peak[k] = a, inv_tol[k] = 1.0 / (rel_tol * a + abs_tol[k]);
+    }
   }
+};
+
+// One run of the transient engine: the state between steps and the pieces of a step.
+class TransientMarch {
+ public:
+  TransientMarch(const Circuit& circuit, const TransientOptions& opt,
+                 const std::vector<Probe>& probes, MnaSystem& sys)
+      : circuit_(circuit),
+        opt_(opt),
+        probes_(probes),
+        sys_(sys),
+        n_(sys.n),
+        tiny_(opt.tstop * 1e-12),  // breakpoints closer than this merge
+        // The local truncation error of a second-order method: O(h^3).
+        control_{.hmax = opt.effective_tmax(),
+                 .hmin = std::max(1e-18, opt.tstop * 1e-13),
+                 .error_order = 3},
+        x_(n_ + 1, 0.0),
+        xdot_(n_ + 1, 0.0),
+        hist_part_(n_ + 1, 0.0),
+        xnew_(n_ + 1) {}
+
+  StatusOr<Waveform> run(TransientStats& stats);
+
+ private:
+  Status initial_state();
+  // The integration formula for a step of `step` from t_: x1' = a0 x1 + hist_part_; returns a0.
+  double formula(double step, bool euler, bool gear, const History& hist);
+  // Solves (G + a0 C) x1 = b1 - C hist_part_ (+ the UIC charge) into xnew_.
+  Status solve_step(double step, double a0);
+  // Truncation error / tolerance of the step (0 until there are four points); the worst unknown
+  // into worst_unknown_.
+  double truncation_ratio(double step, bool gear, const History& hist);
+  // The backward-Euler first step after a breakpoint, judged one step late (see run()).
+  double euler_start_ratio(double step, const History& hist);
+  Status too_small(double t, double h) const;
+  void record(double t, const std::vector<double>& v);
+
+  const Circuit& circuit_;
+  const TransientOptions& opt_;
+  const std::vector<Probe>& probes_;
+  MnaSystem& sys_;
+  const int n_;
+  const double tiny_;
+  const StepControl control_;
+  TransientStats stats_;
+  std::vector<double> x_, xdot_, hist_part_, xnew_;
+  // UIC: the charge the capacitors' ic= add beyond C x0, applied on the first step only.
+  std::vector<double> uic_dq_;
+  std::optional<WatchedStates> watched_;  // set once the initial state is known
+  double t_ = 0.0;
+  int worst_unknown_ = 0;
+  Waveform w_;
+};
+
+Status TransientMarch::initial_state() {
+  for (const auto& [node, v] : opt_.node_ic)
+    if (node > n_) return Status::Error(fmt::format("node_ic: unknown {} is out of range", node));
+  if (!opt_.uic) {
+    if (Status s = sys_.dc(circuit_, x_, opt_.node_ic); !s.ok())
+      return s.with_context("DC operating point");
+    ++stats_.solves;
+    ++stats_.factorizations;
+    return Status::Ok();
+  }
+  for (const auto& [node, v] : opt_.node_ic) x_[node] = v;
+  for (const auto& e : circuit_.elements()) e->uic_state(x_.data());
+  uic_dq_.assign(n_ + 1, 0.0);
+  for (const auto& e : circuit_.elements()) e->uic_charge(x_.data(), uic_dq_.data());
+  uic_dq_[0] = 0.0;
+  if (std::all_of(uic_dq_.begin(), uic_dq_.end(), [](double v) { return v == 0.0; }))
+    uic_dq_.clear();
+  return Status::Ok();
+}
+
+void TransientMarch::record(double t, const std::vector<double>& v) {
+  if (t < opt_.tstart - tiny_) return;
+  w_.time.push_back(t);
+  for (size_t k = 0; k < probes_.size(); ++k) w_.columns[k].push_back(probes_[k].value(v.data()));
+}
+
+double TransientMarch::formula(double step, bool euler, bool gear, const History& hist) {
+  const int n = n_;
+  const double inv_step = 1.0 / step;
+  double a0 = 0.0;
+  if (euler) {
+    a0 = inv_step;
+    for (int u = 1; u <= n; ++u) hist_part_[u] = -x_[u] * inv_step;
+  } else if (gear) {
+    const double h0 = t_ - hist.t(hist.count - 2);
+    const double rho = step / h0;
+    a0 = (1 + 2 * rho) / (step * (1 + rho));
+    const double a1 = -(1 + rho) * inv_step, a2 = rho * rho / (step * (1 + rho));
+    const auto& xm1 = hist.x(hist.count - 2);
+    for (int u = 1; u <= n; ++u) hist_part_[u] = a1 * x_[u] + a2 * xm1[u];
+  } else {
+    a0 = 2.0 * inv_step;
+    for (int u = 1; u <= n; ++u) hist_part_[u] = -a0 * x_[u] - xdot_[u];
+  }
+  return a0;
+}
+
+Status TransientMarch::solve_step(double step, double a0) {
+  const double t1 = t_ + step;
+  sys_.rhs(t1, xnew_);
+  sys_.sub_c_times(hist_part_.data(), xnew_.data());
+  if (!uic_dq_.empty()) {  // Euler: C x1 / h = C x0 / h + dq / h + ...
+    const double inv_step = 1.0 / step;
+    for (int u = 1; u <= n_; ++u) xnew_[u] += uic_dq_[u] * inv_step;
+  }
+  if (Status s = sys_.select_or_factor(circuit_, a0); !s.ok())
+    return s.with_context(fmt::format("transient at t={:g} s", t1));
+  if (Status s = sys_.solve(xnew_); !s.ok()) return s.with_context(fmt::format("t={:g} s", t1));
+  ++stats_.solves;
+  return MnaSystem::check_finite(circuit_, xnew_, t1, "transient step");
+}
+
+// Truncation error h^3 * coef * x''' with x''' = 6 x the third divided difference over the
+// last four points, written as weights on the three successive differences (no division in
+// the loop), against trtol * (reltol * peak |x| + abstol) with the peak up to the last
+// accepted point; ratio = the worst error / tolerance.
+double TransientMarch::truncation_ratio(double step, bool gear, const History& hist) {
+  if (hist.count != 3) return 0.0;
+  const WatchedStates& ws = *watched_;
+  const double t1 = t_ + step, t0 = hist.t(2), tm1 = hist.t(1), tm2 = hist.t(0);
+  const auto &x0 = hist.x(2), &xm1 = hist.x(1), &xm2 = hist.x(0);
+  const double coef = gear ? (2.0 / 9.0) * 6.0 : (1.0 / 12.0) * 6.0;
+  const double ia = 1.0 / (t1 - t0), ib = 1.0 / (t0 - tm1), ic = 1.0 / (tm1 - tm2);
+  const double ie = 1.0 / (t1 - tm1), iff = 1.0 / (t0 - tm2), ig = 1.0 / (t1 - tm2);
+  const double h3 = step * step * step * coef * ig;
+  const double w1 = h3 * ie * ia, w2 = -h3 * ib * (ie + iff), w3 = h3 * iff * ic;
+  double ratio = 0.0;
+  for (size_t k = 0; k < ws.unknowns.size(); ++k) {
+    const int u = ws.unknowns[k];
+    const double r = ws.inv_tol[k] * std::fabs(w1 * (xnew_[u] - x0[u]) + w2 * (x0[u] - xm1[u]) +
+                                               w3 * (xm1[u] - xm2[u]));
+    if (r > ratio) {
+      ratio = r;
+      worst_unknown_ = u;
+    }
+  }
+  return ratio;
+}
+
+// With the second step's point, the second divided difference over the three points gives x''
+// and the first step's Euler truncation error h1^2 x'' / 2.
+double TransientMarch::euler_start_ratio(double step, const History& hist) {
+  const WatchedStates& ws = *watched_;
+  const double t0 = hist.t(0), t1 = hist.t(1), t2 = t_ + step;
+  const auto &x0 = hist.x(0), &x1 = hist.x(1);
+  const double h1 = t1 - t0;
+  const double i21 = 1.0 / (t2 - t1), i10 = 1.0 / h1, i20 = 1.0 / (t2 - t0);
+  double ratio1 = 0.0;
+  for (size_t k = 0; k < ws.unknowns.size(); ++k) {
+    const int u = ws.unknowns[k];
+    const double dd2 = ((xnew_[u] - x1[u]) * i21 - (x1[u] - x0[u]) * i10) * i20;
+    const double r = ws.inv_tol[k] * h1 * h1 * std::fabs(dd2);
+    if (r > ratio1) ratio1 = r, worst_unknown_ = u;
+  }
+  return ratio1;
+}
+
+Status TransientMarch::too_small(double t, double h) const {
+  return Status::Error(
+      fmt::format("time step too small at t={:g} s (h={:g} s): the truncation error of {} does "
+                  "not converge",
+                  t, h, circuit_.unknown_name(worst_unknown_)));
+}
+
+StatusOr<Waveform> TransientMarch::run(TransientStats& stats_out) {
+  const double tstop = opt_.tstop, tiny = tiny_, hmax = control_.hmax, hmin = control_.hmin;
+  const std::vector<double> bps = merged_breakpoints(circuit_, tstop, tiny);
+  stats_.breakpoints = static_cast<int>(bps.size());
+  if (Status s = initial_state(); !s.ok()) return s;
+  for (const auto& p : probes_) w_.add_column(p.label, {});
+  record(0.0, x_);
+  watched_.emplace(circuit_, sys_, opt_, x_);
 
   // History since the last breakpoint: up to 3 points, oldest first (fixed storage).
-  History hist(n, x);
-
-  auto ladder = [&](double h) {  // largest hmax / 2^k not above h (up to rounding)
-    if (h >= hmax) return hmax;
-    // h of 0 (or below hmax * 2^-1074) makes log2 infinite; converting that to int was UB
-    // (UBSan: negation of INT_MIN). Clamp to the double range: the step-size floor then reports.
-    const double k = std::ceil(std::log2(hmax / h) - 1e-9);
-    return std::ldexp(hmax, k < 1100 ? -static_cast<int>(k) : -1100);
-  };
-
-  double t = 0.0;
+  History hist(n_, x_);
   size_t next_bp = 0;
-  double h = ladder(0.1 * std::min(hmax, bps[0]));
+  double h = control_.ladder(0.1 * std::min(hmax, bps[0]));
   // The UIC step that puts the capacitors' ic= charge in place is not error-checked: keep it short.
-  if (!uic_dq.empty()) h = ladder(1e-3 * h);
+  if (!uic_dq_.empty()) h = control_.ladder(1e-3 * h);
   double last_regular_h = hmax;
   bool after_bp = true;  // the next step is the first after a breakpoint (or t = 0)
-  int worst_unknown = 0;
 
-  while (t < tstop - tiny) {
-    if (stats.accepted + stats.rejected >= opt.max_steps)
+  while (t_ < tstop - tiny) {
+    if (stats_.accepted + stats_.rejected >= opt_.max_steps)
       return Status::Error(fmt::format("transient gave up at t={:g} s after {} steps (max_steps)",
-                                       t, opt.max_steps));
-    while (next_bp < bps.size() && bps[next_bp] <= t + tiny) ++next_bp;
+                                       t_, opt_.max_steps));
+    while (next_bp < bps.size() && bps[next_bp] <= t_ + tiny) ++next_bp;
     const double bp = next_bp < bps.size() ? bps[next_bp] : tstop;
     double step = std::min(h, hmax);
     bool lands = false;
-    if (t + step >= bp - tiny) {
-      step = bp - t;
+    if (t_ + step >= bp - tiny) {
+      step = bp - t_;
       lands = true;
-    } else if (t + 1.5 * step > bp) {
-      step = 0.5 * (bp - t);  // avoid a sliver before the breakpoint
+    } else if (t_ + 1.5 * step > bp) {
+      step = 0.5 * (bp - t_);  // avoid a sliver before the breakpoint
     }
 
-    // Integration formula: x1' = a0 x1 + hist; system (G + a0 C) x1 = b1 - C hist.
     const bool euler = after_bp || hist.count < 2;
-    const bool gear = !euler && opt.method == IntegrationMethod::Gear2;
-    const double inv_step = 1.0 / step;
-    double a0;
-    if (euler) {
-      a0 = inv_step;
-      for (int u = 1; u <= n; ++u) hist_part[u] = -x[u] * inv_step;
-    } else if (gear) {
-      const double h0 = t - hist.t(hist.count - 2);
-      const double rho = step / h0;
-      a0 = (1 + 2 * rho) / (step * (1 + rho));
-      const double a1 = -(1 + rho) * inv_step, a2 = rho * rho / (step * (1 + rho));
-      const auto& xm1 = hist.x(hist.count - 2);
-      for (int u = 1; u <= n; ++u) hist_part[u] = a1 * x[u] + a2 * xm1[u];
-    } else {
-      a0 = 2.0 * inv_step;
-      for (int u = 1; u <= n; ++u) hist_part[u] = -a0 * x[u] - xdot[u];
-    }
-    sys.rhs(t + step, xnew);
-    sys.sub_c_times(hist_part.data(), xnew.data());
-    if (!uic_dq.empty())  // Euler: C x1 / h = C x0 / h + dq / h + ...
-      for (int u = 1; u <= n; ++u) xnew[u] += uic_dq[u] * inv_step;
-    if (Status s = sys.select_or_factor(circuit, a0); !s.ok())
-      return s.with_context(fmt::format("transient at t={:g} s", t + step));
-    if (Status s = sys.solve(xnew); !s.ok())
-      return s.with_context(fmt::format("t={:g} s", t + step));
-    ++stats.solves;
-    if (Status s = MnaSystem::check_finite(circuit, xnew, t + step, "transient step"); !s.ok())
-      return s;
-
-    // Truncation error h^3 * coef * x''' with x''' = 6 x the third divided difference over the
-    // last four points, written as weights on the three successive differences (no division in
-    // the loop), against trtol * (reltol * peak |x| + abstol) with the peak up to the last
-    // accepted point; ratio = the worst error / tolerance.
-    double ratio = 0.0;
-    if (hist.count == 3) {
-      const double t1 = t + step, t0 = hist.t(2), tm1 = hist.t(1), tm2 = hist.t(0);
-      const auto &x0 = hist.x(2), &xm1 = hist.x(1), &xm2 = hist.x(0);
-      const double coef = gear ? (2.0 / 9.0) * 6.0 : (1.0 / 12.0) * 6.0;
-      const double ia = 1.0 / (t1 - t0), ib = 1.0 / (t0 - tm1), ic = 1.0 / (tm1 - tm2);
-      const double ie = 1.0 / (t1 - tm1), iff = 1.0 / (t0 - tm2), ig = 1.0 / (t1 - tm2);
-      const double h3 = step * step * step * coef * ig;
-      const double w1 = h3 * ie * ia, w2 = -h3 * ib * (ie + iff), w3 = h3 * iff * ic;
-      for (size_t k = 0; k < watched.size(); ++k) {
-        const int u = watched[k];
-        const double r = inv_tol[k] * std::fabs(w1 * (xnew[u] - x0[u]) + w2 * (x0[u] - xm1[u]) +
-                                                w3 * (xm1[u] - xm2[u]));
-        if (r > ratio) {
-          ratio = r;
-          worst_unknown = u;
-        }
-      }
-    }
+    const bool gear = !euler && opt_.method == IntegrationMethod::Gear2;
+    const double a0 = formula(step, euler, gear, hist);
+    if (Status s = solve_step(step, a0); !s.ok()) return s;
+    const double ratio = truncation_ratio(step, gear, hist);
 
     // The first step after a breakpoint (backward Euler, from a history of one point) is checked
-    // one step late: with the second step's point, the second divided difference over the three
-    // points gives x'' and the Euler truncation error h1^2 x'' / 2. When it is too large both
-    // steps are undone and the first one is retried smaller (the second step, at most twice the
-    // first, is then accurate too: its trapezoidal error is third order).
-    if (hist.count == 2 && !watched.empty()) {
-      const double t0 = hist.t(0), t1 = hist.t(1), t2 = t + step;
-      const auto &x0 = hist.x(0), &x1 = hist.x(1);
-      const double h1 = t1 - t0;
-      const double i21 = 1.0 / (t2 - t1), i10 = 1.0 / h1, i20 = 1.0 / (t2 - t0);
-      double ratio1 = 0.0;
-      for (size_t k = 0; k < watched.size(); ++k) {
-        const int u = watched[k];
-        const double dd2 = ((xnew[u] - x1[u]) * i21 - (x1[u] - x0[u]) * i10) * i20;
-        const double r = inv_tol[k] * h1 * h1 * std::fabs(dd2);
-        if (r > ratio1) ratio1 = r, worst_unknown = u;
-      }
+    // one step late, with the second step's point. When its error is too large both steps are
+    // undone and the first one is retried smaller (the second step, at most twice the first, is
+    // then accurate too: its trapezoidal error is third order).
+    if (hist.count == 2 && !watched_->unknowns.empty()) {
+      const double ratio1 = euler_start_ratio(step, hist);
       if (ratio1 > 1.0) {
-        stats.rejected += 2;
-        --stats.accepted;
-        const double h_retry = h1 * std::max(0.1, 0.9 * std::sqrt(1.0 / ratio1));
-        if (h_retry < hmin)
-          return Status::Error(fmt::format(
-              "time step too small at t={:g} s (h={:g} s): the truncation error of {} does not "
-              "converge",
-              t0, h_retry, circuit.unknown_name(worst_unknown)));
-        if (!w.time.empty() && w.time.back() == t1) {  // t1 was written out: take it back
-          w.time.pop_back();
-          for (auto& c : w.columns) c.pop_back();
+        stats_.rejected += 2;
+        --stats_.accepted;
+        const double t0 = hist.t(0), t1 = hist.t(1);
+        // Backward Euler's local error is O(h^2).
+        const double h_retry = StepControl::shrink_by_order(t1 - t0, ratio1, 2, 0.1);
+        if (h_retry < hmin) return too_small(t0, h_retry);
+        if (!w_.time.empty() && w_.time.back() == t1) {  // t1 was written out: take it back
+          w_.time.pop_back();
+          for (auto& c : w_.columns) c.pop_back();
         }
-        t = t0;
-        std::copy(x0.begin(), x0.end(), x.begin());
-        hist.reset(t0, x);
+        t_ = t0;
+        std::copy(hist.x(0).begin(), hist.x(0).end(), x_.begin());
+        hist.reset(t0, x_);
         after_bp = true;
-        h = ladder(h_retry);
+        h = control_.ladder(h_retry);
         continue;
       }
     }
 
     if (ratio > 1.0) {
-      ++stats.rejected;
-      h = step * std::max(0.25, 0.9 * std::cbrt(1.0 / ratio));
-      if (h < hmin)
-        return Status::Error(fmt::format(
-            "time step too small at t={:g} s (h={:g} s): the truncation error of {} does not "
-            "converge",
-            t, h, circuit.unknown_name(worst_unknown)));
-      h = ladder(h);
+      ++stats_.rejected;
+      h = control_.shrink(step, ratio);
+      if (h < hmin) return too_small(t_, h);
+      h = control_.ladder(h);
       continue;
     }
 
     // Accept.
-    ++stats.accepted;
-    if (opt.on_progress && (stats.accepted & 1023) == 0) opt.on_progress(t);
-    for (int u = 1; u <= n; ++u) xdot[u] = a0 * xnew[u] + hist_part[u];
-    t = lands ? bp : t + step;
-    std::swap(x, xnew);
-    hist.push(t, x);
-    record(t, x);
-    for (size_t k = 0; k < watched.size(); ++k) {
-      const double a = std::fabs(x[watched[k]]);
-      if (a > peak[k]) peak[k] = a, inv_tol[k] = 1.0 / (rel_tol * a + abs_tol[k]);
-    }
+    ++stats_.accepted;
+    if (opt_.on_progress && (stats_.accepted & 1023) == 0) opt_.on_progress(t_);
+    for (int u = 1; u <= n_; ++u) xdot_[u] = a0 * xnew_[u] + hist_part_[u];
+    t_ = lands ? bp : t_ + step;
+    std::swap(x_, xnew_);
+    hist.push(t_, x_);
+    record(t_, x_);
+    watched_->track(x_);
 
-    const double grow = ratio > 0 ? std::min(2.0, 0.9 * std::cbrt(1.0 / ratio)) : 2.0;
     if (!lands) last_regular_h = step;
-    h = ladder(std::max(step * std::max(grow, 0.5), hmin));
+    h = control_.grow(step, ratio);
     after_bp = false;
-    if (!uic_dq.empty()) {
+    if (!uic_dq_.empty()) {
       // The UIC step moved the capacitors' charge to their ic=: restart the formula from here,
       // as at a breakpoint (x is consistent from now on).
-      uic_dq.clear();
+      uic_dq_.clear();
       after_bp = true;
-      hist.reset(t, x);
+      hist.reset(t_, x_);
     }
     if (lands) {
       // Restart the formula at the corner: small Euler step, fresh history.
       after_bp = true;
-      h = ladder(0.1 * std::min(last_regular_h,
-                                (next_bp + 1 < bps.size() ? bps[next_bp + 1] : tstop) - t));
-      hist.reset(t, x);
+      const double next = next_bp + 1 < bps.size() ? bps[next_bp + 1] : tstop;
+      h = control_.ladder(0.1 * std::min(last_regular_h, next - t_));
+      hist.reset(t_, x_);
     }
   }
 
-  stats.factorizations += sys.klu.factorizations();
-  stats.reuses = sys.klu.reuses();
-  if (stats_out) *stats_out = stats;
+  stats_.factorizations += sys_.klu.factorizations();
+  stats_.reuses = sys_.klu.reuses();
+  stats_out = stats_;
+  return std::move(w_);
+}
+
+}  // namespace
+
+StatusOr<Waveform> run_transient(Circuit& circuit, const TransientOptions& opt,
+                                 const std::vector<Probe>& probes, TransientStats* stats_out) {
+  if (Status s = opt.validate(); !s.ok()) return s;
+  for (const auto& e : circuit.elements()) e->bind_time(opt.tstep, opt.tstop);
+  MnaSystem sys;
+  if (Status s = sys.build(circuit); !s.ok()) return s;
+  TransientStats stats;
+  StatusOr<Waveform> w = TransientMarch(circuit, opt, probes, sys).run(stats);
+  if (w.ok() && stats_out) *stats_out = stats;
   return w;
 }
 

@@ -5,7 +5,14 @@
 //   if (Status s = opt.validate(); !s.ok()) ...          // before any work
 //   TransientStats stats;
 //   StatusOr<Waveform> w = run_transient(circuit, opt, probes, &stats);
-// One Waveform row per accepted step with t >= tstart. The circuit must be finalized.
+// One Waveform row per accepted step with t >= tstart (time in s; v(...) in V, i(...) in A).
+//
+// Contract: the circuit must be finalized. run_transient takes it non-const because it binds
+// the sources' time defaults to this run (Element::bind_time: ngspice's PULSE TR defaults to
+// TSTEP); it keeps no reference to it afterwards. Errors: an invalid option (validate()), a
+// node_ic unknown out of range, a DC point that is singular or not finite (naming the unknown), a
+// singular or non-finite step, a step below the floor (naming the unknown whose truncation
+// error does not converge), max_steps reached. `stats` is written on success only.
 //
 // Method, in short (details in the README "Solver" section):
 //   C x' + G x = b(t). G and C are stamped once; each step solves (G + alpha C) x1 = rhs with a
@@ -70,10 +77,11 @@ struct TransientStats {
   int breakpoints = 0;
 };
 
-// DC operating point: the full unknown vector (index 0 = ground). Errors name the node.
+// DC operating point: the full unknown vector (index 0 = ground; V and A). Reads the circuit
+// only. Errors name the node (singular matrix, non-finite value).
 StatusOr<std::vector<double>> dc_operating_point(const Circuit& circuit);
 
-StatusOr<Waveform> run_transient(const Circuit& circuit, const TransientOptions& options,
+StatusOr<Waveform> run_transient(Circuit& circuit, const TransientOptions& options,
                                  const std::vector<Probe>& probes, TransientStats* stats = nullptr);
 
 }  // namespace isolink

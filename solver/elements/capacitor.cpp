@@ -24,18 +24,14 @@ class Capacitor final : public Element {
     const double d = c_ * (*ic_ - (x0[nodes_[0]] - x0[nodes_[1]]));
     dq[nodes_[0]] += d, dq[nodes_[1]] -= d;
   }
-  void declare(MnaPattern& p) override {
+  void stamp(MnaStamp& m) const override {
     const int a = nodes_[0], b = nodes_[1];
-    aa_ = p.slot(a, a), ab_ = p.slot(a, b), ba_ = p.slot(b, a), bb_ = p.slot(b, b);
-  }
-  void stamp(double*, double* c) const override {
-    c[aa_] += c_, c[bb_] += c_, c[ab_] -= c_, c[ba_] -= c_;
+    m.c(a, a, c_), m.c(b, b, c_), m.c(a, b, -c_), m.c(b, a, -c_);
   }
 
  private:
   double c_;
   std::optional<double> ic_;
-  Slot aa_ = 0, ab_ = 0, ba_ = 0, bb_ = 0;
 };
 
 StatusOr<std::unique_ptr<Element>> parse(const Card& card) {

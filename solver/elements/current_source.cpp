@@ -19,8 +19,7 @@ class CurrentSource final : public Element {
  public:
   CurrentSource(const Card& card, SourceFunction f)
       : Element(card.name, card.loc), f_(std::move(f)) {}
-  void declare(MnaPattern&) override {}
-  void stamp(double*, double*) const override {}
+  void stamp(MnaStamp&) const override {}
   bool has_excitation() const override { return true; }
   void stamp_rhs(double t, double* b) const override {
     const double i = f_.value(t);

@@ -5,11 +5,14 @@
 //   2. connect: Circuit maps node names to unknown indices (0 = ground) and hands out branch
 //               unknowns (branch_count()); link() resolves references to other elements (K -> L),
 //               then check() tests what needs them all linked.
-//   3. declare: declare(pattern) asks for every matrix entry it will touch, once, and keeps the
-//               slot handles. Entries in the ground row or column come back as the write-only
-//               trash slot, so stamps never test for ground.
-//   4. stamp:   stamp(g, c) adds constant values into G (conductance) and C (d/dt) once;
-//               stamp_rhs(t, b) adds the excitation at time t into b on every step.
+//   3. stamp:   stamp(m) writes its constant G (conductance) and C (d/dt) entries by unknown
+//               index through an MnaStamp (solver/mna.h), twice: once to declare the pattern,
+//               once to add the values. Entries in the ground row or column are dropped, so
+//               stamps never test for ground. The element keeps nothing of it (no slots).
+//   4. excite:  stamp_rhs(t, b) adds the excitation at time t into b on every step.
+// After Circuit::finalize the engines only read an element (const), except bind_time: run_transient
+// applies it (it takes a Circuit&), the LTI engine's caller applies it before
+// LtiResponses::compute.
 // The circuits isolink targets are linear and time-invariant: G and C never change during a run.
 #pragma once
 
@@ -25,10 +28,8 @@
 namespace isolink {
 
 class Circuit;
-class MnaPattern;
+class MnaStamp;
 class SourceFunction;
-
-using Slot = int;  // index into a matrix value array; MnaPattern::trash() for ground entries
 
 // How an element joins two nodes at DC, for the topology checks before the operating point.
 // Inductive: an inductor, a short at DC; one that would close a loop of voltage sources and
@@ -58,9 +59,9 @@ class Element {
   virtual Status link(const Circuit& circuit) { return Status::Ok(); }
   // Checks that need every element linked (K: the coupled group's inductance matrix).
   virtual Status check(const Circuit& circuit) const { return Status::Ok(); }
-  virtual void declare(MnaPattern& pattern) = 0;
-  // Constant values into G and C (value arrays over the declared pattern).
-  virtual void stamp(double* g, double* c) const = 0;
+  // Constant G and C entries: m.g(row, col, value), m.c(row, col, value), unknown indices. The
+  // same calls, in the same order, every time (the first call declares the pattern).
+  virtual void stamp(MnaStamp& m) const = 0;
   // Excitation at time t into b (b[0] is the ground trash entry).
   virtual void stamp_rhs(double t, double* b) const {}
   // True when stamp_rhs adds anything (sources): the engines call stamp_rhs on these only.

@@ -35,15 +35,10 @@ StatusOr<std::unique_ptr<Element>> parse(const Card& card) {
 
 }  // namespace
 
-void Inductor::declare(MnaPattern& p) {
+void Inductor::stamp(MnaStamp& m) const {
   const int a = nodes_[0], b = nodes_[1], br = branches_[0];
-  a_br_ = p.slot(a, br), b_br_ = p.slot(b, br), br_a_ = p.slot(br, a), br_b_ = p.slot(br, b);
-  br_br_ = p.slot(br, br);
-}
-
-void Inductor::stamp(double* g, double* c) const {
-  g[a_br_] += 1, g[b_br_] -= 1, g[br_a_] += 1, g[br_b_] -= 1;
-  c[br_br_] -= l_;
+  m.g(a, br, 1), m.g(b, br, -1), m.g(br, a, 1), m.g(br, b, -1);
+  m.c(br, br, -l_);
 }
 
 void Inductor::dc_edges(std::vector<DcEdge>& out) const {

@@ -17,15 +17,13 @@ class Inductor final : public Element {
 
   int branch_count() const override { return 1; }
   bool branch_is_state() const override { return true; }
-  void declare(MnaPattern& p) override;
-  void stamp(double* g, double* c) const override;
+  void stamp(MnaStamp& m) const override;
   void dc_edges(std::vector<DcEdge>& out) const override;
   void uic_state(double* x0) const override;
 
  private:
   double l_;
   std::optional<double> ic_;  // ic=, used with UIC
-  Slot a_br_ = 0, b_br_ = 0, br_a_ = 0, br_b_ = 0, br_br_ = 0;
 };
 
 }  // namespace isolink

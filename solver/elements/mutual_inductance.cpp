@@ -119,18 +119,15 @@ class MutualInductance final : public Element {
     }
     return Status::Ok();
   }
-  void declare(MnaPattern& p) override {
-    s12_ = p.slot(l_[0]->branch(), l_[1]->branch());
-    s21_ = p.slot(l_[1]->branch(), l_[0]->branch());
+  void stamp(MnaStamp& m) const override {
+    m.c(l_[0]->branch(), l_[1]->branch(), -m_), m.c(l_[1]->branch(), l_[0]->branch(), -m_);
   }
-  void stamp(double*, double* c) const override { c[s12_] -= m_, c[s21_] -= m_; }
 
  private:
   double k_, m_ = 0.0;
   std::vector<std::string> refs_;
   std::vector<SourceLoc> ref_locs_;
   const Inductor* l_[2] = {nullptr, nullptr};
-  Slot s12_ = 0, s21_ = 0;
 };
 
 StatusOr<std::unique_ptr<Element>> parse(const Card& card) {

@@ -24,12 +24,9 @@ constexpr ParamSpec kParams[] = {
 class Resistor final : public Element {
  public:
   Resistor(const Card& card, double r) : Element(card.name, card.loc), g_(1.0 / r) {}
-  void declare(MnaPattern& p) override {
+  void stamp(MnaStamp& m) const override {
     const int a = nodes_[0], b = nodes_[1];
-    aa_ = p.slot(a, a), ab_ = p.slot(a, b), ba_ = p.slot(b, a), bb_ = p.slot(b, b);
-  }
-  void stamp(double* g, double*) const override {
-    g[aa_] += g_, g[bb_] += g_, g[ab_] -= g_, g[ba_] -= g_;
+    m.g(a, a, g_), m.g(b, b, g_), m.g(a, b, -g_), m.g(b, a, -g_);
   }
   void dc_edges(std::vector<DcEdge>& out) const override {
     out.push_back({nodes_[0], nodes_[1], DcLink::Conductive});
@@ -37,7 +34,6 @@ class Resistor final : public Element {
 
  private:
   double g_;
-  Slot aa_ = 0, ab_ = 0, ba_ = 0, bb_ = 0;
 };
 
 StatusOr<std::unique_ptr<Element>> parse(const Card& card) {

@@ -25,12 +25,9 @@ class VoltageSource final : public Element {
   VoltageSource(const Card& card, SourceFunction f)
       : Element(card.name, card.loc), f_(std::move(f)) {}
   int branch_count() const override { return 1; }
-  void declare(MnaPattern& p) override {
+  void stamp(MnaStamp& m) const override {
     const int a = nodes_[0], b = nodes_[1], br = branches_[0];
-    a_br_ = p.slot(a, br), b_br_ = p.slot(b, br), br_a_ = p.slot(br, a), br_b_ = p.slot(br, b);
-  }
-  void stamp(double* g, double*) const override {
-    g[a_br_] += 1, g[b_br_] -= 1, g[br_a_] += 1, g[br_b_] -= 1;
+    m.g(a, br, 1), m.g(b, br, -1), m.g(br, a, 1), m.g(br, b, -1);
   }
   bool has_excitation() const override { return true; }
   void stamp_rhs(double t, double* b) const override { b[branches_[0]] += f_.value(t); }
@@ -46,7 +43,6 @@ class VoltageSource final : public Element {
 
  private:
   SourceFunction f_;
-  Slot a_br_ = 0, b_br_ = 0, br_a_ = 0, br_b_ = 0;
 };
 
 StatusOr<std::unique_ptr<Element>> parse(const Card& card) {

@@ -19,7 +19,7 @@ struct TestMatrix {
 
   TestMatrix(int size, const std::vector<std::pair<std::pair<int, int>, double>>& entries)
       : n(size), pattern(size) {
-    for (const auto& [rc, v] : entries) pattern.slot(rc.first, rc.second);
+    for (const auto& [rc, v] : entries) pattern.declare(rc.first, rc.second);
     pattern.finalize();
     values.assign(pattern.value_count(), 0.0);
     for (const auto& [rc, v] : entries) values[pattern.slot(rc.first, rc.second)] += v;

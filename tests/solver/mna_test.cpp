@@ -7,9 +7,9 @@ namespace {
 
 TEST(MnaPattern, DeclaredEntriesGetDistinctSlotsAndGroundTheTrash) {
   MnaPattern p(3);
-  p.slot(1, 2);
-  p.slot(3, 1);
-  p.slot(0, 2);  // ground row: not stored
+  p.declare(1, 2);
+  p.declare(3, 1);
+  p.declare(0, 2);  // ground row: not stored
   p.finalize();
   // diagonal (3) + (1,2) + (3,1)
   EXPECT_EQ(p.nonzeros(), 5);

@@ -6,10 +6,13 @@
 // steps grow past what the tolerance allows and fails these bounds. The circuit: V1 = sin(2 pi
 // 1 MHz t) into 1 kohm and 1 nF (tau = 1 us), 5 us, tmax 100 ns so that the error control alone
 // sets the steps (17 ns at reltol 1e-3).
+#include "solver/step_control.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numbers>
 
 #include "solver/transient.h"
@@ -127,6 +130,65 @@ TEST(StepControl, TrapezoidalGlobalErrorFollowsReltol) {
   const double more = static_cast<double>(tight.steps) / static_cast<double>(loose.steps);
   EXPECT_GT(more, 1.5);
   EXPECT_LT(more, 3.0);
+}
+
+// The shared rules of solver/step_control.h, against their closed forms.
+
+// Rungs hmax / 2^k: the largest not above h; an exact rung maps to itself.
+TEST(StepControl, LadderGivesTheLargestRungNotAboveTheStep) {
+  const StepControl control{.hmax = 1e-9, .hmin = 1e-21, .error_order = 3};
+  EXPECT_EQ(control.ladder(5e-9), 1e-9);
+  EXPECT_EQ(control.ladder(1e-9), 1e-9);
+  EXPECT_EQ(control.ladder(0.3e-9), 0.25e-9);
+  EXPECT_EQ(control.ladder(0.25e-9), 0.25e-9);
+  EXPECT_EQ(control.ladder(0.7e-9), 0.5e-9);
+  EXPECT_EQ(control.ladder(1e-9 / 1024 * 1.5), 1e-9 / 1024);
+}
+
+// h = 0 (or a subnormal h) made log2 infinite and its conversion to int undefined (UBSan): the
+// rung exponent is clamped at 1100, which gives 0 or a subnormal, below any floor.
+TEST(StepControl, LadderClampsAZeroOrSubnormalStepBelowTheFloor) {
+  const StepControl control{.hmax = 1.0, .hmin = 1e-18, .error_order = 3};
+  EXPECT_EQ(control.ladder(0.0), std::ldexp(1.0, -1100));  // 0 in double
+  const double tiny = control.ladder(std::numeric_limits<double>::denorm_min());
+  EXPECT_TRUE(std::isfinite(tiny));
+  EXPECT_LT(tiny, control.hmin);
+  EXPECT_EQ(control.ladder(1e-300), std::ldexp(1.0, -997));  // 2^-997 < 1e-300 < 2^-996
+}
+
+// Rejection: step * max(0.25, 0.9 ratio^(-1/order)); order 3 takes the cube root (the transient's
+// local error), order 2 the square root (the march's error per unit time).
+TEST(StepControl, ShrinkScalesByTheRootOfTheErrorOrder) {
+  const StepControl third{.hmax = 1.0, .hmin = 1e-18, .error_order = 3};
+  const StepControl second{.hmax = 1.0, .hmin = 1e-18, .error_order = 2};
+  EXPECT_DOUBLE_EQ(third.shrink(1e-9, 8.0), 0.45e-9);    // 0.9 / 2
+  EXPECT_DOUBLE_EQ(second.shrink(1e-9, 4.0), 0.45e-9);   // 0.9 / 2
+  EXPECT_DOUBLE_EQ(third.shrink(1e-9, 27.0), 0.3e-9);    // 0.9 / 3
+  EXPECT_DOUBLE_EQ(second.shrink(1e-9, 27.0), 0.25e-9);  // 0.9 / 5.2 = 0.17: the floor
+  EXPECT_DOUBLE_EQ(third.shrink(1e-9, 1e6), 0.25e-9);    // floor
+  // The transient's backward-Euler start step: order 2, floor 0.1.
+  EXPECT_DOUBLE_EQ(StepControl::shrink_by_order(1e-9, 4.0, 2, 0.1), 0.45e-9);
+  EXPECT_DOUBLE_EQ(StepControl::shrink_by_order(1e-9, 400.0, 2, 0.1), 0.1e-9);  // 0.045: floor
+}
+
+// Growth: by 0.9 ratio^(-1/order), at most 2x (and 2x when no error was estimated), at least
+// 0.5x, at least hmin, then down to a rung.
+TEST(StepControl, GrowIsBoundedAndLandsOnARung) {
+  const double hmax = 1.0;
+  const StepControl third{.hmax = hmax, .hmin = 1e-12, .error_order = 3};
+  const StepControl second{.hmax = hmax, .hmin = 1e-12, .error_order = 2};
+  EXPECT_EQ(third.grow(0.125, 0.0), 0.25);        // no estimate: 2x
+  EXPECT_EQ(third.grow(0.125, 1e-9), 0.25);       // capped at 2x
+  EXPECT_EQ(third.grow(0.125, 1.0 / 8), 0.125);   // 1.8x = 0.225: rung 0.125
+  EXPECT_EQ(second.grow(0.125, 1.0 / 4), 0.125);  // 1.8x likewise
+  EXPECT_EQ(third.grow(0.125, 1.0), 0.0625);      // 0.9x = 0.1125: rung 0.0625
+  EXPECT_EQ(second.grow(0.125, 1.0), 0.0625);
+  EXPECT_EQ(third.grow(0.5, 1.0), 0.25);   // 0.45: rung 0.25
+  EXPECT_EQ(third.grow(0.75, 0.0), hmax);  // 1.5: the top rung
+  // Never below hmin: a step under the floor grows to the rung at or below hmin, not under it
+  // by more than a factor 2.
+  EXPECT_EQ(third.grow(1e-15, 1.0), third.ladder(1e-12));
+  EXPECT_GT(third.grow(1e-15, 1.0), 0.5e-12);
 }
 
 }  // namespace
