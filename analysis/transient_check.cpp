@@ -32,7 +32,7 @@ std::pair<double, double> worst_column(const Waveform& coarse, const Waveform& f
 
 }  // namespace
 
-StatusOr<Waveform> converge_transient(const Circuit& circuit, TransientOptions opt,
+StatusOr<Waveform> converge_transient(Circuit& circuit, TransientOptions opt,
                                       const std::vector<Probe>& probes, Waveform first,
                                       TransientStats* stats, TransientConvergence* out) {
   *out = TransientConvergence{};

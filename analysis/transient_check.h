@@ -45,7 +45,7 @@ double max_deviation(const Waveform& coarse, const Waveform& fine, size_t k = 0)
 // returns the last; *stats becomes the last run's, *out records every run. Never an error: a
 // tighter run that fails (max_steps, the memory limit) ends the tightening with the run before
 // it kept and out->agreed false.
-StatusOr<Waveform> converge_transient(const Circuit& circuit, TransientOptions opt,
+StatusOr<Waveform> converge_transient(Circuit& circuit, TransientOptions opt,
                                       const std::vector<Probe>& probes, Waveform first,
                                       TransientStats* stats, TransientConvergence* out);
 
