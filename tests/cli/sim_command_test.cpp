@@ -129,7 +129,16 @@ TEST(SimCommand, StatesTheEngineWhyHowLongAndTheAccuracyItPromises) {
   EXPECT_NE(r.err.find("transient engine, not LTI: "), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("source 'v1' is not a continuous piecewise-linear"), std::string::npos);
   EXPECT_NE(r.err.find("(the LTI attempt took 0.0"), std::string::npos) << r.err;
-  // trtol 0.1 x reltol 1e-3, then with --reltol 1e-5.
+  // auto's fallback checks itself (analysis/transient_check.h): reltol 1e-3 and TSTEP 10 ns, then
+  // 1e-4 and 5 ns agree within 5 mV (the 1 V sine's 0.1 % is 1 mV, less than 5 mV).
+  EXPECT_NE(r.err.find("accuracy: transient, checked by tightening (auto's fallback): reltol "
+                       "0.001 -> 0.0001 and largest step 1e-08 -> 5e-09 s in 2 runs"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("within its allowance of 5 m (5 mV"), std::string::npos) << r.err;
+  // --engine transient: as asked, trtol 0.1 x reltol 1e-3; then with --reltol 1e-5.
+  r = run("sim " + sin + " -p 'v(a)' -o /dev/null --engine transient");
+  ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("accuracy: transient: local truncation error per step within trtol x "
                        "reltol = 0.0001 of each unknown's peak (reltol 0.001)"),
             std::string::npos)
