@@ -89,98 +89,157 @@ struct Basis {
 namespace {
 
 // The search of the header's steps 1-4 in one sign form of the equations (`passive_form`: the
-// branch rows negated, below).
-StatusOr<ReducedModel> reduce_in_form(const Circuit& circuit,
-                                      const std::vector<std::vector<double>>& excitations,
-                                      const std::vector<std::vector<double>>& dc_solutions,
-                                      const std::vector<Probe>& probes,
-                                      const ReducedModelOptions& opt, bool passive_form) {
-  StatusOr<AcAnalysis> ac = AcAnalysis::create(circuit);
-  if (!ac) return ac.status();
-  const int n = circuit.unknown_count();
-  const size_t nk = excitations.size(), np = probes.size();
-  ReducedModel model;
-  ReducedModelStats st;  // factorizations and expansion points so far
+// branch rows negated, see the constructor): the basis, the expansion points, the check of each
+// model at the check frequencies and the projection. One Reducer per search; `ac` and every
+// argument must outlive it.
+class Reducer {
+ public:
+  Reducer(const Circuit& circuit, AcAnalysis& ac,
+          const std::vector<std::vector<double>>& excitations,
+          const std::vector<std::vector<double>>& dc_solutions, const std::vector<Probe>& probes,
+          const ReducedModelOptions& opt, bool passive_form);
 
-  // G and C as real sparse matrices over unknowns 1..n (index 0 = unknown 1), with the rows of
-  // the branch unknowns (inductors, voltage sources) negated: -v_a + v_b + s L i = 0 instead of
-  // MNA's v_a - v_b - s L i = 0. The solution is the same for every s (the Krylov vectors too),
-  // but in this form G + G' is positive semi-definite (resistors only; the branch incidence is
-  // skew) and C symmetric positive semi-definite (capacitances, the inductance matrix), so the
-  // congruence projection below keeps the circuit's passivity (PRIMA's theorem): every pole of
-  // the reduced model is stable. With MNA's own signs C is indefinite, and on long links the
-  // projection made dozens of right-half-plane poles and a modal form that could not get within
-  // 2e-5 of a projection that was itself within 1e-11 of the circuit.
-  std::vector<double> row_sign(n);
+  // Runs the search once: the model within opt.tol at every check frequency, or the error.
+  StatusOr<ReducedModel> run();
+
+ private:
+  void assemble_pencil(bool passive_form);
+  Status add_checks(const std::vector<double>& fs);
+  Status start_checks();
+  void seed_basis();
+  StatusOr<bool> expand_at(double f);
+  Status expand_at_first_points();
+  double error_at(const ReducedModel& m, size_t f) const;
+  void measure(ReducedModel* m) const;
+  void project();
+  void project_ports(Eigen::MatrixXd* br, Eigen::MatrixXd* lr) const;
+  Status build();
+  Status modal_form(ReducedModel* mod);
+  StatusOr<bool> refine_checks();
+  Status expand_where_worst();
+
+  const Circuit& circuit_;
+  AcAnalysis& ac_;
+  const std::vector<std::vector<double>>& excitations_;
+  const std::vector<std::vector<double>>& dc_solutions_;
+  const std::vector<Probe>& probes_;
+  const ReducedModelOptions& opt_;
+  const int n_;
+  const size_t nk_, np_;
+  std::vector<double> row_sign_;       // per unknown 1..n (index 0 = unknown 1): +1 or -1
+  Eigen::SparseMatrix<double> g_, c_;  // the pencil in this sign form
+  ReducedModelStats st_;               // factorizations and expansion points so far
+  ReducedModel model_;                 // the last model built
+  std::vector<double> freqs_;          // the check frequencies
+  std::vector<std::vector<std::vector<Cplx>>> exact_;  // [check][k][p]
+  std::vector<std::vector<double>> scale_;             // [k][p]: peak |H| with DC
+  Basis basis_;
+  Eigen::MatrixXd gr_, cr_;  // V'GV and V'CV over the basis so far
+  int max_order_ = 0;
+  std::vector<double> used_;                     // expansion points so far
+  std::vector<std::pair<double, double>> open_;  // check intervals not yet refined
+};
+
+Reducer::Reducer(const Circuit& circuit, AcAnalysis& ac,
+                 const std::vector<std::vector<double>>& excitations,
+                 const std::vector<std::vector<double>>& dc_solutions,
+                 const std::vector<Probe>& probes, const ReducedModelOptions& opt,
+                 bool passive_form)
+    : circuit_(circuit),
+      ac_(ac),
+      excitations_(excitations),
+      dc_solutions_(dc_solutions),
+      probes_(probes),
+      opt_(opt),
+      n_(circuit.unknown_count()),
+      nk_(excitations.size()),
+      np_(probes.size()) {
+  assemble_pencil(passive_form);
+  scale_.assign(nk_, std::vector<double>(np_, 0.0));
+  for (size_t k = 0; k < nk_; ++k)
+    for (size_t p = 0; p < np_; ++p)
+      scale_[k][p] = std::max(
+          1e-15, std::fabs(dc_solutions_[k][probes_[p].a] - dc_solutions_[k][probes_[p].b]));
+  // The basis and its images are three dense n x q arrays: at most kMaxBasisBytes in all (their
+  // capacity, grown by doubling, at most twice that).
+  constexpr double kMaxBasisBytes = 384.0 * (1 << 20);
+  max_order_ = static_cast<int>(
+      std::min<double>(opt_.max_order, kMaxBasisBytes / (3.0 * sizeof(double) * n_)));
+}
+
+// G and C as real sparse matrices over unknowns 1..n (index 0 = unknown 1), with the rows of
+// the branch unknowns (inductors, voltage sources) negated: -v_a + v_b + s L i = 0 instead of
+// MNA's v_a - v_b - s L i = 0. The solution is the same for every s (the Krylov vectors too),
+// but in this form G + G' is positive semi-definite (resistors only; the branch incidence is
+// skew) and C symmetric positive semi-definite (capacitances, the inductance matrix), so the
+// congruence projection below keeps the circuit's passivity (PRIMA's theorem): every pole of
+// the reduced model is stable. With MNA's own signs C is indefinite, and on long links the
+// projection made dozens of right-half-plane poles and a modal form that could not get within
+// 2e-5 of a projection that was itself within 1e-11 of the circuit.
+void Reducer::assemble_pencil(bool passive_form) {
+  const int n = n_;
+  row_sign_.assign(n, 0.0);
   for (int i = 0; i < n; ++i)
-    row_sign[i] = passive_form && !circuit.unknown_is_node(i + 1) ? -1.0 : 1.0;
-  Eigen::SparseMatrix<double> g(n, n), c(n, n);
-  {
-    std::vector<Eigen::Triplet<double>> tg, tc;
-    const auto& cp = ac->col_start();
-    const auto& ri = ac->row_index();
-    for (int col = 0; col < n; ++col)
-      for (int k = cp[col]; k < cp[col + 1]; ++k) {
-        const double sign = row_sign[ri[k]];
-        if (ac->g_values()[k] != 0) tg.emplace_back(ri[k], col, sign * ac->g_values()[k]);
-        if (ac->c_values()[k] != 0) tc.emplace_back(ri[k], col, sign * ac->c_values()[k]);
-      }
-    g.setFromTriplets(tg.begin(), tg.end());
-    c.setFromTriplets(tc.begin(), tc.end());
-  }
-  auto to_full = [n](const Eigen::VectorXcd& x) {
-    AcAnalysis::Vector out(n + 1, 0.0);
-    for (int i = 0; i < n; ++i) out[i + 1] = x[i];
-    return out;
-  };
-  auto probe_of = [](const Probe& p, const AcAnalysis::Vector& x) { return x[p.a] - x[p.b]; };
+    row_sign_[i] = passive_form && !circuit_.unknown_is_node(i + 1) ? -1.0 : 1.0;
+  g_.resize(n, n);
+  c_.resize(n, n);
+  std::vector<Eigen::Triplet<double>> tg, tc;
+  const auto& cp = ac_.col_start();
+  const auto& ri = ac_.row_index();
+  for (int col = 0; col < n; ++col)
+    for (int k = cp[col]; k < cp[col + 1]; ++k) {
+      const double sign = row_sign_[ri[k]];
+      if (ac_.g_values()[k] != 0) tg.emplace_back(ri[k], col, sign * ac_.g_values()[k]);
+      if (ac_.c_values()[k] != 0) tc.emplace_back(ri[k], col, sign * ac_.c_values()[k]);
+    }
+  g_.setFromTriplets(tg.begin(), tg.end());
+  c_.setFromTriplets(tc.begin(), tc.end());
+}
 
-  // The exact transfer at the check frequencies, and each (k, p)'s scale: peak |H| with DC.
-  std::vector<double> freqs;
-  std::vector<std::vector<std::vector<Cplx>>> exact;  // [check][k][p]
-  std::vector<std::vector<double>> scale(nk, std::vector<double>(np, 0.0));
-  for (size_t k = 0; k < nk; ++k)
-    for (size_t p = 0; p < np; ++p)
-      scale[k][p] =
-          std::max(1e-15, std::fabs(dc_solutions[k][probes[p].a] - dc_solutions[k][probes[p].b]));
-  auto add_checks = [&](const std::vector<double>& fs) -> Status {
-    for (double f : fs) {
-      if (Status s = ac->factor(f); !s.ok()) return s;
-      ++st.factorizations;
-      freqs.push_back(f);
-      exact.emplace_back(nk);
-      for (size_t k = 0; k < nk; ++k) {
-        AcAnalysis::Vector b(excitations[k].begin(), excitations[k].end());
-        b[0] = 0.0;
-        const AcAnalysis::Vector x = ac->solve_factored(b);
-        for (size_t p = 0; p < np; ++p) {
-          exact.back()[k].push_back(probe_of(probes[p], x));
-          scale[k][p] = std::max(scale[k][p], std::abs(exact.back()[k][p]));
-        }
+// The exact transfer at check frequencies `fs` (appended to the grid), and each (k, p)'s scale
+// grown to the peak |H|.
+Status Reducer::add_checks(const std::vector<double>& fs) {
+  for (double f : fs) {
+    if (Status s = ac_.factor(f); !s.ok()) return s;
+    ++st_.factorizations;
+    freqs_.push_back(f);
+    exact_.emplace_back(nk_);
+    for (size_t k = 0; k < nk_; ++k) {
+      AcAnalysis::Vector b(excitations_[k].begin(), excitations_[k].end());
+      b[0] = 0.0;
+      const AcAnalysis::Vector x = ac_.solve_factored(b);
+      for (size_t p = 0; p < np_; ++p) {
+        exact_.back()[k].push_back(x[probes_[p].a] - x[probes_[p].b]);
+        scale_[k][p] = std::max(scale_[k][p], std::abs(exact_.back()[k][p]));
       }
     }
-    return Status::Ok();
-  };
-  // Pivots from the middle of the band first: the refactorizations below reuse them, and the
-  // ones a 1 kHz matrix would choose (its 1e-12 S ties on floating nodes) fill in badly.
-  if (Status s = ac->factor(std::sqrt(opt.f_min * opt.f_max)); !s.ok()) return s;
-  ++st.factorizations;
-  {
-    std::vector<double> fs(opt.check_points);
-    for (int i = 0; i < opt.check_points; ++i)
-      fs[i] = opt.f_min *
-              std::pow(opt.f_max / opt.f_min, static_cast<double>(i) / (opt.check_points - 1));
-    if (Status s = add_checks(fs); !s.ok()) return s;
   }
+  return Status::Ok();
+}
 
-  Basis basis;
-  basis.v.resize(n, 0);
-  basis.gv.resize(n, 0);
-  basis.cv.resize(n, 0);
-  for (size_t k = 0; k < nk; ++k) {
+// Pivots from the middle of the band first: the refactorizations below reuse them, and the
+// ones a 1 kHz matrix would choose (its 1e-12 S ties on floating nodes) fill in badly. Then the
+// check grid: opt.check_points frequencies, log-spaced over the band.
+Status Reducer::start_checks() {
+  if (Status s = ac_.factor(std::sqrt(opt_.f_min * opt_.f_max)); !s.ok()) return s;
+  ++st_.factorizations;
+  std::vector<double> fs(opt_.check_points);
+  for (int i = 0; i < opt_.check_points; ++i)
+    fs[i] = opt_.f_min *
+            std::pow(opt_.f_max / opt_.f_min, static_cast<double>(i) / (opt_.check_points - 1));
+  return add_checks(fs);
+}
+
+// The DC solutions, and the excitations that sit on a branch row.
+void Reducer::seed_basis() {
+  const int n = n_;
+  basis_.v.resize(n, 0);
+  basis_.gv.resize(n, 0);
+  basis_.cv.resize(n, 0);
+  for (size_t k = 0; k < nk_; ++k) {
     Eigen::VectorXd x(n);
-    for (int i = 0; i < n; ++i) x[i] = dc_solutions[k][i + 1];
-    basis.add(x, g, c);
+    for (int i = 0; i < n; ++i) x[i] = dc_solutions_[k][i + 1];
+    basis_.add(x, g_, c_);
   }
   // A voltage source's excitation is its own branch unknown (unit at its branch row). The
   // Galerkin projection tests each equation only along the basis, and the source's equation
@@ -189,282 +248,325 @@ StatusOr<ReducedModel> reduce_in_form(const Circuit& circuit,
   // into an inductor: KCL at a ties the source's current to the inductor's in every one of
   // them), so v_a was left undetermined and the projected pencil singular in both sign forms
   // (issue 28: V -> L -> R). The excitation itself is that direction; one more per source.
-  for (size_t k = 0; k < nk; ++k) {
+  for (size_t k = 0; k < nk_; ++k) {
     Eigen::VectorXd e(n);
     bool on_branch = false;
     for (int i = 0; i < n; ++i) {
-      e[i] = excitations[k][i + 1];
-      on_branch |= e[i] != 0 && !circuit.unknown_is_node(i + 1);
+      e[i] = excitations_[k][i + 1];
+      on_branch |= e[i] != 0 && !circuit_.unknown_is_node(i + 1);
     }
-    if (on_branch) basis.add(e, g, c);
+    if (on_branch) basis_.add(e, g_, c_);
   }
-  // Adds the Krylov vectors at j 2 pi f; false when none was new.
-  auto expand_at = [&](double f) -> StatusOr<bool> {
-    if (Status s = ac->factor(f); !s.ok()) return s;
-    ++st.factorizations;
-    bool added = false;
-    for (size_t k = 0; k < nk; ++k) {
-      AcAnalysis::Vector b(excitations[k].begin(), excitations[k].end());
-      b[0] = 0.0;
-      for (int m = 0; m < opt.moments; ++m) {
-        AcAnalysis::Vector x = ac->solve_factored(b);
-        Eigen::VectorXd re(n), im(n);
-        for (int i = 0; i < n; ++i) re[i] = x[i + 1].real(), im[i] = x[i + 1].imag();
-        const double norm = std::sqrt(re.squaredNorm() + im.squaredNorm());
-        if (!(norm > 0) || !std::isfinite(norm)) break;
-        added |= basis.add(re, g, c);
-        added |= basis.add(im, g, c);
-        // Next moment: A^-1 C x (normalised; only the direction matters).
-        Eigen::VectorXcd xc(n);
-        for (int i = 0; i < n; ++i) xc[i] = x[i + 1] / norm;
-        Eigen::VectorXcd cx = c.cast<Cplx>() * xc;  // the circuit's own C x: undo row_sign
-        for (int i = 0; i < n; ++i) cx[i] *= row_sign[i];
-        b = to_full(cx);
-      }
-    }
-    ++st.expansion_points;
-    return added;
-  };
+}
 
-  // A model's error at check frequency f (index into freqs): the largest over sources and probes
-  // of |H_model - H_exact| over that pair's peak |H|.
-  auto error_at = [&](const ReducedModel& m, size_t f) {
-    const Cplx jw(0.0, 2 * std::numbers::pi * freqs[f]);
-    // The edge spectrum's envelope (header: what the check guarantees).
-    const double weight = opt.edge_time > 0
-                              ? std::min(1.0, 1.0 / (std::numbers::pi * freqs[f] * opt.edge_time))
-                              : 1.0;
-    double e = 0;
-    for (size_t k = 0; k < nk; ++k)
-      for (size_t p = 0; p < np; ++p) {
-        const double x = weight * std::abs(m.transfer(k, p, jw) - exact[f][k][p]) / scale[k][p];
-        if (!(x <= e)) e = x;  // a NaN sticks: such a model never passes
-      }
-    return e;
-  };
-
-  // Gr = V'GV and Cr = V'CV, grown by the rows and columns of the vectors added since the last
-  // build (the basis only grows, and its earlier vectors do not change).
-  Eigen::MatrixXd gr, cr;
-  auto project = [&]() {
-    const int q = basis.q, q0 = static_cast<int>(gr.rows());
-    if (q == q0) return;
-    gr.conservativeResize(q, q);
-    cr.conservativeResize(q, q);
-    const auto v = basis.v.leftCols(q);
-    const auto added = basis.v.middleCols(q0, q - q0);
-    gr.rightCols(q - q0) = v.transpose() * basis.gv.middleCols(q0, q - q0);
-    cr.rightCols(q - q0) = v.transpose() * basis.cv.middleCols(q0, q - q0);
-    gr.bottomLeftCorner(q - q0, q0) = added.transpose() * basis.gv.leftCols(q0);
-    cr.bottomLeftCorner(q - q0, q0) = added.transpose() * basis.cv.leftCols(q0);
-  };
-
-  // Builds the pole-residue model from the current basis and measures its error.
-  auto build = [&]() -> Status {
-    const int q = basis.q;
-    ReducedModel mod;
-    ++st.steps;
-    mod.direct.assign(nk, std::vector<double>(np, 0.0));
-    mod.input.assign(nk, {});
-    mod.output.assign(np, {});
-    mod.stats = st;
-    mod.stats.order = q;
-    // The model's error over the check grid, and where it is largest.
-    auto measure = [&]() {
-      mod.stats.error = 0;
-      for (size_t f = 0; f < freqs.size(); ++f) {
-        const double e = error_at(mod, f);
-        if (!(e <= mod.stats.error)) mod.stats.error = e, mod.stats.error_frequency = freqs[f];
-      }
-    };
-    if (q == 0) {  // nothing reaches the probes (no source drives anything): H = 0
-      measure();
-      model = std::move(mod);
-      return Status::Ok();
+// Adds the Krylov vectors at j 2 pi f; false when none was new.
+StatusOr<bool> Reducer::expand_at(double f) {
+  const int n = n_;
+  if (Status s = ac_.factor(f); !s.ok()) return s;
+  ++st_.factorizations;
+  bool added = false;
+  for (size_t k = 0; k < nk_; ++k) {
+    AcAnalysis::Vector b(excitations_[k].begin(), excitations_[k].end());
+    b[0] = 0.0;
+    for (int m = 0; m < opt_.moments; ++m) {
+      AcAnalysis::Vector x = ac_.solve_factored(b);
+      Eigen::VectorXd re(n), im(n);
+      for (int i = 0; i < n; ++i) re[i] = x[i + 1].real(), im[i] = x[i + 1].imag();
+      const double norm = std::sqrt(re.squaredNorm() + im.squaredNorm());
+      if (!(norm > 0) || !std::isfinite(norm)) break;
+      added |= basis_.add(re, g_, c_);
+      added |= basis_.add(im, g_, c_);
+      // Next moment: A^-1 C x (normalised; only the direction matters).
+      Eigen::VectorXcd xc(n);
+      for (int i = 0; i < n; ++i) xc[i] = x[i + 1] / norm;
+      Eigen::VectorXcd cx = c_.cast<Cplx>() * xc;  // the circuit's own C x: undo row_sign
+      for (int i = 0; i < n; ++i) cx[i] *= row_sign_[i];
+      b.assign(n + 1, 0.0);
+      for (int i = 0; i < n; ++i) b[i + 1] = cx[i];
     }
-    const auto v = basis.v.leftCols(q);
-    project();
-    Eigen::MatrixXd br(q, nk), lr(np, q);
-    for (size_t k = 0; k < nk; ++k) {
-      Eigen::VectorXd e(n);
-      for (int i = 0; i < n; ++i) e[i] = row_sign[i] * excitations[k][i + 1];
-      br.col(k) = v.transpose() * e;
-    }
-    for (size_t p = 0; p < np; ++p)
-      for (int j = 0; j < q; ++j)
-        lr(p, j) = (probes[p].a > 0 ? v(probes[p].a - 1, j) : 0.0) -
-                   (probes[p].b > 0 ? v(probes[p].b - 1, j) : 0.0);
-    // sigma: the middle of the band on a log scale, where G + sigma C is far from singular.
-    const double sigma = 2 * std::numbers::pi * std::sqrt(opt.f_min * opt.f_max);
-    Eigen::PartialPivLU<Eigen::MatrixXd> a(gr + sigma * cr);
-    const Eigen::MatrixXd m = a.solve(cr);
-    const Eigen::MatrixXd ab = a.solve(br);
-    if (!m.allFinite() || !ab.allFinite())
-      return Status::Error("reduced model: the projected system is singular");
-    Eigen::EigenSolver<Eigen::MatrixXd> es(m);
-    if (es.info() != Eigen::Success)
-      return Status::Error("reduced model: the eigenvalue problem did not converge");
-    const Eigen::VectorXcd lambda = es.eigenvalues();
-    const Eigen::MatrixXcd w = es.eigenvectors();
-    Eigen::PartialPivLU<Eigen::MatrixXcd> wlu(w);
-    const Eigen::MatrixXcd d = wlu.solve(ab.cast<Cplx>());  // q x nk
-    const Eigen::MatrixXcd cw = lr.cast<Cplx>() * w;        // np x q
-    if (!d.allFinite() || !cw.allFinite())
-      return Status::Error("reduced model: the eigenvectors are singular");
-    double lmax = 0;
-    for (int i = 0; i < q; ++i) lmax = std::max(lmax, std::abs(lambda[i]));
-    // Instantaneous: lambda = 0, or a mode so fast (|lambda| under 1e-6 / (2 pi f_max): a time
-    // constant of 0.05 fs, a pole over 2e16 rad/s) that its share 1 / (1 + (s - sigma) lambda)
-    // is constant within 1e-6 over the whole band. The zero eigenvalues of a singular Cr come
-    // out at about 1e-12 of the largest, of either sign: on V -> L -> R at +-1e-19 s against
-    // 9e-8 s, one was a pole at -8.9e18 rad/s and the other a right-half-plane pole, dropped,
-    // and v(in) lost its direct term (error 1).
-    const double instant = 1e-6 / (2 * std::numbers::pi * opt.f_max);
-    for (int i = 0; i < q; ++i) {
-      if (std::abs(lambda[i]) <= std::max(1e-14 * lmax, instant)) {
-        ++mod.stats.direct_modes;
-        for (size_t k = 0; k < nk; ++k)
-          for (size_t p = 0; p < np; ++p) mod.direct[k][p] += (cw(p, i) * d(i, k)).real();
-        continue;
-      }
-      const Cplx pole = sigma - 1.0 / lambda[i];
-      // A complex pole's conjugate (the next eigenvalue: a real matrix's come in exact pairs,
-      // with conjugate vectors) is carried by it: one mode, output doubled, real part taken.
-      const bool paired =
-          lambda[i].imag() != 0 && i + 1 < q && lambda[i + 1] == std::conj(lambda[i]);
-      const int modes = paired ? 2 : 1;
-      if (paired) ++i;
-      const int at = paired ? i - 1 : i;
-      if (pole.real() > 0 && pole.real() * opt.horizon >= 1e-3) {
-        // Dropped; the check below sees what that costs (a pole with weight fails it).
-        double weight = 0;
-        for (size_t k = 0; k < nk; ++k)
-          for (size_t p = 0; p < np; ++p)
-            weight =
-                std::max(weight, std::abs(cw(p, at) * d(at, k) / lambda[at] / pole) / scale[k][p]);
-        mod.stats.dropped += modes;
-        mod.stats.dropped_weight = std::max(mod.stats.dropped_weight, weight);
-        continue;
-      }
-      mod.poles.push_back(pole);
-      mod.paired.push_back(paired);
-      mod.stats.poles += modes;
-      for (size_t k = 0; k < nk; ++k) mod.input[k].push_back(d(at, k) / lambda[at]);
-      for (size_t p = 0; p < np; ++p)
-        mod.output[p].push_back(static_cast<double>(modes) * cw(p, at));
-    }
-    measure();
-    model = std::move(mod);
-    return Status::Ok();
-  };
+  }
+  ++st_.expansion_points;
+  return added;
+}
 
-  // The basis and its images are three dense n x q arrays: at most kMaxBasisBytes in all (their
-  // capacity, grown by doubling, at most twice that).
-  constexpr double kMaxBasisBytes = 384.0 * (1 << 20);
-  const int max_order = static_cast<int>(
-      std::min<double>(opt.max_order, kMaxBasisBytes / (3.0 * sizeof(double) * n)));
-  std::vector<double> used;
-  std::vector<std::pair<double, double>> open;  // check intervals not yet refined
-  for (size_t i = 0; i + 1 < freqs.size(); ++i) open.push_back({freqs[i], freqs[i + 1]});
-  std::vector<double> first = {opt.f_min, opt.f_max / 10};
-  for (double f : opt.start_points)
-    if (f >= opt.f_min && f <= opt.f_max && std::find(first.begin(), first.end(), f) == first.end())
+// The first expansion points: f_min, f_max / 10 and the caller's start points in the band.
+Status Reducer::expand_at_first_points() {
+  std::vector<double> first = {opt_.f_min, opt_.f_max / 10};
+  for (double f : opt_.start_points)
+    if (f >= opt_.f_min && f <= opt_.f_max &&
+        std::find(first.begin(), first.end(), f) == first.end())
       first.push_back(f);
   for (double f : first) {
     StatusOr<bool> added = expand_at(f);
     if (!added) return added.status();
-    used.push_back(f);
+    used_.push_back(f);
   }
+  return Status::Ok();
+}
+
+// A model's error at check frequency f (index into freqs_): the largest over sources and probes
+// of |H_model - H_exact| over that pair's peak |H|.
+double Reducer::error_at(const ReducedModel& m, size_t f) const {
+  const Cplx jw(0.0, 2 * std::numbers::pi * freqs_[f]);
+  // The edge spectrum's envelope (header: what the check guarantees).
+  const double weight = opt_.edge_time > 0
+                            ? std::min(1.0, 1.0 / (std::numbers::pi * freqs_[f] * opt_.edge_time))
+                            : 1.0;
+  double e = 0;
+  for (size_t k = 0; k < nk_; ++k)
+    for (size_t p = 0; p < np_; ++p) {
+      const double x = weight * std::abs(m.transfer(k, p, jw) - exact_[f][k][p]) / scale_[k][p];
+      if (!(x <= e)) e = x;  // a NaN sticks: such a model never passes
+    }
+  return e;
+}
+
+// The model's error over the check grid, and where it is largest.
+void Reducer::measure(ReducedModel* m) const {
+  m->stats.error = 0;
+  for (size_t f = 0; f < freqs_.size(); ++f) {
+    const double e = error_at(*m, f);
+    if (!(e <= m->stats.error)) m->stats.error = e, m->stats.error_frequency = freqs_[f];
+  }
+}
+
+// Gr = V'GV and Cr = V'CV, grown by the rows and columns of the vectors added since the last
+// build (the basis only grows, and its earlier vectors do not change).
+void Reducer::project() {
+  const int q = basis_.q, q0 = static_cast<int>(gr_.rows());
+  if (q == q0) return;
+  gr_.conservativeResize(q, q);
+  cr_.conservativeResize(q, q);
+  const auto v = basis_.v.leftCols(q);
+  const auto added = basis_.v.middleCols(q0, q - q0);
+  gr_.rightCols(q - q0) = v.transpose() * basis_.gv.middleCols(q0, q - q0);
+  cr_.rightCols(q - q0) = v.transpose() * basis_.cv.middleCols(q0, q - q0);
+  gr_.bottomLeftCorner(q - q0, q0) = added.transpose() * basis_.gv.leftCols(q0);
+  cr_.bottomLeftCorner(q - q0, q0) = added.transpose() * basis_.cv.leftCols(q0);
+}
+
+// The projected inputs Br = V'B (q x nk, in this sign form) and outputs Lr = LV (np x q).
+void Reducer::project_ports(Eigen::MatrixXd* br, Eigen::MatrixXd* lr) const {
+  const int q = basis_.q, n = n_;
+  const auto v = basis_.v.leftCols(q);
+  for (size_t k = 0; k < nk_; ++k) {
+    Eigen::VectorXd e(n);
+    for (int i = 0; i < n; ++i) e[i] = row_sign_[i] * excitations_[k][i + 1];
+    br->col(k) = v.transpose() * e;
+  }
+  for (size_t p = 0; p < np_; ++p)
+    for (int j = 0; j < q; ++j)
+      (*lr)(p, j) = (probes_[p].a > 0 ? v(probes_[p].a - 1, j) : 0.0) -
+                    (probes_[p].b > 0 ? v(probes_[p].b - 1, j) : 0.0);
+}
+
+// Builds the pole-residue model from the current basis into model_ and measures its error.
+Status Reducer::build() {
+  ReducedModel mod;
+  ++st_.steps;
+  mod.direct.assign(nk_, std::vector<double>(np_, 0.0));
+  mod.input.assign(nk_, {});
+  mod.output.assign(np_, {});
+  mod.stats = st_;
+  mod.stats.order = basis_.q;
+  // q = 0: nothing reaches the probes (no source drives anything): H = 0
+  if (basis_.q != 0)
+    if (Status s = modal_form(&mod); !s.ok()) return s;
+  measure(&mod);
+  model_ = std::move(mod);
+  return Status::Ok();
+}
+
+// The reduced pencil's eigen-decomposition as poles and residues in `mod`: direct terms for the
+// instantaneous modes, right-half-plane poles dropped (and counted).
+Status Reducer::modal_form(ReducedModel* mod) {
+  const int q = basis_.q;
+  project();
+  Eigen::MatrixXd br(q, nk_), lr(np_, q);
+  project_ports(&br, &lr);
+  // sigma: the middle of the band on a log scale, where G + sigma C is far from singular.
+  const double sigma = 2 * std::numbers::pi * std::sqrt(opt_.f_min * opt_.f_max);
+  Eigen::PartialPivLU<Eigen::MatrixXd> a(gr_ + sigma * cr_);
+  const Eigen::MatrixXd m = a.solve(cr_);
+  const Eigen::MatrixXd ab = a.solve(br);
+  if (!m.allFinite() || !ab.allFinite())
+    return Status::Error("reduced model: the projected system is singular");
+  Eigen::EigenSolver<Eigen::MatrixXd> es(m);
+  if (es.info() != Eigen::Success)
+    return Status::Error("reduced model: the eigenvalue problem did not converge");
+  const Eigen::VectorXcd lambda = es.eigenvalues();
+  const Eigen::MatrixXcd w = es.eigenvectors();
+  Eigen::PartialPivLU<Eigen::MatrixXcd> wlu(w);
+  const Eigen::MatrixXcd d = wlu.solve(ab.cast<Cplx>());  // q x nk
+  const Eigen::MatrixXcd cw = lr.cast<Cplx>() * w;        // np x q
+  if (!d.allFinite() || !cw.allFinite())
+    return Status::Error("reduced model: the eigenvectors are singular");
+  double lmax = 0;
+  for (int i = 0; i < q; ++i) lmax = std::max(lmax, std::abs(lambda[i]));
+  // Instantaneous: lambda = 0, or a mode so fast (|lambda| under 1e-6 / (2 pi f_max): a time
+  // constant of 0.05 fs, a pole over 2e16 rad/s) that its share 1 / (1 + (s - sigma) lambda)
+  // is constant within 1e-6 over the whole band. The zero eigenvalues of a singular Cr come
+  // out at about 1e-12 of the largest, of either sign: on V -> L -> R at +-1e-19 s against
+  // 9e-8 s, one was a pole at -8.9e18 rad/s and the other a right-half-plane pole, dropped,
+  // and v(in) lost its direct term (error 1).
+  const double instant = 1e-6 / (2 * std::numbers::pi * opt_.f_max);
+  for (int i = 0; i < q; ++i) {
+    if (std::abs(lambda[i]) <= std::max(1e-14 * lmax, instant)) {
+      ++mod->stats.direct_modes;
+      for (size_t k = 0; k < nk_; ++k)
+        for (size_t p = 0; p < np_; ++p) mod->direct[k][p] += (cw(p, i) * d(i, k)).real();
+      continue;
+    }
+    const Cplx pole = sigma - 1.0 / lambda[i];
+    // A complex pole's conjugate (the next eigenvalue: a real matrix's come in exact pairs,
+    // with conjugate vectors) is carried by it: one mode, output doubled, real part taken.
+    const bool paired = lambda[i].imag() != 0 && i + 1 < q && lambda[i + 1] == std::conj(lambda[i]);
+    const int modes = paired ? 2 : 1;
+    if (paired) ++i;
+    const int at = paired ? i - 1 : i;
+    if (pole.real() > 0 && pole.real() * opt_.horizon >= 1e-3) {
+      // Dropped; the check sees what that costs (a pole with weight fails it).
+      double weight = 0;
+      for (size_t k = 0; k < nk_; ++k)
+        for (size_t p = 0; p < np_; ++p)
+          weight =
+              std::max(weight, std::abs(cw(p, at) * d(at, k) / lambda[at] / pole) / scale_[k][p]);
+      mod->stats.dropped += modes;
+      mod->stats.dropped_weight = std::max(mod->stats.dropped_weight, weight);
+      continue;
+    }
+    mod->poles.push_back(pole);
+    mod->paired.push_back(paired);
+    mod->stats.poles += modes;
+    for (size_t k = 0; k < nk_; ++k) mod->input[k].push_back(d(at, k) / lambda[at]);
+    for (size_t p = 0; p < np_; ++p)
+      mod->output[p].push_back(static_cast<double>(modes) * cw(p, at));
+  }
+  return Status::Ok();
+}
+
+// Refinement of a model that passes the grid, as adaptive quadrature refines: every open
+// interval of the check grid (at first all of them) is tested at its geometric midpoint, where
+// a resonance could hide. An interval whose midpoint passes is closed; one whose midpoint fails
+// leaves its two halves open, the midpoint joins the grid and the search goes on (model_'s error
+// then the worst midpoint's). True when the search is done: every midpoint passed, or the grid
+// would grow past opt.max_check_points.
+StatusOr<bool> Reducer::refine_checks() {
+  std::vector<std::pair<double, double>> next;
+  std::vector<double> mids;
+  for (const auto& [lo, hi] : open_)
+    if (hi > lo * (1 + 1e-9)) mids.push_back(std::sqrt(lo * hi));
+  if (freqs_.size() + mids.size() > static_cast<size_t>(opt_.max_check_points)) return true;
+  const size_t before = freqs_.size();
+  if (Status s = add_checks(mids); !s.ok()) return s;
+  double worst = 0, worst_f = 0;
+  for (size_t f = before; f < freqs_.size(); ++f) {
+    const double e = error_at(model_, f);
+    if (e > opt_.tol) {
+      const auto it = std::find_if(open_.begin(), open_.end(), [&](const auto& iv) {
+        return iv.first < freqs_[f] && freqs_[f] < iv.second;
+      });
+      next.push_back({it->first, freqs_[f]});
+      next.push_back({freqs_[f], it->second});
+    }
+    if (!(e <= worst)) worst = e, worst_f = freqs_[f];
+  }
+  open_ = std::move(next);
+  if (worst <= opt_.tol) return true;
+  model_.stats.error = worst;
+  model_.stats.error_frequency = worst_f;
+  return false;
+}
+
+// Check frequencies by the error there, worst first; the first one whose vectors are new.
+// Then, up to `batch` points in all, the next-worst local maxima of the error over the grid
+// (other resonances): one build per step instead of one per point. An error when no point adds
+// a new direction.
+Status Reducer::expand_where_worst() {
+  std::vector<std::pair<double, double>> ranked;  // (error, f)
+  std::vector<std::pair<double, double>> by_f;    // (f, error), by frequency
+  for (size_t f = 0; f < freqs_.size(); ++f) {
+    const double e = error_at(model_, f);
+    by_f.emplace_back(freqs_[f], e);
+    if (e > opt_.tol) ranked.emplace_back(e, freqs_[f]);
+  }
+  std::sort(ranked.rbegin(), ranked.rend());
+  std::sort(by_f.begin(), by_f.end());
+  std::vector<std::pair<double, double>> peaks;  // (error, f): local maxima over tol
+  for (size_t i = 0; i < by_f.size(); ++i) {
+    const double e = by_f[i].second;
+    if (e > opt_.tol && !(i > 0 && by_f[i - 1].second > e) &&
+        !(i + 1 < by_f.size() && by_f[i + 1].second > e))
+      peaks.emplace_back(e, by_f[i].first);
+  }
+  std::sort(peaks.rbegin(), peaks.rend());
+  auto is_used = [&](double f) { return std::find(used_.begin(), used_.end(), f) != used_.end(); };
+  bool grew = false;
+  for (const auto& [e, f] : ranked) {
+    if (is_used(f)) continue;
+    StatusOr<bool> added = expand_at(f);
+    if (!added) return added.status();
+    used_.push_back(f);
+    if (*added) {
+      grew = true;
+      break;
+    }
+    if (static_cast<int>(used_.size()) >= opt_.max_points) break;
+  }
+  for (int taken = 1; taken < opt_.batch && grew;) {
+    const auto next = std::find_if(peaks.begin(), peaks.end(),
+                                   [&](const auto& pk) { return !is_used(pk.second); });
+    if (next == peaks.end() || static_cast<int>(used_.size()) >= opt_.max_points) break;
+    StatusOr<bool> added = expand_at(next->second);
+    if (!added) return added.status();
+    used_.push_back(next->second);
+    ++taken;
+  }
+  if (!grew)
+    return Status::Error(fmt::format(
+        "reduced model: error {:.2g} at {:.4g} Hz and no expansion point adds a new direction "
+        "(order {})",
+        model_.stats.error, model_.stats.error_frequency, basis_.q));
+  return Status::Ok();
+}
+
+StatusOr<ReducedModel> Reducer::run() {
+  if (Status s = start_checks(); !s.ok()) return s;
+  seed_basis();
+  for (size_t i = 0; i + 1 < freqs_.size(); ++i) open_.push_back({freqs_[i], freqs_[i + 1]});
+  if (Status s = expand_at_first_points(); !s.ok()) return s;
   while (true) {
     if (Status s = build(); !s.ok()) return s;
-    if (model.stats.error <= opt.tol) {
-      // Refinement, as adaptive quadrature refines: every open interval of the check grid
-      // (at first all of them) is tested at its geometric midpoint, where a resonance could
-      // hide. An interval whose midpoint passes is closed; one whose midpoint fails leaves its
-      // two halves open, the midpoint joins the grid and the search goes on.
-      std::vector<std::pair<double, double>> next;
-      std::vector<double> mids;
-      for (const auto& [lo, hi] : open)
-        if (hi > lo * (1 + 1e-9)) mids.push_back(std::sqrt(lo * hi));
-      if (freqs.size() + mids.size() > static_cast<size_t>(opt.max_check_points)) break;
-      const size_t before = freqs.size();
-      if (Status s = add_checks(mids); !s.ok()) return s;
-      double worst = 0, worst_f = 0;
-      for (size_t f = before; f < freqs.size(); ++f) {
-        const double e = error_at(model, f);
-        if (e > opt.tol) {
-          const auto it = std::find_if(open.begin(), open.end(), [&](const auto& iv) {
-            return iv.first < freqs[f] && freqs[f] < iv.second;
-          });
-          next.push_back({it->first, freqs[f]});
-          next.push_back({freqs[f], it->second});
-        }
-        if (!(e <= worst)) worst = e, worst_f = freqs[f];
-      }
-      open = std::move(next);
-      if (worst <= opt.tol) break;
-      model.stats.error = worst;
-      model.stats.error_frequency = worst_f;
+    if (model_.stats.error <= opt_.tol) {
+      StatusOr<bool> done = refine_checks();
+      if (!done) return done.status();
+      if (*done) break;
     }
-    if (static_cast<int>(used.size()) >= opt.max_points || basis.q >= max_order)
+    if (static_cast<int>(used_.size()) >= opt_.max_points || basis_.q >= max_order_)
       return Status::Error(fmt::format(
           "reduced model: error {:.2g} at {:.4g} Hz after {} expansion points (order {}), over "
           "the {:.2g} allowed",
-          model.stats.error, model.stats.error_frequency, used.size(), basis.q, opt.tol));
-    // Check frequencies by the error there, worst first; the first one whose vectors are new.
-    // Then, up to `batch` points in all, the next-worst local maxima of the error over the grid
-    // (other resonances): one build per step instead of one per point.
-    std::vector<std::pair<double, double>> ranked;  // (error, f)
-    std::vector<std::pair<double, double>> by_f;    // (f, error), by frequency
-    for (size_t f = 0; f < freqs.size(); ++f) {
-      const double e = error_at(model, f);
-      by_f.emplace_back(freqs[f], e);
-      if (e > opt.tol) ranked.emplace_back(e, freqs[f]);
-    }
-    std::sort(ranked.rbegin(), ranked.rend());
-    std::sort(by_f.begin(), by_f.end());
-    std::vector<std::pair<double, double>> peaks;  // (error, f): local maxima over tol
-    for (size_t i = 0; i < by_f.size(); ++i) {
-      const double e = by_f[i].second;
-      if (e > opt.tol && !(i > 0 && by_f[i - 1].second > e) &&
-          !(i + 1 < by_f.size() && by_f[i + 1].second > e))
-        peaks.emplace_back(e, by_f[i].first);
-    }
-    std::sort(peaks.rbegin(), peaks.rend());
-    auto is_used = [&](double f) { return std::find(used.begin(), used.end(), f) != used.end(); };
-    bool grew = false;
-    for (const auto& [e, f] : ranked) {
-      if (is_used(f)) continue;
-      StatusOr<bool> added = expand_at(f);
-      if (!added) return added.status();
-      used.push_back(f);
-      if (*added) {
-        grew = true;
-        break;
-      }
-      if (static_cast<int>(used.size()) >= opt.max_points) break;
-    }
-    for (int taken = 1; taken < opt.batch && grew;) {
-      const auto next = std::find_if(peaks.begin(), peaks.end(),
-                                     [&](const auto& pk) { return !is_used(pk.second); });
-      if (next == peaks.end() || static_cast<int>(used.size()) >= opt.max_points) break;
-      StatusOr<bool> added = expand_at(next->second);
-      if (!added) return added.status();
-      used.push_back(next->second);
-      ++taken;
-    }
-    if (!grew)
-      return Status::Error(fmt::format(
-          "reduced model: error {:.2g} at {:.4g} Hz and no expansion point adds a new direction "
-          "(order {})",
-          model.stats.error, model.stats.error_frequency, basis.q));
+          model_.stats.error, model_.stats.error_frequency, used_.size(), basis_.q, opt_.tol));
+    if (Status s = expand_where_worst(); !s.ok()) return s;
   }
-  model.stats.factorizations = st.factorizations;
-  model.stats.check_points = static_cast<int>(freqs.size());
-  model.stats.expansion_points = st.expansion_points;
-  model.stats.steps = st.steps;
-  model.stats.points = used;
-  return model;
+  model_.stats.factorizations = st_.factorizations;
+  model_.stats.check_points = static_cast<int>(freqs_.size());
+  model_.stats.expansion_points = st_.expansion_points;
+  model_.stats.steps = st_.steps;
+  model_.stats.points = used_;
+  return model_;
+}
+
+// One search in one sign form.
+StatusOr<ReducedModel> reduce_in_form(const Circuit& circuit,
+                                      const std::vector<std::vector<double>>& excitations,
+                                      const std::vector<std::vector<double>>& dc_solutions,
+                                      const std::vector<Probe>& probes,
+                                      const ReducedModelOptions& opt, bool passive_form) {
+  StatusOr<AcAnalysis> ac = AcAnalysis::create(circuit);
+  if (!ac) return ac.status();
+  Reducer reducer(circuit, *ac, excitations, dc_solutions, probes, opt, passive_form);
+  return reducer.run();
 }
 
 }  // namespace
