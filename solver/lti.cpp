@@ -317,238 +317,320 @@ void LtiResponses::superpose(const std::vector<SourceInput>& inputs, double t0, 
   }
 }
 
-void LtiResponses::modal_add(const std::vector<SourceInput>& inputs,
-                             const std::vector<double>& times, double uniform_dt,
-                             std::vector<std::vector<double>>& out, ModeRates* rates) const {
-  const ReducedModel& m = *model_;
-  const size_t nm = m.poles.size(), np = labels_.size();
-  const size_t nk = std::min(sources_.size(), inputs.size());
-  struct Corner {
-    double t;
-    size_t k;
-    double slope;
-  };
-  std::vector<Corner> corners;
-  for (size_t k = 0; k < nk; ++k)
-    for (const Ramp& r : inputs[k].ramps) corners.push_back({r.t, k, r.slope});
-  std::stable_sort(corners.begin(), corners.end(),
-                   [](const Corner& a, const Corner& b) { return a.t < b.t; });
-  // Per mode, as real and imaginary parts in separate arrays (the loops below vectorise): its
-  // state x, its input b = sum_k in_k (u_k - u_k(start)) and that input's slope g.
-  std::vector<double> xr(nm, 0.0), xi(nm, 0.0), br(nm, 0.0), bi(nm, 0.0), gr(nm, 0.0), gi(nm, 0.0);
-  std::vector<std::vector<double>> outr(np, std::vector<double>(nm)), outi = outr;
-  for (size_t p = 0; p < np; ++p)
-    for (size_t i = 0; i < nm; ++i)
-      outr[p][i] = m.output[p][i].real(), outi[p][i] = m.output[p][i].imag();
-  std::vector<double> u(nk, 0.0), slope(nk, 0.0);  // u_k - initial, and its slope
-  struct Step {
-    double h = -1;
-    std::vector<double> er, ei, f1r, f1i, f2r, f2i;  // e^{ph}, h phi1(ph), h^2 phi2(ph)
-    void set(const ReducedModel& m, double step) {
-      h = step;
-      const size_t n = m.poles.size();
-      for (auto* v : {&er, &ei, &f1r, &f1i, &f2r, &f2i}) v->resize(n);
-      for (size_t i = 0; i < n; ++i) {
-        const Phi f = phi(m.poles[i] * step);
-        const std::complex<double> f1 = step * f.phi1, f2 = step * step * f.phi2;
-        er[i] = f.e.real(), ei[i] = f.e.imag();
-        f1r[i] = f1.real(), f1i[i] = f1.imag(), f2r[i] = f2.real(), f2i[i] = f2.imag();
-      }
-    }
-  };
-  // The uniform step, and a few recent others (a pass over the midpoints of a locally refined
-  // grid repeats a handful of gaps: twice each refinement level's step).
-  Step uniform;
-  std::array<Step, 8> recent;
-  size_t next_recent = 0;
-  if (uniform_dt > 0) uniform.set(m, uniform_dt);
-  bool active = false;  // a corner has passed: before it everything is zero
-  // A cached step serves any h within 1e-9 of it: times t0 + i dt differ from i dt by rounding
-  // of t0 (1e-11 relative at 100 us on a 1 ns step); the states are not moved in time by it
-  // (each query restarts from its own time), only the phase e^{ph} is off by |p| 1e-9 h.
-  auto step_for = [&](double h) -> const Step* {
-    if (std::fabs(h - uniform.h) <= 1e-9 * uniform.h) return &uniform;
-    for (const Step& st : recent)
-      if (std::fabs(h - st.h) <= 1e-9 * st.h) return &st;
-    Step& st = recent[next_recent];
-    next_recent = (next_recent + 1) % recent.size();
-    st.set(m, h);
-    return &st;
-  };
-  auto advance = [&](double h) {
-    if (!(h > 0) || !active) return;
-    const Step* st = step_for(h);
-    const double *er = st->er.data(), *ei = st->ei.data(), *f1r = st->f1r.data(),
-                 *f1i = st->f1i.data(), *f2r = st->f2r.data(), *f2i = st->f2i.data();
-    for (size_t i = 0; i < nm; ++i) {
-      const double nr = er[i] * xr[i] - ei[i] * xi[i] + f1r[i] * br[i] - f1i[i] * bi[i] +
-                        f2r[i] * gr[i] - f2i[i] * gi[i];
-      const double ni = er[i] * xi[i] + ei[i] * xr[i] + f1r[i] * bi[i] + f1i[i] * br[i] +
-                        f2r[i] * gi[i] + f2i[i] * gr[i];
-      xr[i] = nr, xi[i] = ni;
-      br[i] += gr[i] * h, bi[i] += gi[i] * h;
-    }
-    for (size_t k = 0; k < nk; ++k) u[k] += slope[k] * h;
-  };
-  // Tail: past the last corner, with every source's slope back to zero (up to rounding), each
-  // mode's input b is constant. A mode that decays within what is left of the record (|Re p|
-  // times the span left above 1) is written x = x_ss + d, x_ss = -b / p its steady state, and
-  // d just decays by e^{p h}: its share of a probe is the constant Re(out x_ss) plus Re(out d),
-  // and once max_p |out_pi d_i| is below kTailTol of that probe's scale it leaves the loop for
-  // good (|e^{p h}| < 1). Slower modes keep the exact update. A long record after the last edge
-  // (the worst-case search's edge response: 160,000 samples) then costs the slow modes alone.
-  constexpr double kTailTol = 1e-13;
-  std::vector<double> slope_scale(nk, 0.0);  // largest |slope| a source has had
-  bool tail = false;
-  std::vector<size_t> slow, fast;  // mode indices in the tail; fast ones are dropped when decayed
-  std::vector<double> dr, di;      // per fast mode: d = x - x_ss
-  std::vector<double> tail_const;  // per probe: what the modes settle to, and the direct term
-  std::vector<double> tail_scale;  // per probe: |tail_const| + sum |out d| at the tail's start
-  auto enter_tail = [&](double left) {
-    for (size_t k = 0; k < nk; ++k)
-      if (std::fabs(slope[k]) > 1e-12 * slope_scale[k]) return;
-    tail_const.assign(np, 0.0);
-    tail_scale.assign(np, 0.0);
-    for (size_t p = 0; p < np; ++p)
-      for (size_t k = 0; k < nk; ++k) tail_const[p] += m.direct[k][p] * u[k];
-    for (size_t i = 0; i < nm; ++i) {
-      const std::complex<double> pole = m.poles[i];
-      if (!(-pole.real() * left > 1.0)) {
-        slow.push_back(i);
-        continue;
-      }
-      const std::complex<double> xss = -std::complex<double>(br[i], bi[i]) / pole;
-      fast.push_back(i);
-      dr.push_back(xr[i] - xss.real());
-      di.push_back(xi[i] - xss.imag());
-      for (size_t p = 0; p < np; ++p) {
-        tail_const[p] += outr[p][i] * xss.real() - outi[p][i] * xss.imag();
-        tail_scale[p] += std::abs(m.output[p][i]) * std::hypot(dr.back(), di.back());
-      }
-    }
-    for (size_t p = 0; p < np; ++p) tail_scale[p] += std::fabs(tail_const[p]);
-    tail = true;
-  };
-  // One tail step of h: the slow modes' exact update, the fast ones' decay.
-  auto tail_step = [&](double h) {
-    if (!(h > 0)) return;
-    const Step* st = step_for(h);
-    for (size_t i : slow) {
-      const double nr =
-          st->er[i] * xr[i] - st->ei[i] * xi[i] + st->f1r[i] * br[i] - st->f1i[i] * bi[i];
-      const double ni =
-          st->er[i] * xi[i] + st->ei[i] * xr[i] + st->f1r[i] * bi[i] + st->f1i[i] * br[i];
-      xr[i] = nr, xi[i] = ni;
-    }
-    for (size_t f = 0; f < fast.size(); ++f) {
-      const size_t i = fast[f];
-      const double nr = st->er[i] * dr[f] - st->ei[i] * di[f];
-      const double ni = st->er[i] * di[f] + st->ei[i] * dr[f];
-      dr[f] = nr, di[f] = ni;
-    }
-  };
-  // Drops the fast modes whose share of every probe has decayed below kTailTol of its scale.
-  auto prune = [&]() {
-    size_t kept = 0;
-    for (size_t f = 0; f < fast.size(); ++f) {
-      const size_t i = fast[f];
-      const double d = std::hypot(dr[f], di[f]);
-      bool live = false;
-      for (size_t p = 0; p < np && !live; ++p)
-        live = std::abs(m.output[p][i]) * d > kTailTol * tail_scale[p];
-      if (!live) continue;
-      fast[kept] = i, dr[kept] = dr[f], di[kept] = di[f];
-      ++kept;
-    }
-    fast.resize(kept), dr.resize(kept), di.resize(kept);
-  };
-  // ModeRates: each mode's weight on the probes, and the transient part d = x - x_ss of its state
-  // (x_ss = -(b + g t) / p - g / p^2 follows the input; d decays as e^{p t}).
-  // ModeRates: each mode's weight on the probes (squared, over the threshold squared), and the
-  // transient part d = x - x_ss of its state (x_ss = -(b + g t) / p - g / p^2 follows the input;
-  // d decays as e^{p t}), from 1 / p and 1 / p^2 kept as real arrays.
-  std::vector<double> w2, ipr, ipi, ip2r, ip2i, speed;
-  if (rates) {
-    rates->rate.assign(times.size(), 0.0);
-    w2.assign(nm, 0.0);
-    for (size_t p = 0; p < np && p < rates->probe_weight.size(); ++p)
-      for (size_t i = 0; i < nm; ++i)
-        w2[i] = std::max(w2[i], rates->probe_weight[p] * std::abs(m.output[p][i]));
-    for (size_t i = 0; i < nm; ++i) {
-      w2[i] = w2[i] * w2[i] / (rates->threshold * rates->threshold);
-      const std::complex<double> ip = 1.0 / m.poles[i], ip2 = ip * ip;
-      ipr.push_back(ip.real()), ipi.push_back(ip.imag());
-      ip2r.push_back(ip2.real()), ip2i.push_back(ip2.imag());
-      speed.push_back(std::abs(m.poles[i]));
+namespace {
+
+// A piecewise-linear input's corner: at t, source k's slope changes by `slope`.
+struct Corner {
+  double t;
+  size_t k;
+  double slope;
+};
+
+// One step h of every mode: e^{ph}, h phi1(ph), h^2 phi2(ph) as real and imaginary parts.
+struct ModalStep {
+  double h = -1;
+  std::vector<double> er, ei, f1r, f1i, f2r, f2i;
+  void set(const ReducedModel& m, double step) {
+    h = step;
+    const size_t n = m.poles.size();
+    for (auto* v : {&er, &ei, &f1r, &f1i, &f2r, &f2i}) v->resize(n);
+    for (size_t i = 0; i < n; ++i) {
+      const Phi f = phi(m.poles[i] * step);
+      const std::complex<double> f1 = step * f.phi1, f2 = step * step * f.phi2;
+      er[i] = f.e.real(), ei[i] = f.e.imag();
+      f1r[i] = f1.real(), f1i[i] = f1.imag(), f2r[i] = f2.real(), f2i[i] = f2.imag();
     }
   }
-  auto rate_at = [&](size_t j) {
-    if (!rates) return;
-    double fastest = 0.0;
-    auto consider = [&](size_t i, double d_r, double d_i) {
-      if (w2[i] * (d_r * d_r + d_i * d_i) > 1.0) fastest = std::max(fastest, speed[i]);
-    };
-    if (!tail) {
-      for (size_t i = 0; i < nm; ++i)
-        consider(i, xr[i] + br[i] * ipr[i] - bi[i] * ipi[i] + gr[i] * ip2r[i] - gi[i] * ip2i[i],
-                 xi[i] + br[i] * ipi[i] + bi[i] * ipr[i] + gr[i] * ip2i[i] + gi[i] * ip2r[i]);
-    } else {
-      for (size_t i : slow)
-        consider(i, xr[i] + br[i] * ipr[i] - bi[i] * ipi[i],
-                 xi[i] + br[i] * ipi[i] + bi[i] * ipr[i]);
-      for (size_t f = 0; f < fast.size(); ++f) consider(fast[f], dr[f], di[f]);
+};
+
+// The march of LtiResponses::modal_add: the modes' states from corner to corner and query to
+// query, the tail past the last corner, and the mode rates (ModeRates) when asked. The model
+// and the rate arguments must outlive it.
+class ModalMarch {
+ public:
+  // probe_weight, threshold and rate: ModeRates's, or nullptr (no rates).
+  ModalMarch(const ReducedModel& m, size_t np, size_t nk, double uniform_dt,
+             const std::vector<double>* probe_weight, double threshold, std::vector<double>* rate);
+
+  // Adds the response to the corners (sorted by time) at `times` into out[p][j].
+  void run(const std::vector<Corner>& corners, const std::vector<double>& times,
+           std::vector<std::vector<double>>& out);
+
+ private:
+  const ModalStep* step_for(double h);
+  void advance(double h);
+  void take_corner(const Corner& corner);
+  void enter_tail(double left);
+  void tail_step(double h);
+  void prune();
+  void start_rates(const std::vector<double>& probe_weight, double threshold);
+  void rate_at(size_t j);
+  double tail_value(size_t p) const;
+  double value(size_t p) const;
+
+  // Past the last corner: see enter_tail.
+  static constexpr double kTailTol = 1e-13;
+
+  const ReducedModel& m_;
+  const size_t nm_, np_, nk_;
+  std::vector<double>* rate_;
+  // Per mode, as real and imaginary parts in separate arrays (the loops below vectorise): its
+  // state x, its input b = sum_k in_k (u_k - u_k(start)) and that input's slope g.
+  std::vector<double> xr_, xi_, br_, bi_, gr_, gi_;
+  std::vector<std::vector<double>> outr_, outi_;  // [p][mode]
+  std::vector<double> u_, slope_;                 // u_k - initial, and its slope
+  // The uniform step, and a few recent others (a pass over the midpoints of a locally refined
+  // grid repeats a handful of gaps: twice each refinement level's step).
+  ModalStep uniform_;
+  std::array<ModalStep, 8> recent_;
+  size_t next_recent_ = 0;
+  bool active_ = false;              // a corner has passed: before it everything is zero
+  std::vector<double> slope_scale_;  // largest |slope| a source has had
+  bool tail_ = false;
+  std::vector<size_t> slow_, fast_;  // mode indices in the tail; fast ones are dropped when decayed
+  std::vector<double> dr_, di_;      // per fast mode: d = x - x_ss
+  std::vector<double> tail_const_;   // per probe: what the modes settle to, and the direct term
+  std::vector<double> tail_scale_;   // per probe: |tail_const| + sum |out d| at the tail's start
+  // ModeRates: each mode's weight on the probes (squared, over the threshold squared), and 1 / p
+  // and 1 / p^2 as real arrays, and |p|.
+  std::vector<double> w2_, ipr_, ipi_, ip2r_, ip2i_, speed_;
+};
+
+ModalMarch::ModalMarch(const ReducedModel& m, size_t np, size_t nk, double uniform_dt,
+                       const std::vector<double>* probe_weight, double threshold,
+                       std::vector<double>* rate)
+    : m_(m), nm_(m.poles.size()), np_(np), nk_(nk), rate_(rate) {
+  const size_t nm = nm_;
+  for (auto* v : {&xr_, &xi_, &br_, &bi_, &gr_, &gi_}) v->assign(nm, 0.0);
+  outr_.assign(np, std::vector<double>(nm));
+  outi_ = outr_;
+  for (size_t p = 0; p < np; ++p)
+    for (size_t i = 0; i < nm; ++i)
+      outr_[p][i] = m.output[p][i].real(), outi_[p][i] = m.output[p][i].imag();
+  u_.assign(nk, 0.0);
+  slope_.assign(nk, 0.0);
+  slope_scale_.assign(nk, 0.0);
+  if (uniform_dt > 0) uniform_.set(m, uniform_dt);
+  if (rate_) start_rates(*probe_weight, threshold);
+}
+
+// A cached step serves any h within 1e-9 of it: times t0 + i dt differ from i dt by rounding
+// of t0 (1e-11 relative at 100 us on a 1 ns step); the states are not moved in time by it
+// (each query restarts from its own time), only the phase e^{ph} is off by |p| 1e-9 h.
+const ModalStep* ModalMarch::step_for(double h) {
+  if (std::fabs(h - uniform_.h) <= 1e-9 * uniform_.h) return &uniform_;
+  for (const ModalStep& st : recent_)
+    if (std::fabs(h - st.h) <= 1e-9 * st.h) return &st;
+  ModalStep& st = recent_[next_recent_];
+  next_recent_ = (next_recent_ + 1) % recent_.size();
+  st.set(m_, h);
+  return &st;
+}
+
+void ModalMarch::advance(double h) {
+  if (!(h > 0) || !active_) return;
+  const ModalStep* st = step_for(h);
+  const double *er = st->er.data(), *ei = st->ei.data(), *f1r = st->f1r.data(),
+               *f1i = st->f1i.data(), *f2r = st->f2r.data(), *f2i = st->f2i.data();
+  double *xr = xr_.data(), *xi = xi_.data(), *br = br_.data(), *bi = bi_.data();
+  const double *gr = gr_.data(), *gi = gi_.data();
+  for (size_t i = 0; i < nm_; ++i) {
+    const double nr = er[i] * xr[i] - ei[i] * xi[i] + f1r[i] * br[i] - f1i[i] * bi[i] +
+                      f2r[i] * gr[i] - f2i[i] * gi[i];
+    const double ni = er[i] * xi[i] + ei[i] * xr[i] + f1r[i] * bi[i] + f1i[i] * br[i] +
+                      f2r[i] * gi[i] + f2i[i] * gr[i];
+    xr[i] = nr, xi[i] = ni;
+    br[i] += gr[i] * h, bi[i] += gi[i] * h;
+  }
+  for (size_t k = 0; k < nk_; ++k) u_[k] += slope_[k] * h;
+}
+
+// The corner's slope change joins its source's slope and every mode's input slope g.
+void ModalMarch::take_corner(const Corner& corner) {
+  active_ = true;
+  slope_[corner.k] += corner.slope;
+  slope_scale_[corner.k] =
+      std::max({slope_scale_[corner.k], std::fabs(corner.slope), std::fabs(slope_[corner.k])});
+  const auto& in = m_.input[corner.k];
+  for (size_t i = 0; i < nm_; ++i)
+    gr_[i] += in[i].real() * corner.slope, gi_[i] += in[i].imag() * corner.slope;
+}
+
+// Tail: past the last corner, with every source's slope back to zero (up to rounding), each
+// mode's input b is constant. A mode that decays within what is left of the record (|Re p|
+// times the span left above 1) is written x = x_ss + d, x_ss = -b / p its steady state, and
+// d just decays by e^{p h}: its share of a probe is the constant Re(out x_ss) plus Re(out d),
+// and once max_p |out_pi d_i| is below kTailTol of that probe's scale it leaves the loop for
+// good (|e^{p h}| < 1). Slower modes keep the exact update. A long record after the last edge
+// (the worst-case search's edge response: 160,000 samples) then costs the slow modes alone.
+void ModalMarch::enter_tail(double left) {
+  for (size_t k = 0; k < nk_; ++k)
+    if (std::fabs(slope_[k]) > 1e-12 * slope_scale_[k]) return;
+  tail_const_.assign(np_, 0.0);
+  tail_scale_.assign(np_, 0.0);
+  for (size_t p = 0; p < np_; ++p)
+    for (size_t k = 0; k < nk_; ++k) tail_const_[p] += m_.direct[k][p] * u_[k];
+  for (size_t i = 0; i < nm_; ++i) {
+    const std::complex<double> pole = m_.poles[i];
+    if (!(-pole.real() * left > 1.0)) {
+      slow_.push_back(i);
+      continue;
     }
-    rates->rate[j] = fastest;
+    const std::complex<double> xss = -std::complex<double>(br_[i], bi_[i]) / pole;
+    fast_.push_back(i);
+    dr_.push_back(xr_[i] - xss.real());
+    di_.push_back(xi_[i] - xss.imag());
+    for (size_t p = 0; p < np_; ++p) {
+      tail_const_[p] += outr_[p][i] * xss.real() - outi_[p][i] * xss.imag();
+      tail_scale_[p] += std::abs(m_.output[p][i]) * std::hypot(dr_.back(), di_.back());
+    }
+  }
+  for (size_t p = 0; p < np_; ++p) tail_scale_[p] += std::fabs(tail_const_[p]);
+  tail_ = true;
+}
+
+// One tail step of h: the slow modes' exact update, the fast ones' decay.
+void ModalMarch::tail_step(double h) {
+  if (!(h > 0)) return;
+  const ModalStep* st = step_for(h);
+  for (size_t i : slow_) {
+    const double nr =
+        st->er[i] * xr_[i] - st->ei[i] * xi_[i] + st->f1r[i] * br_[i] - st->f1i[i] * bi_[i];
+    const double ni =
+        st->er[i] * xi_[i] + st->ei[i] * xr_[i] + st->f1r[i] * bi_[i] + st->f1i[i] * br_[i];
+    xr_[i] = nr, xi_[i] = ni;
+  }
+  for (size_t f = 0; f < fast_.size(); ++f) {
+    const size_t i = fast_[f];
+    const double nr = st->er[i] * dr_[f] - st->ei[i] * di_[f];
+    const double ni = st->er[i] * di_[f] + st->ei[i] * dr_[f];
+    dr_[f] = nr, di_[f] = ni;
+  }
+}
+
+// Drops the fast modes whose share of every probe has decayed below kTailTol of its scale.
+void ModalMarch::prune() {
+  size_t kept = 0;
+  for (size_t f = 0; f < fast_.size(); ++f) {
+    const size_t i = fast_[f];
+    const double d = std::hypot(dr_[f], di_[f]);
+    bool live = false;
+    for (size_t p = 0; p < np_ && !live; ++p)
+      live = std::abs(m_.output[p][i]) * d > kTailTol * tail_scale_[p];
+    if (!live) continue;
+    fast_[kept] = i, dr_[kept] = dr_[f], di_[kept] = di_[f];
+    ++kept;
+  }
+  fast_.resize(kept), dr_.resize(kept), di_.resize(kept);
+}
+
+// ModeRates: each mode's weight on the probes (squared, over the threshold squared), and the
+// transient part d = x - x_ss of its state (x_ss = -(b + g t) / p - g / p^2 follows the input;
+// d decays as e^{p t}), from 1 / p and 1 / p^2 kept as real arrays.
+void ModalMarch::start_rates(const std::vector<double>& probe_weight, double threshold) {
+  w2_.assign(nm_, 0.0);
+  for (size_t p = 0; p < np_ && p < probe_weight.size(); ++p)
+    for (size_t i = 0; i < nm_; ++i)
+      w2_[i] = std::max(w2_[i], probe_weight[p] * std::abs(m_.output[p][i]));
+  for (size_t i = 0; i < nm_; ++i) {
+    w2_[i] = w2_[i] * w2_[i] / (threshold * threshold);
+    const std::complex<double> ip = 1.0 / m_.poles[i], ip2 = ip * ip;
+    ipr_.push_back(ip.real()), ipi_.push_back(ip.imag());
+    ip2r_.push_back(ip2.real()), ip2i_.push_back(ip2.imag());
+    speed_.push_back(std::abs(m_.poles[i]));
+  }
+}
+
+void ModalMarch::rate_at(size_t j) {
+  if (!rate_) return;
+  double fastest = 0.0;
+  auto consider = [&](size_t i, double d_r, double d_i) {
+    if (w2_[i] * (d_r * d_r + d_i * d_i) > 1.0) fastest = std::max(fastest, speed_[i]);
   };
+  const std::vector<double>&xr = xr_, &xi = xi_, &br = br_, &bi = bi_, &gr = gr_, &gi = gi_;
+  const std::vector<double>&ipr = ipr_, &ipi = ipi_, &ip2r = ip2r_, &ip2i = ip2i_;
+  if (!tail_) {
+    for (size_t i = 0; i < nm_; ++i)
+      consider(i, xr[i] + br[i] * ipr[i] - bi[i] * ipi[i] + gr[i] * ip2r[i] - gi[i] * ip2i[i],
+               xi[i] + br[i] * ipi[i] + bi[i] * ipr[i] + gr[i] * ip2i[i] + gi[i] * ip2r[i]);
+  } else {
+    for (size_t i : slow_)
+      consider(i, xr[i] + br[i] * ipr[i] - bi[i] * ipi[i], xi[i] + br[i] * ipi[i] + bi[i] * ipr[i]);
+    for (size_t f = 0; f < fast_.size(); ++f) consider(fast_[f], dr_[f], di_[f]);
+  }
+  (*rate_)[j] = fastest;
+}
+
+// Probe p's value in the tail.
+double ModalMarch::tail_value(size_t p) const {
+  double d = tail_const_[p];
+  for (size_t i : slow_) d += outr_[p][i] * xr_[i] - outi_[p][i] * xi_[i];
+  for (size_t f = 0; f < fast_.size(); ++f)
+    d += outr_[p][fast_[f]] * dr_[f] - outi_[p][fast_[f]] * di_[f];
+  return d;
+}
+
+// Probe p's value before the tail.
+double ModalMarch::value(size_t p) const {
+  const double *orr = outr_[p].data(), *oi = outi_[p].data();
+  const double *xr = xr_.data(), *xi = xi_.data();
+  const size_t nm = nm_;
+  double y0 = 0, y1 = 0;  // two partial sums: a shorter dependency chain
+  size_t i = 0;
+  for (; i + 1 < nm; i += 2) {
+    y0 += orr[i] * xr[i] - oi[i] * xi[i];
+    y1 += orr[i + 1] * xr[i + 1] - oi[i + 1] * xi[i + 1];
+  }
+  if (i < nm) y0 += orr[i] * xr[i] - oi[i] * xi[i];
+  double d = y0 + y1;
+  for (size_t k = 0; k < nk_; ++k) d += m_.direct[k][p] * u_[k];
+  return d;
+}
+
+void ModalMarch::run(const std::vector<Corner>& corners, const std::vector<double>& times,
+                     std::vector<std::vector<double>>& out) {
+  if (rate_) rate_->assign(times.size(), 0.0);
   double tc = times.empty() ? 0.0 : times[0];
   if (!corners.empty()) tc = std::min(tc, corners[0].t);
   size_t c = 0;
   for (size_t j = 0; j < times.size(); ++j) {
     const double tq = times[j];
-    if (tail) {
+    if (tail_) {
       tail_step(tq - tc);
       tc = tq;
       if (j % 64 == 0) prune();
       rate_at(j);
-      for (size_t p = 0; p < np; ++p) {
-        double d = tail_const[p];
-        for (size_t i : slow) d += outr[p][i] * xr[i] - outi[p][i] * xi[i];
-        for (size_t f = 0; f < fast.size(); ++f)
-          d += outr[p][fast[f]] * dr[f] - outi[p][fast[f]] * di[f];
-        out[p][j] += d;
-      }
+      for (size_t p = 0; p < np_; ++p) out[p][j] += tail_value(p);
       continue;
     }
     for (; c < corners.size() && corners[c].t <= tq; ++c) {
       advance(corners[c].t - tc);
       tc = corners[c].t;
-      active = true;
-      slope[corners[c].k] += corners[c].slope;
-      slope_scale[corners[c].k] = std::max(
-          {slope_scale[corners[c].k], std::fabs(corners[c].slope), std::fabs(slope[corners[c].k])});
-      const auto& in = m.input[corners[c].k];
-      for (size_t i = 0; i < nm; ++i)
-        gr[i] += in[i].real() * corners[c].slope, gi[i] += in[i].imag() * corners[c].slope;
+      take_corner(corners[c]);
     }
     advance(tq - tc);
     tc = tq;
-    if (!active) continue;
+    if (!active_) continue;
     if (c == corners.size() && j + 1 < times.size()) enter_tail(times.back() - tc);
     rate_at(j);
-    for (size_t p = 0; p < np; ++p) {
-      const double *orr = outr[p].data(), *oi = outi[p].data();
-      double y0 = 0, y1 = 0;  // two partial sums: a shorter dependency chain
-      size_t i = 0;
-      for (; i + 1 < nm; i += 2) {
-        y0 += orr[i] * xr[i] - oi[i] * xi[i];
-        y1 += orr[i + 1] * xr[i + 1] - oi[i + 1] * xi[i + 1];
-      }
-      if (i < nm) y0 += orr[i] * xr[i] - oi[i] * xi[i];
-      double d = y0 + y1;
-      for (size_t k = 0; k < nk; ++k) d += m.direct[k][p] * u[k];
-      out[p][j] += d;
-    }
+    for (size_t p = 0; p < np_; ++p) out[p][j] += value(p);
   }
+}
+
+}  // namespace
+
+void LtiResponses::modal_add(const std::vector<SourceInput>& inputs,
+                             const std::vector<double>& times, double uniform_dt,
+                             std::vector<std::vector<double>>& out, ModeRates* rates) const {
+  const size_t nk = std::min(sources_.size(), inputs.size());
+  std::vector<Corner> corners;
+  for (size_t k = 0; k < nk; ++k)
+    for (const Ramp& r : inputs[k].ramps) corners.push_back({r.t, k, r.slope});
+  std::stable_sort(corners.begin(), corners.end(),
+                   [](const Corner& a, const Corner& b) { return a.t < b.t; });
+  ModalMarch march(*model_, labels_.size(), nk, uniform_dt, rates ? &rates->probe_weight : nullptr,
+                   rates ? rates->threshold : 0.0, rates ? &rates->rate : nullptr);
+  march.run(corners, times, out);
 }
 
 std::vector<std::vector<double>> LtiResponses::values(const std::vector<SourceInput>& inputs,
