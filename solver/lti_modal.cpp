@@ -1,0 +1,506 @@
+// The LTI engine's output from the reduced model (solver/lti.h): the modes marched over the
+// query times (LtiResponses::modal_add) and the output grid refined where the response bends
+// (LtiResponses::modal_waveform).
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <complex>
+#include <functional>
+#include <vector>
+
+#include "solver/lti.h"
+#include "solver/lti_internal.h"
+
+namespace isolink {
+
+using lti_internal::coarsest_grid_step;
+using lti_internal::Phi;
+using lti_internal::phi;
+using lti_internal::Rows;
+
+namespace {
+
+// A piecewise-linear input's corner: at t, source k's slope changes by `slope`.
+struct Corner {
+  double t;
+  size_t k;
+  double slope;
+};
+
+// One step h of every mode: e^{ph}, h phi1(ph), h^2 phi2(ph) as real and imaginary parts.
+struct ModalStep {
+  double h = -1;
+  std::vector<double> er, ei, f1r, f1i, f2r, f2i;
+  void set(const ReducedModel& m, double step) {
+    h = step;
+    const size_t n = m.poles.size();
+    for (auto* v : {&er, &ei, &f1r, &f1i, &f2r, &f2i}) v->resize(n);
+    for (size_t i = 0; i < n; ++i) {
+      const Phi f = phi(m.poles[i] * step);
+      const std::complex<double> f1 = step * f.phi1, f2 = step * step * f.phi2;
+      er[i] = f.e.real(), ei[i] = f.e.imag();
+      f1r[i] = f1.real(), f1i[i] = f1.imag(), f2r[i] = f2.real(), f2i[i] = f2.imag();
+    }
+  }
+};
+
+// The march of LtiResponses::modal_add: the modes' states from corner to corner and query to
+// query, the tail past the last corner, and the mode rates (ModeRates) when asked. The model
+// and the rate arguments must outlive it.
+class ModalMarch {
+ public:
+  // probe_weight, threshold and rate: ModeRates's, or nullptr (no rates).
+  ModalMarch(const ReducedModel& m, size_t np, size_t nk, double uniform_dt,
+             const std::vector<double>* probe_weight, double threshold, std::vector<double>* rate);
+
+  // Adds the response to the corners (sorted by time) at `times` into out[p][j].
+  void run(const std::vector<Corner>& corners, const std::vector<double>& times,
+           std::vector<std::vector<double>>& out);
+
+ private:
+  const ModalStep* step_for(double h);
+  void advance(double h);
+  void take_corner(const Corner& corner);
+  void enter_tail(double left);
+  void tail_step(double h);
+  void prune();
+  void start_rates(const std::vector<double>& probe_weight, double threshold);
+  void rate_at(size_t j);
+  double tail_value(size_t p) const;
+  double value(size_t p) const;
+
+  // Past the last corner: see enter_tail.
+  static constexpr double kTailTol = 1e-13;
+
+  const ReducedModel& m_;
+  const size_t nm_, np_, nk_;
+  std::vector<double>* rate_;
+  // Per mode, as real and imaginary parts in separate arrays (the loops below vectorise): its
+  // state x, its input b = sum_k in_k (u_k - u_k(start)) and that input's slope g.
+  std::vector<double> xr_, xi_, br_, bi_, gr_, gi_;
+  std::vector<std::vector<double>> outr_, outi_;  // [p][mode]
+  std::vector<double> u_, slope_;                 // u_k - initial, and its slope
+  // The uniform step, and a few recent others (a pass over the midpoints of a locally refined
+  // grid repeats a handful of gaps: twice each refinement level's step).
+  ModalStep uniform_;
+  std::array<ModalStep, 8> recent_;
+  size_t next_recent_ = 0;
+  bool active_ = false;              // a corner has passed: before it everything is zero
+  std::vector<double> slope_scale_;  // largest |slope| a source has had
+  bool tail_ = false;
+  std::vector<size_t> slow_, fast_;  // mode indices in the tail; fast ones are dropped when decayed
+  std::vector<double> dr_, di_;      // per fast mode: d = x - x_ss
+  std::vector<double> tail_const_;   // per probe: what the modes settle to, and the direct term
+  std::vector<double> tail_scale_;   // per probe: |tail_const| + sum |out d| at the tail's start
+  // ModeRates: each mode's weight on the probes (squared, over the threshold squared), and 1 / p
+  // and 1 / p^2 as real arrays, and |p|.
+  std::vector<double> w2_, ipr_, ipi_, ip2r_, ip2i_, speed_;
+};
+
+ModalMarch::ModalMarch(const ReducedModel& m, size_t np, size_t nk, double uniform_dt,
+                       const std::vector<double>* probe_weight, double threshold,
+                       std::vector<double>* rate)
+    : m_(m), nm_(m.poles.size()), np_(np), nk_(nk), rate_(rate) {
+  const size_t nm = nm_;
+  for (auto* v : {&xr_, &xi_, &br_, &bi_, &gr_, &gi_}) v->assign(nm, 0.0);
+  outr_.assign(np, std::vector<double>(nm));
+  outi_ = outr_;
+  for (size_t p = 0; p < np; ++p)
+    for (size_t i = 0; i < nm; ++i)
+      outr_[p][i] = m.output[p][i].real(), outi_[p][i] = m.output[p][i].imag();
+  u_.assign(nk, 0.0);
+  slope_.assign(nk, 0.0);
+  slope_scale_.assign(nk, 0.0);
+  if (uniform_dt > 0) uniform_.set(m, uniform_dt);
+  if (rate_) start_rates(*probe_weight, threshold);
+}
+
+// A cached step serves any h within 1e-9 of it: times t0 + i dt differ from i dt by rounding
+// of t0 (1e-11 relative at 100 us on a 1 ns step); the states are not moved in time by it
+// (each query restarts from its own time), only the phase e^{ph} is off by |p| 1e-9 h.
+const ModalStep* ModalMarch::step_for(double h) {
+  if (std::fabs(h - uniform_.h) <= 1e-9 * uniform_.h) return &uniform_;
+  for (const ModalStep& st : recent_)
+    if (std::fabs(h - st.h) <= 1e-9 * st.h) return &st;
+  ModalStep& st = recent_[next_recent_];
+  next_recent_ = (next_recent_ + 1) % recent_.size();
+  st.set(m_, h);
+  return &st;
+}
+
+void ModalMarch::advance(double h) {
+  if (!(h > 0) || !active_) return;
+  const ModalStep* st = step_for(h);
+  const double *er = st->er.data(), *ei = st->ei.data(), *f1r = st->f1r.data(),
+               *f1i = st->f1i.data(), *f2r = st->f2r.data(), *f2i = st->f2i.data();
+  double *xr = xr_.data(), *xi = xi_.data(), *br = br_.data(), *bi = bi_.data();
+  const double *gr = gr_.data(), *gi = gi_.data();
+  for (size_t i = 0; i < nm_; ++i) {
+    const double nr = er[i] * xr[i] - ei[i] * xi[i] + f1r[i] * br[i] - f1i[i] * bi[i] +
+                      f2r[i] * gr[i] - f2i[i] * gi[i];
+    const double ni = er[i] * xi[i] + ei[i] * xr[i] + f1r[i] * bi[i] + f1i[i] * br[i] +
+                      f2r[i] * gi[i] + f2i[i] * gr[i];
+    xr[i] = nr, xi[i] = ni;
+    br[i] += gr[i] * h, bi[i] += gi[i] * h;
+  }
+  for (size_t k = 0; k < nk_; ++k) u_[k] += slope_[k] * h;
+}
+
+// The corner's slope change joins its source's slope and every mode's input slope g.
+void ModalMarch::take_corner(const Corner& corner) {
+  active_ = true;
+  slope_[corner.k] += corner.slope;
+  slope_scale_[corner.k] =
+      std::max({slope_scale_[corner.k], std::fabs(corner.slope), std::fabs(slope_[corner.k])});
+  const auto& in = m_.input[corner.k];
+  for (size_t i = 0; i < nm_; ++i)
+    gr_[i] += in[i].real() * corner.slope, gi_[i] += in[i].imag() * corner.slope;
+}
+
+// Tail: past the last corner, with every source's slope back to zero (up to rounding), each
+// mode's input b is constant. A mode that decays within what is left of the record (|Re p|
+// times the span left above 1) is written x = x_ss + d, x_ss = -b / p its steady state, and
+// d just decays by e^{p h}: its share of a probe is the constant Re(out x_ss) plus Re(out d),
+// and once max_p |out_pi d_i| is below kTailTol of that probe's scale it leaves the loop for
+// good (|e^{p h}| < 1). Slower modes keep the exact update. A long record after the last edge
+// (the worst-case search's edge response: 160,000 samples) then costs the slow modes alone.
+void ModalMarch::enter_tail(double left) {
+  for (size_t k = 0; k < nk_; ++k)
+    if (std::fabs(slope_[k]) > 1e-12 * slope_scale_[k]) return;
+  tail_const_.assign(np_, 0.0);
+  tail_scale_.assign(np_, 0.0);
+  for (size_t p = 0; p < np_; ++p)
+    for (size_t k = 0; k < nk_; ++k) tail_const_[p] += m_.direct[k][p] * u_[k];
+  for (size_t i = 0; i < nm_; ++i) {
+    const std::complex<double> pole = m_.poles[i];
+    if (!(-pole.real() * left > 1.0)) {
+      slow_.push_back(i);
+      continue;
+    }
+    const std::complex<double> xss = -std::complex<double>(br_[i], bi_[i]) / pole;
+    fast_.push_back(i);
+    dr_.push_back(xr_[i] - xss.real());
+    di_.push_back(xi_[i] - xss.imag());
+    for (size_t p = 0; p < np_; ++p) {
+      tail_const_[p] += outr_[p][i] * xss.real() - outi_[p][i] * xss.imag();
+      tail_scale_[p] += std::abs(m_.output[p][i]) * std::hypot(dr_.back(), di_.back());
+    }
+  }
+  for (size_t p = 0; p < np_; ++p) tail_scale_[p] += std::fabs(tail_const_[p]);
+  tail_ = true;
+}
+
+// One tail step of h: the slow modes' exact update, the fast ones' decay.
+void ModalMarch::tail_step(double h) {
+  if (!(h > 0)) return;
+  const ModalStep* st = step_for(h);
+  for (size_t i : slow_) {
+    const double nr =
+        st->er[i] * xr_[i] - st->ei[i] * xi_[i] + st->f1r[i] * br_[i] - st->f1i[i] * bi_[i];
+    const double ni =
+        st->er[i] * xi_[i] + st->ei[i] * xr_[i] + st->f1r[i] * bi_[i] + st->f1i[i] * br_[i];
+    xr_[i] = nr, xi_[i] = ni;
+  }
+  for (size_t f = 0; f < fast_.size(); ++f) {
+    const size_t i = fast_[f];
+    const double nr = st->er[i] * dr_[f] - st->ei[i] * di_[f];
+    const double ni = st->er[i] * di_[f] + st->ei[i] * dr_[f];
+    dr_[f] = nr, di_[f] = ni;
+  }
+}
+
+// Drops the fast modes whose share of every probe has decayed below kTailTol of its scale.
+void ModalMarch::prune() {
+  size_t kept = 0;
+  for (size_t f = 0; f < fast_.size(); ++f) {
+    const size_t i = fast_[f];
+    const double d = std::hypot(dr_[f], di_[f]);
+    bool live = false;
+    for (size_t p = 0; p < np_ && !live; ++p)
+      live = std::abs(m_.output[p][i]) * d > kTailTol * tail_scale_[p];
+    if (!live) continue;
+    fast_[kept] = i, dr_[kept] = dr_[f], di_[kept] = di_[f];
+    ++kept;
+  }
+  fast_.resize(kept), dr_.resize(kept), di_.resize(kept);
+}
+
+// ModeRates: each mode's weight on the probes (squared, over the threshold squared), and the
+// transient part d = x - x_ss of its state (x_ss = -(b + g t) / p - g / p^2 follows the input;
+// d decays as e^{p t}), from 1 / p and 1 / p^2 kept as real arrays.
+void ModalMarch::start_rates(const std::vector<double>& probe_weight, double threshold) {
+  w2_.assign(nm_, 0.0);
+  for (size_t p = 0; p < np_ && p < probe_weight.size(); ++p)
+    for (size_t i = 0; i < nm_; ++i)
+      w2_[i] = std::max(w2_[i], probe_weight[p] * std::abs(m_.output[p][i]));
+  for (size_t i = 0; i < nm_; ++i) {
+    w2_[i] = w2_[i] * w2_[i] / (threshold * threshold);
+    const std::complex<double> ip = 1.0 / m_.poles[i], ip2 = ip * ip;
+    ipr_.push_back(ip.real()), ipi_.push_back(ip.imag());
+    ip2r_.push_back(ip2.real()), ip2i_.push_back(ip2.imag());
+    speed_.push_back(std::abs(m_.poles[i]));
+  }
+}
+
+void ModalMarch::rate_at(size_t j) {
+  if (!rate_) return;
+  double fastest = 0.0;
+  auto consider = [&](size_t i, double d_r, double d_i) {
+    if (w2_[i] * (d_r * d_r + d_i * d_i) > 1.0) fastest = std::max(fastest, speed_[i]);
+  };
+  const std::vector<double>&xr = xr_, &xi = xi_, &br = br_, &bi = bi_, &gr = gr_, &gi = gi_;
+  const std::vector<double>&ipr = ipr_, &ipi = ipi_, &ip2r = ip2r_, &ip2i = ip2i_;
+  if (!tail_) {
+    for (size_t i = 0; i < nm_; ++i)
+      consider(i, xr[i] + br[i] * ipr[i] - bi[i] * ipi[i] + gr[i] * ip2r[i] - gi[i] * ip2i[i],
+               xi[i] + br[i] * ipi[i] + bi[i] * ipr[i] + gr[i] * ip2i[i] + gi[i] * ip2r[i]);
+  } else {
+    for (size_t i : slow_)
+      consider(i, xr[i] + br[i] * ipr[i] - bi[i] * ipi[i], xi[i] + br[i] * ipi[i] + bi[i] * ipr[i]);
+    for (size_t f = 0; f < fast_.size(); ++f) consider(fast_[f], dr_[f], di_[f]);
+  }
+  (*rate_)[j] = fastest;
+}
+
+// Probe p's value in the tail.
+double ModalMarch::tail_value(size_t p) const {
+  double d = tail_const_[p];
+  for (size_t i : slow_) d += outr_[p][i] * xr_[i] - outi_[p][i] * xi_[i];
+  for (size_t f = 0; f < fast_.size(); ++f)
+    d += outr_[p][fast_[f]] * dr_[f] - outi_[p][fast_[f]] * di_[f];
+  return d;
+}
+
+// Probe p's value before the tail.
+double ModalMarch::value(size_t p) const {
+  const double *orr = outr_[p].data(), *oi = outi_[p].data();
+  const double *xr = xr_.data(), *xi = xi_.data();
+  const size_t nm = nm_;
+  double y0 = 0, y1 = 0;  // two partial sums: a shorter dependency chain
+  size_t i = 0;
+  for (; i + 1 < nm; i += 2) {
+    y0 += orr[i] * xr[i] - oi[i] * xi[i];
+    y1 += orr[i + 1] * xr[i + 1] - oi[i + 1] * xi[i + 1];
+  }
+  if (i < nm) y0 += orr[i] * xr[i] - oi[i] * xi[i];
+  double d = y0 + y1;
+  for (size_t k = 0; k < nk_; ++k) d += m_.direct[k][p] * u_[k];
+  return d;
+}
+
+void ModalMarch::run(const std::vector<Corner>& corners, const std::vector<double>& times,
+                     std::vector<std::vector<double>>& out) {
+  if (rate_) rate_->assign(times.size(), 0.0);
+  double tc = times.empty() ? 0.0 : times[0];
+  if (!corners.empty()) tc = std::min(tc, corners[0].t);
+  size_t c = 0;
+  for (size_t j = 0; j < times.size(); ++j) {
+    const double tq = times[j];
+    if (tail_) {
+      tail_step(tq - tc);
+      tc = tq;
+      if (j % 64 == 0) prune();
+      rate_at(j);
+      for (size_t p = 0; p < np_; ++p) out[p][j] += tail_value(p);
+      continue;
+    }
+    for (; c < corners.size() && corners[c].t <= tq; ++c) {
+      advance(corners[c].t - tc);
+      tc = corners[c].t;
+      take_corner(corners[c]);
+    }
+    advance(tq - tc);
+    tc = tq;
+    if (!active_) continue;
+    if (c == corners.size() && j + 1 < times.size()) enter_tail(times.back() - tc);
+    rate_at(j);
+    for (size_t p = 0; p < np_; ++p) out[p][j] += value(p);
+  }
+}
+
+}  // namespace
+
+void LtiResponses::modal_add(const std::vector<SourceInput>& inputs,
+                             const std::vector<double>& times, double uniform_dt,
+                             std::vector<std::vector<double>>& out, ModeRates* rates) const {
+  const size_t nk = std::min(sources_.size(), inputs.size());
+  std::vector<Corner> corners;
+  for (size_t k = 0; k < nk; ++k)
+    for (const Ramp& r : inputs[k].ramps) corners.push_back({r.t, k, r.slope});
+  std::stable_sort(corners.begin(), corners.end(),
+                   [](const Corner& a, const Corner& b) { return a.t < b.t; });
+  ModalMarch march(*model_, labels_.size(), nk, uniform_dt, rates ? &rates->probe_weight : nullptr,
+                   rates ? rates->threshold : 0.0, rates ? &rates->rate : nullptr);
+  march.run(corners, times, out);
+}
+
+namespace {
+
+// The reduced model's first grid level: the uniform grid of step dt, plus every corner inside the
+// span as a row of its own.
+std::vector<double> first_level(double tstart, double tstop, double dt,
+                                const std::vector<double>& corners) {
+  std::vector<double> t;
+  const long count = static_cast<long>(std::floor((tstop - tstart) / dt * (1 + 1e-12))) + 1;
+  for (long i = 0; i < count; ++i) t.push_back(tstart + static_cast<double>(i) * dt);
+  t.insert(t.end(), corners.begin(), corners.end());
+  std::sort(t.begin(), t.end());
+  std::vector<double> out;  // closer than 1e-6 dt: one row (the uniform one first)
+  for (double x : t)
+    if (out.empty() || x >= out.back() + 1e-6 * dt) out.push_back(x);
+  return out;
+}
+
+// GridOptions' rule by local refinement, as adaptive quadrature refines: every interval not yet
+// accepted is tested at its midpoint; one that fails is split there (the midpoint, already
+// computed, becomes a row) and its two halves are tested in the next pass. Each pass evaluates
+// only the new midpoints. A midpoint alone can be fooled by a mode that turns through a whole
+// period inside the interval (0, 0 and 0 at its ends and middle: the 15 m transformer link's
+// ringing was 9 mV off that way), so an interval is also split while it is longer than 1 / |p|
+// of the fastest mode still active at either end (`evaluate` gives those rates, ModeRates): the
+// grid is sized from the circuit's time constants where they act. Returns the finest step; sets
+// `warning` when max_rows stops it.
+using Evaluate = std::function<Rows(const std::vector<double>&, double, std::vector<double>&)>;
+double refine_grid(std::vector<double>& times, Rows& rows, const Evaluate& evaluate,
+                   const LtiResponses::GridOptions& grid, const std::vector<bool>& is_current,
+                   double dt, std::string& warning) {
+  const size_t np = is_current.size();
+  std::vector<double> mids, row_rate, mid_rate;
+  Rows mid_values;
+  {  // The first level's rows and midpoints in one pass (interleaved: dt / 2 is cached).
+    std::vector<double> all, rate;
+    all.reserve(2 * times.size());
+    for (size_t j = 0; j < times.size(); ++j) {
+      all.push_back(times[j]);
+      if (j + 1 < times.size()) all.push_back(0.5 * (times[j] + times[j + 1]));
+    }
+    rows = evaluate(all, 0.5 * dt, rate);
+    mid_values.resize(np);
+    for (size_t p = 0; p < np; ++p) {
+      mid_values[p].resize(times.size() - 1);
+      for (size_t j = 0; j + 1 < times.size(); ++j) mid_values[p][j] = rows[p][2 * j + 1];
+      for (size_t j = 0; 2 * j < all.size(); ++j) rows[p][j] = rows[p][2 * j];
+      rows[p].resize(times.size());
+    }
+    for (size_t j = 0; j < times.size(); ++j) row_rate.push_back(rate[2 * j]);
+    for (size_t j = 0; j + 1 < times.size(); ++j) mid_rate.push_back(rate[2 * j + 1]);
+  }
+  std::vector<size_t> open(times.size() - 1);  // intervals [times[i], times[i + 1]] to test
+  for (size_t i = 0; i < open.size(); ++i) open[i] = i;
+  double finest = dt;
+  while (!open.empty()) {
+    std::vector<char> split(open.size(), 0);
+    size_t splits = 0;
+    double worst = 0.0;
+    for (size_t j = 0; j < open.size(); ++j) {
+      const size_t i = open[j];
+      double e = 0.0;
+      for (size_t p = 0; p < np; ++p) {
+        if (!grid.grid_probes.empty() && (p >= grid.grid_probes.size() || !grid.grid_probes[p]))
+          continue;
+        const double scale = is_current[p] ? 1e3 : 1.0;  // 1 mV -> 1 uA
+        e = std::max(e, scale * std::fabs(mid_values[p][j] - 0.5 * (rows[p][i] + rows[p][i + 1])));
+      }
+      worst = std::max(worst, e);
+      const double rate = std::max(row_rate[i], row_rate[i + 1]);
+      if (e > 0.5 * grid.interp_tol || (times[i + 1] - times[i]) * rate > 1.0)
+        split[j] = 1, ++splits;
+    }
+    if (splits == 0) break;
+    if (static_cast<long>(times.size() + splits) > grid.max_rows) {
+      warning = fmt::format(
+          "LTI output grid stopped at {} rows (step {:g} s): linear interpolation between rows "
+          "may be off by up to {:.3g} mV, over the {:g} mV target",
+          times.size(), finest, 2e3 * worst, 1e3 * grid.interp_tol);
+      break;
+    }
+    // The failing midpoints join the rows; their halves are the next pass's intervals.
+    std::vector<double> new_times, new_rate;
+    new_times.reserve(times.size() + splits);
+    new_rate.reserve(times.size() + splits);
+    Rows new_rows(np);
+    for (auto& r : new_rows) r.reserve(times.size() + splits);
+    std::vector<size_t> new_open;
+    new_open.reserve(2 * splits);
+    size_t j = 0;
+    for (size_t i = 0; i < times.size(); ++i) {
+      new_times.push_back(times[i]);
+      new_rate.push_back(row_rate[i]);
+      for (size_t p = 0; p < np; ++p) new_rows[p].push_back(rows[p][i]);
+      if (j == open.size() || open[j] != i) continue;  // open is ascending
+      if (split[j]) {
+        new_open.push_back(new_times.size() - 1);
+        new_times.push_back(0.5 * (times[i] + times[i + 1]));
+        new_rate.push_back(mid_rate[j]);
+        for (size_t p = 0; p < np; ++p) new_rows[p].push_back(mid_values[p][j]);
+        new_open.push_back(new_times.size() - 1);
+        finest = std::min(finest, 0.5 * (times[i + 1] - times[i]));
+      }
+      ++j;
+    }
+    times = std::move(new_times);
+    row_rate = std::move(new_rate);
+    rows = std::move(new_rows);
+    open = std::move(new_open);
+    mids.resize(open.size());
+    for (size_t k = 0; k < open.size(); ++k) mids[k] = 0.5 * (times[open[k]] + times[open[k] + 1]);
+    mid_values = evaluate(mids, 0.0, mid_rate);
+  }
+  return finest;
+}
+
+}  // namespace
+
+Waveform LtiResponses::modal_waveform(const std::vector<SourceInput>& inputs,
+                                      const GridOptions& grid, const std::vector<double>& base,
+                                      GridInfo& gi) const {
+  const size_t np = labels_.size();
+  const double span = grid.tstop - grid.tstart;
+  // The modes the grid must resolve: a share over a twentieth of the tolerance on a grid probe.
+  ModeRates mode_rates;
+  mode_rates.threshold = 0.05 * grid.interp_tol;
+  for (size_t p = 0; p < np; ++p) {
+    const bool looked_at =
+        grid.grid_probes.empty() || (p < grid.grid_probes.size() && grid.grid_probes[p]);
+    mode_rates.probe_weight.push_back(!looked_at ? 0.0 : is_current_[p] ? 1e3 : 1.0);
+  }
+  auto evaluate = [&](const std::vector<double>& times, double dt, std::vector<double>& rate) {
+    Rows v(np);
+    for (size_t p = 0; p < np; ++p) v[p].assign(times.size(), base[p]);
+    modal_add(inputs, times, dt, v, &mode_rates);
+    rate = std::move(mode_rates.rate);
+    return v;
+  };
+  std::vector<double> times;
+  Rows rows;
+  double dt = grid.step;
+  if (dt > 0) {
+    times = first_level(grid.tstart, grid.tstop, dt, {});
+    rows = Rows(np);
+    for (size_t p = 0; p < np; ++p) rows[p].assign(times.size(), base[p]);
+    modal_add(inputs, times, dt, rows);
+  } else {
+    // Rows gather where the response bends (after each corner, for as long as its fast modes
+    // last) and stay coarse elsewhere: 1 ns and 1 ms time constants over 5 ms take about
+    // 66,000 rows, where uniform halving went to its 4,000,000-row limit.
+    std::vector<double> corners;
+    for (const SourceInput& in : inputs)
+      for (const Ramp& ramp : in.ramps)
+        if (ramp.t > grid.tstart && ramp.t < grid.tstop) corners.push_back(ramp.t);
+    dt = span;
+    while (dt > coarsest_grid_step(span)) dt *= 0.5;
+    gi.coarse_step = dt;
+    times = first_level(grid.tstart, grid.tstop, dt, corners);
+    dt = refine_grid(times, rows, evaluate, grid, is_current_, dt, gi.warning);
+  }
+  Waveform w;
+  w.time = std::move(times);
+  for (size_t p = 0; p < np; ++p) w.add_column(labels_[p], std::move(rows[p]));
+  gi.rows = static_cast<long>(w.time.size());
+  gi.step = dt;
+  return w;
+}
+
+}  // namespace isolink
