@@ -66,10 +66,12 @@ Status write_compare_png(const analysis::CompareResult& r, const std::string& pa
   const std::span<const double> t = r.time;
   const bool simulated = r.sim.size() == t.size();  // not for an inconclusive record
   std::vector<double> res(simulated ? t.size() : 0), res_fit;
-  for (size_t i = 0; i < res.size(); ++i) res[i] = r.capture[i] - r.sim[i];
+  // As the residual is counted: 0 where the capture sits on a rail the design exceeds (Clipping).
+  for (size_t i = 0; i < res.size(); ++i) res[i] = r.clipping.difference(r.capture[i], r.sim[i]);
   if (fitted) {
     res_fit.resize(t.size());
-    for (size_t i = 0; i < t.size(); ++i) res_fit[i] = r.capture[i] - r.sim_after_fit[i];
+    for (size_t i = 0; i < t.size(); ++i)
+      res_fit[i] = r.clipping.difference(r.capture[i], r.sim_after_fit[i]);
   }
   const Color verdict = r.verdict == "match" ? kPass : kFail;
   // Runs placed by hand: draw_runs measures a run's ink, so a trailing space vanished
