@@ -380,8 +380,18 @@ std::map<link::Direction, std::vector<double>> sweep_start_points(const SweepSpe
   WorstOptions fine = point_worst_options(s, opt);
   fine.dt /= kSynthesisOversample;
   if (!fast_path_refused(po.point.spec, opt, fine.dt).empty()) return out;
+  std::map<std::string, link::Direction> done;  // link::circuit_key -> the direction computed
   for (link::Direction d : po.point.spec.stimulus.directions) {
     if (out.count(d)) continue;
+    // A direction that is the same circuit as one done (a symmetric link) takes its points, as
+    // run_link reuses its response.
+    StatusOr<link::ExpandedLink> ex = link::expand_link(po.point.spec, parts, d, opt.run.expand);
+    if (!ex) continue;
+    const auto [same, fresh] = done.emplace(link::circuit_key(*ex), d);
+    if (!fresh) {
+      if (out.count(same->second)) out[d] = out[same->second];
+      continue;
+    }
     StatusOr<EdgeResponse> e = edge_response(po.point.spec, parts, d, fine);
     if (e && !e->expansion_points.empty()) out[d] = e->expansion_points;
   }
