@@ -65,6 +65,8 @@ class ModalMarch {
   void take_corner(const Corner& corner);
   void enter_tail(double left);
   void tail_step(double h);
+  size_t uniform_run(const std::vector<double>& times, size_t j, double tc) const;
+  void tail_block(size_t j, size_t end, std::vector<std::vector<double>>& out);
   void prune();
   void start_rates(const std::vector<double>& probe_weight, double threshold);
   void rate_at(size_t j);
@@ -211,6 +213,73 @@ void ModalMarch::tail_step(double h) {
   }
 }
 
+// How many of the queries from j on follow each other (and tc) by the uniform step: the run
+// tail_block takes.
+size_t ModalMarch::uniform_run(const std::vector<double>& times, size_t j, double tc) const {
+  if (!(uniform_.h > 0)) return 0;
+  const double tol = 1e-9 * uniform_.h;
+  size_t end = j;
+  for (double prev = tc; end < times.size() && std::fabs(times[end] - prev - uniform_.h) <= tol;
+       ++end)
+    prev = times[end];
+  return end - j;
+}
+
+// Queries j..end-1 of the tail on the uniform step, mode by mode rather than query by query (the
+// same updates and sums as tail_step, prune and tail_value, in another order: a mode's state
+// stays in registers over the whole run, and a long record costs its few live modes alone).
+void ModalMarch::tail_block(size_t j, size_t end, std::vector<std::vector<double>>& out) {
+  const ModalStep& st = uniform_;
+  for (size_t p = 0; p < np_; ++p)
+    for (size_t q = j; q < end; ++q) out[p][q] += tail_const_[p];
+  for (size_t i : slow_) {  // x <- e x + f1 b (b constant in the tail)
+    const double er = st.er[i], ei = st.ei[i];
+    const double cr = st.f1r[i] * br_[i] - st.f1i[i] * bi_[i];
+    const double ci = st.f1r[i] * bi_[i] + st.f1i[i] * br_[i];
+    for (size_t p = 0; p < np_; ++p) {
+      double xr = xr_[i], xi = xi_[i];
+      const double o_r = outr_[p][i], o_i = outi_[p][i];
+      double* y = out[p].data();
+      for (size_t q = j; q < end; ++q) {
+        const double nr = er * xr - ei * xi + cr;
+        xi = er * xi + ei * xr + ci;
+        xr = nr;
+        y[q] += o_r * xr - o_i * xi;
+      }
+      if (p + 1 == np_) xr_[i] = xr, xi_[i] = xi;
+    }
+  }
+  // Fast modes: d <- e d, dropped at the first query q (q % 64 == 0, as prune) where their share
+  // of every probe is below kTailTol of its scale.
+  size_t kept = 0;
+  for (size_t f = 0; f < fast_.size(); ++f) {
+    const size_t i = fast_[f];
+    const double er = st.er[i], ei = st.ei[i];
+    double dr = dr_[f], di = di_[f];
+    size_t stop = end;  // first query not added
+    for (size_t q = j; q < end; ++q) {
+      const double nr = er * dr - ei * di;
+      di = er * di + ei * dr;
+      dr = nr;
+      if (q % 64 == 0) {
+        const double d = std::hypot(dr, di);
+        bool live = false;
+        for (size_t p = 0; p < np_ && !live; ++p)
+          live = std::abs(m_.output[p][i]) * d > kTailTol * tail_scale_[p];
+        if (!live) {
+          stop = q;
+          break;
+        }
+      }
+      for (size_t p = 0; p < np_; ++p) out[p][q] += outr_[p][i] * dr - outi_[p][i] * di;
+    }
+    if (stop < end) continue;  // dropped
+    fast_[kept] = i, dr_[kept] = dr, di_[kept] = di;
+    ++kept;
+  }
+  fast_.resize(kept), dr_.resize(kept), di_.resize(kept);
+}
+
 // Drops the fast modes whose share of every probe has decayed below kTailTol of its scale.
 void ModalMarch::prune() {
   size_t kept = 0;
@@ -298,6 +367,14 @@ void ModalMarch::run(const std::vector<Corner>& corners, const std::vector<doubl
   size_t c = 0;
   for (size_t j = 0; j < times.size(); ++j) {
     const double tq = times[j];
+    if (tail_ && !rate_) {
+      if (const size_t run = uniform_run(times, j, tc); run >= 64) {
+        tail_block(j, j + run, out);
+        j += run - 1;
+        tc = times[j];
+        continue;
+      }
+    }
     if (tail_) {
       tail_step(tq - tc);
       tc = tq;

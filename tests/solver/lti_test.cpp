@@ -141,20 +141,22 @@ TEST(Lti, PulseTrainThroughRcIsTheSumOfRampsAtExactCorners) {
 
 // The reduced model's batch evaluation long after the last corner, where it lets the modes that
 // have decayed go (the worst-case search's edge response: 160,000 samples after one edge): the
-// same values as the closed form per ramp (value()), with a fast mode (10 ns) and a slow one
-// (50 us, still moving at the end), on a uniform grid and at times off it.
+// same values as the closed form per ramp (value()), with a fast mode (10 ns), one that decays
+// within the record (50 us) and one that does not (1 ms: the tail marches it exactly), on a
+// uniform grid (taken mode by mode) and at times off it.
 TEST(Lti, BatchValuesLongAfterTheLastCornerEqualTheClosedForm) {
   auto b = make({card("v1", {"in", "0"}, {call("pwl", {0, 0, 10e-9, 1})}),
                  card("r1", {"in", "a"}, {num(1e3)}), card("c1", {"a", "0"}, {num(10e-12)}),
-                 card("r2", {"in", "b"}, {num(10e3)}), card("c2", {"b", "0"}, {num(5e-9)})},
-                {"v(a)", "v(b)", "v(a,b)", "v(in)"});
+                 card("r2", {"in", "b"}, {num(10e3)}), card("c2", {"b", "0"}, {num(5e-9)}),
+                 card("r3", {"in", "c"}, {num(100e3)}), card("c3", {"c", "0"}, {num(10e-9)})},
+                {"v(a)", "v(b)", "v(a,b)", "v(in)", "v(c)"});
   LtiResponses lti = responses(*b, 200e-6, Method::Reduced);
   const auto inputs = lti.netlist_inputs(200e-6);
   std::vector<double> times;
   for (int i = 0; i <= 100'000; ++i) times.push_back(i * 1e-9);
   for (double t : {100.0003e-6, 100.7e-6, 131e-6, 199.9e-6}) times.push_back(t);
   const auto batch = lti.values(inputs, times);
-  for (size_t p = 0; p < 4; ++p) {
+  for (size_t p = 0; p < 5; ++p) {
     SCOPED_TRACE(lti.probe_labels()[p]);
     double dev = 0;
     for (size_t j = 0; j < times.size(); ++j)
@@ -169,6 +171,7 @@ TEST(Lti, BatchValuesLongAfterTheLastCornerEqualTheClosedForm) {
   for (size_t j = 0; j < times.size(); j += 997) {
     EXPECT_NEAR(batch[0][j], lag(times[j], 10e-9), 2e-5);
     EXPECT_NEAR(batch[1][j], lag(times[j], 50e-6), 2e-5);
+    EXPECT_NEAR(batch[4][j], lag(times[j], 1e-3), 2e-5);
   }
   EXPECT_NEAR(batch[1].back(), 1 - std::exp(-(199.9e-6 - 5e-9) / 50e-6), 2e-5);
   // The driven node itself (partly the model's direct term): the source, to rounding.
