@@ -22,10 +22,21 @@ EXTERNAL = {"tests/general/rc.cir"}  # ngspice's own test deck (README, "Solver"
 LINK = re.compile(r"\]\(([^)#\s]+)(?:#[^)]*)?\)")
 
 
+def tracked_pages(root: pathlib.Path):
+    """The .md files git tracks, or None outside a git work tree or without git (an exported
+    tree, as the README's bare-root recipe makes with `git archive`)."""
+    try:
+        out = subprocess.run(["git", "ls-files", "*.md"], cwd=root, capture_output=True, text=True)
+    except OSError:
+        return None
+    return out.stdout.split() if out.returncode == 0 else None
+
+
 def pages(root: pathlib.Path):
-    out = subprocess.run(["git", "ls-files", "*.md"], cwd=root, capture_output=True, text=True)
-    names = out.stdout.split() if out.returncode == 0 else [
-        p.relative_to(root).as_posix() for p in root.rglob("*.md") if "build" not in p.parts[0]]
+    names = tracked_pages(root)
+    if names is None:  # every page outside build folders and reports/out
+        names = [p.relative_to(root).as_posix() for p in root.rglob("*.md")
+                 if not p.relative_to(root).parts[0].startswith(("build", ".git"))]
     for name in names:
         parts = name.split("/")
         # The top README, docs/, and each folder's own README (not data folders' notes).
