@@ -68,6 +68,7 @@ class ModalMarch {
   size_t uniform_run(const std::vector<double>& times, size_t j, double tc) const;
   void tail_block(size_t j, size_t end, std::vector<std::vector<double>>& out);
   void prune();
+  bool fast_mode_live(size_t i, double dr, double di) const;
   void start_rates(const std::vector<double>& probe_weight, double threshold);
   void rate_at(size_t j);
   double tail_value(size_t p) const;
@@ -261,15 +262,9 @@ void ModalMarch::tail_block(size_t j, size_t end, std::vector<std::vector<double
       const double nr = er * dr - ei * di;
       di = er * di + ei * dr;
       dr = nr;
-      if (q % 64 == 0) {
-        const double d = std::hypot(dr, di);
-        bool live = false;
-        for (size_t p = 0; p < np_ && !live; ++p)
-          live = std::abs(m_.output[p][i]) * d > kTailTol * tail_scale_[p];
-        if (!live) {
-          stop = q;
-          break;
-        }
+      if (q % 64 == 0 && !fast_mode_live(i, dr, di)) {
+        stop = q;
+        break;
       }
       for (size_t p = 0; p < np_; ++p) out[p][q] += outr_[p][i] * dr - outi_[p][i] * di;
     }
@@ -280,16 +275,20 @@ void ModalMarch::tail_block(size_t j, size_t end, std::vector<std::vector<double
   fast_.resize(kept), dr_.resize(kept), di_.resize(kept);
 }
 
+// Whether fast mode i, its transient part at d, still moves some probe by kTailTol of its scale.
+bool ModalMarch::fast_mode_live(size_t i, double dr, double di) const {
+  const double d = std::hypot(dr, di);
+  for (size_t p = 0; p < np_; ++p)
+    if (std::abs(m_.output[p][i]) * d > kTailTol * tail_scale_[p]) return true;
+  return false;
+}
+
 // Drops the fast modes whose share of every probe has decayed below kTailTol of its scale.
 void ModalMarch::prune() {
   size_t kept = 0;
   for (size_t f = 0; f < fast_.size(); ++f) {
     const size_t i = fast_[f];
-    const double d = std::hypot(dr_[f], di_[f]);
-    bool live = false;
-    for (size_t p = 0; p < np_ && !live; ++p)
-      live = std::abs(m_.output[p][i]) * d > kTailTol * tail_scale_[p];
-    if (!live) continue;
+    if (!fast_mode_live(i, dr_[f], di_[f])) continue;
     fast_[kept] = i, dr_[kept] = dr_[f], di_[kept] = di_[f];
     ++kept;
   }

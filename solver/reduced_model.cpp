@@ -201,22 +201,33 @@ void Reducer::assemble_pencil(bool passive_form) {
 // solve per probe, z_p = A^-T l_p and H_kp = z_p' e_k: whichever is fewer (an edge response
 // drives two sources and reads one probe).
 Status Reducer::add_checks(const std::vector<double>& fs) {
+  const bool transposed = np_ < nk_;
+  std::vector<AcAnalysis::Vector> probe_rows;  // l_p, when transposed
+  std::vector<std::vector<int>> source_rows;   // the unknowns where e_k is not 0
+  if (transposed) {
+    for (size_t p = 0; p < np_; ++p) {
+      AcAnalysis::Vector& l = probe_rows.emplace_back(static_cast<size_t>(n_) + 1, 0.0);
+      l[probes_[p].a] += 1.0;
+      l[probes_[p].b] -= 1.0;
+      l[0] = 0.0;
+    }
+    for (size_t k = 0; k < nk_; ++k) {
+      std::vector<int>& rows = source_rows.emplace_back();
+      for (int i = 1; i <= n_; ++i)
+        if (excitations_[k][i] != 0) rows.push_back(i);
+    }
+  }
   for (double f : fs) {
     if (Status s = ac_.factor(f); !s.ok()) return s;
     ++st_.factorizations;
     freqs_.push_back(f);
     exact_.emplace_back(nk_, std::vector<Cplx>(np_));
     std::vector<std::vector<Cplx>>& h = exact_.back();
-    if (np_ < nk_) {
+    if (transposed) {
       for (size_t p = 0; p < np_; ++p) {
-        AcAnalysis::Vector l(static_cast<size_t>(n_) + 1, 0.0);
-        l[probes_[p].a] += 1.0;
-        l[probes_[p].b] -= 1.0;
-        l[0] = 0.0;
-        const AcAnalysis::Vector z = ac_.solve_transposed(l);
+        const AcAnalysis::Vector z = ac_.solve_transposed(probe_rows[p]);
         for (size_t k = 0; k < nk_; ++k)
-          for (int i = 1; i <= n_; ++i)
-            if (excitations_[k][i] != 0) h[k][p] += z[i] * excitations_[k][i];
+          for (int i : source_rows[k]) h[k][p] += z[i] * excitations_[k][i];
       }
     } else {
       for (size_t k = 0; k < nk_; ++k) {
