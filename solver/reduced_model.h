@@ -22,12 +22,18 @@
 //    points are added greedily at the check frequency with the largest error (the next-worst
 //    when its vectors are already in the basis), with up to `batch` - 1 more at the next-worst
 //    local maxima of the error over the grid (the other resonances the model still misses: one
-//    eigendecomposition per step rather than per point), until the error is at most `tol`. Then the
+//    model built per step rather than per point), until the error is at most `tol`. Then the
 //    grid is refined as adaptive quadrature does: the model must also pass at the geometric
 //    midpoint of every check interval (a resonance can hide between check points); an interval
 //    whose midpoint fails joins the grid as two halves, tested again at their own midpoints
 //    once the search has fixed the model there (up to max_check_points). Accepted: every check
-//    point passes and every interval's midpoint passed.
+//    point passes and every interval's midpoint passed. The models of the search are measured
+//    without their eigenvectors, through the Hessenberg form of M (solver/hessenberg_transfer.h:
+//    O(q^2) a frequency instead of the O(q^3) eigendecomposition a step); only the one that
+//    passes is diagonalised (step 2) and measured again over the whole grid. Should its modal
+//    form fail where the projection passed (step 4's dropped poles), the search goes on with the
+//    modal form at every step. On the corpus's 72 m transformer link (order 658, 26 steps) this
+//    took the model from 30 s to 10 s, with the same expansion points and the same output.
 // 4. A pole in the right half plane is a projection artefact (the circuits here are passive). It
 //    is kept when it is so slow that it cannot grow over `horizon` (Re p horizon < 1e-3), and
 //    dropped otherwise, before the check: a model that needed it fails the check there, and the
@@ -103,7 +109,7 @@ struct ReducedModelStats {
   int dropped = 0;            // right-half-plane poles dropped (step 4)
   double dropped_weight = 0;  // the largest of their weights |out in / p| over the peak
   int expansion_points = 0;
-  int steps = 0;               // models built and checked, one eigendecomposition each
+  int steps = 0;               // models built and checked
   double error = 0.0;          // the check's error (relative)
   double error_frequency = 0;  // Hz, where it is largest
   int factorizations = 0;      // complex sparse LUs (expansion points and check)

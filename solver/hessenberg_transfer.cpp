@@ -1,0 +1,174 @@
+#include "solver/hessenberg_transfer.h"
+
+#include <cmath>
+#include <utility>
+
+namespace isolink {
+
+Status HessenbergTransfer::set(const Eigen::MatrixXd& g, const Eigen::MatrixXd& c,
+                               const Eigen::MatrixXd& b, const Eigen::MatrixXd& l, double sigma) {
+  q_ = static_cast<int>(g.rows());
+  sigma_ = sigma;
+  lq_.resize(l.rows(), q_);
+  qab_.resize(q_, b.cols());
+  if (q_ == 0) return Status::Ok();
+  Eigen::PartialPivLU<Eigen::MatrixXd> a(g + sigma * c);
+  const Eigen::MatrixXd m = a.solve(c);
+  const Eigen::MatrixXd ab = a.solve(b);
+  if (!m.allFinite() || !ab.allFinite())
+    return Status::Error("reduced model: the projected system is singular");
+  Eigen::HessenbergDecomposition<Eigen::MatrixXd> hd(m);
+  const Eigen::MatrixXd q = hd.matrixQ();
+  t_ = hd.matrixH();
+  lq_ = l * q;
+  qab_ = q.transpose() * ab;
+  return Status::Ok();
+}
+
+Eigen::MatrixXcd HessenbergTransfer::at(std::complex<double> s) const {
+  if (q_ == 0) return Eigen::MatrixXcd::Zero(qab_.cols(), lq_.rows());
+  return lq_.rows() <= qab_.cols() ? at_by_probes(s.real() - sigma_, s.imag())
+                                   : at_by_sources(s.real() - sigma_, s.imag());
+}
+
+// With A = I + z T eliminated as E A = U (E the row swaps and multipliers, U upper triangular),
+// H_kp = y_p' Q'A^-1B_k where A' y_p = (L Q)_p', that is U' w_p = (L Q)_p' and y_p = E' w_p.
+// U's rows come out of the elimination in the order the forward substitution of U' w = c uses
+// them (row j final after step j, and it updates c past j), so neither U nor the shifted matrix
+// is stored: two row buffers, and T read once. Cost per frequency about (9 + 8 (np - 1)) q^2
+// flops against 12 q^2 + 4 q^2 (nk - 1) for the sources' path below.
+Eigen::MatrixXcd HessenbergTransfer::at_by_probes(double zr, double zi) const {
+  const int q = q_, nk = static_cast<int>(qab_.cols()), np = static_cast<int>(lq_.rows());
+  re_.resize(4 * static_cast<size_t>(q));
+  double *ar = re_.data(), *ai = ar + q, *br = ai + q, *bi = br + q;  // rows j and j + 1
+  xr_.assign(static_cast<size_t>(np) * q, 0.0);                       // c, then w, then y
+  xi_.assign(static_cast<size_t>(np) * q, 0.0);
+  for (int p = 0; p < np; ++p)
+    for (int i = 0; i < q; ++i) xr_[static_cast<size_t>(p) * q + i] = lq_(p, i);
+  mult_.resize(q);
+  swapped_.resize(q);
+  auto shifted_row = [&](int i, double* r, double* m) {  // row i of I + z T, from column i - 1
+    const double* t = t_.data() + static_cast<size_t>(i) * q;
+    for (int c = std::max(0, i - 1); c < q; ++c) r[c] = zr * t[c], m[c] = zi * t[c];
+    r[i] += 1.0;
+  };
+  shifted_row(0, ar, ai);
+  for (int j = 0; j < q; ++j) {
+    if (j + 1 < q) {
+      shifted_row(j + 1, br, bi);
+      swapped_[j] = br[j] * br[j] + bi[j] * bi[j] > ar[j] * ar[j] + ai[j] * ai[j];
+      if (swapped_[j]) std::swap(ar, br), std::swap(ai, bi);
+      const std::complex<double> l =
+          std::complex<double>(br[j], bi[j]) / std::complex<double>(ar[j], ai[j]);
+      mult_[j] = l;
+      const double lr = l.real(), li = l.imag();
+      for (int c = j + 1; c < q; ++c) {
+        br[c] -= lr * ar[c] - li * ai[c];
+        bi[c] -= lr * ai[c] + li * ar[c];
+      }
+    }
+    // Row j of U is final: w_j, and its share taken from c past j.
+    const std::complex<double> u = 1.0 / std::complex<double>(ar[j], ai[j]);
+    for (int p = 0; p < np; ++p) {
+      double* cr = xr_.data() + static_cast<size_t>(p) * q;
+      double* ci = xi_.data() + static_cast<size_t>(p) * q;
+      const std::complex<double> w = std::complex<double>(cr[j], ci[j]) * u;
+      cr[j] = w.real(), ci[j] = w.imag();
+      const double wr = w.real(), wi = w.imag();
+      for (int c = j + 1; c < q; ++c) {
+        cr[c] -= wr * ar[c] - wi * ai[c];
+        ci[c] -= wr * ai[c] + wi * ar[c];
+      }
+    }
+    std::swap(ar, br), std::swap(ai, bi);
+  }
+  // y = E' w: E = E_{q-2} ... E_0 with E_j = (I - l_j e_{j+1} e_j') P_j, so E' applies E_j'
+  // from j = q - 2 down: w_j -= l_j w_{j+1}, then rows j and j + 1 swapped where P_j swapped.
+  Eigen::MatrixXcd h(nk, np);
+  for (int p = 0; p < np; ++p) {
+    double* cr = xr_.data() + static_cast<size_t>(p) * q;
+    double* ci = xi_.data() + static_cast<size_t>(p) * q;
+    for (int j = q - 2; j >= 0; --j) {
+      const std::complex<double> y = std::complex<double>(cr[j], ci[j]) -
+                                     mult_[j] * std::complex<double>(cr[j + 1], ci[j + 1]);
+      cr[j] = y.real(), ci[j] = y.imag();
+      if (swapped_[j]) std::swap(cr[j], cr[j + 1]), std::swap(ci[j], ci[j + 1]);
+    }
+    for (int k = 0; k < nk; ++k) {
+      double hr = 0, hi = 0;
+      for (int i = 0; i < q; ++i) hr += cr[i] * qab_(i, k), hi += ci[i] * qab_(i, k);
+      h(k, p) = {hr, hi};
+    }
+  }
+  return h;
+}
+
+// (I + z T) x = Q' A^-1 B by elimination down the subdiagonal (rows j and j + 1 swapped where
+// the lower one's entry is larger), then back substitution. Only the Hessenberg part of the
+// work array is touched. The arithmetic is written out in real and imaginary parts so that the
+// row updates vectorise.
+Eigen::MatrixXcd HessenbergTransfer::at_by_sources(double zr, double zi) const {
+  const int q = q_, nk = static_cast<int>(qab_.cols()), np = static_cast<int>(lq_.rows());
+  Eigen::MatrixXcd h(nk, np);
+  re_.resize(static_cast<size_t>(q) * q);
+  im_.resize(static_cast<size_t>(q) * q);
+  double* re = re_.data();
+  double* im = im_.data();
+  for (int i = 0; i < q; ++i) {
+    const int from = std::max(0, i - 1);
+    const double* t = t_.data() + static_cast<size_t>(i) * q;
+    double* r = re + static_cast<size_t>(i) * q;
+    double* m = im + static_cast<size_t>(i) * q;
+    for (int j = from; j < q; ++j) r[j] = zr * t[j], m[j] = zi * t[j];
+    r[i] += 1.0;
+  }
+  Eigen::MatrixXcd x = qab_.cast<std::complex<double>>();  // q x nk, becomes the solution
+  for (int j = 0; j + 1 < q; ++j) {
+    double* r0 = re + static_cast<size_t>(j) * q;
+    double* m0 = im + static_cast<size_t>(j) * q;
+    double* r1 = r0 + q;
+    double* m1 = m0 + q;
+    if (r1[j] * r1[j] + m1[j] * m1[j] > r0[j] * r0[j] + m0[j] * m0[j]) {
+      for (int c = j; c < q; ++c) std::swap(r0[c], r1[c]), std::swap(m0[c], m1[c]);
+      x.row(j).swap(x.row(j + 1));
+    }
+    const std::complex<double> lj =
+        std::complex<double>(r1[j], m1[j]) / std::complex<double>(r0[j], m0[j]);
+    const double lr = lj.real(), li = lj.imag();
+    for (int c = j + 1; c < q; ++c) {
+      r1[c] -= lr * r0[c] - li * m0[c];
+      m1[c] -= lr * m0[c] + li * r0[c];
+    }
+    x.row(j + 1) -= lj * x.row(j);
+  }
+  // Back substitution, every source at once (one pass over the triangle), on the solution's
+  // real and imaginary parts kept apart (contiguous, so that the dot products vectorise).
+  xr_.resize(static_cast<size_t>(q) * nk);
+  xi_.resize(static_cast<size_t>(q) * nk);
+  for (int k = 0; k < nk; ++k)
+    for (int i = 0; i < q; ++i) xr_[k * q + i] = x(i, k).real(), xi_[k * q + i] = x(i, k).imag();
+  for (int i = q - 1; i >= 0; --i) {
+    const double* r = re + static_cast<size_t>(i) * q;
+    const double* m = im + static_cast<size_t>(i) * q;
+    for (int k = 0; k < nk; ++k) {
+      const double* vr = xr_.data() + static_cast<size_t>(k) * q;
+      const double* vi = xi_.data() + static_cast<size_t>(k) * q;
+      double sr = vr[i], si = vi[i];
+      for (int c = i + 1; c < q; ++c) {
+        sr -= r[c] * vr[c] - m[c] * vi[c];
+        si -= r[c] * vi[c] + m[c] * vr[c];
+      }
+      const std::complex<double> xi =
+          std::complex<double>(sr, si) / std::complex<double>(r[i], m[i]);
+      xr_[k * q + i] = xi.real();
+      xi_[k * q + i] = xi.imag();
+    }
+  }
+  for (int k = 0; k < nk; ++k)
+    for (int i = 0; i < q; ++i) x(i, k) = std::complex<double>(xr_[k * q + i], xi_[k * q + i]);
+  for (int k = 0; k < nk; ++k)
+    for (int p = 0; p < np; ++p) h(k, p) = lq_.row(p).cast<std::complex<double>>().dot(x.col(k));
+  return h;
+}
+
+}  // namespace isolink
