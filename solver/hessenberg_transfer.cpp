@@ -5,6 +5,15 @@
 
 namespace isolink {
 
+StatusOr<ShiftInvert> shift_invert(const Eigen::MatrixXd& g, const Eigen::MatrixXd& c,
+                                   const Eigen::MatrixXd& b, double sigma) {
+  Eigen::PartialPivLU<Eigen::MatrixXd> a(g + sigma * c);
+  ShiftInvert si{a.solve(c), a.solve(b)};
+  if (!si.m.allFinite() || !si.ab.allFinite())
+    return Status::Error("reduced model: the projected system is singular");
+  return si;
+}
+
 Status HessenbergTransfer::set(const Eigen::MatrixXd& g, const Eigen::MatrixXd& c,
                                const Eigen::MatrixXd& b, const Eigen::MatrixXd& l, double sigma) {
   q_ = static_cast<int>(g.rows());
@@ -12,16 +21,13 @@ Status HessenbergTransfer::set(const Eigen::MatrixXd& g, const Eigen::MatrixXd& 
   lq_.resize(l.rows(), q_);
   qab_.resize(q_, b.cols());
   if (q_ == 0) return Status::Ok();
-  Eigen::PartialPivLU<Eigen::MatrixXd> a(g + sigma * c);
-  const Eigen::MatrixXd m = a.solve(c);
-  const Eigen::MatrixXd ab = a.solve(b);
-  if (!m.allFinite() || !ab.allFinite())
-    return Status::Error("reduced model: the projected system is singular");
-  Eigen::HessenbergDecomposition<Eigen::MatrixXd> hd(m);
+  StatusOr<ShiftInvert> si = shift_invert(g, c, b, sigma);
+  if (!si) return si.status();
+  Eigen::HessenbergDecomposition<Eigen::MatrixXd> hd(si->m);
   const Eigen::MatrixXd q = hd.matrixQ();
   t_ = hd.matrixH();
   lq_ = l * q;
-  qab_ = q.transpose() * ab;
+  qab_ = q.transpose() * si->ab;
   return Status::Ok();
 }
 

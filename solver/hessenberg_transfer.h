@@ -22,6 +22,15 @@
 
 namespace isolink {
 
+// The shift-and-invert form both the Hessenberg transfer and the reduced model's modal form
+// start from: M = (G + sigma C)^-1 C and AB = (G + sigma C)^-1 B. Error: G + sigma C singular (a
+// non-finite result).
+struct ShiftInvert {
+  Eigen::MatrixXd m, ab;
+};
+StatusOr<ShiftInvert> shift_invert(const Eigen::MatrixXd& g, const Eigen::MatrixXd& c,
+                                   const Eigen::MatrixXd& b, double sigma);
+
 class HessenbergTransfer {
  public:
   // Takes the system (copies what it needs; the arguments need not outlive it). Errors: G +

@@ -479,12 +479,10 @@ Status Reducer::modal_form(ReducedModel* mod) {
   Eigen::MatrixXd br(q, nk_), lr(np_, q);
   project_ports(&br, &lr);
   const double sigma = this->sigma();
-  Eigen::PartialPivLU<Eigen::MatrixXd> a(gr_ + sigma * cr_);
-  const Eigen::MatrixXd m = a.solve(cr_);
-  const Eigen::MatrixXd ab = a.solve(br);
-  if (!m.allFinite() || !ab.allFinite())
-    return Status::Error("reduced model: the projected system is singular");
-  Eigen::EigenSolver<Eigen::MatrixXd> es(m);
+  StatusOr<ShiftInvert> si = shift_invert(gr_, cr_, br, sigma);
+  if (!si) return si.status();
+  const Eigen::MatrixXd& ab = si->ab;
+  Eigen::EigenSolver<Eigen::MatrixXd> es(si->m);
   if (es.info() != Eigen::Success)
     return Status::Error("reduced model: the eigenvalue problem did not converge");
   const Eigen::VectorXcd lambda = es.eigenvalues();
