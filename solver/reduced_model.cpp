@@ -117,7 +117,8 @@ class Reducer {
   double error_at(size_t f) const;
   void measure();
   void project();
-  void project_ports(Eigen::MatrixXd* br, Eigen::MatrixXd* lr) const;
+  void project_ports(Eigen::MatrixXd* br, Eigen::MatrixXd* lr);
+  ReducedModel empty_model(const ReducedModelStats& stats) const;
   double sigma() const;
   Status build();
   StatusOr<bool> accept();
@@ -396,9 +397,13 @@ void Reducer::project() {
   cr_.bottomLeftCorner(q - q0, q0) = added.transpose() * basis_.cv.leftCols(q0);
 }
 
-// The projected inputs Br = V'B (q x nk, in this sign form) and outputs Lr = LV (np x q).
-void Reducer::project_ports(Eigen::MatrixXd* br, Eigen::MatrixXd* lr) const {
+// Brings Gr and Cr up to the basis (project()) and gives the projected inputs Br = V'B (q x nk,
+// in this sign form) and outputs Lr = LV (np x q).
+void Reducer::project_ports(Eigen::MatrixXd* br, Eigen::MatrixXd* lr) {
+  project();
   const int q = basis_.q, n = n_;
+  br->resize(q, static_cast<Eigen::Index>(nk_));
+  lr->resize(static_cast<Eigen::Index>(np_), q);
   const auto v = basis_.v.leftCols(q);
   for (size_t k = 0; k < nk_; ++k) {
     Eigen::VectorXd e(n);
@@ -411,6 +416,16 @@ void Reducer::project_ports(Eigen::MatrixXd* br, Eigen::MatrixXd* lr) const {
                     (probes_[p].b > 0 ? v(probes_[p].b - 1, j) : 0.0);
 }
 
+// A model with no modes yet (H = 0) and the given stats.
+ReducedModel Reducer::empty_model(const ReducedModelStats& stats) const {
+  ReducedModel mod;
+  mod.direct.assign(nk_, std::vector<double>(np_, 0.0));
+  mod.input.assign(nk_, {});
+  mod.output.assign(np_, {});
+  mod.stats = stats;
+  return mod;
+}
+
 // sigma: the middle of the band on a log scale, where G + sigma C is far from singular.
 double Reducer::sigma() const {
   return 2 * std::numbers::pi * std::sqrt(opt_.f_min * opt_.f_max);
@@ -420,12 +435,8 @@ double Reducer::sigma() const {
 // the projection's transfer through its Hessenberg form, or the pole-residue form (below, and
 // at every step once modal_each_step_).
 Status Reducer::build() {
-  ReducedModel mod;
   ++st_.steps;
-  mod.direct.assign(nk_, std::vector<double>(np_, 0.0));
-  mod.input.assign(nk_, {});
-  mod.output.assign(np_, {});
-  mod.stats = st_;
+  ReducedModel mod = empty_model(st_);
   mod.stats.order = basis_.q;
   // Diagonalised directly where staging does not pay. The Hessenberg evaluation costs about
   // 9 q^2 flops a check frequency, the eigendecomposition about 25 q^3 once: below q of about
@@ -440,9 +451,7 @@ Status Reducer::build() {
   if (modal_ && basis_.q != 0)
     if (Status s = modal_form(&mod); !s.ok()) return s;
   if (!modal_) {
-    const int q = basis_.q;
-    project();
-    Eigen::MatrixXd br(q, nk_), lr(np_, q);
+    Eigen::MatrixXd br, lr;
     project_ports(&br, &lr);
     if (Status s = projected_.set(gr_, cr_, br, lr, sigma()); !s.ok()) return s;
   }
@@ -456,11 +465,7 @@ Status Reducer::build() {
 // failed modal form and the search goes on with a modal form at every step.
 StatusOr<bool> Reducer::accept() {
   if (modal_) return true;
-  ReducedModel mod;
-  mod.direct.assign(nk_, std::vector<double>(np_, 0.0));
-  mod.input.assign(nk_, {});
-  mod.output.assign(np_, {});
-  mod.stats = model_.stats;
+  ReducedModel mod = empty_model(model_.stats);
   if (basis_.q != 0)
     if (Status s = modal_form(&mod); !s.ok()) return s;
   model_ = std::move(mod);
@@ -475,8 +480,7 @@ StatusOr<bool> Reducer::accept() {
 // instantaneous modes, right-half-plane poles dropped (and counted).
 Status Reducer::modal_form(ReducedModel* mod) {
   const int q = basis_.q;
-  project();
-  Eigen::MatrixXd br(q, nk_), lr(np_, q);
+  Eigen::MatrixXd br, lr;
   project_ports(&br, &lr);
   const double sigma = this->sigma();
   StatusOr<ShiftInvert> si = shift_invert(gr_, cr_, br, sigma);
