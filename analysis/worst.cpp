@@ -461,6 +461,14 @@ EdgeResponse coarsened(const EdgeResponse& e, int k, const WorstOptions& opt) {
 
 namespace {
 
+// EdgeResponse::Tail's column c at q samples after its start, from the closed form.
+double tail_value(const EdgeResponse::Tail& t, size_t c, long q) {
+  double v = t.constant[c];
+  for (size_t i = 0; i < t.z.size(); ++i)
+    v += (t.amplitude[c][i] * std::pow(t.z[i], static_cast<double>(q))).real();
+  return v;
+}
+
 // One direction's edge response (EdgeResponse): the link driven by one 0 -> +1 edge at kLead,
 // sampled from the reduced model in closed form (EdgeEngine::Auto) or from tight transients, on
 // longer records until it settles.
@@ -536,6 +544,7 @@ class EdgeResponseBuilder {
   Status sample_model(const LtiResponses& lti, const std::string& description);
   // Samples a transient's waveform w (a record of `span` after the edge).
   void sample_transient(const Waveform& w, double span);
+  void attach_tail(const LtiResponses& lti, const std::vector<SourceInput>& inputs);
 
   const link::LinkSpec& spec_;
   const link::PartLibrary& parts_;
@@ -593,9 +602,49 @@ Status EdgeResponseBuilder::sample_model(const LtiResponses& lti, const std::str
     for (size_t i = 0; i < out_.more.size(); ++i)
       for (double x : v[i + 1]) out_.more[i].e.push_back(x - out_.more[i].v_idle);
     if (Status s = finite(description); !s.ok()) return s;
-    if (settled(span)) return Status::Ok();
+    if (settled(span)) {
+      attach_tail(lti, inputs);
+      return Status::Ok();
+    }
     if (span * 2 > opt_.max_span) return unsettled(description, span);
   }
+}
+
+// EdgeResponse::tail from the model at the first sample past the ramp's last corner, kept only
+// where it reproduces the sampled record (every column, 16 samples spread over the rest of the
+// record, within 1e-9 V + 1e-9 of the most the tail can be, |constant| + sum |a|): the
+// superposition then trusts it past the record too.
+void EdgeResponseBuilder::attach_tail(const LtiResponses& lti,
+                                      const std::vector<SourceInput>& inputs) {
+  double last = kLead;
+  for (const SourceInput& in : inputs)
+    for (const Ramp& r : in.ramps) last = std::max(last, r.t);
+  const long start = static_cast<long>(std::ceil((last - kLead) / opt_.dt - 1e-9));
+  const long n = static_cast<long>(out_.e.size());
+  if (out_.pre + start >= n) return;
+  const std::optional<LtiResponses::ModalTail> mt =
+      lti.modal_tail(inputs, kLead + static_cast<double>(start) * opt_.dt);
+  if (!mt) return;
+  EdgeResponse::Tail tail;
+  tail.start = start;
+  for (const std::complex<double>& p : mt->poles) tail.z.push_back(std::exp(p * opt_.dt));
+  tail.amplitude = mt->amplitude;
+  tail.constant = mt->constant;
+  tail.constant[0] -= out_.v_idle;
+  for (size_t c = 0; c < out_.more.size(); ++c) tail.constant[c + 1] -= out_.more[c].v_idle;
+  for (size_t c = 0; c <= out_.more.size(); ++c) {
+    const std::vector<double>& rec = c == 0 ? out_.e : out_.more[c - 1].e;
+    double peak = std::abs(tail.constant[c]);  // the most the tail can be
+    for (const std::complex<double>& a : tail.amplitude[c]) peak += std::abs(a);
+    const long len = n - out_.pre - start;
+    for (long j = 0; j < 16; ++j) {
+      const long q = j * (len - 1) / 15;
+      if (std::abs(tail_value(tail, c, q) - rec[static_cast<size_t>(out_.pre + start + q)]) >
+          1e-9 + 1e-9 * peak)
+        return;
+    }
+  }
+  out_.tail = std::move(tail);
 }
 
 Status EdgeResponseBuilder::from_transients() {
@@ -745,22 +794,151 @@ std::vector<double> superpose(const std::vector<double>& resp, long pre, double 
   add_response(coarse_resp, pre / k, coarse_edges, 0, vc);
   // The residual on the fine grid, 0 at the coarse samples and past the record (E constant).
   std::vector<double> r(static_cast<size_t>(m), 0.0);
-  for (long i = 0; i < m; ++i) {
-    const long p = i % k, a = i - p;
-    if (p != 0)
-      r[static_cast<size_t>(i)] =
-          at(i) - (at(a) + (at(a + k) - at(a)) * static_cast<double>(p) / static_cast<double>(k));
+  for (long a = 0; a < m; a += k) {
+    const double ya = at(a), slope = (at(a + k) - ya) / static_cast<double>(k);
+    for (long p = 1; p < k && a + p < m; ++p)
+      r[static_cast<size_t>(a + p)] = at(a + p) - (ya + slope * static_cast<double>(p));
   }
   const double cut = weight > 0 ? tol / 2 / weight : 0.0;
   long last = m - 1;
   while (last >= 0 && std::abs(r[static_cast<size_t>(last)]) <= cut) --last;
   r.resize(static_cast<size_t>(last + 2), 0.0);  // ends in 0: no step after it
-  for (long i = 0; i < n; ++i) {
-    const long j = i / k, p = i % k;
-    const double a = vc[static_cast<size_t>(j)], b = vc[static_cast<size_t>(j + 1)];
-    v[static_cast<size_t>(i)] = a + (b - a) * static_cast<double>(p) / static_cast<double>(k);
+  for (long j = 0; j * k < n; ++j) {
+    const double a = vc[static_cast<size_t>(j)], slope = (vc[static_cast<size_t>(j + 1)] - a) / k;
+    for (long p = 0; p < k && j * k + p < n; ++p)
+      v[static_cast<size_t>(j * k + p)] = a + slope * static_cast<double>(p);
   }
   add_response(r, pre, edges, 0, v);
+  return v;
+}
+
+// What superpose_with_tail does with a record's tail: which modes it sums by recursion (slow) and
+// how many samples of the rest it keeps past the tail's start (head).
+struct TailSplit {
+  std::vector<size_t> slow;
+  long head = 0;
+};
+
+// The split with the least work: the edges' overlap with the kept record (superpose's coarse pass,
+// every k-th sample) against the recursion's n samples per slow mode (a complex multiply each,
+// counted as three). A mode outside the slow set must have fallen below cut / modes by the end
+// of the kept record (|a| |z|^head), so the modes cut off move no sample by more than cut; the
+// kept record cannot outrun the sampled one (`room` samples past the tail's start). Empty
+// (nothing slow, head -1) when keeping the whole record costs least.
+TailSplit split_tail(const EdgeResponse::Tail& t, size_t column, long record,
+                     const std::vector<std::pair<long, int>>& edges, long pre, long n, long k,
+                     double cut) {
+  const long room = record - pre - t.start;
+  const size_t modes = t.z.size();
+  std::vector<std::pair<double, size_t>> life;  // samples until the mode is below its share
+  for (size_t i = 0; i < modes; ++i) {
+    const double a = std::abs(t.amplitude[column][i]), r = std::abs(t.z[i]);
+    const double share = cut / static_cast<double>(modes);
+    double samples = 0;
+    if (a > share) samples = r < 1 ? std::ceil(std::log(share / a) / std::log(r)) : kInf;
+    life.emplace_back(samples, i);
+  }
+  std::sort(life.begin(), life.end());
+  auto overlap = [&](long kept) {  // coarse samples the edges' kept records cover
+    double c = 0;
+    for (const auto& [at, dl] : edges)
+      c += static_cast<double>(std::max(0L, std::min(kept, n - (at - pre)))) / k;
+    return c;
+  };
+  constexpr double kRecursionCost = 3;
+  TailSplit best;
+  best.head = -1;
+  double best_cost = overlap(record);    // no split: every edge's whole record
+  for (size_t m = 0; m <= modes; ++m) {  // the m shortest-lived modes kept in the record
+    const double head = m == 0 ? 0.0 : life[m - 1].first;
+    if (head >= static_cast<double>(room)) break;
+    if (m < modes && life[m].first == head) continue;  // ties: take them all
+    const double cost = overlap(pre + static_cast<long>(head) + 1) +
+                        kRecursionCost * static_cast<double>(n) * static_cast<double>(modes - m);
+    if (cost < best_cost) {
+      best_cost = cost;
+      best.head = static_cast<long>(head);
+      best.slow.clear();
+      for (size_t j = m; j < modes; ++j) best.slow.push_back(life[j].second);
+    }
+  }
+  return best;
+}
+
+// superpose() of a record whose tail is known in closed form (EdgeResponse::Tail, `column` of
+// it): E = S + H, S the slow modes and the constant from the tail's start on (0 before it), H
+// the rest, which the fast modes make short. H is summed as superpose() sums any record (cut
+// where its modes have decayed: they move no sample by more than tol / 4); S by one recursion per
+// mode over the record, s <- z s plus dL a at each edge's tail start, whatever the number of
+// edges. The slow tail of a long record (a transformer link's 160 us) no longer costs each edge
+// its whole length. Exact but for those cuts: within tol, as superpose().
+std::vector<double> superpose_with_tail(const std::vector<double>& resp, long pre, double v_idle,
+                                        const EdgeResponse::Tail& t, size_t column,
+                                        const std::vector<std::pair<long, int>>& edges, long n,
+                                        long k, double tol) {
+  double weight = 0;
+  for (const auto& [at_, dl] : edges) weight += std::abs(dl);
+  const long ts = pre + t.start, m = static_cast<long>(resp.size());
+  if (weight == 0 || ts >= m) return superpose(resp, pre, v_idle, edges, n, k, tol);
+  const TailSplit split = split_tail(t, column, m, edges, pre, n, k, tol / 4 / weight);
+  if (split.head < 0) return superpose(resp, pre, v_idle, edges, n, k, tol);
+  // H: the record up to the tail's start, then minus S, cut after `head` samples (ends in 0).
+  std::vector<double> h(resp.begin(), resp.begin() + ts + split.head);
+  for (long q = 0; q < split.head; ++q) h[static_cast<size_t>(ts + q)] -= t.constant[column];
+  for (size_t mode : split.slow) {
+    const double zr = t.z[mode].real(), zi = t.z[mode].imag();
+    double yr = t.amplitude[column][mode].real(), yi = t.amplitude[column][mode].imag();
+    for (long q = 0; q < split.head; ++q) {
+      h[static_cast<size_t>(ts + q)] -= yr;
+      const double nr = yr * zr - yi * zi;
+      yi = yr * zi + yi * zr;
+      yr = nr;
+    }
+  }
+  h.push_back(0.0);
+  std::vector<double> v = superpose(h, pre, v_idle, edges, n, k, tol / 2);
+  // S: the constant as steps, each slow mode by its recursion, from each edge's tail start.
+  std::vector<std::pair<long, double>> starts;  // (sample of the tail's start, dL)
+  for (const auto& [at, dl] : edges) starts.emplace_back(at + t.start, dl);
+  std::sort(starts.begin(), starts.end());
+  // Between two tail starts (and after the last) every term runs freely: [from, to) of v.
+  auto between = [&](size_t e, long* from, long* to) {
+    *from = std::clamp(starts[e].first, 0L, n);
+    *to = e + 1 < starts.size() ? std::clamp(starts[e + 1].first, 0L, n) : n;
+  };
+  double level = 0;
+  long from = 0, to = 0;
+  for (size_t e = 0; e < starts.size(); ++e) {
+    level += starts[e].second * t.constant[column];
+    between(e, &from, &to);
+    for (long i = from; i < to; ++i) v[static_cast<size_t>(i)] += level;
+  }
+  for (size_t mode : split.slow) {
+    const std::complex<double> z = t.z[mode], a = t.amplitude[column][mode];
+    std::complex<double> y = 0;  // the mode's sum at sample `at`
+    long at = starts.front().first;
+    auto move_to = [&](long sample) {
+      if (sample > at) y *= std::pow(z, static_cast<double>(sample - at)), at = sample;
+    };
+    for (size_t e = 0; e < starts.size(); ++e) {
+      move_to(starts[e].first);
+      y += starts[e].second * a;
+      between(e, &from, &to);
+      move_to(from);  // a start before sample 0
+      if (from >= to) continue;
+      const double zr = z.real(), zi = z.imag();
+      double yr = y.real(), yi = y.imag();
+      double* out = v.data();
+      for (long i = from; i < to; ++i) {
+        out[i] += yr;
+        const double nr = yr * zr - yi * zi;
+        yi = yr * zi + yi * zr;
+        yr = nr;
+      }
+      y = {yr, yi};
+      at = to;
+    }
+  }
   return v;
 }
 
@@ -793,9 +971,14 @@ StatusOr<Waveform> synthesize_drive(const EdgeResponse& e, const traffic::Drive&
   Waveform w;
   w.time.resize(static_cast<size_t>(n));
   for (long i = 0; i < n; ++i) w.time[static_cast<size_t>(i)] = static_cast<double>(i) * e.dt;
-  w.add_column("v(rxp,rxn)", superpose(e.e, e.pre, e.v_idle, edges, n, k, kTol));
-  for (const EdgeResponse::Column& c : e.more)
-    w.add_column(c.probe, superpose(c.e, e.pre, c.v_idle, edges, n, k, kTol));
+  auto column = [&](size_t c) {
+    const std::vector<double>& resp = c == 0 ? e.e : e.more[c - 1].e;
+    const double v_idle = c == 0 ? e.v_idle : e.more[c - 1].v_idle;
+    return e.tail ? superpose_with_tail(resp, e.pre, v_idle, *e.tail, c, edges, n, k, kTol)
+                  : superpose(resp, e.pre, v_idle, edges, n, k, kTol);
+  };
+  w.add_column("v(rxp,rxn)", column(0));
+  for (size_t c = 0; c < e.more.size(); ++c) w.add_column(e.more[c].probe, column(c + 1));
   return w;
 }
 

@@ -44,6 +44,7 @@
 //   encoding whose frames are not affine in their bits. A failing worst case is pass false.
 #pragma once
 
+#include <complex>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -78,6 +79,19 @@ struct EdgeResponse {
     double v_idle = 0;
   };
   std::vector<Column> more;
+  // The reduced model's closed form past the driver's ramp (empty from the transient, and in a
+  // coarsened copy): at n >= start samples after the corner, e is
+  //   constant[0] + sum_i Re(amplitude[0][i] z_i^(n - start)),  z_i = e^{p_i dt},
+  // and more's column c the same with constant[c + 1], amplitude[c + 1] (each minus its v_idle).
+  // It is the model the record was sampled from (checked against the record when made), and it
+  // goes on past the record's end where at() holds the last sample.
+  struct Tail {
+    long start = 0;
+    std::vector<std::complex<double>> z;                       // per mode
+    std::vector<double> constant;                              // per column
+    std::vector<std::vector<std::complex<double>>> amplitude;  // [column][mode]
+  };
+  std::optional<Tail> tail;
   std::string engine;       // what produced it ("reduced model, order 119 ...", "transient ...")
   std::string engine_note;  // edge_engine auto: why the reduced model was not used
   double seconds = 0;       // wall time

@@ -41,6 +41,7 @@
 // over hours, so for them the march simply runs to the horizon with large steps on the slow tail.
 #pragma once
 
+#include <complex>
 #include <functional>
 #include <optional>
 #include <string>
@@ -195,6 +196,18 @@ class LtiResponses {
   // times costs O(times + corners) per mode.
   std::vector<std::vector<double>> values(const std::vector<SourceInput>& inputs,
                                           const std::vector<double>& times) const;
+
+  // The probes from t0 on in closed form, when t0 is at or after every input's last corner and
+  // every slope is back to zero there (a step, a ramp that has ended): probe p at t >= t0 is
+  // constant[p] + sum_i Re(amplitude[p][i] e^{poles[i] (t - t0)}), the same modal sums values()
+  // steps through. Empty when the slopes do not end by t0, or without the reduced model.
+  struct ModalTail {
+    double t0 = 0.0;
+    std::vector<std::complex<double>> poles;                   // 1/s, every mode of the model
+    std::vector<double> constant;                              // per probe: where it settles
+    std::vector<std::vector<std::complex<double>>> amplitude;  // [probe][mode], at t0
+  };
+  std::optional<ModalTail> modal_tail(const std::vector<SourceInput>& inputs, double t0) const;
 
   const LtiStats& stats() const { return stats_; }
   bool reduced() const { return model_.has_value(); }

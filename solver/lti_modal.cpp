@@ -58,6 +58,10 @@ class ModalMarch {
   // Adds the response to the corners (sorted by time) at `times` into out[p][j].
   void run(const std::vector<Corner>& corners, const std::vector<double>& times,
            std::vector<std::vector<double>>& out);
+  // After run() has taken every corner: each mode's state x split into its steady state
+  // x_ss = -b / p and the transient d = x - x_ss (the probes' constant and amplitudes), when every
+  // slope is zero; false otherwise.
+  bool closed_tail(LtiResponses::ModalTail& tail) const;
 
  private:
   const ModalStep* step_for(double h);
@@ -332,6 +336,24 @@ void ModalMarch::rate_at(size_t j) {
   (*rate_)[j] = fastest;
 }
 
+bool ModalMarch::closed_tail(LtiResponses::ModalTail& tail) const {
+  for (size_t k = 0; k < nk_; ++k)
+    if (std::fabs(slope_[k]) > 1e-12 * slope_scale_[k]) return false;
+  tail.poles = m_.poles;
+  tail.amplitude.assign(np_, std::vector<std::complex<double>>(nm_));
+  for (size_t p = 0; p < np_; ++p)
+    for (size_t k = 0; k < nk_; ++k) tail.constant[p] += m_.direct[k][p] * u_[k];
+  for (size_t i = 0; i < nm_; ++i) {
+    const std::complex<double> xss = -std::complex<double>(br_[i], bi_[i]) / m_.poles[i];
+    const std::complex<double> d = std::complex<double>(xr_[i], xi_[i]) - xss;
+    for (size_t p = 0; p < np_; ++p) {
+      tail.constant[p] += (m_.output[p][i] * xss).real();
+      tail.amplitude[p][i] = m_.output[p][i] * d;
+    }
+  }
+  return true;
+}
+
 // Probe p's value in the tail.
 double ModalMarch::tail_value(size_t p) const {
   double d = tail_const_[p];
@@ -410,6 +432,28 @@ void LtiResponses::modal_add(const std::vector<SourceInput>& inputs,
   ModalMarch march(*model_, labels_.size(), nk, uniform_dt, rates ? &rates->probe_weight : nullptr,
                    rates ? rates->threshold : 0.0, rates ? &rates->rate : nullptr);
   march.run(corners, times, out);
+}
+
+std::optional<LtiResponses::ModalTail> LtiResponses::modal_tail(
+    const std::vector<SourceInput>& inputs, double t0) const {
+  if (!model_) return std::nullopt;
+  const size_t nk = std::min(sources_.size(), inputs.size());
+  std::vector<Corner> corners;
+  for (size_t k = 0; k < nk; ++k)
+    for (const Ramp& r : inputs[k].ramps) {
+      if (r.t > t0) return std::nullopt;
+      corners.push_back({r.t, k, r.slope});
+    }
+  std::stable_sort(corners.begin(), corners.end(),
+                   [](const Corner& a, const Corner& b) { return a.t < b.t; });
+  ModalMarch march(*model_, labels_.size(), nk, 0.0, nullptr, 0.0, nullptr);
+  std::vector<std::vector<double>> at_t0(labels_.size(), std::vector<double>(1, 0.0));
+  march.run(corners, {t0}, at_t0);
+  ModalTail tail;
+  tail.t0 = t0;
+  tail.constant = base_values(inputs);
+  if (!march.closed_tail(tail)) return std::nullopt;
+  return tail;
 }
 
 namespace {

@@ -13,6 +13,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
+#include <numbers>
 #include <random>
 #include <string>
 #include <vector>
@@ -174,6 +176,96 @@ TEST(WorstCase, SynthesizedRunMatchesTheSimulatedRun) {
   EXPECT_FALSE(on_grid(shifted, f.edge.dt));
   EXPECT_NE(synthesize_drive(f.edge, shifted, 1e-4).status().message().find("off the 1 ns grid"),
             std::string::npos);
+}
+
+// The reduced model's edge response carries its closed form past the driver's ramp
+// (EdgeResponse::tail), and that closed form is the record: every 997th sample from its start
+// to the record's end, within 1 nV.
+TEST(WorstCase, EdgeResponseTailIsTheSampledRecord) {
+  const Fixture& f = fixture();
+  ASSERT_TRUE(f.edge.tail.has_value()) << f.edge.engine;
+  const EdgeResponse::Tail& t = *f.edge.tail;
+  EXPECT_GE(t.start, 0);
+  EXPECT_LE(static_cast<double>(t.start) * f.edge.dt, 10e-9);  // the ramp's second half: 5 ns
+  const long n = static_cast<long>(f.edge.e.size()) - f.edge.pre;
+  double worst = 0;
+  for (long q = 0; t.start + q < n; q += 997) {
+    double v = t.constant[0];
+    for (size_t i = 0; i < t.z.size(); ++i)
+      v += (t.amplitude[0][i] * std::pow(t.z[i], static_cast<double>(q))).real();
+    worst = std::max(worst, std::abs(v - f.edge.e[static_cast<size_t>(f.edge.pre + t.start + q)]));
+  }
+  EXPECT_LT(worst, 1e-9);
+}
+
+// Superposition with a closed-form tail (synthesize_drive on an EdgeResponse with `tail`): a
+// made-up response of a 30 MHz ring (40 ns), a 20 us lag and a 2 ms lag, recorded for 40 us, and
+// 240 edges of +-2 over 60 us on a 100 us record. Against the exact sum of the closed form, edge
+// by edge: within synthesize_drive's 20 uV everywhere, also past the response's record, where the
+// record alone (no tail: its last sample held) is off by the 2 ms lag's drift.
+TEST(WorstCase, SynthesisWithTheClosedFormTailIsTheExactSum) {
+  const double dt = 0.25e-9;
+  EdgeResponse e;
+  e.dt = dt;
+  e.pre = 200;
+  e.v_idle = 0.3;
+  EdgeResponse::Tail t;
+  t.start = 20;
+  const std::vector<std::complex<double>> poles = {
+      {-1 / 40e-9, 2 * std::numbers::pi * 30e6}, {-1 / 20e-6, 0}, {-1 / 2e-3, 0}};
+  t.amplitude = {{{0.3, -0.2}, {-0.25, 0}, {0.05, 0}}};
+  t.constant = {0.9};
+  for (const auto& p : poles) t.z.push_back(std::exp(p * dt));
+  auto exact = [&](long n) {  // samples after the corner
+    if (n < t.start) {        // the ramp: a line from 0 at -20 to the tail's start
+      if (n <= -20) return 0.0;
+      double at_start = t.constant[0];
+      for (const auto& a : t.amplitude[0]) at_start += a.real();
+      return at_start * static_cast<double>(n + 20) / static_cast<double>(t.start + 20);
+    }
+    double v = t.constant[0];
+    for (size_t i = 0; i < poles.size(); ++i)
+      v +=
+          (t.amplitude[0][i] * std::exp(poles[i] * (static_cast<double>(n - t.start) * dt))).real();
+    return v;
+  };
+  const long record = static_cast<long>(40e-6 / dt);
+  for (long i = 0; i < e.pre + record; ++i) e.e.push_back(exact(i - e.pre));
+  traffic::Drive drive;
+  std::mt19937 rng(28);
+  std::uniform_int_distribution<int> gap(240 / 4, 400 / 4);  // 60-100 ns, on the 1 ns grid
+  double at = 1e-6;
+  int level = 0;
+  drive.segments.push_back({0.0, at, 0});
+  std::vector<std::pair<long, int>> edges;
+  for (int j = 0; j < 240; ++j) {
+    const int next = level == 1 ? -1 : 1;
+    const double end = at + gap(rng) * 4 * dt;
+    drive.segments.push_back({at, end, next});
+    edges.push_back({std::lround(at / dt), next - level});
+    level = next, at = end;
+  }
+  drive.segments.back().end = 100e-6;
+  auto worst_against_exact = [&](const EdgeResponse& r, long from, long to) {
+    StatusOr<Waveform> w = synthesize_drive(r, drive, 100e-6);
+    EXPECT_TRUE(w.ok()) << w.status().message();
+    if (!w) return 1.0;
+    double worst = 0;
+    for (long i = from; i < to; i += 101) {
+      double v = e.v_idle;
+      for (const auto& [edge, dl] : edges) v += dl * exact(i - edge);
+      worst = std::max(worst, std::abs(w->columns[0][static_cast<size_t>(i)] - v));
+    }
+    return worst;
+  };
+  const long within = static_cast<long>(40.9e-6 / dt);  // every lag inside the record
+  const long end = static_cast<long>(100e-6 / dt);
+  e.tail = t;
+  EXPECT_LT(worst_against_exact(e, 0, end), 20e-6);
+  EdgeResponse record_only = e;
+  record_only.tail.reset();
+  EXPECT_LT(worst_against_exact(record_only, 0, within), 20e-6);
+  EXPECT_GT(worst_against_exact(record_only, within, end), 100e-6);
 }
 
 TEST(WorstCase, TailBoundCoversTheResponse) {

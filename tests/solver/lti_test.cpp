@@ -178,6 +178,47 @@ TEST(Lti, BatchValuesLongAfterTheLastCornerEqualTheClosedForm) {
   for (size_t j = 20; j < times.size(); j += 997) EXPECT_NEAR(batch[3][j], 1.0, 1e-8);
 }
 
+// The closed form past the last corner (modal_tail) is the model that values() steps through:
+// every probe, from t0 to far past it, and each lag's settled value. Refused before the last
+// corner, while a slope goes on, and without the reduced model.
+TEST(Lti, ModalTailIsTheModelPastTheLastCorner) {
+  auto b = make({card("v1", {"in", "0"}, {call("pwl", {0, 0, 10e-9, 1})}),
+                 card("r1", {"in", "a"}, {num(1e3)}), card("c1", {"a", "0"}, {num(10e-12)}),
+                 card("r2", {"in", "b"}, {num(10e3)}), card("c2", {"b", "0"}, {num(5e-9)}),
+                 card("r3", {"in", "c"}, {num(100e3)}), card("c3", {"c", "0"}, {num(10e-9)}),
+                 card("r4", {"in", "d"}, {num(10)}), card("l4", {"d", "e"}, {num(1e-6)}),
+                 card("c4", {"e", "0"}, {num(1e-9)})},  // and a ring: Q 3.2 at 5 MHz
+                {"v(a)", "v(b)", "v(c)", "v(e)"});
+  LtiResponses lti = responses(*b, 200e-6, Method::Reduced);
+  const auto inputs = lti.netlist_inputs(200e-6);
+  const double t0 = 20e-9;
+  const std::optional<LtiResponses::ModalTail> tail = lti.modal_tail(inputs, t0);
+  ASSERT_TRUE(tail.has_value());
+  EXPECT_EQ(tail->t0, t0);
+  std::vector<double> times;
+  for (double dt : {0.0, 1e-9, 37e-9, 1e-6, 50e-6, 180e-6}) times.push_back(t0 + dt);
+  const auto v = lti.values(inputs, times);
+  for (size_t p = 0; p < 4; ++p) {
+    SCOPED_TRACE(lti.probe_labels()[p]);
+    for (size_t j = 0; j < times.size(); ++j) {
+      double closed = tail->constant[p];
+      for (size_t i = 0; i < tail->poles.size(); ++i)
+        closed += (tail->amplitude[p][i] * std::exp(tail->poles[i] * (times[j] - t0))).real();
+      EXPECT_NEAR(closed, v[p][j], 1e-9) << times[j];
+    }
+    EXPECT_NEAR(tail->constant[p], 1.0, 2e-5);  // every lag settles at the source's 1 V
+  }
+  // v(a) at t0 from the amplitudes alone: its 10 ns lag's response to the ramp, closed form.
+  double at_t0 = tail->constant[0];
+  for (const auto& a : tail->amplitude[0]) at_t0 += a.real();
+  EXPECT_NEAR(at_t0, (lag_ramp(t0, 10e-9) - lag_ramp(t0 - 10e-9, 10e-9)) / 10e-9, 2e-5);
+  EXPECT_FALSE(lti.modal_tail(inputs, 5e-9).has_value());  // inside the ramp
+  std::vector<SourceInput> open = inputs;                  // the ramp never ends
+  open[0].ramps.pop_back();
+  EXPECT_FALSE(lti.modal_tail(open, t0).has_value());
+  EXPECT_FALSE(responses(*b, 200e-6, Method::March).modal_tail(inputs, t0).has_value());
+}
+
 // Series RLC, underdamped: v(c) for a unit step, the closed form.
 TEST(Lti, UnderdampedRlcStepResponseMatchesClosedForm) {
   const double r = 10, l = 1e-6, cap = 1e-9;
