@@ -812,6 +812,21 @@ std::vector<double> superpose(const std::vector<double>& resp, long pre, double 
   return v;
 }
 
+// out[i] += sign Re(y z^i) for i in [0, count): one mode's terms by its recursion, y <- z y (the
+// real and imaginary parts in registers); returns y z^count.
+std::complex<double> add_mode(std::complex<double> y, std::complex<double> z, double sign,
+                              double* out, long count) {
+  const double zr = z.real(), zi = z.imag();
+  double yr = y.real(), yi = y.imag();
+  for (long i = 0; i < count; ++i) {
+    out[i] += sign * yr;
+    const double nr = yr * zr - yi * zi;
+    yi = yr * zi + yi * zr;
+    yr = nr;
+  }
+  return {yr, yi};
+}
+
 // What superpose_with_tail does with a record's tail: which modes it sums by recursion (slow) and
 // how many samples of the rest it keeps past the tail's start (head).
 struct TailSplit {
@@ -885,16 +900,8 @@ std::vector<double> superpose_with_tail(const std::vector<double>& resp, long pr
   // H: the record up to the tail's start, then minus S, cut after `head` samples (ends in 0).
   std::vector<double> h(resp.begin(), resp.begin() + ts + split.head);
   for (long q = 0; q < split.head; ++q) h[static_cast<size_t>(ts + q)] -= t.constant[column];
-  for (size_t mode : split.slow) {
-    const double zr = t.z[mode].real(), zi = t.z[mode].imag();
-    double yr = t.amplitude[column][mode].real(), yi = t.amplitude[column][mode].imag();
-    for (long q = 0; q < split.head; ++q) {
-      h[static_cast<size_t>(ts + q)] -= yr;
-      const double nr = yr * zr - yi * zi;
-      yi = yr * zi + yi * zr;
-      yr = nr;
-    }
-  }
+  for (size_t mode : split.slow)
+    add_mode(t.amplitude[column][mode], t.z[mode], -1.0, h.data() + ts, split.head);
   h.push_back(0.0);
   std::vector<double> v = superpose(h, pre, v_idle, edges, n, k, tol / 2);
   // S: the constant as steps, each slow mode by its recursion, from each edge's tail start.
@@ -926,16 +933,7 @@ std::vector<double> superpose_with_tail(const std::vector<double>& resp, long pr
       between(e, &from, &to);
       move_to(from);  // a start before sample 0
       if (from >= to) continue;
-      const double zr = z.real(), zi = z.imag();
-      double yr = y.real(), yi = y.imag();
-      double* out = v.data();
-      for (long i = from; i < to; ++i) {
-        out[i] += yr;
-        const double nr = yr * zr - yi * zi;
-        yi = yr * zi + yi * zr;
-        yr = nr;
-      }
-      y = {yr, yi};
+      y = add_mode(y, z, 1.0, v.data() + from, to - from);
       at = to;
     }
   }

@@ -64,6 +64,14 @@ class ModalMarch {
   bool closed_tail(LtiResponses::ModalTail& tail) const;
 
  private:
+  // Past the last corner with every source's slope back to zero (up to rounding): each mode's
+  // input is then constant, and its state tends to steady_state(i) = -b_i / p_i.
+  bool slopes_ended() const;
+  std::complex<double> steady_state(size_t i) const {
+    return -std::complex<double>(br_[i], bi_[i]) / m_.poles[i];
+  }
+  // The direct terms' share of probe p at the present inputs.
+  double direct_value(size_t p) const;
   const ModalStep* step_for(double h);
   void advance(double h);
   void take_corner(const Corner& corner);
@@ -173,20 +181,30 @@ void ModalMarch::take_corner(const Corner& corner) {
 // and once max_p |out_pi d_i| is below kTailTol of that probe's scale it leaves the loop for
 // good (|e^{p h}| < 1). Slower modes keep the exact update. A long record after the last edge
 // (the worst-case search's edge response: 160,000 samples) then costs the slow modes alone.
-void ModalMarch::enter_tail(double left) {
+bool ModalMarch::slopes_ended() const {
   for (size_t k = 0; k < nk_; ++k)
-    if (std::fabs(slope_[k]) > 1e-12 * slope_scale_[k]) return;
+    if (std::fabs(slope_[k]) > 1e-12 * slope_scale_[k]) return false;
+  return true;
+}
+
+double ModalMarch::direct_value(size_t p) const {
+  double d = 0;
+  for (size_t k = 0; k < nk_; ++k) d += m_.direct[k][p] * u_[k];
+  return d;
+}
+
+void ModalMarch::enter_tail(double left) {
+  if (!slopes_ended()) return;
   tail_const_.assign(np_, 0.0);
   tail_scale_.assign(np_, 0.0);
-  for (size_t p = 0; p < np_; ++p)
-    for (size_t k = 0; k < nk_; ++k) tail_const_[p] += m_.direct[k][p] * u_[k];
+  for (size_t p = 0; p < np_; ++p) tail_const_[p] = direct_value(p);
   for (size_t i = 0; i < nm_; ++i) {
     const std::complex<double> pole = m_.poles[i];
     if (!(-pole.real() * left > 1.0)) {
       slow_.push_back(i);
       continue;
     }
-    const std::complex<double> xss = -std::complex<double>(br_[i], bi_[i]) / pole;
+    const std::complex<double> xss = steady_state(i);
     fast_.push_back(i);
     dr_.push_back(xr_[i] - xss.real());
     di_.push_back(xi_[i] - xss.imag());
@@ -337,14 +355,12 @@ void ModalMarch::rate_at(size_t j) {
 }
 
 bool ModalMarch::closed_tail(LtiResponses::ModalTail& tail) const {
-  for (size_t k = 0; k < nk_; ++k)
-    if (std::fabs(slope_[k]) > 1e-12 * slope_scale_[k]) return false;
+  if (!slopes_ended()) return false;
   tail.poles = m_.poles;
   tail.amplitude.assign(np_, std::vector<std::complex<double>>(nm_));
-  for (size_t p = 0; p < np_; ++p)
-    for (size_t k = 0; k < nk_; ++k) tail.constant[p] += m_.direct[k][p] * u_[k];
+  for (size_t p = 0; p < np_; ++p) tail.constant[p] += direct_value(p);
   for (size_t i = 0; i < nm_; ++i) {
-    const std::complex<double> xss = -std::complex<double>(br_[i], bi_[i]) / m_.poles[i];
+    const std::complex<double> xss = steady_state(i);
     const std::complex<double> d = std::complex<double>(xr_[i], xi_[i]) - xss;
     for (size_t p = 0; p < np_; ++p) {
       tail.constant[p] += (m_.output[p][i] * xss).real();
@@ -420,15 +436,25 @@ void ModalMarch::run(const std::vector<Corner>& corners, const std::vector<doubl
 
 }  // namespace
 
-void LtiResponses::modal_add(const std::vector<SourceInput>& inputs,
-                             const std::vector<double>& times, double uniform_dt,
-                             std::vector<std::vector<double>>& out, ModeRates* rates) const {
-  const size_t nk = std::min(sources_.size(), inputs.size());
+namespace {
+
+// Every input's corners (the first nk inputs), by time.
+std::vector<Corner> sorted_corners(const std::vector<SourceInput>& inputs, size_t nk) {
   std::vector<Corner> corners;
   for (size_t k = 0; k < nk; ++k)
     for (const Ramp& r : inputs[k].ramps) corners.push_back({r.t, k, r.slope});
   std::stable_sort(corners.begin(), corners.end(),
                    [](const Corner& a, const Corner& b) { return a.t < b.t; });
+  return corners;
+}
+
+}  // namespace
+
+void LtiResponses::modal_add(const std::vector<SourceInput>& inputs,
+                             const std::vector<double>& times, double uniform_dt,
+                             std::vector<std::vector<double>>& out, ModeRates* rates) const {
+  const size_t nk = std::min(sources_.size(), inputs.size());
+  const std::vector<Corner> corners = sorted_corners(inputs, nk);
   ModalMarch march(*model_, labels_.size(), nk, uniform_dt, rates ? &rates->probe_weight : nullptr,
                    rates ? rates->threshold : 0.0, rates ? &rates->rate : nullptr);
   march.run(corners, times, out);
@@ -438,14 +464,8 @@ std::optional<LtiResponses::ModalTail> LtiResponses::modal_tail(
     const std::vector<SourceInput>& inputs, double t0) const {
   if (!model_) return std::nullopt;
   const size_t nk = std::min(sources_.size(), inputs.size());
-  std::vector<Corner> corners;
-  for (size_t k = 0; k < nk; ++k)
-    for (const Ramp& r : inputs[k].ramps) {
-      if (r.t > t0) return std::nullopt;
-      corners.push_back({r.t, k, r.slope});
-    }
-  std::stable_sort(corners.begin(), corners.end(),
-                   [](const Corner& a, const Corner& b) { return a.t < b.t; });
+  const std::vector<Corner> corners = sorted_corners(inputs, nk);
+  if (!corners.empty() && corners.back().t > t0) return std::nullopt;
   ModalMarch march(*model_, labels_.size(), nk, 0.0, nullptr, 0.0, nullptr);
   std::vector<std::vector<double>> at_t0(labels_.size(), std::vector<double>(1, 0.0));
   march.run(corners, {t0}, at_t0);
