@@ -452,6 +452,7 @@ EdgeResponse coarsened(const EdgeResponse& e, int k, const WorstOptions& opt) {
   out.seconds = e.seconds;
   out.dt = e.dt * k;
   out.pre = e.pre / k;
+  out.e.reserve(e.e.size() / static_cast<size_t>(k) + 1);
   for (size_t i = static_cast<size_t>(e.pre % k); i < e.e.size(); i += static_cast<size_t>(k))
     out.e.push_back(e.e[i]);
   out.engine = fmt::format("{}; every {}th sample kept: a {:g} ns grid", e.engine, k, out.dt * 1e9);
@@ -508,13 +509,16 @@ class EdgeResponseBuilder {
         "worst-case search",
         what, span * 1e6, out_.drift * 1e6, opt_.settle_tol * 1e6));
   }
-  Status finite(const std::string& what) const {
-    for (double x : out_.e)
-      if (!std::isfinite(x)) return Status::Error(what + ": the edge response is not finite");
+  // The records from sample `from` on.
+  Status finite(const std::string& what, size_t from = 0) const {
+    auto all_finite = [from](const std::vector<double>& rec) {
+      return std::all_of(rec.begin() + static_cast<long>(std::min(from, rec.size())), rec.end(),
+                         [](double x) { return std::isfinite(x); });
+    };
+    if (!all_finite(out_.e)) return Status::Error(what + ": the edge response is not finite");
     for (const EdgeResponse::Column& c : out_.more)
-      for (double x : c.e)
-        if (!std::isfinite(x))
-          return Status::Error(what + ": the edge response of " + c.probe + " is not finite");
+      if (!all_finite(c.e))
+        return Status::Error(what + ": the edge response of " + c.probe + " is not finite");
     return Status::Ok();
   }
   // The link driven by one 0 -> +1 edge at kLead, held for `span`.
@@ -598,10 +602,14 @@ Status EdgeResponseBuilder::sample_model(const LtiResponses& lti, const std::str
     for (long i = from; i < n; ++i)
       times[static_cast<size_t>(i - from)] = kLead + static_cast<double>(i - out_.pre) * opt_.dt;
     const std::vector<std::vector<double>> v = lti.values(inputs, times);
-    for (double x : v[0]) out_.e.push_back(x - out_.v_idle);
+    auto append = [n](std::vector<double>& rec, const std::vector<double>& x, double idle) {
+      rec.reserve(static_cast<size_t>(n));
+      for (double y : x) rec.push_back(y - idle);
+    };
+    append(out_.e, v[0], out_.v_idle);
     for (size_t i = 0; i < out_.more.size(); ++i)
-      for (double x : v[i + 1]) out_.more[i].e.push_back(x - out_.more[i].v_idle);
-    if (Status s = finite(description); !s.ok()) return s;
+      append(out_.more[i].e, v[i + 1], out_.more[i].v_idle);
+    if (Status s = finite(description, static_cast<size_t>(from)); !s.ok()) return s;
     if (settled(span)) {
       attach_tail(lti, inputs);
       return Status::Ok();
@@ -812,19 +820,47 @@ std::vector<double> superpose(const std::vector<double>& resp, long pre, double 
   return v;
 }
 
-// out[i] += sign Re(y z^i) for i in [0, count): one mode's terms by its recursion, y <- z y (the
-// real and imaginary parts in registers); returns y z^count.
-std::complex<double> add_mode(std::complex<double> y, std::complex<double> z, double sign,
-                              double* out, long count) {
-  const double zr = z.real(), zi = z.imag();
-  double yr = y.real(), yi = y.imag();
+// out[i] += sign Re(y_m z_m^i) for i in [0, count) and each of N modes: their recursions
+// y <- z y (real and imaginary parts in registers), interleaved so that the N independent chains
+// share the multiplies' latency; each out[i] gets its terms in the modes' order, the sums of one
+// mode after another to the bit. y becomes y z^count.
+template <int N>
+void add_modes(std::complex<double>* y, const std::complex<double>* z, double sign, double* out,
+               long count) {
+  double yr[N], yi[N], zr[N], zi[N];
+  for (int m = 0; m < N; ++m)
+    yr[m] = y[m].real(), yi[m] = y[m].imag(), zr[m] = z[m].real(), zi[m] = z[m].imag();
   for (long i = 0; i < count; ++i) {
-    out[i] += sign * yr;
-    const double nr = yr * zr - yi * zi;
-    yi = yr * zi + yi * zr;
-    yr = nr;
+    double acc = out[i];
+    for (int m = 0; m < N; ++m) {
+      acc += sign * yr[m];
+      const double nr = yr[m] * zr[m] - yi[m] * zi[m];
+      yi[m] = yr[m] * zi[m] + yi[m] * zr[m];
+      yr[m] = nr;
+    }
+    out[i] = acc;
   }
-  return {yr, yi};
+  for (int m = 0; m < N; ++m) y[m] = {yr[m], yi[m]};
+}
+
+// add_modes over any number of modes, four at a time.
+void add_mode_groups(std::complex<double>* y, const std::complex<double>* z, size_t modes,
+                     double sign, double* out, long count) {
+  for (size_t g = 0; g < modes; g += 4) {
+    switch (std::min<size_t>(4, modes - g)) {
+      case 4:
+        add_modes<4>(y + g, z + g, sign, out, count);
+        break;
+      case 3:
+        add_modes<3>(y + g, z + g, sign, out, count);
+        break;
+      case 2:
+        add_modes<2>(y + g, z + g, sign, out, count);
+        break;
+      default:
+        add_modes<1>(y + g, z + g, sign, out, count);
+    }
+  }
 }
 
 // What superpose_with_tail does with a record's tail: which modes it sums by recursion (slow) and
@@ -900,8 +936,11 @@ std::vector<double> superpose_with_tail(const std::vector<double>& resp, long pr
   // H: the record up to the tail's start, then minus S, cut after `head` samples (ends in 0).
   std::vector<double> h(resp.begin(), resp.begin() + ts + split.head);
   for (long q = 0; q < split.head; ++q) h[static_cast<size_t>(ts + q)] -= t.constant[column];
-  for (size_t mode : split.slow)
-    add_mode(t.amplitude[column][mode], t.z[mode], -1.0, h.data() + ts, split.head);
+  const size_t ns = split.slow.size();
+  std::vector<std::complex<double>> z(ns), a(ns), y(ns);  // the slow modes' z, amplitude, sum
+  for (size_t s = 0; s < ns; ++s)
+    z[s] = t.z[split.slow[s]], a[s] = y[s] = t.amplitude[column][split.slow[s]];
+  add_mode_groups(y.data(), z.data(), ns, -1.0, h.data() + ts, split.head);
   h.push_back(0.0);
   std::vector<double> v = superpose(h, pre, v_idle, edges, n, k, tol / 2);
   // S: the constant as steps, each slow mode by its recursion, from each edge's tail start.
@@ -920,22 +959,22 @@ std::vector<double> superpose_with_tail(const std::vector<double>& resp, long pr
     between(e, &from, &to);
     for (long i = from; i < to; ++i) v[static_cast<size_t>(i)] += level;
   }
-  for (size_t mode : split.slow) {
-    const std::complex<double> z = t.z[mode], a = t.amplitude[column][mode];
-    std::complex<double> y = 0;  // the mode's sum at sample `at`
-    long at = starts.front().first;
-    auto move_to = [&](long sample) {
-      if (sample > at) y *= std::pow(z, static_cast<double>(sample - at)), at = sample;
-    };
-    for (size_t e = 0; e < starts.size(); ++e) {
-      move_to(starts[e].first);
-      y += starts[e].second * a;
-      between(e, &from, &to);
-      move_to(from);  // a start before sample 0
-      if (from >= to) continue;
-      y = add_mode(y, z, 1.0, v.data() + from, to - from);
-      at = to;
-    }
+  // Every slow mode's sum y at sample `at`, all of them together from edge to edge.
+  std::fill(y.begin(), y.end(), 0.0);
+  long at = starts.front().first;
+  auto move_to = [&](long sample) {
+    if (sample <= at) return;
+    for (size_t s = 0; s < ns; ++s) y[s] *= std::pow(z[s], static_cast<double>(sample - at));
+    at = sample;
+  };
+  for (size_t e = 0; e < starts.size(); ++e) {
+    move_to(starts[e].first);
+    for (size_t s = 0; s < ns; ++s) y[s] += starts[e].second * a[s];
+    between(e, &from, &to);
+    move_to(from);  // a start before sample 0
+    if (from >= to) continue;
+    add_mode_groups(y.data(), z.data(), ns, 1.0, v.data() + from, to - from);
+    at = to;
   }
   return v;
 }

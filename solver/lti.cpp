@@ -297,12 +297,12 @@ void LtiResponses::superpose(const std::vector<SourceInput>& inputs, double t0, 
 std::vector<std::vector<double>> LtiResponses::values(const std::vector<SourceInput>& inputs,
                                                       const std::vector<double>& times) const {
   const size_t np = labels_.size();
-  std::vector<std::vector<double>> out(np, std::vector<double>(times.size(), 0.0));
   const std::vector<double> base = base_values(inputs);
+  std::vector<std::vector<double>> out;
+  out.reserve(np);
   for (size_t p = 0; p < np; ++p) {
-    if (model_)
-      std::fill(out[p].begin(), out[p].end(), base[p]);
-    else
+    out.emplace_back(times.size(), model_ ? base[p] : 0.0);
+    if (!model_)
       for (size_t j = 0; j < times.size(); ++j) out[p][j] = value(p, times[j], inputs);
   }
   if (model_) {

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <complex>
 #include <functional>
+#include <type_traits>
 #include <vector>
 
 #include "solver/lti.h"
@@ -248,6 +249,70 @@ size_t ModalMarch::uniform_run(const std::vector<double>& times, size_t j, doubl
   return end - j;
 }
 
+// N modes' recursions over queries [q0, q1) of the uniform step, interleaved: x <- e x + c
+// (kAffine; x <- e x for the fast modes' transient parts), and out[p][q] += Re(o_p x) for each mode
+// in turn. The recursions are independent, so N of them share the multiplies' latency; each
+// out[p][q] still gets its terms in the modes' order, the sums of one mode after another to the
+// bit. x: the modes' states, updated.
+template <int N, bool kAffine>
+void march_modes(const ModalStep& st, const size_t* mode, const double* cr, const double* ci,
+                 double* xr, double* xi, const std::vector<std::vector<double>>& outr,
+                 const std::vector<std::vector<double>>& outi, size_t q0, size_t q1,
+                 std::vector<std::vector<double>>& out) {
+  double er[N], ei[N], ar[N], ai[N];
+  for (int m = 0; m < N; ++m)
+    er[m] = st.er[mode[m]], ei[m] = st.ei[mode[m]], ar[m] = xr[m], ai[m] = xi[m];
+  for (size_t p = 0; p < out.size(); ++p) {
+    double o_r[N], o_i[N];
+    for (int m = 0; m < N; ++m)
+      ar[m] = xr[m], ai[m] = xi[m], o_r[m] = outr[p][mode[m]], o_i[m] = outi[p][mode[m]];
+    double* y = out[p].data();
+    for (size_t q = q0; q < q1; ++q) {
+      double acc = y[q];
+      for (int m = 0; m < N; ++m) {
+        double nr = er[m] * ar[m] - ei[m] * ai[m];
+        double ni = er[m] * ai[m] + ei[m] * ar[m];
+        if constexpr (kAffine) nr += cr[m], ni += ci[m];
+        ar[m] = nr, ai[m] = ni;
+        acc += o_r[m] * ar[m] - o_i[m] * ai[m];
+      }
+      y[q] = acc;
+    }
+  }
+  for (int m = 0; m < N; ++m) xr[m] = ar[m], xi[m] = ai[m];
+}
+
+// march_modes over `count` modes (any number), four at a time.
+template <bool kAffine>
+void march_mode_groups(const ModalStep& st, const size_t* mode, const double* cr, const double* ci,
+                       double* xr, double* xi, size_t count,
+                       const std::vector<std::vector<double>>& outr,
+                       const std::vector<std::vector<double>>& outi, size_t q0, size_t q1,
+                       std::vector<std::vector<double>>& out) {
+  for (size_t g = 0; g < count; g += 4) {
+    const size_t* md = mode + g;
+    const double* gcr = kAffine ? cr + g : nullptr;  // no offset on the fast modes' nullptr
+    const double* gci = kAffine ? ci + g : nullptr;
+    auto run = [&](auto n) {
+      march_modes<decltype(n)::value, kAffine>(st, md, gcr, gci, xr + g, xi + g, outr, outi, q0, q1,
+                                               out);
+    };
+    switch (std::min<size_t>(4, count - g)) {
+      case 4:
+        run(std::integral_constant<int, 4>{});
+        break;
+      case 3:
+        run(std::integral_constant<int, 3>{});
+        break;
+      case 2:
+        run(std::integral_constant<int, 2>{});
+        break;
+      default:
+        run(std::integral_constant<int, 1>{});
+    }
+  }
+}
+
 // Queries j..end-1 of the tail on the uniform step, mode by mode rather than query by query (the
 // same updates and sums as tail_step, prune and tail_value, in another order: a mode's state
 // stays in registers over the whole run, and a long record costs its few live modes alone).
@@ -255,46 +320,39 @@ void ModalMarch::tail_block(size_t j, size_t end, std::vector<std::vector<double
   const ModalStep& st = uniform_;
   for (size_t p = 0; p < np_; ++p)
     for (size_t q = j; q < end; ++q) out[p][q] += tail_const_[p];
-  for (size_t i : slow_) {  // x <- e x + f1 b (b constant in the tail)
-    const double er = st.er[i], ei = st.ei[i];
-    const double cr = st.f1r[i] * br_[i] - st.f1i[i] * bi_[i];
-    const double ci = st.f1r[i] * bi_[i] + st.f1i[i] * br_[i];
-    for (size_t p = 0; p < np_; ++p) {
-      double xr = xr_[i], xi = xi_[i];
-      const double o_r = outr_[p][i], o_i = outi_[p][i];
-      double* y = out[p].data();
-      for (size_t q = j; q < end; ++q) {
-        const double nr = er * xr - ei * xi + cr;
-        xi = er * xi + ei * xr + ci;
-        xr = nr;
-        y[q] += o_r * xr - o_i * xi;
-      }
-      if (p + 1 == np_) xr_[i] = xr, xi_[i] = xi;
+  {  // Slow modes: x <- e x + f1 b (b constant in the tail).
+    const size_t ns = slow_.size();
+    std::vector<double> cr(ns), ci(ns), xr(ns), xi(ns);
+    for (size_t s = 0; s < ns; ++s) {
+      const size_t i = slow_[s];
+      cr[s] = st.f1r[i] * br_[i] - st.f1i[i] * bi_[i];
+      ci[s] = st.f1r[i] * bi_[i] + st.f1i[i] * br_[i];
+      xr[s] = xr_[i], xi[s] = xi_[i];
     }
+    march_mode_groups<true>(st, slow_.data(), cr.data(), ci.data(), xr.data(), xi.data(), ns, outr_,
+                            outi_, j, end, out);
+    for (size_t s = 0; s < ns; ++s) xr_[slow_[s]] = xr[s], xi_[slow_[s]] = xi[s];
   }
-  // Fast modes: d <- e d, dropped at the first query q (q % 64 == 0, as prune) where their share
-  // of every probe is below kTailTol of its scale.
-  size_t kept = 0;
-  for (size_t f = 0; f < fast_.size(); ++f) {
-    const size_t i = fast_[f];
-    const double er = st.er[i], ei = st.ei[i];
-    double dr = dr_[f], di = di_[f];
-    size_t stop = end;  // first query not added
-    for (size_t q = j; q < end; ++q) {
-      const double nr = er * dr - ei * di;
-      di = er * di + ei * dr;
-      dr = nr;
-      if (q % 64 == 0 && !fast_mode_live(i, dr, di)) {
-        stop = q;
-        break;
-      }
+  // Fast modes: d <- e d, each dropped at the first query q (q % 64 == 0, as prune) where its
+  // share of every probe is below kTailTol of its scale. In chunks from one such query to the
+  // next: the chunk's first query steps, tests and adds mode by mode, the rest march_modes.
+  for (size_t q = j; q < end && !fast_.empty();) {
+    const size_t chunk_end = std::min(end, (q / 64 + 1) * 64);
+    size_t kept = 0;
+    for (size_t f = 0; f < fast_.size(); ++f) {
+      const size_t i = fast_[f];
+      const double dr = st.er[i] * dr_[f] - st.ei[i] * di_[f];
+      const double di = st.er[i] * di_[f] + st.ei[i] * dr_[f];
+      if (q % 64 == 0 && !fast_mode_live(i, dr, di)) continue;  // dropped
       for (size_t p = 0; p < np_; ++p) out[p][q] += outr_[p][i] * dr - outi_[p][i] * di;
+      fast_[kept] = i, dr_[kept] = dr, di_[kept] = di;
+      ++kept;
     }
-    if (stop < end) continue;  // dropped
-    fast_[kept] = i, dr_[kept] = dr, di_[kept] = di;
-    ++kept;
+    fast_.resize(kept), dr_.resize(kept), di_.resize(kept);
+    march_mode_groups<false>(st, fast_.data(), nullptr, nullptr, dr_.data(), di_.data(), kept,
+                             outr_, outi_, q + 1, chunk_end, out);
+    q = chunk_end;
   }
-  fast_.resize(kept), dr_.resize(kept), di_.resize(kept);
 }
 
 // Whether fast mode i, its transient part at d, still moves some probe by kTailTol of its scale.
