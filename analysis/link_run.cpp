@@ -177,7 +177,7 @@ std::string off_grid_why(const traffic::Drive& drive, double dt) {
 
 StatusOr<LinkRun> run_link_from_edges(const link::LinkSpec& spec, const link::PartLibrary& parts,
                                       const RunOptions& opt, const WorstOptions& wopt,
-                                      std::vector<EdgeResponse>& edges) {
+                                      std::vector<EdgeResponse>* edges) {
   WorstOptions fine = wopt;  // the synthesis grid
   fine.dt = wopt.dt / kSynthesisOversample;
   std::vector<std::optional<EdgeResponse>> per;  // per direction run so far, on wopt's grid
@@ -190,7 +190,7 @@ StatusOr<LinkRun> run_link_from_edges(const link::LinkSpec& spec, const link::Pa
           StatusOr<EdgeResponse> e = edge_response(spec, parts, d, fine);
           if (e) {
             StatusOr<DirectionRun> dr = run_direction_synthesized(std::move(ex), *e);
-            per.back() = coarsened(*e, kSynthesisOversample, wopt);
+            if (edges) per.back() = coarsened(*e, kSynthesisOversample, wopt);
             return dr;
           }
           why = "edge response: " + e.status().message();
@@ -200,14 +200,15 @@ StatusOr<LinkRun> run_link_from_edges(const link::LinkSpec& spec, const link::Pa
         return dr;
       },
       [&](size_t same) { per.push_back(per[same]); });
-  edges.clear();
+  if (!edges) return run;
+  edges->clear();
   if (!run) return run;
   for (std::optional<EdgeResponse>& e : per) {
     if (!e) {
-      edges.clear();
+      edges->clear();
       break;
     }
-    edges.push_back(std::move(*e));
+    edges->push_back(std::move(*e));
   }
   return run;
 }

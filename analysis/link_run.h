@@ -85,12 +85,13 @@ inline constexpr int kSynthesisOversample = 4;
 // run_probes() when the caller needs the pins or the driver: the noise analysis, waveform
 // files). A direction is simulated (run_direction) instead, and says why in its simulated_why,
 // when its drive changes level off the fine grid or its edge response cannot be computed (it
-// has not settled within wopt.max_span, say). `edges` receives one response per direction on
-// wopt.dt's grid, for worst_case, or none when a direction was simulated. A direction with the
+// has not settled within wopt.max_span, say). `edges`, unless null, receives one response per
+// direction on wopt.dt's grid, for worst_case, or none when a direction was simulated (null: no
+// coarsened copies are made, a plain sweep's case). A direction with the
 // same circuit key as one before (link::circuit_key) takes its response and result (same_as).
 StatusOr<LinkRun> run_link_from_edges(const link::LinkSpec& spec, const link::PartLibrary& parts,
                                       const RunOptions& opt, const WorstOptions& wopt,
-                                      std::vector<EdgeResponse>& edges);
+                                      std::vector<EdgeResponse>* edges);
 // "down: why; up: why" over the directions of a run_link_from_edges run that were simulated;
 // empty when every direction was synthesized.
 std::string simulated_note(const LinkRun& run);

@@ -450,7 +450,8 @@ PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t
         fast_path_refused(po.point.spec, opt, wopt.dt / kSynthesisOversample);
     std::vector<EdgeResponse> edges;
     StatusOr<LinkRun> run = simulate_why.empty()
-                                ? run_link_from_edges(po.point.spec, parts, opt.run, wopt, edges)
+                                ? run_link_from_edges(po.point.spec, parts, opt.run, wopt,
+                                                      s.worst_outputs ? &edges : nullptr)
                                 : run_link(po.point.spec, parts, opt.run);
     if (!run) return fail(run.status().message());
     std::vector<std::string> cells = std::move(r.cells);

@@ -102,7 +102,7 @@ void BM_SweepPoint(benchmark::State& state) {
   for (auto _ : state) {
     std::vector<analysis::EdgeResponse> edges;
     StatusOr<analysis::LinkRun> run =
-        analysis::run_link_from_edges(spec, f.parts, {}, f.wopt, edges);
+        analysis::run_link_from_edges(spec, f.parts, {}, f.wopt, &edges);
     if (!run) die(run.status());
     StatusOr<analysis::WorstResult> w = analysis::worst_case(spec, f.parts, f.wopt, edges);
     if (!w) die(w.status());

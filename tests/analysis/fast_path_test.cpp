@@ -71,7 +71,7 @@ void compare_one(const fs::path& path, const link::PartLibrary& parts) {
   WorstOptions wopt;
   wopt.more_probes.assign(run_probes().begin() + 1, run_probes().end());
   std::vector<EdgeResponse> edges;
-  StatusOr<LinkRun> fast = run_link_from_edges(*spec, parts, {}, wopt, edges);
+  StatusOr<LinkRun> fast = run_link_from_edges(*spec, parts, {}, wopt, &edges);
   ASSERT_TRUE(fast.ok()) << path << ": " << fast.status().message();
   RunOptions ro;
   ro.engine = Engine::Lti;

@@ -51,7 +51,7 @@ TEST(LinkRun, MirrorSymmetricDirectionIsSimulatedOnce) {
   // superposed from it, within 1 mV of the simulated run's VSTART.
   std::vector<EdgeResponse> edges;
   StatusOr<LinkRun> from_edges =
-      run_link_from_edges(spec_of(xfmr, "both"), *parts, {}, WorstOptions{}, edges);
+      run_link_from_edges(spec_of(xfmr, "both"), *parts, {}, WorstOptions{}, &edges);
   ASSERT_TRUE(from_edges.ok()) << from_edges.status().message();
   ASSERT_EQ(edges.size(), 2u);
   EXPECT_EQ(edges[0].e, edges[1].e);
