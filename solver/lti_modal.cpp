@@ -110,6 +110,8 @@ class ModalMarch {
   std::vector<double> dr_, di_;      // per fast mode: d = x - x_ss
   std::vector<double> tail_const_;   // per probe: what the modes settle to, and the direct term
   std::vector<double> tail_scale_;   // per probe: |tail_const| + sum |out d| at the tail's start
+  std::vector<double> live_limit2_;  // per probe: (kTailTol tail_scale)^2
+  std::vector<std::vector<double>> out_norm2_;  // [p][mode]: |output|^2
   // ModeRates: each mode's weight on the probes (squared, over the threshold squared), and 1 / p
   // and 1 / p^2 as real arrays, and |p|.
   std::vector<double> w2_, ipr_, ipi_, ip2r_, ip2i_, speed_;
@@ -215,6 +217,12 @@ void ModalMarch::enter_tail(double left) {
     }
   }
   for (size_t p = 0; p < np_; ++p) tail_scale_[p] += std::fabs(tail_const_[p]);
+  live_limit2_.assign(np_, 0.0);
+  out_norm2_.assign(np_, std::vector<double>(nm_));
+  for (size_t p = 0; p < np_; ++p) {
+    live_limit2_[p] = kTailTol * tail_scale_[p] * (kTailTol * tail_scale_[p]);
+    for (size_t i = 0; i < nm_; ++i) out_norm2_[p][i] = std::norm(m_.output[p][i]);
+  }
   tail_ = true;
 }
 
@@ -249,68 +257,136 @@ size_t ModalMarch::uniform_run(const std::vector<double>& times, size_t j, doubl
   return end - j;
 }
 
-// N modes' recursions over queries [q0, q1) of the uniform step, interleaved: x <- e x + c
-// (kAffine; x <- e x for the fast modes' transient parts), and out[p][q] += Re(o_p x) for each mode
-// in turn. The recursions are independent, so N of them share the multiplies' latency; each
-// out[p][q] still gets its terms in the modes' order, the sums of one mode after another to the
-// bit. x: the modes' states, updated.
-template <int N, bool kAffine>
+// Two doubles as one SIMD register (GCC's and Clang's vector extension: SSE2 on x86-64, NEON on
+// arm64); arithmetic on it is lane by lane, the same operations as on two doubles.
+using Pair = double __attribute__((vector_size(16)));
+
+// The modes' recursions over queries [q0, q1) of the uniform step, 2P of them a pair per SIMD
+// register and one more on scalars when kOdd: x <- e x + c (kAffine; x <- e x for the fast
+// modes' transient parts), and out[p][q] += Re(o_p x) for each mode in turn, after `base[p]`
+// when kBase. One pass over out: the recursions are independent, so the modes share the
+// multiplies' latency and the vector units, and each out[p][q] still gets its terms one after
+// another in the modes' order, the sums of march mode by mode to the bit. mode[m]: the modes,
+// cr, ci (nullptr unless kAffine) and xr, xi theirs (xr, xi updated).
+template <int P, bool kOdd, bool kAffine, bool kBase>
 void march_modes(const ModalStep& st, const size_t* mode, const double* cr, const double* ci,
                  double* xr, double* xi, const std::vector<std::vector<double>>& outr,
-                 const std::vector<std::vector<double>>& outi, size_t q0, size_t q1,
-                 std::vector<std::vector<double>>& out) {
-  double er[N], ei[N], ar[N], ai[N];
-  for (int m = 0; m < N; ++m)
-    er[m] = st.er[mode[m]], ei[m] = st.ei[mode[m]], ar[m] = xr[m], ai[m] = xi[m];
+                 const std::vector<std::vector<double>>& outi, const std::vector<double>& base,
+                 size_t q0, size_t q1, std::vector<std::vector<double>>& out) {
+  constexpr int kLast = 2 * P;  // the odd mode's index
+  auto pair = [](double lo, double hi) { return Pair{lo, hi}; };
+  Pair er[P + 1], ei[P + 1], c_r[P + 1], c_i[P + 1], ar[P + 1], ai[P + 1];  // + 1: P may be 0
+  for (int k = 0; k < P; ++k) {
+    const size_t m0 = mode[2 * k], m1 = mode[2 * k + 1];
+    er[k] = pair(st.er[m0], st.er[m1]), ei[k] = pair(st.ei[m0], st.ei[m1]);
+    c_r[k] = kAffine ? pair(cr[2 * k], cr[2 * k + 1]) : Pair{0, 0};
+    c_i[k] = kAffine ? pair(ci[2 * k], ci[2 * k + 1]) : Pair{0, 0};
+  }
+  const double er1 = kOdd ? st.er[mode[kLast]] : 0, ei1 = kOdd ? st.ei[mode[kLast]] : 0;
+  const double cr1 = kOdd && kAffine ? cr[kLast] : 0, ci1 = kOdd && kAffine ? ci[kLast] : 0;
   for (size_t p = 0; p < out.size(); ++p) {
-    double o_r[N], o_i[N];
-    for (int m = 0; m < N; ++m)
-      ar[m] = xr[m], ai[m] = xi[m], o_r[m] = outr[p][mode[m]], o_i[m] = outi[p][mode[m]];
+    Pair o_r[P + 1], o_i[P + 1];
+    for (int k = 0; k < P; ++k) {
+      ar[k] = pair(xr[2 * k], xr[2 * k + 1]), ai[k] = pair(xi[2 * k], xi[2 * k + 1]);
+      o_r[k] = pair(outr[p][mode[2 * k]], outr[p][mode[2 * k + 1]]);
+      o_i[k] = pair(outi[p][mode[2 * k]], outi[p][mode[2 * k + 1]]);
+    }
+    double ar1 = kOdd ? xr[kLast] : 0, ai1 = kOdd ? xi[kLast] : 0;
+    const double o_r1 = kOdd ? outr[p][mode[kLast]] : 0, o_i1 = kOdd ? outi[p][mode[kLast]] : 0;
+    const double b = kBase ? base[p] : 0;
     double* y = out[p].data();
     for (size_t q = q0; q < q1; ++q) {
       double acc = y[q];
-      for (int m = 0; m < N; ++m) {
-        double nr = er[m] * ar[m] - ei[m] * ai[m];
-        double ni = er[m] * ai[m] + ei[m] * ar[m];
-        if constexpr (kAffine) nr += cr[m], ni += ci[m];
-        ar[m] = nr, ai[m] = ni;
-        acc += o_r[m] * ar[m] - o_i[m] * ai[m];
+      if constexpr (kBase) acc += b;
+      for (int k = 0; k < P; ++k) {
+        Pair nr = er[k] * ar[k] - ei[k] * ai[k];
+        Pair ni = er[k] * ai[k] + ei[k] * ar[k];
+        if constexpr (kAffine) nr += c_r[k], ni += c_i[k];
+        ar[k] = nr, ai[k] = ni;
+        const Pair term = o_r[k] * nr - o_i[k] * ni;
+        acc += term[0];
+        acc += term[1];
+      }
+      if constexpr (kOdd) {
+        double nr = er1 * ar1 - ei1 * ai1;
+        double ni = er1 * ai1 + ei1 * ar1;
+        if constexpr (kAffine) nr += cr1, ni += ci1;
+        ar1 = nr, ai1 = ni;
+        acc += o_r1 * nr - o_i1 * ni;
       }
       y[q] = acc;
     }
+    if (p + 1 < out.size()) continue;
+    for (int k = 0; k < P; ++k)
+      xr[2 * k] = ar[k][0], xr[2 * k + 1] = ar[k][1], xi[2 * k] = ai[k][0],
+             xi[2 * k + 1] = ai[k][1];
+    if constexpr (kOdd) xr[kLast] = ar1, xi[kLast] = ai1;
   }
-  for (int m = 0; m < N; ++m) xr[m] = ar[m], xi[m] = ai[m];
 }
 
-// march_modes over `count` modes (any number), four at a time.
-template <bool kAffine>
+// march_modes over `count` modes (any number), one pass over out per eight (nine for the last
+// pass), out[p][q] += base[p] first (kBase; also when there are no modes).
+template <bool kAffine, bool kBase>
 void march_mode_groups(const ModalStep& st, const size_t* mode, const double* cr, const double* ci,
                        double* xr, double* xi, size_t count,
                        const std::vector<std::vector<double>>& outr,
-                       const std::vector<std::vector<double>>& outi, size_t q0, size_t q1,
+                       const std::vector<std::vector<double>>& outi,
+                       const std::vector<double>& base, size_t q0, size_t q1,
                        std::vector<std::vector<double>>& out) {
-  for (size_t g = 0; g < count; g += 4) {
-    const size_t* md = mode + g;
-    const double* gcr = kAffine ? cr + g : nullptr;  // no offset on the fast modes' nullptr
-    const double* gci = kAffine ? ci + g : nullptr;
-    auto run = [&](auto n) {
-      march_modes<decltype(n)::value, kAffine>(st, md, gcr, gci, xr + g, xi + g, outr, outi, q0, q1,
-                                               out);
-    };
-    switch (std::min<size_t>(4, count - g)) {
-      case 4:
-        run(std::integral_constant<int, 4>{});
+  auto pass = [&](auto pairs, auto odd, auto with_base, size_t g) {
+    march_modes<decltype(pairs)::value, decltype(odd)::value, kAffine, decltype(with_base)::value>(
+        st, mode + g, kAffine ? cr + g : nullptr, kAffine ? ci + g : nullptr, xr + g, xi + g, outr,
+        outi, base, q0, q1, out);
+  };
+  using std::integral_constant;
+  using Base = integral_constant<bool, kBase>;
+  using NoBase = integral_constant<bool, false>;
+  using Even = integral_constant<bool, false>;  // no odd mode
+  using Odd = integral_constant<bool, true>;
+  size_t g = 0;
+  for (; count - g > 9; g += 8) {
+    if (g == 0)
+      pass(integral_constant<int, 4>{}, Even{}, Base{}, g);
+    else
+      pass(integral_constant<int, 4>{}, Even{}, NoBase{}, g);
+  }
+  auto last = [&](auto with_base) {
+    switch (count - g) {
+      case 0:
+        if (decltype(with_base)::value) pass(integral_constant<int, 0>{}, Even{}, with_base, g);
         break;
-      case 3:
-        run(std::integral_constant<int, 3>{});
+      case 1:
+        pass(integral_constant<int, 0>{}, Odd{}, with_base, g);
         break;
       case 2:
-        run(std::integral_constant<int, 2>{});
+        pass(integral_constant<int, 1>{}, Even{}, with_base, g);
+        break;
+      case 3:
+        pass(integral_constant<int, 1>{}, Odd{}, with_base, g);
+        break;
+      case 4:
+        pass(integral_constant<int, 2>{}, Even{}, with_base, g);
+        break;
+      case 5:
+        pass(integral_constant<int, 2>{}, Odd{}, with_base, g);
+        break;
+      case 6:
+        pass(integral_constant<int, 3>{}, Even{}, with_base, g);
+        break;
+      case 7:
+        pass(integral_constant<int, 3>{}, Odd{}, with_base, g);
+        break;
+      case 8:
+        pass(integral_constant<int, 4>{}, Even{}, with_base, g);
         break;
       default:
-        run(std::integral_constant<int, 1>{});
+        pass(integral_constant<int, 4>{}, Odd{}, with_base, g);
     }
-  }
+  };
+  if (g == 0)
+    last(Base{});
+  else
+    last(NoBase{});
 }
 
 // Queries j..end-1 of the tail on the uniform step, mode by mode rather than query by query (the
@@ -318,9 +394,7 @@ void march_mode_groups(const ModalStep& st, const size_t* mode, const double* cr
 // stays in registers over the whole run, and a long record costs its few live modes alone).
 void ModalMarch::tail_block(size_t j, size_t end, std::vector<std::vector<double>>& out) {
   const ModalStep& st = uniform_;
-  for (size_t p = 0; p < np_; ++p)
-    for (size_t q = j; q < end; ++q) out[p][q] += tail_const_[p];
-  {  // Slow modes: x <- e x + f1 b (b constant in the tail).
+  {  // The constant, and the slow modes: x <- e x + f1 b (b constant in the tail).
     const size_t ns = slow_.size();
     std::vector<double> cr(ns), ci(ns), xr(ns), xi(ns);
     for (size_t s = 0; s < ns; ++s) {
@@ -329,8 +403,8 @@ void ModalMarch::tail_block(size_t j, size_t end, std::vector<std::vector<double
       ci[s] = st.f1r[i] * bi_[i] + st.f1i[i] * br_[i];
       xr[s] = xr_[i], xi[s] = xi_[i];
     }
-    march_mode_groups<true>(st, slow_.data(), cr.data(), ci.data(), xr.data(), xi.data(), ns, outr_,
-                            outi_, j, end, out);
+    march_mode_groups<true, true>(st, slow_.data(), cr.data(), ci.data(), xr.data(), xi.data(), ns,
+                                  outr_, outi_, tail_const_, j, end, out);
     for (size_t s = 0; s < ns; ++s) xr_[slow_[s]] = xr[s], xi_[slow_[s]] = xi[s];
   }
   // Fast modes: d <- e d, each dropped at the first query q (q % 64 == 0, as prune) where its
@@ -349,17 +423,19 @@ void ModalMarch::tail_block(size_t j, size_t end, std::vector<std::vector<double
       ++kept;
     }
     fast_.resize(kept), dr_.resize(kept), di_.resize(kept);
-    march_mode_groups<false>(st, fast_.data(), nullptr, nullptr, dr_.data(), di_.data(), kept,
-                             outr_, outi_, q + 1, chunk_end, out);
+    march_mode_groups<false, false>(st, fast_.data(), nullptr, nullptr, dr_.data(), di_.data(),
+                                    kept, outr_, outi_, tail_const_, q + 1, chunk_end, out);
     q = chunk_end;
   }
 }
 
 // Whether fast mode i, its transient part at d, still moves some probe by kTailTol of its scale.
+// Squared (|o|^2 |d|^2 against (kTailTol scale)^2): two complex moduli per mode every 64
+// queries cost a third of the march of the modes between.
 bool ModalMarch::fast_mode_live(size_t i, double dr, double di) const {
-  const double d = std::hypot(dr, di);
+  const double d2 = dr * dr + di * di;
   for (size_t p = 0; p < np_; ++p)
-    if (std::abs(m_.output[p][i]) * d > kTailTol * tail_scale_[p]) return true;
+    if (out_norm2_[p][i] * d2 > live_limit2_[p]) return true;
   return false;
 }
 
