@@ -602,9 +602,11 @@ Status EdgeResponseBuilder::sample_model(const LtiResponses& lti, const std::str
     for (long i = from; i < n; ++i)
       times[static_cast<size_t>(i - from)] = kLead + static_cast<double>(i - out_.pre) * opt_.dt;
     const std::vector<std::vector<double>> v = lti.values(inputs, times);
-    auto append = [n](std::vector<double>& rec, const std::vector<double>& x, double idle) {
-      rec.reserve(static_cast<size_t>(n));
-      for (double y : x) rec.push_back(y - idle);
+    auto append = [](std::vector<double>& rec, const std::vector<double>& x, double idle) {
+      const size_t at = rec.size();
+      rec.resize(at + x.size());
+      double* out = rec.data() + at;
+      for (size_t i = 0; i < x.size(); ++i) out[i] = x[i] - idle;
     };
     append(out_.e, v[0], out_.v_idle);
     for (size_t i = 0; i < out_.more.size(); ++i)
