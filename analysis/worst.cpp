@@ -206,7 +206,7 @@ Score score_check(const eye::CheckResult& c, const eye::Rules& rules) {
 class Search {
  public:
   Search(const EdgeResponse& e, const eye::Rules& rules, const WorstOptions& opt)
-      : e_(e), rules_(rules), opt_(opt), enc_(opt.expand.stimulus.encoding) {
+      : e_(e), rules_(rules), enc_(opt.expand.stimulus.encoding) {
     half_ = to_samples(enc_.half_bit, e.dt);
     frame_ = half_ * traffic::byte_half_bit_count(enc_);
     pre_ = to_samples(300e-9, e.dt);
@@ -294,7 +294,6 @@ class Search {
  private:
   const EdgeResponse& e_;
   const eye::Rules& rules_;
-  const WorstOptions& opt_;
   traffic::EncodingOptions enc_;
   long half_ = 0, frame_ = 0, pre_ = 0, post_ = 0, len_ = 0;
   std::vector<double> t_;

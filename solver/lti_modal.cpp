@@ -9,6 +9,7 @@
 #include <complex>
 #include <functional>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "solver/lti.h"
@@ -339,54 +340,29 @@ void march_mode_groups(const ModalStep& st, const size_t* mode, const double* cr
         outi, base, q0, q1, out);
   };
   using std::integral_constant;
-  using Base = integral_constant<bool, kBase>;
-  using NoBase = integral_constant<bool, false>;
-  using Even = integral_constant<bool, false>;  // no odd mode
-  using Odd = integral_constant<bool, true>;
   size_t g = 0;
-  for (; count - g > 9; g += 8) {
+  for (; count - g > 9; g += 8)  // the base with the first pass only
     if (g == 0)
-      pass(integral_constant<int, 4>{}, Even{}, Base{}, g);
+      pass(integral_constant<int, 4>{}, std::false_type{}, integral_constant<bool, kBase>{}, g);
     else
-      pass(integral_constant<int, 4>{}, Even{}, NoBase{}, g);
-  }
+      pass(integral_constant<int, 4>{}, std::false_type{}, std::false_type{}, g);
+  // The last 0-9 modes: pairs, and the odd one; a pass with none only to add the base.
   auto last = [&](auto with_base) {
-    switch (count - g) {
-      case 0:
-        if (decltype(with_base)::value) pass(integral_constant<int, 0>{}, Even{}, with_base, g);
-        break;
-      case 1:
-        pass(integral_constant<int, 0>{}, Odd{}, with_base, g);
-        break;
-      case 2:
-        pass(integral_constant<int, 1>{}, Even{}, with_base, g);
-        break;
-      case 3:
-        pass(integral_constant<int, 1>{}, Odd{}, with_base, g);
-        break;
-      case 4:
-        pass(integral_constant<int, 2>{}, Even{}, with_base, g);
-        break;
-      case 5:
-        pass(integral_constant<int, 2>{}, Odd{}, with_base, g);
-        break;
-      case 6:
-        pass(integral_constant<int, 3>{}, Even{}, with_base, g);
-        break;
-      case 7:
-        pass(integral_constant<int, 3>{}, Odd{}, with_base, g);
-        break;
-      case 8:
-        pass(integral_constant<int, 4>{}, Even{}, with_base, g);
-        break;
-      default:
-        pass(integral_constant<int, 4>{}, Odd{}, with_base, g);
+    using WithBase = decltype(with_base);
+    auto rest = [&](auto left) {
+      constexpr int k = decltype(left)::value;
+      if constexpr (k > 0 || WithBase::value)
+        pass(integral_constant<int, k / 2>{}, integral_constant<bool, k % 2 == 1>{}, WithBase{}, g);
+    };
+    [&]<int... K>(std::integer_sequence<int, K...>) {
+      ((count - g == static_cast<size_t>(K) ? rest(integral_constant<int, K>{}) : void()), ...);
     }
+    (std::make_integer_sequence<int, 10>{});
   };
   if (g == 0)
-    last(Base{});
+    last(integral_constant<bool, kBase>{});
   else
-    last(NoBase{});
+    last(std::false_type{});
 }
 
 // Queries j..end-1 of the tail on the uniform step, mode by mode rather than query by query (the

@@ -151,7 +151,6 @@ Status read_end(const YamlDoc& doc, const YAML::Node& node, const std::string& p
 }
 
 Status read_cable(const YamlDoc& doc, const YAML::Node& node, CableSpec* cable) {
-  std::optional<double> r, l, c, g;
   Status s = read_map(
       doc, node, "cable",
       {
