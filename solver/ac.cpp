@@ -1,5 +1,6 @@
 #include "solver/ac.h"
 
+#include <amd.h>
 #include <fmt/format.h>
 #include <klu.h>
 
@@ -9,6 +10,7 @@
 #include <cstdint>
 #include <limits>
 #include <numbers>
+#include <numeric>
 
 #include "solver/mna.h"
 
@@ -30,20 +32,120 @@ struct AcAnalysis::Impl {
   std::vector<double> g_row_max, c_row_max;  // per row: the largest |g|, |c|
   klu_common common{};
   klu_symbolic* symbolic = nullptr;
+  // COLAMD's ordering, until the first factorization keeps whichever of it and `symbolic` (the
+  // paired ordering, below) needs fewer flops.
+  klu_symbolic* candidate = nullptr;
   klu_numeric* numeric = nullptr;
+  bool paired = true;     // `symbolic` is the paired ordering (else COLAMD's)
   double frequency = -1;  // of the current factorization, -1: none
   ~Impl() {
     if (numeric) klu_z_free_numeric(&numeric, &common);
     if (symbolic) klu_free_symbolic(&symbolic, &common);
+    if (candidate) klu_free_symbolic(&candidate, &common);
   }
+  klu_symbolic* analyze_paired();
+  bool keep_cheaper_ordering(bool factored);
 };
+
+namespace {
+
+// |g| + |c| of the pattern's entry (row, col) (0-based), 0 where the pattern has none.
+double entry_size(const MnaPattern& pattern, const std::vector<double>& g,
+                  const std::vector<double>& c, int row, int col) {
+  const std::vector<int>& cp = pattern.col_start();
+  const std::vector<int>& ri = pattern.row_index();
+  for (int k = cp[col]; k < cp[col + 1]; ++k)
+    if (ri[k] == row) return std::fabs(g[k]) + std::fabs(c[k]);
+  return 0;
+}
+
+// Each branch unknown (a voltage source's or an inductor's current) paired with a node of its
+// element: pair[i] is the row that stands on unknown i's diagonal (an involution; unpaired
+// unknowns keep their own row). A branch row, v_a - v_b - j w L i = 0, has a zero diagonal for a
+// source and a small one for an inductor below its corner (w L under the ohms around it), so
+// pivoting swaps it with a node's row, and an ordering that counted on the diagonal fills in: a
+// 12 m link's cable (R and L per section) took 55.7k flops a factorization under COLAMD. The
+// pair's two entries (the branch's +-1 in the node's KCL row, the node's +-1 in the branch row)
+// do not depend on frequency; ordered with them as the diagonal, the same link takes 16-20k.
+std::vector<int> pair_branches_with_nodes(const Circuit& circuit, const MnaPattern& pattern,
+                                          const std::vector<double>& g,
+                                          const std::vector<double>& c) {
+  const int n = pattern.size();
+  std::vector<int> pair(static_cast<size_t>(n));
+  std::iota(pair.begin(), pair.end(), 0);
+  std::vector<char> paired(static_cast<size_t>(n), 0);
+  for (const auto& e : circuit.elements())
+    for (int branch : e->branches()) {
+      const int b = branch - 1;  // unknowns count from 1 (0 is ground); KLU's from 0
+      if (b < 0 || b >= n || paired[b]) continue;
+      for (int node : e->nodes()) {
+        const int v = node - 1;
+        if (v < 0 || v >= n || paired[v]) continue;
+        if (entry_size(pattern, g, c, v, b) == 0 || entry_size(pattern, g, c, b, v) == 0) continue;
+        pair[b] = v, pair[v] = b;
+        paired[b] = paired[v] = 1;
+        break;
+      }
+    }
+  return pair;
+}
+
+}  // namespace
+
+// AMD on the pattern with each pair's rows swapped (pair_branches_with_nodes), given to KLU as
+// rows P = pair(Q), columns Q. KLU still pivots (threshold partial pivoting) where a paired
+// diagonal is too small: the ordering only sets the fill, never whether the LU is sound.
+klu_symbolic* AcAnalysis::Impl::analyze_paired() {
+  const int n = pattern.size();
+  const std::vector<int> pair = pair_branches_with_nodes(*circuit, pattern, g, c);
+  std::vector<int> bi(ai.size());  // the swapped pattern's rows, sorted in each column
+  for (int col = 0; col < n; ++col) {
+    for (int k = ap[col]; k < ap[col + 1]; ++k) bi[k] = pair[ai[k]];
+    std::sort(bi.begin() + ap[col], bi.begin() + ap[col + 1]);
+  }
+  std::vector<int> q(static_cast<size_t>(n));
+  double control[AMD_CONTROL], info[AMD_INFO];
+  amd_defaults(control);
+  const int status = amd_order(n, ap.data(), bi.data(), q.data(), control, info);
+  if (status != AMD_OK && status != AMD_OK_BUT_JUMBLED) return nullptr;
+  std::vector<int> p(static_cast<size_t>(n));
+  for (int k = 0; k < n; ++k) p[k] = pair[q[k]];
+  const int btf = common.btf;
+  common.btf = 0;  // the order is for the whole matrix
+  klu_symbolic* s = klu_analyze_given(n, ap.data(), ai.data(), p.data(), q.data(), &common);
+  common.btf = btf;
+  return s;
+}
+
+// After the first factorization (with `symbolic`; `factored`: it succeeded): factors with the
+// candidate too and keeps the one with fewer flops, or the one that factors. The paired order
+// won on every link spec tried; COLAMD stays for netlists where pairing does not pay. True when
+// `numeric` holds a factorization.
+bool AcAnalysis::Impl::keep_cheaper_ordering(bool factored) {
+  klu_symbolic* other = candidate;
+  candidate = nullptr;
+  if (!factored && numeric) klu_z_free_numeric(&numeric, &common);
+  klu_numeric* num = klu_z_factor(ap.data(), ai.data(), a.data(), other, &common);
+  const bool other_ok = num != nullptr && common.status == KLU_OK;
+  double mine = 0;
+  if (factored && other_ok && klu_z_flops(symbolic, numeric, &common)) mine = common.flops;
+  if (other_ok && (!factored || (klu_z_flops(other, num, &common) && common.flops < mine))) {
+    std::swap(symbolic, other);
+    std::swap(numeric, num);
+    paired = false;
+    factored = true;
+  }
+  if (num) klu_z_free_numeric(&num, &common);
+  klu_free_symbolic(&other, &common);
+  return factored;
+}
 
 AcAnalysis::AcAnalysis() : impl_(std::make_unique<Impl>()) {}
 AcAnalysis::AcAnalysis(AcAnalysis&&) noexcept = default;
 AcAnalysis& AcAnalysis::operator=(AcAnalysis&&) noexcept = default;
 AcAnalysis::~AcAnalysis() = default;
 
-StatusOr<AcAnalysis> AcAnalysis::create(const Circuit& circuit) {
+StatusOr<AcAnalysis> AcAnalysis::create(const Circuit& circuit, AcOrdering ordering) {
   AcAnalysis ac;
   Impl& m = *ac.impl_;
   m.circuit = &circuit;
@@ -58,13 +160,13 @@ StatusOr<AcAnalysis> AcAnalysis::create(const Circuit& circuit) {
   m.ai = m.pattern.row_index();
 
   klu_defaults(&m.common);
-  // COLAMD, not KLU's default AMD: on a 40 m link (2732 unknowns) AMD's pivoted LU held 230k
-  // entries (17 ms a refactorization), COLAMD's 34k.
+  // The candidate: COLAMD, not KLU's default AMD, which (on the unpaired pattern) left a 40 m
+  // link's (2732 unknowns) pivoted LU with 230k entries, 17 ms a refactorization; COLAMD's 34k.
   m.common.ordering = 1;
   // The rows are scaled here (Impl::row_scale); the pattern is KLU's own analysis's, checked.
   m.common.scale = -1;
-  m.symbolic = klu_analyze(n, m.ap.data(), m.ai.data(), &m.common);
-  if (m.symbolic == nullptr)
+  m.candidate = klu_analyze(n, m.ap.data(), m.ai.data(), &m.common);
+  if (m.candidate == nullptr)
     return Status::Error(
         fmt::format("ac analysis: KLU symbolic analysis failed (status {})", m.common.status));
   m.a.assign(2 * static_cast<size_t>(m.pattern.nonzeros()), 0.0);
@@ -77,6 +179,12 @@ StatusOr<AcAnalysis> AcAnalysis::create(const Circuit& circuit) {
     gm = std::max(gm, std::fabs(m.g[k]));
     cm = std::max(cm, std::fabs(m.c[k]));
   }
+  if (ordering != AcOrdering::kColamd) m.symbolic = m.analyze_paired();
+  if (m.symbolic == nullptr) {  // COLAMD alone
+    std::swap(m.symbolic, m.candidate);
+    m.paired = false;
+  }
+  if (ordering == AcOrdering::kPaired && m.candidate) klu_free_symbolic(&m.candidate, &m.common);
   return ac;
 }
 
@@ -156,6 +264,7 @@ Status AcAnalysis::factor(double frequency) {
   if (!ok) {
     m.numeric = klu_z_factor(ap, ai, m.a.data(), m.symbolic, &m.common);
     ok = m.numeric != nullptr && m.common.status == KLU_OK;
+    if (m.candidate) ok = m.keep_cheaper_ordering(ok);
   }
   if (!ok)
     return Status::Error(fmt::format("ac analysis at {:g} Hz: singular matrix (KLU status {})",
@@ -166,6 +275,16 @@ Status AcAnalysis::factor(double frequency) {
 
 double AcAnalysis::factored_frequency() const {
   return impl_->frequency;
+}
+
+double AcAnalysis::factor_flops() const {
+  Impl& m = *impl_;
+  if (!m.numeric || !klu_z_flops(m.symbolic, m.numeric, &m.common)) return 0;
+  return m.common.flops;
+}
+
+const char* AcAnalysis::ordering_name() const {
+  return impl_->paired ? "paired AMD" : "COLAMD";
 }
 
 namespace {

@@ -9,6 +9,12 @@
 // transient engine uses, floating nodes tied as there. Used for impedances, attenuation and
 // filter responses (cable and part-library checks), not for time-domain results.
 //
+// Ordering: MNA's branch unknowns (voltage sources, inductors) have a zero or, below an
+// inductor's corner, a small diagonal, and pivoting trades it for a node's row. Each is paired
+// with a node of its element up front (the +-1s of KCL and of the branch equation as the
+// diagonal) and the swapped pattern ordered by AMD; COLAMD on the unswapped one is the
+// alternative, and the first factorization keeps whichever needs fewer flops. A 12 m link's LU
+// took 55.7k flops under COLAMD, 16-20k paired (bench/README.md).
 // Units: frequencies in Hz; solutions in V (nodes) and A (branches) per unit source amplitude.
 // Lifetime: the analysis keeps a pointer to the circuit (names, sources): the circuit must
 // outlive it. It owns its pattern, stamps and KLU factorization; moving it is cheap.
@@ -34,10 +40,15 @@ struct AcSolution {
   std::complex<double> voltage(const Probe& p) const { return x[p.a] - x[p.b]; }
 };
 
+// The LU's fill-reducing ordering (header: Ordering). kCheaper: both, the first factorization
+// keeps the one with fewer flops; the others force one (tests, bench).
+enum class AcOrdering { kCheaper, kPaired, kColamd };
+
 class AcAnalysis {
  public:
   // The circuit must be finalized and outlive the analysis.
-  static StatusOr<AcAnalysis> create(const Circuit& circuit);
+  static StatusOr<AcAnalysis> create(const Circuit& circuit,
+                                     AcOrdering ordering = AcOrdering::kCheaper);
   AcAnalysis(AcAnalysis&&) noexcept;
   AcAnalysis& operator=(AcAnalysis&&) noexcept;
   ~AcAnalysis();
@@ -52,6 +63,10 @@ class AcAnalysis {
   // Factors G + j 2 pi f C at f (Hz, >= 0); the solves below reuse it until the next factor().
   Status factor(double frequency);
   double factored_frequency() const;
+  // KLU's flop count of the current factorization (0 before the first), and the ordering in use
+  // (header: "paired AMD" or "COLAMD"; under kCheaper, decided by the first factor()).
+  double factor_flops() const;
+  const char* ordering_name() const;
   // x with A x = b.
   Vector solve_factored(const Vector& b) const;
   // z with A^T z = c: for an output c.x, a change dA of the matrix moves it by -z^T dA x.
