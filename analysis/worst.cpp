@@ -567,6 +567,9 @@ Status EdgeResponseBuilder::from_reduced_model(bool* done) {
   LtiOptions lo;
   lo.method = LtiOptions::Method::Reduced;
   lo.horizon = kLead + opt_.max_span;
+  // The driver's two lines move together (n = vdd - p): one model input, half the order. The
+  // responses are only ever taken for the netlist's own drive (netlist_inputs).
+  lo.tie_sources = true;
   const auto by_direction = opt_.reduced_start_points_by_direction.find(d_);
   lo.reduced.start_points = by_direction != opt_.reduced_start_points_by_direction.end()
                                 ? by_direction->second

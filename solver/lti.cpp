@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <complex>
+#include <limits>
 
 #include "solver/lti_internal.h"
 #include "solver/mna_system.h"
@@ -103,6 +104,7 @@ StatusOr<LtiResponses> LtiResponses::compute(const Circuit& circuit,
   MnaSystem sys;
   if (Status s = sys.build(circuit); !s.ok()) return s;
   const std::vector<std::vector<double>> unit = r.collect_sources(circuit, sys.n);
+  if (opt.tie_sources) r.find_ties(opt.horizon);
   std::vector<std::vector<double>> dc_solutions;  // per source: G^-1 e_k
   if (Status s = r.solve_dc(circuit, sys, probes, unit, dc_solutions); !s.ok()) return s;
   if (opt.method != LtiOptions::Method::March && !r.sources_.empty()) {
@@ -125,6 +127,49 @@ std::vector<std::vector<double>> LtiResponses::collect_sources(const Circuit& ci
     unit.back()[0] = 0.0;
   }
   return unit;
+}
+
+namespace {
+
+// Whether every slope change of `a` is b times `leader`'s at the same time (within 1e-12 of the
+// largest); two empty lists do.
+bool moves_as(const std::vector<Ramp>& a, const std::vector<Ramp>& leader, double b) {
+  if (a.size() != leader.size()) return false;
+  double largest = 0.0;
+  for (const Ramp& r : a) largest = std::max(largest, std::fabs(r.slope));
+  for (size_t i = 0; i < a.size(); ++i)
+    if (a[i].t != leader[i].t || !(std::fabs(a[i].slope - b * leader[i].slope) <= 1e-12 * largest))
+      return false;
+  return true;
+}
+
+}  // namespace
+
+void LtiResponses::find_ties(double tstop) {
+  std::vector<std::vector<Ramp>> ramps;
+  for (const Source& s : sources_) ramps.push_back(s.function->ramps(tstop));
+  for (size_t k = 0; k < sources_.size(); ++k)
+    for (size_t j = 0; j < k; ++j) {
+      if (sources_[j].tied_to >= 0 || ramps[k].empty() || ramps[j].empty()) continue;
+      if (ramps[j].front().slope == 0) continue;
+      const double b = ramps[k].front().slope / ramps[j].front().slope;
+      if (b == 0 || !std::isfinite(b) || !moves_as(ramps[k], ramps[j], b)) continue;
+      sources_[k].tied_to = static_cast<int>(j);
+      sources_[k].tie_factor = b;
+      break;
+    }
+}
+
+bool LtiResponses::follows_ties(const std::vector<SourceInput>& inputs) const {
+  static const std::vector<Ramp> kNone;
+  for (size_t k = 0; k < sources_.size() && k < inputs.size(); ++k) {
+    const size_t j = static_cast<size_t>(sources_[k].tied_to);
+    if (sources_[k].tied_to < 0) continue;
+    if (!moves_as(inputs[k].ramps, j < inputs.size() ? inputs[j].ramps : kNone,
+                  sources_[k].tie_factor))
+      return false;
+  }
+  return true;
 }
 
 // The operating point of the netlist's sources at t = 0, and each source's DC gain.
@@ -162,8 +207,44 @@ StatusOr<bool> LtiResponses::try_reduced_model(const Circuit& circuit,
   std::vector<const SourceFunction*> functions;
   for (const Source& src : sources_) functions.push_back(src.function);
   ro.edge_time = opt.edge_time > 0 ? opt.edge_time : shortest_edge(functions, opt.horizon);
+  // One model input per source that is not tied (LtiOptions::tie_sources), its excitation and
+  // DC solution summed with its tied sources' (scaled): the model is linear in both.
+  std::vector<std::vector<double>> in_unit, in_dc;
+  std::vector<int> input_of(sources_.size(), -1);  // per source: its model input, -1 if tied
+  for (size_t k = 0; k < sources_.size(); ++k) {
+    const int j = sources_[k].tied_to;
+    if (j < 0) {
+      input_of[k] = static_cast<int>(in_unit.size());
+      in_unit.push_back(unit[k]);
+      in_dc.push_back(dc_solutions[k]);
+      continue;
+    }
+    const double b = sources_[k].tie_factor;
+    const size_t i = static_cast<size_t>(input_of[static_cast<size_t>(j)]);
+    for (size_t u = 0; u < unit[k].size(); ++u) {
+      in_unit[i][u] += b * unit[k][u];
+      in_dc[i][u] += b * dc_solutions[k][u];
+    }
+  }
   const auto started = std::chrono::steady_clock::now();
-  StatusOr<ReducedModel> model = reduce_circuit(circuit, unit, dc_solutions, probes, ro);
+  StatusOr<ReducedModel> model = reduce_circuit(circuit, in_unit, in_dc, probes, ro);
+  if (model && in_unit.size() != sources_.size()) {
+    // Back to one row per source: a tied source's are 0 (its leader's carry it).
+    ReducedModel& m = *model;
+    std::vector<std::vector<std::complex<double>>> input(sources_.size());
+    std::vector<std::vector<double>> direct(sources_.size());
+    for (size_t k = 0; k < sources_.size(); ++k) {
+      if (input_of[k] >= 0) {
+        input[k] = m.input[static_cast<size_t>(input_of[k])];
+        direct[k] = m.direct[static_cast<size_t>(input_of[k])];
+      } else {
+        input[k].assign(m.poles.size(), 0.0);
+        direct[k].assign(probes.size(), 0.0);
+      }
+    }
+    m.input = std::move(input);
+    m.direct = std::move(direct);
+  }
   stats_.model_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   if (model) {
@@ -235,6 +316,7 @@ double LtiResponses::step_response(size_t k, size_t p, double tau) const {
 }
 
 double LtiResponses::value(size_t p, double t, const std::vector<SourceInput>& inputs) const {
+  if (model_ && !follows_ties(inputs)) return std::numeric_limits<double>::quiet_NaN();
   double y = y_dc_[p];
   for (size_t k = 0; k < sources_.size() && k < inputs.size(); ++k) {
     y += (inputs[k].initial - sources_[k].initial) * gain_[k][p];

@@ -71,6 +71,14 @@ struct LtiOptions {
   // circuit's own sources up to the horizon (none when no source moves). Set it when other
   // inputs, with faster edges, will be applied (SourceInput).
   double edge_time = 0.0;
+  // Sources whose netlist waveforms move as an earlier source's does, scaled (the same corners,
+  // every slope change b times its: a differential driver's two lines, n = vdd - p, b = -1),
+  // share one input of the reduced model, driven by the excitation e_leader + b e_tied: half the
+  // Krylov vectors and about half the model order for such a pair. The leader's responses then
+  // carry the tied source's too (the tied source's ramp_response and step_response are 0), so
+  // every input given later must keep the relation (netlist_inputs does): one that breaks it
+  // makes value(), values() and waveform() NaN and modal_tail() empty. The march ignores this.
+  bool tie_sources = false;
   double step_reltol = 1e-5;   // truncation error per unit time, relative to peak |S|
   double step_abstol = 1e-7;   // same, absolute (V/V for nodes, A/V for branch currents)
   double settle_tol = 1e-6;    // V/V (A/V): early stop, see above
@@ -235,6 +243,10 @@ class LtiResponses {
     // this LtiResponses (netlist_inputs reads it).
     const SourceFunction* function = nullptr;
     double initial = 0.0;  // the netlist's value at t = 0
+    // LtiOptions::tie_sources: the earlier source whose model input carries this one (its
+    // slopes `tie_factor` times the leader's), -1 when it has an input of its own.
+    int tied_to = -1;
+    double tie_factor = 0.0;
   };
   friend class LtiMarch;   // lti_march.cpp: fills tau_, r_, s_, end_slope_
   friend class MarchGrid;  // lti.cpp: waveform() on the march's responses
@@ -244,6 +256,16 @@ class LtiResponses {
   // entries); the DC point and gains; the reduced model (true: built and kept; false: failed
   // under Method::Auto, the reason in stats_.note); the march.
   std::vector<std::vector<double>> collect_sources(const Circuit& circuit, int n);
+  // LtiOptions::tie_sources: fills tie_ from the netlist waveforms up to tstop.
+  void find_ties(double tstop);
+  // False when an input breaks a tie (tie_sources): the model cannot evaluate it.
+  bool follows_ties(const std::vector<SourceInput>& inputs) const;
+  // Per source: 1 when tied to an earlier one.
+  std::vector<char> tied_sources() const {
+    std::vector<char> t;
+    for (const Source& s : sources_) t.push_back(s.tied_to >= 0);
+    return t;
+  }
   Status solve_dc(const Circuit& circuit, const MnaSystem& sys, const std::vector<Probe>& probes,
                   const std::vector<std::vector<double>>& unit,
                   std::vector<std::vector<double>>& dc_solutions);

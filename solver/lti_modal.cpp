@@ -8,6 +8,7 @@
 #include <cmath>
 #include <complex>
 #include <functional>
+#include <limits>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -548,11 +549,14 @@ void ModalMarch::run(const std::vector<Corner>& corners, const std::vector<doubl
 
 namespace {
 
-// Every input's corners (the first nk inputs), by time.
-std::vector<Corner> sorted_corners(const std::vector<SourceInput>& inputs, size_t nk) {
+// Every input's corners (the first nk inputs, but those `tied`: their leader's carry them), by
+// time.
+std::vector<Corner> sorted_corners(const std::vector<SourceInput>& inputs, size_t nk,
+                                   const std::vector<char>& tied) {
   std::vector<Corner> corners;
   for (size_t k = 0; k < nk; ++k)
-    for (const Ramp& r : inputs[k].ramps) corners.push_back({r.t, k, r.slope});
+    if (!tied[k])
+      for (const Ramp& r : inputs[k].ramps) corners.push_back({r.t, k, r.slope});
   std::stable_sort(corners.begin(), corners.end(),
                    [](const Corner& a, const Corner& b) { return a.t < b.t; });
   return corners;
@@ -563,8 +567,13 @@ std::vector<Corner> sorted_corners(const std::vector<SourceInput>& inputs, size_
 void LtiResponses::modal_add(const std::vector<SourceInput>& inputs,
                              const std::vector<double>& times, double uniform_dt,
                              std::vector<std::vector<double>>& out, ModeRates* rates) const {
+  if (!follows_ties(inputs)) {
+    for (auto& row : out)
+      std::fill(row.begin(), row.end(), std::numeric_limits<double>::quiet_NaN());
+    return;
+  }
   const size_t nk = std::min(sources_.size(), inputs.size());
-  const std::vector<Corner> corners = sorted_corners(inputs, nk);
+  const std::vector<Corner> corners = sorted_corners(inputs, nk, tied_sources());
   ModalMarch march(*model_, labels_.size(), nk, uniform_dt, rates ? &rates->probe_weight : nullptr,
                    rates ? rates->threshold : 0.0, rates ? &rates->rate : nullptr);
   march.run(corners, times, out);
@@ -572,9 +581,9 @@ void LtiResponses::modal_add(const std::vector<SourceInput>& inputs,
 
 std::optional<LtiResponses::ModalTail> LtiResponses::modal_tail(
     const std::vector<SourceInput>& inputs, double t0) const {
-  if (!model_) return std::nullopt;
+  if (!model_ || !follows_ties(inputs)) return std::nullopt;
   const size_t nk = std::min(sources_.size(), inputs.size());
-  const std::vector<Corner> corners = sorted_corners(inputs, nk);
+  const std::vector<Corner> corners = sorted_corners(inputs, nk, tied_sources());
   if (!corners.empty() && corners.back().t > t0) return std::nullopt;
   ModalMarch march(*model_, labels_.size(), nk, 0.0, nullptr, 0.0, nullptr);
   std::vector<std::vector<double>> at_t0(labels_.size(), std::vector<double>(1, 0.0));

@@ -219,6 +219,72 @@ TEST(Lti, ModalTailIsTheModelPastTheLastCorner) {
   EXPECT_FALSE(responses(*b, 200e-6, Method::March).modal_tail(inputs, t0).has_value());
 }
 
+// A differential driver's two lines (p: 0 -> 5 V, n: 5 -> 0 V, the same corners), each into a
+// lag (100 ns and 300 ns) and a 30-section RC ladder, and a third source on corners of its own
+// into a lag of its own (a part of the circuit the others never reach). With tie_sources the n
+// line shares p's model input (LtiOptions): the model's order nearly halves, yet every probe
+// keeps the closed form (the lags) and the untied model's values (the ladders); an input that
+// breaks the tie cannot be evaluated (NaN, no tail).
+TEST(Lti, TiedSourcesShareOneModelInputAndKeepTheClosedForm) {
+  const double tr = 10e-9, t1 = 2e-6;
+  std::vector<Card> cards = {
+      card("vp", {"p", "0"}, {call("pwl", {0, 0, tr, 5, t1, 5, t1 + tr, 0})}),
+      card("vn", {"n", "0"}, {call("pwl", {0, 5, tr, 0, t1, 0, t1 + tr, 5})}),
+      card("vq", {"q", "0"}, {call("pwl", {0, 0, 3 * tr, 1})}),
+      card("rp", {"p", "a"}, {num(1e3)}),
+      card("cp", {"a", "0"}, {num(100e-12)}),
+      card("rn", {"n", "b"}, {num(1e3)}),
+      card("cn", {"b", "0"}, {num(300e-12)}),
+      card("rq", {"q", "c"}, {num(1e3)}),
+      card("cq", {"c", "0"}, {num(50e-12)})};
+  for (const std::string line : {"p", "n"})
+    for (int i = 1; i <= 30; ++i) {
+      const std::string from = i == 1 ? line : line + "l" + std::to_string(i - 1),
+                        to = line + "l" + std::to_string(i);
+      cards.push_back(card("r" + to, {from, to}, {num(100)}));
+      cards.push_back(card("c" + to, {to, "0"}, {num(10e-12)}));
+    }
+  auto b = make(cards, {"v(a,b)", "v(pl30,nl30)", "v(c)"});
+  auto model = [&](bool tie) {
+    LtiOptions opt;
+    opt.horizon = 10e-6;
+    opt.method = Method::Reduced;
+    opt.tie_sources = tie;
+    auto r = LtiResponses::compute(b->circuit, b->probes, opt);
+    EXPECT_TRUE(r.ok()) << r.status().message();
+    return std::move(*r);
+  };
+  const LtiResponses tied = model(true), free = model(false);
+  EXPECT_LT(tied.stats().model.order, free.stats().model.order * 3 / 4)
+      << tied.stats().model.order << " vs " << free.stats().model.order;
+  const auto inputs = tied.netlist_inputs(10e-6);
+  std::vector<double> times;
+  for (int i = 0; i <= 400; ++i) times.push_back(i * 10e-9);
+  const auto v = tied.values(inputs, times), w = free.values(inputs, times);
+  auto pulse = [&](double t, double tau) {  // a 0 -> 1 -> 0 pulse through a lag
+    return (lag_ramp(t, tau) - lag_ramp(t - tr, tau) - lag_ramp(t - t1, tau) +
+            lag_ramp(t - t1 - tr, tau)) /
+           tr;
+  };
+  for (size_t j = 0; j < times.size(); ++j) {
+    const double t = times[j];
+    SCOPED_TRACE(t);
+    // The model's check bounds each edge's response by 0.095 mV per volt (5 V edges here).
+    EXPECT_NEAR(v[0][j], 5 * pulse(t, 100e-9) - (5 - 5 * pulse(t, 300e-9)), 1e-3);
+    EXPECT_NEAR(v[1][j], w[1][j], 1e-3);
+    EXPECT_NEAR(v[2][j], (lag_ramp(t, 50e-9) - lag_ramp(t - 3 * tr, 50e-9)) / (3 * tr), 2e-4);
+  }
+  // The tied line's own responses are carried by p's.
+  EXPECT_EQ(tied.step_response(1, 0, 1e-6), 0.0);
+  std::vector<SourceInput> broken = inputs;
+  broken[1].ramps.back().slope *= 2;
+  EXPECT_TRUE(std::isnan(tied.values(broken, {1e-6})[0][0]));
+  EXPECT_TRUE(std::isnan(tied.value(0, 1e-6, broken)));
+  EXPECT_FALSE(tied.modal_tail(broken, 5e-6).has_value());
+  EXPECT_TRUE(tied.modal_tail(inputs, 5e-6).has_value());
+  EXPECT_FALSE(std::isnan(free.values(broken, {1e-6})[0][0]));
+}
+
 // Series RLC, underdamped: v(c) for a unit step, the closed form.
 TEST(Lti, UnderdampedRlcStepResponseMatchesClosedForm) {
   const double r = 10, l = 1e-6, cap = 1e-9;
