@@ -89,7 +89,16 @@ struct SubcktDef {
 struct Scope {
   std::unordered_map<std::string, double> values;
   std::unordered_map<std::string, spice::UserFunction> funcs;  // .func
+  // .model cards (a subcircuit's are local to it, as in ngspice)
+  std::unordered_map<std::string, std::shared_ptr<const CardModel>> models;
   const Scope* parent = nullptr;
+  std::shared_ptr<const CardModel> find_model(const std::string& name) const {
+    for (const Scope* s = this; s; s = s->parent) {
+      auto it = s->models.find(name);
+      if (it != s->models.end()) return it->second;
+    }
+    return nullptr;
+  }
   std::optional<double> find(const std::string& name) const {
     for (const Scope* s = this; s; s = s->parent) {
       auto it = s->values.find(name);
@@ -122,8 +131,8 @@ struct RefusedLetter {
   const char* hint;
 };
 constexpr const char* kSemiconductor =
-    "isolink simulates linear passive links; model an isolator or transceiver pin by its "
-    "R/C/L network, as the part library does";
+    "isolink simulates passive links with diodes; model an isolator or transceiver pin by its "
+    "R/C/L network and clamp diodes, as the part library does";
 constexpr const char* kLine =
     "for the cable, write a link spec: its 'cable:' key (length, material, gauge) builds the "
     "RLGC ladder; see the README section on link specs";
@@ -131,7 +140,6 @@ constexpr RefusedLetter kRefusedLetters[] = {
     {'a', "XSPICE code model ('a' device)", "isolink has no XSPICE code models"},
     {'b', "behavioural source (B)",
      "write the waveform as PULSE, PWL, SIN or EXP on a V or I source"},
-    {'d', "diode (D)", kSemiconductor},
     {'e', "voltage-controlled voltage source (E)", "controlled sources are out of scope"},
     {'f', "current-controlled current source (F)", "controlled sources are out of scope"},
     {'g', "voltage-controlled current source (G)", "controlled sources are out of scope"},
@@ -153,10 +161,14 @@ constexpr RefusedLetter kRefusedLetters[] = {
 // Dot cards skipped with one warning: they ask for output or analyses isolink does not run, and
 // leave the transient of a linear circuit unchanged. Any other unknown dot card is an error.
 constexpr const char* kIgnoredCards[] = {
-    ".print", ".plot", ".save",  ".probe", ".meas",    ".measure",  ".op",
-    ".ac",    ".dc",   ".noise", ".four",  ".width",   ".model",    ".disto",
-    ".sens",  ".pz",   ".tf",    ".title", ".csparam", ".backanno", ".nodeset",
+    ".print", ".plot", ".save",  ".probe",   ".meas",     ".measure", ".op",
+    ".ac",    ".dc",   ".noise", ".four",    ".width",    ".disto",   ".sens",
+    ".pz",    ".tf",   ".title", ".csparam", ".backanno", ".nodeset",
 };
+
+// .model parameters that only document a part (PSpice's data-sheet fields in vendor models):
+// dropped with a warning, as they change nothing in a simulation.
+constexpr const char* kDocumentationModelKeys[] = {"iave", "vpk", "mfg", "type"};
 
 // Source functions that may be written without parentheses: "SIN 0 1 1K".
 bool is_source_function(const std::string& w) {
@@ -518,6 +530,7 @@ class Reader {
     };
     std::vector<Cond> stack;
     std::vector<const Line*> out;
+    std::vector<const Line*> models;  // read once the body's .param cards are all applied
     auto condition = [&](const Line& l) -> StatusOr<bool> {
       if (l.toks.size() < 2) return error_at(l.end(), "expected a condition after " + l.key());
       const std::size_t from = l.toks[1].offset;
@@ -566,12 +579,77 @@ class Reader {
         if (Status s = param_card(*l, scope); !s.ok()) return s;
       } else if (key == ".func") {
         if (Status s = func_card(*l, scope); !s.ok()) return s;
+      } else if (key == ".model") {
+        models.push_back(l);
       } else {
         out.push_back(l);
       }
     }
     if (!stack.empty()) return error_at(stack.back().loc, "missing '.endif' for this '.if'");
+    for (const Line* l : models)
+      if (Status s = model_card(*l, scope); !s.ok()) return s;
     return out;
+  }
+
+  // .model NAME TYPE(KEY=VALUE ...), the parentheses optional, commas allowed. A type no element
+  // kind takes (NPN, NMOS, ...) is kept out with a warning: no card can name it (their letters
+  // are refused).
+  Status model_card(const Line& line, Scope& scope) {
+    if (!line.word(1) || !line.word(2) || line.kind(2, TokenKind::Equals))
+      return error_at(line.at_or_end(1), "expected .model NAME TYPE(KEY=VALUE ...)");
+    auto model = std::make_shared<CardModel>();
+    model->name = lower(line.toks[1].text);
+    model->type = lower(line.toks[2].text);
+    model->loc = line.at(1);
+    if (scope.models.count(model->name))
+      return error_at(line.at(1), "model '" + model->name + "' defined twice (first at " +
+                                      scope.models[model->name]->loc.str() + ")");
+    bool known_type = false;
+    for (const ElementKind& k : element_kinds())
+      known_type = known_type || (k.model_type && model->type == k.model_type);
+    if (!known_type) {  // kept (for the duplicate check and a clear error), parameters unread
+      warn_once(".model " + model->type, line.at(2),
+                "model type '" + model->type + "' ignored (isolink's models: d)");
+      scope.models[model->name] = std::move(model);
+      return Status::Ok();
+    }
+    std::size_t i = 3;
+    const std::size_t n = line.toks.size();
+    const bool paren = line.kind(i, TokenKind::LParen);
+    if (paren) ++i;
+    while (i < n && !line.kind(i, TokenKind::RParen)) {
+      if (line.kind(i, TokenKind::Comma)) {
+        ++i;
+        continue;
+      }
+      if (!line.assignment(i))
+        return error_at(line.at(i), "expected KEY=VALUE in .model " + model->name + ", got '" +
+                                        describe(line.toks[i]) + "'");
+      const std::string key = lower(line.toks[i].text);
+      const SourceLoc key_loc = line.at(i);
+      i += 2;
+      if (i >= n || (line.toks[i].kind != TokenKind::Word && line.toks[i].kind != TokenKind::Expr))
+        return error_at(line.at_or_end(i), "missing value for '" + key + "'");
+      const bool documentation =
+          std::find(std::begin(kDocumentationModelKeys), std::end(kDocumentationModelKeys), key) !=
+          std::end(kDocumentationModelKeys);
+      auto v = value(line, i, scope, documentation);
+      if (!v) return v.status();
+      if (documentation) {
+        warn_once(".model doc", key_loc,
+                  "'" + key + "' in .model " + model->name +
+                      " ignored (it documents the part and changes nothing in a simulation)");
+        continue;
+      }
+      v->loc = key_loc;
+      model->params.emplace_back(key, std::move(*v));
+    }
+    if (paren && i >= n) return error_at(line.end(), "missing ')' in .model " + model->name);
+    if (i + 1 < n)
+      return error_at(line.at(i + 1), "unexpected '" + describe(line.toks[i + 1]) +
+                                          "' after .model " + model->name + "(...)");
+    scope.models[model->name] = std::move(model);
+    return Status::Ok();
   }
 
   // .func NAME(a, b) {body}  (also with '=' before the body, or an unbraced body)
@@ -694,6 +772,28 @@ class Reader {
     return Status::Ok();
   }
 
+  // The .model a card of a kind with models names at token *i (D1 a k MODEL ...).
+  Status read_model_name(const Line& line, const Ctx& ctx, const ElementKind& kind,
+                         const std::string& local, Card& card, std::size_t* i) {
+    if (!line.word(*i) || line.kind(*i + 1, TokenKind::Equals))
+      return error_at(line.at_or_end(*i), "expected a model name after the nodes of " +
+                                              std::string(kind.name) + " '" + local +
+                                              "' (usage: " + kind.usage + ")");
+    const std::string name = lower(line.toks[*i].text);
+    std::shared_ptr<const CardModel> model = ctx.scope->find_model(name);
+    if (!model)
+      return error_at(line.at(*i), "unknown model '" + name + "' (no .model " + name +
+                                       " in this netlist or subcircuit)");
+    if (model->type != kind.model_type)
+      return error_at(line.at(*i), "model '" + name + "' is a '" + model->type + "' model; " +
+                                       kind.name + " '" + local + "' needs a '" + kind.model_type +
+                                       "' model");
+    card.model = std::move(model);
+    card.model_loc = line.at(*i);
+    ++*i;
+    return Status::Ok();
+  }
+
   // A source function without parentheses ("SIN 0 1 1K") from token *i: its numbers up to the
   // next word that is not one.
   Status read_bare_source_call(const Line& line, const Ctx& ctx, const std::string& w, Card& card,
@@ -757,7 +857,7 @@ class Reader {
           if (Status s = read_bare_source_call(line, ctx, w, card, i); !s.ok()) return s;
           continue;
         }
-        if (w == "dc") {
+        if (w == "dc" || (w == "off" && card.model)) {  // DC, or a diode's OFF
           CardArg a;
           a.kind = CardArg::Kind::Word;
           a.word = w;
@@ -799,6 +899,8 @@ class Reader {
     card.loc = line.at(0);
     std::size_t i = 1;
     if (Status s = read_nodes_and_refs(line, ctx, **kind, local, card, &i); !s.ok()) return s;
+    if ((*kind)->model_type)
+      if (Status s = read_model_name(line, ctx, **kind, local, card, &i); !s.ok()) return s;
     if (Status s = read_positional(line, ctx, card, &i); !s.ok()) return s;
     if (Status s = key_values(line, i, *ctx.scope, card.params); !s.ok()) return s;
     if (Status s = claim_name(card.name, card.loc); !s.ok()) return s;
@@ -951,8 +1053,9 @@ class Reader {
     return Status::Ok();
   }
 
-  // .temp, .options temp= / tnom=: given to every resistor with a temperature coefficient (as
-  // its temp= / tnom= unless the card sets them). The options are consumed here.
+  // .temp, .options temp= / tnom=: given to every resistor with a temperature coefficient and
+  // every diode (as its temp= / tnom= unless the card sets them; a diode's model's TNOM wins
+  // over the option's). The options are consumed here.
   Status apply_temperature() {
     std::optional<double> tnom;
     for (auto it = out_.options.begin(); it != out_.options.end();) {
@@ -966,7 +1069,8 @@ class Reader {
       it = out_.options.erase(it);
     }
     for (Card& c : out_.cards) {
-      if (c.letter != 'r' || (!c.param("tc1") && !c.param("tc2"))) continue;
+      const bool diode = c.letter == 'd';
+      if (!diode && (c.letter != 'r' || (!c.param("tc1") && !c.param("tc2")))) continue;
       for (auto [key, value] : {std::pair{"temp", temp_}, std::pair{"tnom", tnom}}) {
         if (!value || c.param(key)) continue;
         CardArg a;

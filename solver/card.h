@@ -9,8 +9,10 @@
 //   V2 p 0 DC 2.5          -> args {Word "dc", 2.5}
 //   K1 L1 L2 0.99          -> refs {l1, l2}, args {0.99}
 //   C1 a b 1n ic=0         -> args {1e-9}, params {ic: 0}
+//   D1 a k dclamp 2 off    -> model {dclamp: D(...)}, args {2, Word "off"}
 #pragma once
 
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -28,6 +30,22 @@ struct CardArg {
   SourceLoc loc;
 };
 
+// A .model card as the netlist layer resolved it: the model's name and type ("d"), and its
+// parameters with their values already numbers (expressions and .param resolved) and locations.
+//   .model DCLAMP D(IS=1e-14 BV=27 CJO=12p)  -> name "dclamp", type "d", params {is, bv, cjo}
+struct CardModel {
+  std::string name;                                     // lower case
+  std::string type;                                     // lower case ("d")
+  SourceLoc loc;                                        // the model's name on its .model card
+  std::vector<std::pair<std::string, CardArg>> params;  // keys lower case, in card order
+
+  const CardArg* param(const std::string& key) const {
+    for (const auto& [k, v] : params)
+      if (k == key) return &v;
+    return nullptr;
+  }
+};
+
 struct Card {
   char letter = 0;                   // element kind letter, lower case ('r', 'c', ...)
   std::string name;                  // full hierarchical name, lower case ("x1.r3")
@@ -38,6 +56,9 @@ struct Card {
   std::vector<SourceLoc> ref_locs;   // one per ref
   std::vector<CardArg> args;         // positional values after nodes and refs
   std::vector<std::pair<std::string, CardArg>> params;  // key=value pairs, keys lower case
+  // Kinds that take a model (D): the .model the card names, resolved by the reader; else empty.
+  std::shared_ptr<const CardModel> model;
+  SourceLoc model_loc;  // where the card names its model
 
   const CardArg* param(const std::string& key) const {
     for (const auto& [k, v] : params)

@@ -33,7 +33,9 @@ Status Circuit::add(const Card& card) {
         card.loc, fmt::format("{} needs {} nodes ({})", card.name, kind->node_count, kind->usage));
   StatusOr<std::unique_ptr<Element>> e = kind->parse(card);
   if (!e) return e.status();
-  (*e)->set_node_names(card.nodes);
+  std::vector<std::string> names = card.nodes;
+  for (std::string& internal : (*e)->internal_node_names()) names.push_back(std::move(internal));
+  (*e)->set_node_names(std::move(names));
   return add(std::move(*e));
 }
 

@@ -4,6 +4,7 @@
 #include <klu.h>
 
 #include <algorithm>
+#include <limits>
 #include <list>
 #include <utility>
 #include <vector>
@@ -156,6 +157,7 @@ struct KluSolver::Impl {
   klu_symbolic* candidate = nullptr;  // nested dissection, until the first factorization decides
   const char* ordering = "amd";
   std::list<Factors> cache;  // most recently used first
+  Factors scratch;           // factor_once's: outside the cache
   const Factors* current = nullptr;
   std::vector<double> y;   // solve workspace
   std::vector<double> ax;  // the values being factored: KLU's C interface takes double*
@@ -187,6 +189,31 @@ struct KluSolver::Impl {
     const bool ok = extract(common, sym, num, n, f);
     klu_free_numeric(&num, &common);
     return ok;
+  }
+
+  // Factors with the ordering in use into f; on the first factorization also with the candidate
+  // ordering, keeping whichever solves faster (modelled), for good.
+  Status factor_choosing(Factors& f, const double* values, int* singular_col) {
+    *singular_col = -1;
+    if (!factor_into(symbolic, values, f)) {
+      if (common.status == KLU_SINGULAR) {
+        *singular_col = common.singular_col;
+        return Status::Error("singular matrix at column " + std::to_string(*singular_col));
+      }
+      return Status::Error("KLU factorization failed (status " + std::to_string(common.status) +
+                           ")");
+    }
+    if (candidate) {
+      Factors g;
+      if (factor_into(candidate, values, g) && g.cost() < f.cost()) {
+        std::swap(symbolic, candidate);
+        ordering = "nested dissection";
+        f = std::move(g);
+      }
+      klu_free_symbolic(&candidate, &common);
+      candidate = nullptr;
+    }
+    return Status::Ok();
   }
 };
 
@@ -235,7 +262,6 @@ bool KluSolver::select(double key) {
 
 Status KluSolver::factor(double key, const double* values) {
   Impl& m = *impl_;
-  singular_col_ = -1;
   m.current = nullptr;
   // Storage: a new entry, or the least recently used one once the cache is full.
   if (m.cache.size() >= kCacheSize)
@@ -243,29 +269,23 @@ Status KluSolver::factor(double key, const double* values) {
   else
     m.cache.emplace_front();
   Factors& f = m.cache.front();
-  if (!m.factor_into(m.symbolic, values, f)) {
+  if (Status s = m.factor_choosing(f, values, &singular_col_); !s.ok()) {
     m.cache.pop_front();
-    if (m.common.status == KLU_SINGULAR) {
-      singular_col_ = m.common.singular_col;
-      return Status::Error("singular matrix at column " + std::to_string(singular_col_));
-    }
-    return Status::Error("KLU factorization failed (status " + std::to_string(m.common.status) +
-                         ")");
-  }
-  if (m.candidate) {
-    // First factorization: keep whichever ordering solves faster (modelled), for good.
-    Factors g;
-    if (m.factor_into(m.candidate, values, g) && g.cost() < f.cost()) {
-      std::swap(m.symbolic, m.candidate);
-      m.ordering = "nested dissection";
-      f = std::move(g);
-    }
-    klu_free_symbolic(&m.candidate, &m.common);
-    m.candidate = nullptr;
+    return s;
   }
   f.key = key;
   ++factorizations_;
   m.current = &f;
+  return Status::Ok();
+}
+
+Status KluSolver::factor_once(const double* values) {
+  Impl& m = *impl_;
+  m.current = nullptr;
+  if (Status s = m.factor_choosing(m.scratch, values, &singular_col_); !s.ok()) return s;
+  m.scratch.key = std::numeric_limits<double>::quiet_NaN();  // select() never finds it
+  ++factorizations_;
+  m.current = &m.scratch;
   return Status::Ok();
 }
 

@@ -56,6 +56,9 @@ class KluSolver {
   // Factors values (over the pattern) and stores it under key. On a singular matrix the error
   // names the column, and singular_column() gives it (0-based matrix index, unknown - 1).
   Status factor(double key, const double* values);
+  // Factors values into a slot of its own, outside the cache, and makes it current: for
+  // matrices that do not come back (a Newton iteration's). Errors as factor().
+  Status factor_once(const double* values);
   // Solves A x = b in place with the current factorization.
   Status solve(double* x);
   int singular_column() const { return singular_col_; }

@@ -23,6 +23,7 @@
 #include "solver/circuit.h"
 #include "solver/klu_solver.h"
 #include "solver/mna.h"
+#include "solver/newton.h"
 
 namespace isolink {
 
@@ -105,43 +106,64 @@ struct MnaSystem {
   // unknown = value; dc() puts the values in the right-hand side.
   Status factor_dc(const Circuit& circuit, KluSolver& dc_klu,
                    const std::vector<std::pair<int, double>>& held = {}) const {
-    std::vector<double> gd;
-    const double* values = g.data();
-    if (!held.empty() || !circuit.dc_open_branches().empty()) {
-      gd = g;
-      const auto& cp = pattern.col_start();
-      const auto& ri = pattern.row_index();
-      std::vector<bool> replaced(n + 1, false);
-      for (const auto& r : held) replaced[r.first] = true;
-      for (int br : circuit.dc_open_branches()) replaced[br] = true;
-      for (int col = 0; col < n; ++col)
-        for (int k = cp[col]; k < cp[col + 1]; ++k)
-          if (replaced[ri[k] + 1]) gd[k] = ri[k] == col ? 1.0 : 0.0;
-      values = gd.data();
-    }
+    const std::vector<double> values = dc_values(circuit, held, nullptr);
     if (Status s = dc_klu.analyze(pattern, KluSolver::Ordering::Amd); !s.ok()) return s;
-    return name_singular(circuit, dc_klu, dc_klu.factor(0.0, values));
+    return name_singular(circuit, dc_klu, dc_klu.factor(0.0, values.data()));
   }
 
-  // The DC operating point into x (n + 1 entries), `held` unknowns at their values (.ic nodes),
-  // the opened inductors at 0 A; a non-finite solution is an error naming the unknown.
-  Status dc(const Circuit& circuit, std::vector<double>& x,
-            const std::vector<std::pair<int, double>>& held = {}) const {
-    KluSolver dc_klu;
-    if (Status s = factor_dc(circuit, dc_klu, held); !s.ok()) return s;
+  // The DC matrix's values: G with the rows of `held` unknowns and of the opened inductors
+  // replaced by unknown = value; *replaced (n + 1 flags, when given) marks those rows.
+  std::vector<double> dc_values(const Circuit& circuit,
+                                const std::vector<std::pair<int, double>>& held,
+                                std::vector<bool>* replaced_rows) const {
+    std::vector<double> gd = g;
+    std::vector<bool> replaced(n + 1, false);
+    for (const auto& r : held) replaced[r.first] = true;
+    for (int br : circuit.dc_open_branches()) replaced[br] = true;
+    const auto& cp = pattern.col_start();
+    const auto& ri = pattern.row_index();
+    for (int col = 0; col < n; ++col)
+      for (int k = cp[col]; k < cp[col + 1]; ++k)
+        if (replaced[ri[k] + 1]) gd[k] = ri[k] == col ? 1.0 : 0.0;
+    if (replaced_rows) *replaced_rows = std::move(replaced);
+    return gd;
+  }
+
+  // The DC right-hand side: the excitation at t = 0, `held` unknowns at their values, the opened
+  // inductors at 0 A.
+  void dc_rhs(const Circuit& circuit, const std::vector<std::pair<int, double>>& held,
+              std::vector<double>& x) const {
     rhs(0.0, x);
     for (const auto& [u, v] : held) x[u] = v;
     for (int br : circuit.dc_open_branches()) x[br] = 0.0;
+  }
+
+  // The DC operating point into x (n + 1 entries), `held` unknowns at their values, the opened
+  // inductors at 0 A; a non-finite solution is an error naming the unknown. With nonlinear
+  // elements: Newton's iteration, then gmin stepping, then source stepping (newton.h).
+  Status dc(const Circuit& circuit, std::vector<double>& x,
+            const std::vector<std::pair<int, double>>& held = {}) const {
+    if (has_nonlinear_ports(circuit)) return nonlinear_dc(circuit, *this, x, held);
+    KluSolver dc_klu;
+    if (Status s = factor_dc(circuit, dc_klu, held); !s.ok()) return s;
+    dc_rhs(circuit, held, x);
     Status s = dc_klu.solve(x.data() + 1);
     x[0] = 0.0;
     if (s.ok()) s = check_finite(circuit, x, 0.0, "the DC operating point");
     return s;
   }
 
+  static bool has_nonlinear_ports(const Circuit& circuit) {
+    for (const auto& e : circuit.elements())
+      if (e->nonlinear_port_count() > 0) return true;
+    return false;
+  }
+
   // Exit-worthy error when x has a NaN or infinity, naming the unknown and the likely cause.
   static Status check_finite(const Circuit& circuit, const std::vector<double>& x, double t,
                              const char* where) {
-    for (std::size_t u = 1; u < x.size(); ++u) {
+    const std::size_t unknowns = static_cast<std::size_t>(circuit.unknown_count());
+    for (std::size_t u = 1; u < x.size() && u <= unknowns; ++u) {
       if (std::isfinite(x[u])) continue;
       const int ui = static_cast<int>(u);
       const char* cause =

@@ -31,6 +31,7 @@ Status TransientOptions::validate() const {
   if (!(vntol > 0)) return bad("vntol", vntol, "must be positive");
   if (!(abstol > 0)) return bad("abstol", abstol, "must be positive");
   if (!(trtol > 0)) return bad("trtol", trtol, "must be positive");
+  if (!(chgtol > 0)) return bad("chgtol", chgtol, "must be positive");
   if (max_steps <= 0) return bad("max_steps", static_cast<double>(max_steps), "must be positive");
   for (const auto& [node, v] : node_ic) {
     if (node <= 0) return bad("node_ic node", node, "must be a node unknown (> 0)");
@@ -56,6 +57,7 @@ Status TransientOptions::set_option(const std::string& key, const CardArg& value
   if (key == "vntol") return number(&vntol);
   if (key == "abstol") return number(&abstol);
   if (key == "trtol") return number(&trtol);
+  if (key == "chgtol") return number(&chgtol);
   if (key == "method") {
     if (value.kind == CardArg::Kind::Word && (value.word == "trap" || value.word == "trapezoidal"))
       method = IntegrationMethod::Trapezoidal;
@@ -135,6 +137,7 @@ struct WatchedStates {
   std::vector<double> abs_tol, peak, inv_tol;
   double rel_tol = 0.0;
 
+  // x0: the unknowns, then the nonlinear ports' charges (x0.size() - 1 - sys.n of them).
   WatchedStates(const Circuit& circuit, const MnaSystem& sys, const TransientOptions& opt,
                 const std::vector<double>& x0) {
     for (int u = 1; u <= sys.n; ++u) {
@@ -143,6 +146,12 @@ struct WatchedStates {
         unknowns.push_back(u);
         abs_tol.push_back(opt.trtol * (circuit.unknown_is_node(u) ? opt.vntol : opt.abstol));
       }
+    }
+    // The nonlinear charges (junction and diffusion charge): their truncation error is measured
+    // on the charge itself, against chgtol as SPICE's.
+    for (int u = sys.n + 1; u < static_cast<int>(x0.size()); ++u) {
+      unknowns.push_back(u);
+      abs_tol.push_back(opt.trtol * opt.chgtol);
     }
     rel_tol = opt.trtol * opt.reltol;
     peak.assign(unknowns.size(), 0.0);
@@ -176,10 +185,20 @@ class TransientMarch {
         control_{.hmax = opt.effective_tmax(),
                  .hmin = std::max(1e-18, opt.tstop * 1e-13),
                  .error_order = 3},
-        x_(n_ + 1, 0.0),
-        xdot_(n_ + 1, 0.0),
-        hist_part_(n_ + 1, 0.0),
-        xnew_(n_ + 1) {}
+        ports_(count_ports(circuit)),
+        m_(n_ + ports_),
+        x_(m_ + 1, 0.0),
+        xdot_(m_ + 1, 0.0),
+        hist_part_(m_ + 1, 0.0),
+        xnew_(m_ + 1) {
+    if (ports_ > 0) {
+      newton_.bind(circuit, sys.pattern);
+      newton_.tolerances() = opt.newton;
+      newton_x_.assign(n_ + 1, 0.0);
+      newton_rhs_.assign(n_ + 1, 0.0);
+      a_lin_.assign(sys.pattern.nonzeros(), 0.0);
+    }
+  }
 
   StatusOr<Waveform> run(TransientStats& stats);
 
@@ -187,8 +206,14 @@ class TransientMarch {
   Status initial_state();
   // The integration formula for a step of `step` from t_: x1' = a0 x1 + hist_part_; returns a0.
   double formula(double step, bool euler, bool gear, const History& hist);
-  // Solves (G + a0 C) x1 = b1 - C hist_part_ (+ the UIC charge) into xnew_.
-  Status solve_step(double step, double a0);
+  // Solves (G + a0 C) x1 = b1 - C hist_part_ (+ the UIC charge) into xnew_; with nonlinear
+  // ports by Newton's iteration, *converged = false when it did not converge (the caller
+  // retries a shorter step).
+  Status solve_step(double step, double a0, bool* converged);
+  Status newton_step(double t1, double a0, bool* converged);
+  // The ports' charges at x_ (after the operating point) into x_'s charge entries.
+  void initial_charges();
+  Status newton_failed(double t, double h) const;
   // Truncation error / tolerance of the step (0 until there are four points); the worst unknown
   // into worst_unknown_.
   double truncation_ratio(double step, bool gear, const History& hist);
@@ -196,6 +221,12 @@ class TransientMarch {
   double euler_start_ratio(double step, const History& hist);
   Status too_small(double t, double h) const;
   void record(double t, const std::vector<double>& v);
+
+  static int count_ports(const Circuit& circuit) {
+    int p = 0;
+    for (const auto& e : circuit.elements()) p += e->nonlinear_port_count();
+    return p;
+  }
 
   const Circuit& circuit_;
   const TransientOptions& opt_;
@@ -205,7 +236,14 @@ class TransientMarch {
   const double tiny_;
   const StepControl control_;
   TransientStats stats_;
+  // The nonlinear ports' count; the state vectors hold the unknowns 0..n_, then one charge per
+  // port (n_ + 1 .. m_), integrated by the same formula and watched by the same error control.
+  const int ports_;
+  const int m_;
   std::vector<double> x_, xdot_, hist_part_, xnew_;
+  NewtonSolver newton_;
+  std::vector<double> newton_x_, newton_rhs_, a_lin_;
+  double a_lin_alpha_ = -1.0;  // the a0 that a_lin_ = G + a0 C was computed for
   // UIC: the charge the capacitors' ic= add beyond C x0, applied on the first step only.
   std::vector<double> uic_dq_;
   std::optional<WatchedStates> watched_;  // set once the initial state is known
@@ -222,6 +260,7 @@ Status TransientMarch::initial_state() {
       return s.with_context("DC operating point");
     ++stats_.solves;
     ++stats_.factorizations;
+    initial_charges();
     return Status::Ok();
   }
   for (const auto& [node, v] : opt_.node_ic) x_[node] = v;
@@ -231,7 +270,17 @@ Status TransientMarch::initial_state() {
   uic_dq_[0] = 0.0;
   if (std::all_of(uic_dq_.begin(), uic_dq_.end(), [](double v) { return v == 0.0; }))
     uic_dq_.clear();
+  initial_charges();
   return Status::Ok();
+}
+
+void TransientMarch::initial_charges() {
+  int k = 0;
+  for (const auto& e : circuit_.elements())
+    for (int j = 0; j < e->nonlinear_port_count(); ++j, ++k) {
+      const NonlinearPort p = e->nonlinear_port(j);
+      x_[n_ + 1 + k] = e->eval_port(j, x_[p.p] - x_[p.n]).q;
+    }
 }
 
 void TransientMarch::record(double t, const std::vector<double>& v) {
@@ -241,7 +290,7 @@ void TransientMarch::record(double t, const std::vector<double>& v) {
 }
 
 double TransientMarch::formula(double step, bool euler, bool gear, const History& hist) {
-  const int n = n_;
+  const int n = m_;  // the unknowns and the ports' charges alike
   const double inv_step = 1.0 / step;
   double a0 = 0.0;
   if (euler) {
@@ -261,8 +310,10 @@ double TransientMarch::formula(double step, bool euler, bool gear, const History
   return a0;
 }
 
-Status TransientMarch::solve_step(double step, double a0) {
+Status TransientMarch::solve_step(double step, double a0, bool* converged) {
   const double t1 = t_ + step;
+  *converged = true;
+  if (ports_ > 0) return newton_step(t1, a0, converged);
   sys_.rhs(t1, xnew_);
   sys_.sub_c_times(hist_part_.data(), xnew_.data());
   if (!uic_dq_.empty()) {  // Euler: C x1 / h = C x0 / h + dq / h + ...
@@ -274,6 +325,48 @@ Status TransientMarch::solve_step(double step, double a0) {
   if (Status s = sys_.solve(xnew_); !s.ok()) return s.with_context(fmt::format("t={:g} s", t1));
   ++stats_.solves;
   return MnaSystem::check_finite(circuit_, xnew_, t1, "transient step");
+}
+
+Status TransientMarch::newton_step(double t1, double a0, bool* converged) {
+  std::vector<double>& rhs = newton_rhs_;
+  sys_.rhs(t1, rhs);
+  sys_.sub_c_times(hist_part_.data(), rhs.data());
+  if (!uic_dq_.empty()) {
+    const double inv_step = 1.0 / (t1 - t_);
+    for (int u = 1; u <= n_; ++u) rhs[u] += uic_dq_[u] * inv_step;
+  }
+  if (a0 != a_lin_alpha_) {
+    for (std::size_t k = 0; k < a_lin_.size(); ++k) a_lin_[k] = sys_.g[k] + a0 * sys_.c[k];
+    a_lin_alpha_ = a0;
+  }
+  // The first iterate: the last accepted point, moved along its slope (a predictor).
+  const double step = t1 - t_;
+  for (int u = 0; u <= n_; ++u) newton_x_[u] = x_[u] + step * xdot_[u];
+  NewtonInput in;
+  in.linear_values = a_lin_.data();
+  in.rhs = &rhs;
+  in.a0 = a0;
+  in.charge_history = hist_part_.data() + n_ + 1;
+  NewtonResult r = newton_.solve(circuit_, sys_.klu, in, newton_x_);
+  stats_.newton_iterations += r.iterations;
+  stats_.solves += r.iterations;
+  if (!r.error.ok()) return r.error.with_context(fmt::format("transient at t={:g} s", t1));
+  *converged = r.converged;
+  if (!r.converged) {
+    ++stats_.newton_failures;
+    return Status::Ok();
+  }
+  std::copy(newton_x_.begin(), newton_x_.end(), xnew_.begin());
+  for (int k = 0; k < ports_; ++k) xnew_[n_ + 1 + k] = newton_.charge(k);
+  return Status::Ok();
+}
+
+Status TransientMarch::newton_failed(double t, double h) const {
+  return Status::Error(fmt::format(
+      "time step too small at t={:g} s (h={:g} s): Newton's iteration does not converge at {}; "
+      "try a smaller .tran TMAX, a series resistance (RS) in the diode's model, or a resistor "
+      "where an ideal source drives the diode directly",
+      t, h, newton_.worst_port(circuit_)));
 }
 
 // Truncation error h^3 * coef * x''' with x''' = 6 x the third divided difference over the
@@ -338,7 +431,7 @@ StatusOr<Waveform> TransientMarch::run(TransientStats& stats_out) {
   watched_.emplace(circuit_, sys_, opt_, x_);
 
   // History since the last breakpoint: up to 3 points, oldest first (fixed storage).
-  History hist(n_, x_);
+  History hist(m_, x_);
   size_t next_bp = 0;
   double h = control_.ladder(0.1 * std::min(hmax, bps[0]));
   // The UIC step that puts the capacitors' ic= charge in place is not error-checked: keep it short.
@@ -364,7 +457,15 @@ StatusOr<Waveform> TransientMarch::run(TransientStats& stats_out) {
     const bool euler = after_bp || hist.count < 2;
     const bool gear = !euler && opt_.method == IntegrationMethod::Gear2;
     const double a0 = formula(step, euler, gear, hist);
-    if (Status s = solve_step(step, a0); !s.ok()) return s;
+    bool converged = true;
+    if (Status s = solve_step(step, a0, &converged); !s.ok()) return s;
+    if (!converged) {  // Newton did not converge: an eighth of the step, as SPICE
+      ++stats_.rejected;
+      h = step / 8;
+      if (h < hmin) return newton_failed(t_, h);
+      h = control_.ladder(h);
+      continue;
+    }
     const double ratio = truncation_ratio(step, gear, hist);
 
     // The first step after a breakpoint (backward Euler, from a history of one point) is checked
@@ -404,7 +505,7 @@ StatusOr<Waveform> TransientMarch::run(TransientStats& stats_out) {
     // Accept.
     ++stats_.accepted;
     if (opt_.on_progress && (stats_.accepted & 1023) == 0) opt_.on_progress(t_);
-    for (int u = 1; u <= n_; ++u) xdot_[u] = a0 * xnew_[u] + hist_part_[u];
+    for (int u = 1; u <= m_; ++u) xdot_[u] = a0 * xnew_[u] + hist_part_[u];
     t_ = lands ? bp : t_ + step;
     std::swap(x_, xnew_);
     hist.push(t_, x_);

@@ -1,4 +1,4 @@
-// Transient analysis of a linear circuit: DC operating point, then trapezoidal or Gear-2 steps
+// Transient analysis of a circuit: DC operating point, then trapezoidal or Gear-2 steps
 // under local-truncation-error control, with breakpoints at every source corner.
 //
 //   TransientOptions opt{.tstep = 1e-9, .tstop = 20e-6};
@@ -22,6 +22,11 @@
 //   BDF2 truncation term from the third divided difference of node voltages and inductor
 //   currents, against trtol * (reltol * peak |x| + vntol|abstol), peak = the unknown's largest
 //   |x| so far; steps come from a ladder tmax / 2^k so factorizations are reused.
+//   Nonlinear elements (diodes): each step is Newton's iteration (solver/newton.h) on the same
+//   formula, the elements' charges integrated as states of their own (charge-conserving) and
+//   watched by the error control against chgtol; a step whose Newton does not converge is retried
+//   at 1/8 of its size. The DC operating point is Newton's too, then gmin stepping, then source
+//   stepping (newton.h: nonlinear_dc).
 #pragma once
 
 #include <functional>
@@ -32,6 +37,7 @@
 #include "base/waveform.h"
 #include "solver/card.h"
 #include "solver/circuit.h"
+#include "solver/newton.h"
 #include "solver/probe.h"
 
 namespace isolink {
@@ -47,6 +53,10 @@ struct TransientOptions {
   double reltol = 1e-3;   // relative tolerance of the truncation error
   double vntol = 1e-6;    // V, absolute tolerance on node voltages
   double abstol = 1e-12;  // A, absolute tolerance on inductor currents
+  double chgtol = 1e-14;  // C, absolute tolerance on the nonlinear elements' charges
+  // Newton's iteration on the nonlinear elements (diodes): its own tolerances, tighter than the
+  // truncation error's (the iteration converges quadratically, so the last one is cheap).
+  NewtonTolerances newton;
   // Multiplies the truncation tolerance. The tolerance is relative to each unknown's peak |x| so
   // far (not to its value now, as ngspice), hence a default well below ngspice's 7; see the
   // README "Solver" section and bench/README.md for the accuracy and speed at this default.
@@ -75,6 +85,8 @@ struct TransientStats {
   int reuses = 0;
   long solves = 0;
   int breakpoints = 0;
+  long newton_iterations = 0;  // with nonlinear elements: iterations over all steps
+  long newton_failures = 0;    // steps retried shorter because Newton did not converge
 };
 
 // DC operating point: the full unknown vector (index 0 = ground; V and A). Reads the circuit

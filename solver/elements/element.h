@@ -13,7 +13,13 @@
 // After Circuit::finalize the engines only read an element (const), except bind_time: run_transient
 // applies it (it takes a Circuit&), the LTI engine's caller applies it before
 // LtiResponses::compute.
-// The circuits isolink targets are linear and time-invariant: G and C never change during a run.
+//   5. load:    nonlinear elements (the diode) also have nonlinear ports: two-terminal branches
+//               whose current i(v) and charge q(v) depend on the branch voltage v = x[p] - x[n].
+//               The engines' Newton iteration (solver/newton.h) evaluates each port at every
+//               iteration (eval_port), limits the voltage step (limit_port) and stamps the
+//               linearised current and charge itself; stamp() declares the port's four entries.
+// The linear part of a circuit is time-invariant: G and C never change during a run; only the
+// nonlinear ports' linearisation does, and it is added on top of them.
 #pragma once
 
 #include <memory>
@@ -38,6 +44,16 @@ enum class DcLink { Conductive, VoltageDefining, Inductive, CurrentSource };
 struct DcEdge {
   int a, b;
   DcLink link;
+};
+
+// One nonlinear port: a two-terminal branch from unknown p to unknown n (0 = ground).
+struct NonlinearPort {
+  int p = 0, n = 0;
+};
+// A port evaluated at branch voltage v: the current from p through the element to n (A), its
+// derivative (S), the charge stored between p and n (C) and its derivative (F).
+struct PortEval {
+  double i = 0, g = 0, q = 0, c = 0;
 };
 
 class Element {
@@ -71,9 +87,26 @@ class Element {
   // The LTI engine (solver/lti.h) superposes responses to these unit excitations.
   virtual const SourceFunction* source_function() const { return nullptr; }
   virtual void stamp_unit(double* b) const {}
-  // False for an element whose stamps change with time or with the solution (a switch, a diode):
-  // the LTI engine refuses a circuit holding one. Every kind in the registry today is LTI.
+  // False for an element whose stamps change with time or with the solution (a diode): the LTI
+  // engine refuses a circuit holding one.
   virtual bool linear_time_invariant() const { return true; }
+  // Nonlinear ports (solver/newton.h); none for linear kinds. The ports' unknowns are known after
+  // Circuit::finalize.
+  virtual int nonlinear_port_count() const { return 0; }
+  virtual NonlinearPort nonlinear_port(int k) const { return {}; }
+  // Current and charge of port k at branch voltage v. Must be finite for any finite v.
+  virtual PortEval eval_port(int k, double v) const { return {}; }
+  // Newton's voltage step limit (SPICE's pnjlim): the voltage to evaluate at, given the new
+  // iterate v_new and the last evaluated v_old; *limited = true when it changed v_new.
+  virtual double limit_port(int k, double v_new, double v_old, bool* limited) const {
+    *limited = false;
+    return v_new;
+  }
+  // The branch voltage the DC Newton iteration starts from (SPICE: vcrit, or 0 for "off").
+  virtual double port_start_voltage(int k) const { return 0.0; }
+  // Internal nodes the element adds (a diode's series resistance: "d1#internal"), named in full;
+  // Circuit::add appends them to the card's nodes, so nodes() lists them after the card's.
+  virtual std::vector<std::string> internal_node_names() const { return {}; }
   // Resolves time defaults that depend on the analysis (ngspice: PULSE TR defaults to TSTEP).
   virtual void bind_time(double tstep, double tstop) {}
   // Times in (0, tstop] where the excitation has a corner.
@@ -117,6 +150,10 @@ struct ElementKind {
   int ref_count;      // element-name tokens after the nodes (K: 2)
   std::span<const ParamSpec> params;
   StatusOr<std::unique_ptr<Element>> (*parse)(const Card& card);
+  // Kinds that name a .model (D): the model type the card must name ("d"), and the model's
+  // parameter table (the reader checks names and numbers against it). nullptr / empty: none.
+  const char* model_type = nullptr;
+  std::span<const ParamSpec> model_params = {};
 };
 
 // All element kinds, in letter order.

@@ -10,8 +10,8 @@
 namespace isolink {
 
 std::span<const ElementKind> element_kinds() {
-  static const std::array<ElementKind, 6> kKinds = {
-      capacitor_kind(), current_source_kind(), mutual_inductance_kind(),
+  static const std::array<ElementKind, 7> kKinds = {
+      capacitor_kind(), current_source_kind(), diode_kind(),          mutual_inductance_kind(),
       inductor_kind(),  resistor_kind(),       voltage_source_kind(),
   };
   return kKinds;
@@ -36,14 +36,18 @@ std::string element_reference_markdown() {
       "| kind | usage | parameter | default | unit | meaning |\n|---|---|---|---|---|---|\n";
   for (const ElementKind& k : element_kinds()) {
     bool first = true;
-    for (const ParamSpec& p : k.params) {
+    auto row = [&](const ParamSpec& p, const std::string& name) {
       out += fmt::format("| {} | {} | {} | {} | {} | {} |\n", first ? k.name : "",
-                         first ? cell(fmt::format("`{}`", k.usage)) : "", p.name,
+                         first ? cell(fmt::format("`{}`", k.usage)) : "", name,
                          std::isnan(p.default_value) ? (p.optional ? "none" : "required")
                                                      : fmt::format("{:g}", p.default_value),
                          p.unit, cell(p.doc));
       first = false;
-    }
+    };
+    for (const ParamSpec& p : k.params) row(p, p.name);
+    // The model's parameters (.model NAME TYPE(...)), after the instance's.
+    for (const ParamSpec& p : k.model_params)
+      row(p, fmt::format(".model {} {}", k.model_type, p.name));
   }
   return out;
 }

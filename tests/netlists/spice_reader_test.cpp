@@ -388,7 +388,6 @@ TEST(SpiceReader, AnalysisOptionsAndSkippedCards) {
   for (const auto& w : n.warnings) heads.push_back(split(w).head);
   EXPECT_EQ(heads, (std::vector<std::string>{
                        "t.cir:12:1: warning: '.control' ... '.endc' block ignored",
-                       "t.cir:5:1: warning: unsupported card '.model' ignored",
                        "t.cir:6:1: warning: unsupported card '.print' ignored",
                        "t.cir:8:1: warning: unsupported card '.save' ignored",
                        "t.cir:10:1: warning: unsupported card '.meas' ignored",
@@ -469,13 +468,63 @@ TEST(SpiceReaderErrors, RefusedElementLetters) {
   d = read_error("t\nT1 a 0 b 0 z0=100 td=1n\n");
   EXPECT_EQ(d.head.substr(0, 56), "t.cir:2:1: error: transmission line (T) is not supported");
   EXPECT_NE(d.head.find("'cable:' key"), std::string::npos) << d.head;
-  for (const char* card :
-       {"D1 a 0 dmod", "B1 a 0 v=1", "E1 a 0 b 0 2", "A1 a b amp", "O1 a 0 b 0 m", "U1 a b 0 m",
-        "P1 a b 0 c d 0 m", "M1 d g s b n", "J1 d g s j", "S1 a b c d sw"}) {
+  for (const char* card : {"B1 a 0 v=1", "E1 a 0 b 0 2", "A1 a b amp", "O1 a 0 b 0 m", "U1 a b 0 m",
+                           "P1 a b 0 c d 0 m", "M1 d g s b n", "J1 d g s j", "S1 a b c d sw"}) {
     d = read_error(std::string("t\n") + card + "\n");
     EXPECT_NE(d.head.find("t.cir:2:1: error: "), std::string::npos) << d.head;
     EXPECT_NE(d.head.find(" is not supported ("), std::string::npos) << d.head;
   }
+}
+
+TEST(SpiceReaderDialect, DiodeModelsResolveInTheirScope) {
+  Netlist n = read_ok(
+      "diodes\n"
+      ".param bvx=27\n"
+      ".model dtvs D(IS=1e-14 BV={bvx} CJO=12p, IBV=1m)\n"
+      ".model dsig d is=2e-14 n=1.1 mfg=NXP\n"
+      ".subckt clamp a\n"
+      ".model dsig D(IS=5e-15)\n"  // local: shadows the top level's inside the subcircuit
+      "D1 a 0 dsig\n"
+      ".ends\n"
+      "D1 a 0 DTVS 2 off\n"
+      "D2 0 a dsig area=3 ic=0.1\n"
+      "X1 a clamp\n"
+      ".temp 85\n");
+  ASSERT_EQ(n.cards.size(), 3u);
+  ASSERT_TRUE(n.cards[0].model);
+  EXPECT_EQ(n.cards[0].model->name, "dtvs");
+  EXPECT_EQ(n.cards[0].model->type, "d");
+  ASSERT_NE(n.cards[0].model->param("bv"), nullptr);
+  EXPECT_DOUBLE_EQ(n.cards[0].model->param("bv")->number, 27);
+  EXPECT_DOUBLE_EQ(n.cards[0].model->param("ibv")->number, 1e-3);
+  EXPECT_EQ(n.cards[0].model->param("bv")->loc.line, 3);
+  ASSERT_EQ(n.cards[0].args.size(), 2u);
+  EXPECT_DOUBLE_EQ(n.cards[0].args[0].number, 2);
+  EXPECT_EQ(n.cards[0].args[1].word, "off");
+  EXPECT_EQ(n.cards[1].model->param("n")->number, 1.1);
+  EXPECT_EQ(n.cards[1].model->param("mfg"), nullptr);  // documentation only, dropped
+  EXPECT_DOUBLE_EQ(n.cards[2].model->param("is")->number, 5e-15);
+  for (const Card& c : n.cards) {  // .temp reaches every diode
+    ASSERT_NE(c.param("temp"), nullptr) << c.name;
+    EXPECT_DOUBLE_EQ(c.param("temp")->number, 85);
+  }
+  ASSERT_FALSE(n.warnings.empty());
+  EXPECT_NE(n.warnings[0].find("'mfg' in .model dsig ignored"), std::string::npos) << n.warnings[0];
+}
+
+TEST(SpiceReaderErrors, DiodeModelErrorsPointAtTheModel) {
+  Diag d = read_error("t\nD1 a 0 nomodel\n");
+  EXPECT_EQ(d.head,
+            "t.cir:2:8: error: unknown model 'nomodel' (no .model nomodel in this "
+            "netlist or subcircuit)");
+  d = read_error("t\n.model q1 d\n.model q1 npn(bf=100)\nD1 a 0 q1\n");
+  EXPECT_NE(d.head.find("t.cir:3:8: error: model 'q1' defined twice"), std::string::npos) << d.head;
+  d = read_error("t\n.model dm d(is 1e-14)\n");
+  EXPECT_EQ(d.head.substr(0, 45), "t.cir:2:13: error: expected KEY=VALUE in .mod");
+  d = read_error("t\n.model dm d(is=1e-14\n");
+  EXPECT_NE(d.head.find("missing ')'"), std::string::npos) << d.head;
+  d = read_error("t\nD1 a 0\n");
+  EXPECT_NE(d.head.find("expected a model name"), std::string::npos) << d.head;
 }
 
 TEST(SpiceReaderErrors, TooFewNodes) {
