@@ -437,6 +437,12 @@ StatusOr<std::unique_ptr<Element>> parse(const Card& card) {
     ic = *v;
   }
   const Junction j = junction_at(values, temp_k, *area, *mult);
+  if (!(j.vj > 0) || !(j.czero >= 0))
+    return error_at(card.loc,
+                    fmt::format("diode {}: at {:g} degC model {} gives a junction "
+                                "potential of {:g} V and a capacitance of {:g} F (the "
+                                "temperature is outside what the model describes)",
+                                card.name, temp_k - kCtoK, card.model->name, j.vj, j.czero));
   const double knee = std::isinf(j.bv) ? 0.0 : j.bv;  // infinite: no breakdown
   for (double x : {j.csat, j.csat_rec, j.vj, j.czero, j.vcrit, knee})
     if (!std::isfinite(x))

@@ -1,7 +1,8 @@
-// libFuzzer targets for every reader (issue 15): one source, built once per reader with
-// ISOLINK_FUZZ_READER set (tests/fuzz/CMakeLists.txt). Each feeds the bytes to the reader as a
-// file's text; any crash, sanitizer report, leak, timeout or memory blow-up is a finding. The
-// readers answer bad input with a Status, so the return value is ignored.
+// libFuzzer targets for every reader (issue 15), and for .model through the diode (issue 41): one
+// source, built once per reader with ISOLINK_FUZZ_READER set (tests/fuzz/CMakeLists.txt). Each
+// feeds the bytes to the reader as a file's text; any crash, sanitizer report, leak, timeout or
+// memory blow-up is a finding. The readers answer bad input with a Status, so the return value is
+// ignored.
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -25,6 +26,12 @@
 #include <cstdio>
 
 #include "eye/scope_binary.h"
+#elif ISOLINK_FUZZ_READER == 9
+#include <cmath>
+#include <cstdlib>
+
+#include "netlists/spice_reader.h"
+#include "solver/circuit.h"
 #endif
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -53,6 +60,26 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::fclose(f);
     if (wrote == size) (void)isolink::eye::read_binary(path);
   }
+#elif ISOLINK_FUZZ_READER == 9
+  // .model: the netlist read, its circuit built (the diode checks its model's parameters), and
+  // every nonlinear port evaluated and limited from -1 kV to 1 kV: a non-finite current, charge
+  // or limited voltage from a model the element accepted is a finding (abort).
+  auto netlist = isolink::read_spice_text(text, "fuzz.cir");
+  if (!netlist) return 0;
+  isolink::Circuit circuit;
+  for (const auto& card : netlist->cards)
+    if (!circuit.add(card).ok()) return 0;
+  if (!circuit.finalize().ok()) return 0;
+  for (const auto& e : circuit.elements())
+    for (int k = 0; k < e->nonlinear_port_count(); ++k)
+      for (double v : {-1e3, -100.0, -27.0, -5.0, -0.1, 0.0, 0.1, 0.6, 0.8, 2.0, 30.0, 1e3}) {
+        const isolink::PortEval p = e->eval_port(k, v);
+        bool limited = false;
+        const double vl = e->limit_port(k, v, 0.5 * v, &limited);
+        if (!std::isfinite(p.i) || !std::isfinite(p.g) || !std::isfinite(p.q) ||
+            !std::isfinite(p.c) || !std::isfinite(vl) || !std::isfinite(e->port_start_voltage(k)))
+          std::abort();
+      }
 #endif
   return 0;
 }
