@@ -26,7 +26,7 @@
 //    the receiver's rules; its decoded frames (byte, error bit, preamble start) are the traffic.
 //    With none decoded, the spec's stimulus (or CompareOptions::frames) is the traffic.
 // 2. The link is linear: the receiver's v(t) is v_idle + sum_k dL_k E(t - t_k), E the edge
-//    response (analysis/worst.h, the LTI engine's reduced model), evaluated at the capture's own
+//    response (edge_response.h, the LTI engine's reduced model), evaluated at the capture's own
 //    sample times (E interpolated linearly on its 1 ns grid), so edges fall at any time.
 // 3. Alignment: a squared-error scan of integer lags on a 1 ns grid, then a golden-section
 //    search of the continuous offset; no amplitude scaling.

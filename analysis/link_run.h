@@ -102,7 +102,7 @@ std::vector<int> same_circuits(const LinkRun& run);
 // hop first and simulate each distinct circuit once).
 StatusOr<DirectionRun> run_direction(link::ExpandedLink link, const RunOptions& opt = {});
 
-// One expanded direction scored on v(rxp,rxn) synthesized from its edge response (worst.h,
+// One expanded direction scored on v(rxp,rxn) synthesized from its edge response (edge_response.h,
 // synthesize_drive: exact superposition on the response's grid) instead of simulated: the
 // sweep's path. The waveform has that column and one per probe of e.more; an error when a level
 // change of the drive is off the grid.

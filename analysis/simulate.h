@@ -104,7 +104,7 @@ struct SimulationResult {
 // The accuracy the engine that produced `r` promises, one sentence with its figures, for the
 // run's statistics (issue 28: `auto` never trades accuracy silently): the reduced model's bound
 // per edge from its check, the march's and the transient's error control and what they gave
-// against converged references (README, section Solver).
+// against converged references (docs/solver.md).
 std::string engine_accuracy(const SimulationResult& r);
 
 StatusOr<SimulationResult> simulate_netlist(const Netlist& netlist, const SimulationRequest& req);

@@ -362,7 +362,8 @@ std::string fast_path_refused(const link::LinkSpec& spec, const PointOptions& op
 // The options of a point's edge responses: the run's expansion, the probes its noise analysis
 // and waveform files read, the sweep's start points.
 WorstOptions point_worst_options(const SweepSpec& s, const PointOptions& opt) {
-  WorstOptions wopt{.expand = opt.run.expand};
+  WorstOptions wopt;
+  wopt.expand = opt.run.expand;
   if (s.noise_outputs || !opt.waves_dir.empty())  // they read the pins (and the files the driver)
     wopt.more_probes.assign(run_probes().begin() + 1, run_probes().end());
   wopt.reduced_start_points_by_direction = opt.start_points;

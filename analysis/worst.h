@@ -13,7 +13,7 @@
 // 1. Every link is linear and time-invariant, and the driver moves both lines by the same linear
 //    10 ns ramp scaled by the level change (P = 2.5 (1 + L), N = 2.5 (1 - L)), so the receiver's
 //    v(t) for any traffic is exactly v_idle + sum_i dL_i E(t - t_i): E is the response to one
-//    0 -> +1 level change (edge_response; today from a tight transient run until it settles).
+//    0 -> +1 level change (edge_response.h: edge_response, sampled until it settles).
 // 2. Memory: p(t) = E(t) - E(t - T) is one half bit's response. Half bits older than tau move v
 //    by at most B(tau) = sum_k max |p| over [tau + kT, tau + (k + 1) T) (|level| <= 1, at most one
 //    half bit per T). The memory M is the smallest tau with B(tau) <= tail_tol (at most
@@ -44,14 +44,11 @@
 //   encoding whose frames are not affine in their bits. A failing worst case is pass false.
 #pragma once
 
-#include <complex>
 #include <cstdint>
-#include <functional>
-#include <map>
-#include <optional>
 #include <string>
 #include <vector>
 
+#include "analysis/edge_response.h"
 #include "base/status.h"
 #include "base/waveform.h"
 #include "eye/check.h"
@@ -62,86 +59,19 @@
 
 namespace isolink::analysis {
 
-// The receiver's response to one driver edge, on a uniform grid.
-struct EdgeResponse {
-  double dt = 1e-9;       // sample spacing (s)
-  long pre = 0;           // e[pre] is at the corner (the middle of the driver's ramp)
-  std::vector<double> e;  // v(rxp,rxn) after a 0 -> +1 level change, minus v_idle (V)
-  double v_idle = 0;      // v(rxp,rxn) with the line idle (V)
-  double span = 0;        // simulated time after the corner (s)
-  double settle = 0;      // max |e - e.back()| over the last 10 % of the span (V)
-  double drift = 0;       // max |E(t) - E(t - T)| over the last 10 %: a half bit's residue (V)
-  // With WorstOptions::more_probes: the same response of each of those probes (in that order),
-  // e minus v_idle of that probe, on the same grid (the spec traffic's other columns).
-  struct Column {
-    std::string probe;
-    std::vector<double> e;
-    double v_idle = 0;
-  };
-  std::vector<Column> more;
-  // The reduced model's closed form past the driver's ramp (empty from the transient, and in a
-  // coarsened copy): at n >= start samples after the corner, e is
-  //   constant[0] + sum_i Re(amplitude[0][i] z_i^(n - start)),  z_i = e^{p_i dt},
-  // and more's column c the same with constant[c + 1], amplitude[c + 1] (each minus its v_idle).
-  // It is the model the record was sampled from (checked against the record when made), and it
-  // goes on past the record's end where at() holds the last sample.
-  struct Tail {
-    long start = 0;
-    std::vector<std::complex<double>> z;                       // per mode
-    std::vector<double> constant;                              // per column
-    std::vector<std::vector<std::complex<double>>> amplitude;  // [column][mode]
-  };
-  std::optional<Tail> tail;
-  std::string engine;       // what produced it ("reduced model, order 119 ...", "transient ...")
-  std::string engine_note;  // edge_engine auto: why the reduced model was not used
-  double seconds = 0;       // wall time
-  // Hz, the reduced model's expansion points (WorstOptions::reduced_start_points of a
-  // neighbouring link); empty from the transient.
-  std::vector<double> expansion_points;
-  // e at n samples after the corner: 0 before the record, e.back() after it.
-  double at(long n) const {
-    const long i = n + pre;
-    if (i < 0) return 0.0;
-    if (i >= static_cast<long>(e.size())) return e.back();
-    return e[static_cast<size_t>(i)];
-  }
-};
-
-struct WorstOptions {
-  double dt = 1e-9;          // synthesis grid (s); edges and gaps fall on it
-  double gap_min = 3.8e-6;   // shortest idle between byte frames (traffic::Timing byte_gap)
-  double gap_step = 50e-9;   // gap grid of the previous byte (s)
-  double tail_tol = 0.5e-3;  // V: the memory ends where the tail bound falls below this
-  // The edge response's engine: `auto` takes the LTI engine's reduced model (solver/lti.h,
-  // checked against the exact AC solution within 2e-5 of the peak from 1 kHz to 3 GHz) and falls
-  // back to the transient when the model does not pass; `transient` always runs the transient.
-  enum class EdgeEngine { Auto, Transient };
-  EdgeEngine edge_engine = EdgeEngine::Auto;
-  // Hz: the reduced model's first expansion points (ReducedModelOptions::start_points), e.g. the
-  // expansion_points of the same link with other part values (isolink compare's fit); the model
-  // passes the same check either way.
-  std::vector<double> reduced_start_points;
-  // The same per direction (a sweep's point 0, sweep::PointOptions::start_points): an entry for
-  // the direction of edge_response replaces reduced_start_points.
-  std::map<link::Direction, std::vector<double>> reduced_start_points_by_direction;
-  double reltol = 1e-6;       // transient tolerance of the edge response
-  double settle_tol = 20e-6;  // V: settled when a half bit's response stays below this
+// The search's options; the edge response's (dt, edge_engine, reltol, settle_tol, max_span,
+// expand, more_probes, progress, ...) are EdgeResponseOptions's (edge_response.h).
+struct WorstOptions : EdgeResponseOptions {
+  double gap_min = 3.8e-6;    // shortest idle between byte frames (traffic::Timing byte_gap)
+  double gap_step = 50e-9;    // gap grid of the previous byte (s)
+  double tail_tol = 0.5e-3;   // V: the memory ends where the tail bound falls below this
   double max_memory = 20e-6;  // s: longest memory searched; B there is reported as the bound
-  double max_span = 400e-6;   // s: longest edge-response run before giving up
   int max_candidates = 24;    // target patterns carried into the history search per metric
   int verify = 6;             // best-ranked histories scored exactly per candidate and metric
   bool exhaustive = false;    // score every target x history combination (brute force)
   // Restrict the patterns searched (tests; empty = all 512). A pattern is byte | error_bit << 8.
   std::vector<int> targets;
   std::vector<int> previous;
-  link::ExpandOptions expand;  // driver, load, encoding (its half bit is the T above)
-  // Probes recorded besides v(rxp,rxn) (EdgeResponse::more): the sweep's fast path asks for the
-  // other columns of a run (v(rxp), v(rxn), v(txp,txn)) when its noise analysis or waveform files
-  // need them. The reduced model is then checked on these probes too.
-  std::vector<std::string> more_probes;
-  // Progress for a display: what runs ("down edge response", "down search") and the fraction
-  // of it done (0-1). Empty: none.
-  std::function<void(const std::string& what, double fraction)> progress;
 
   Status validate() const;  // names the field, its value and the rule
 };
@@ -203,32 +133,12 @@ struct WorstResult {
   double seconds = 0;
 };
 
-// The edge response of one direction of the link (the one adapter to the engine).
-StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::PartLibrary& parts,
-                                     link::Direction d, const WorstOptions& opt);
-
-// e on a grid k times coarser: every k-th sample counted from the corner (e.pre a multiple of
-// k), settle and drift measured again with opt's half bit; `more` dropped. The response
-// edge_response gives with dt = k e.dt, from the same model sampled at the same times (the sweep
-// synthesizes its traffic on the fine grid and searches the worst case on the coarse one).
-EdgeResponse coarsened(const EdgeResponse& e, int k, const WorstOptions& opt);
-
 // B(tau): the most that half bits older than tau (s) can move v (V). See the method above.
 double tail_bound(const EdgeResponse& e, double half_bit, double tau);
 
 // v(rxp,rxn) of traffic by superposition, on [t0, t1] every e.dt (times from the record start).
 Waveform synthesize(const EdgeResponse& e, const Traffic& traffic,
                     const traffic::EncodingOptions& enc, double t0, double t1);
-
-// v(rxp,rxn) of a whole drive (a link's own traffic, link::ExpandedLink::drive) by superposition,
-// on [0, t_end] every e.dt: exact at the samples for the link whose edge response e is. Every
-// level change must fall on the grid (within 1e-6 of a sample); an error names the first that
-// does not. The probes of e.more follow as further columns, each superposed the same way.
-StatusOr<Waveform> synthesize_drive(const EdgeResponse& e, const traffic::Drive& drive,
-                                    double t_end);
-
-// Whether every level change of the drive falls on a grid of step dt (within 1e-6 of a step).
-bool on_grid(const traffic::Drive& drive, double dt);
 
 // The worst case of every direction in spec.stimulus.directions; `edges`, when given, are their
 // edge responses (one per direction, in order, from edge_response with the same options).

@@ -104,10 +104,11 @@ int run_run(const RunArgs& a) {
   // The worst case over all legal traffic, beside the spec's traffic (its own verdict).
   std::optional<analysis::WorstResult> worst;
   if (!a.no_worst) {
-    StatusOr<analysis::WorstResult> w =
-        analysis::worst_case(*spec, *parts, {.progress = [&](const std::string& what, double f) {
-          line.show_fraction("worst case, " + what, f);
-        }});
+    analysis::WorstOptions wopt;
+    wopt.progress = [&](const std::string& what, double f) {
+      line.show_fraction("worst case, " + what, f);
+    };
+    StatusOr<analysis::WorstResult> w = analysis::worst_case(*spec, *parts, wopt);
     if (!w) return fail(w.status().with_context(a.spec + ", worst case"));
     worst = std::move(*w);
   }

@@ -18,7 +18,7 @@ TOP = ("base", "protocol", "solver", "config", "netlists", "eye", "analysis", "r
        "python", "tests", "tools", "bench", "docs", "cmake")
 PATH = re.compile(r"(?<![\w/.-])((?:%s)/[\w./*-]+\.[a-z]{1,4})\b" % "|".join(TOP))
 # Paths of other projects that a page cites as theirs.
-EXTERNAL = {"tests/general/rc.cir"}  # ngspice's own test deck (README, "Solver")
+EXTERNAL = {"tests/general/rc.cir"}  # ngspice's own test deck (docs/solver.md)
 LINK = re.compile(r"\]\(([^)#\s]+)(?:#[^)]*)?\)")
 
 

@@ -1,4 +1,4 @@
-// The transient step-size control against its accuracy promise (README "Solver"): each step's
+// The transient step-size control against its accuracy promise (docs/solver.md): each step's
 // local truncation error stays below trtol * (reltol * peak|x| + vntol), so on a smooth circuit
 // the error against the closed form follows the tolerance: below reltol * peak, and shrinking as
 // reltol^(2/3) (steps scale as tol^(1/3), the global error of a second-order method as h^2).
