@@ -555,8 +555,7 @@ StatusOr<CompareResult> compare_capture(const CompareInput& in, const link::Part
     r.residual_after_fit = residual_of(vs, sw, r.clipping);
     if (r.residual_after_fit->rms_v > r.threshold_rms_v ||
         r.residual_after_fit->max_v > r.threshold_max_v)
-      if (Status s = cd::locate_residual(model, p->spec, parts, opt, fitted, data, sw, r);
-          !s.ok())
+      if (Status s = cd::locate_residual(model, p->spec, parts, opt, fitted, data, sw, r); !s.ok())
         return s;
     StatusOr<eye::CheckResult> sf = eye::check_samples(t, r.sim_after_fit, p->rules);
     if (sf) r.metrics_after_fit = metric_summaries(r.check, *sf);

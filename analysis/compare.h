@@ -76,7 +76,7 @@ struct CompareOptions {
   // A stimulus script (netlists/traffic/stimulus.h) used when nothing in the capture decodes;
   // empty: the spec's own stimulus.
   std::string frames;
-  std::vector<std::string> fit;                             // keys, dotted paths as in sweeps
+  std::vector<std::string> fit;  // keys, dotted paths as in sweeps
   // key -> [low, high], SI. Default (fit_bounds in compare_model.h): resistors and capacitors
   // 1/10..10x the design value (a wrong multiplier digit), inductances 1/10..2x (a wrong part, a
   // saturated core), cable.length 0.1..100 m (widened to hold the design).
@@ -84,7 +84,7 @@ struct CompareOptions {
   // Scan the bounds when the refinement from the design does not explain the capture (or ends on
   // a bound); false: the refinement from the design only.
   bool global_search = true;
-  int scan_points = 0;  // points of that scan; 0: 24 for one key, 32 per key for more
+  int scan_points = 0;            // points of that scan; 0: 24 for one key, 32 per key for more
   double model_floor_rel = 0.01;  // model floor of the verdict, a fraction of the peak |v|
   int max_iterations = 30;        // Levenberg-Marquardt iterations
   int threads = 0;                // the fit's Jacobian columns evaluated at once (0: all cores)
@@ -154,11 +154,11 @@ struct KeyCorrelation {
 // Where a residual the fitted keys do not explain is largest, and the spec keys that move the
 // waveform there most.
 struct ResidualPlace {
-  size_t window = 0;              // index in CompareResult::windows (the frame)
-  std::optional<size_t> pulse;    // the capture's pulse nearest to it (index in check.pulses)
-  double time = 0;                // capture time of the largest |capture - simulation|
-  double residual_v = 0;          // capture - simulation there
-  double window_rms_v = 0;        // rms of the residual within +/-200 ns of it
+  size_t window = 0;            // index in CompareResult::windows (the frame)
+  std::optional<size_t> pulse;  // the capture's pulse nearest to it (index in check.pulses)
+  double time = 0;              // capture time of the largest |capture - simulation|
+  double residual_v = 0;        // capture - simulation there
+  double window_rms_v = 0;      // rms of the residual within +/-200 ns of it
   struct Suggestion {
     std::string key;
     double sensitivity_v = 0;  // rms change there when the key moves by +10 % (V)
@@ -169,13 +169,13 @@ struct ResidualPlace {
 // What the global search did.
 struct SearchSummary {
   bool scanned = false;
-  std::string why;        // why it scanned, or why not
-  int points = 0;         // scan points evaluated
-  int failed = 0;         // scan points whose model did not build (left out)
-  int starts = 0;         // refinements run from scan points
-  double local_rms_v = 0;  // the refinement from the design's residual rms
+  std::string why;          // why it scanned, or why not
+  int points = 0;           // scan points evaluated
+  int failed = 0;           // scan points whose model did not build (left out)
+  int starts = 0;           // refinements run from scan points
+  double local_rms_v = 0;   // the refinement from the design's residual rms
   double chosen_rms_v = 0;  // the kept solution's
-  bool from_scan = false;  // the kept solution started from a scan point
+  bool from_scan = false;   // the kept solution started from a scan point
 };
 
 struct Finding {
@@ -194,10 +194,10 @@ struct LsqResult {
   std::vector<double> stderr_x;  // sqrt(diag(sigma^2 (J^T J)^+)), sigma^2 = SSE / (m - n)
   double sse = 0;                // sum of squared residuals at x
   int iterations = 0;
-  int evaluations = 0;             // residual evaluations, derivatives included
-  std::string report;              // Ceres' brief report
-  std::vector<bool> identifiable;  // per parameter
-  std::vector<double> singular;    // of J with columns scaled to unit norm, decreasing
+  int evaluations = 0;              // residual evaluations, derivatives included
+  std::string report;               // Ceres' brief report
+  std::vector<bool> identifiable;   // per parameter
+  std::vector<double> singular;     // of J with columns scaled to unit norm, decreasing
   std::vector<double> correlation;  // n x n, row-major, from sigma^2 (J^T J)^+ (0 where unknown)
   double max_abs_residual = 0;      // largest |r_i| at x
 };
@@ -227,7 +227,7 @@ struct CompareResult {
   double threshold_max_v = 0;  // 6 noise + q + 5 floor
   Clipping clipping;           // the capture's rails, if it clips
   std::vector<FitKey> fit;
-  std::vector<std::string> unidentifiable;  // sentences about rank deficiency
+  std::vector<std::string> unidentifiable;   // sentences about rank deficiency
   std::vector<KeyCorrelation> correlations;  // every pair of fitted keys
   SearchSummary search;
   std::optional<ResidualPlace> unexplained;  // after a fit whose residual is over the threshold

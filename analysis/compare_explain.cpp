@@ -22,13 +22,23 @@ constexpr double kSensitivityStep = 0.10;   // a suggested key's change: +10 %
 
 // Keys whose sensitivity is tried when a residual stays unexplained (those the spec gives a
 // value, directly or by its board preset or transformer part).
-const char* const kCandidateKeys[] = {
-    "cable.length",         "rx.isolation.cap",         "tx.isolation.cap",
-    "rx.termination",       "tx.termination",           "rx.series_r",
-    "tx.series_r",          "rx.bypass_c",              "tx.bypass_c",
-    "rx.isolation.leakage", "tx.isolation.leakage",     "rx.isolation.inductance",
-    "tx.isolation.inductance", "rx.isolation.cable_side_c", "tx.isolation.cable_side_c",
-    "rx.isolation.winding_c",  "tx.isolation.winding_c"};
+const char* const kCandidateKeys[] = {"cable.length",
+                                      "rx.isolation.cap",
+                                      "tx.isolation.cap",
+                                      "rx.termination",
+                                      "tx.termination",
+                                      "rx.series_r",
+                                      "tx.series_r",
+                                      "rx.bypass_c",
+                                      "tx.bypass_c",
+                                      "rx.isolation.leakage",
+                                      "tx.isolation.leakage",
+                                      "rx.isolation.inductance",
+                                      "tx.isolation.inductance",
+                                      "rx.isolation.cable_side_c",
+                                      "tx.isolation.cable_side_c",
+                                      "rx.isolation.winding_c",
+                                      "tx.isolation.winding_c"};
 
 std::string label_of(const std::string& key) {
   std::string s = key;
@@ -133,9 +143,8 @@ void report_fit(const CompareOptions& opt, const std::vector<DesignValue>& desig
     const double rel = k.value / k.initial - 1;
     r.findings.push_back(
         {k.key, k.initial, k.value, rel,
-         fmt::format("{} behaves like {} against {} in the design ({:+.0f} %): {}",
-                     label_of(k.key), si_of(k.key, k.value), si_of(k.key, k.initial), rel * 100,
-                     advice_of(k.key))});
+         fmt::format("{} behaves like {} against {} in the design ({:+.0f} %): {}", label_of(k.key),
+                     si_of(k.key, k.value), si_of(k.key, k.initial), rel * 100, advice_of(k.key))});
   }
   if (!unident.empty()) {
     std::string keys;
@@ -148,10 +157,9 @@ void report_fit(const CompareOptions& opt, const std::vector<DesignValue>& desig
   }
 }
 
-Status locate_residual(LinkModel& model, const link::LinkSpec& spec,
-                       const link::PartLibrary& parts, const CompareOptions& opt,
-                       const std::vector<double>& fitted, const FitData& data,
-                       std::span<const double> sim, CompareResult& r) {
+Status locate_residual(LinkModel& model, const link::LinkSpec& spec, const link::PartLibrary& parts,
+                       const CompareOptions& opt, const std::vector<double>& fitted,
+                       const FitData& data, std::span<const double> sim, CompareResult& r) {
   const std::span<const double> t = data.t, v = data.v;
   if (t.empty() || !r.offset_after_fit_s) return Status::Ok();
   ResidualPlace pl;
@@ -211,7 +219,8 @@ Status locate_residual(LinkModel& model, const link::LinkSpec& spec,
       std::vector<double> moved(tw.size());
       synth_at(**e, *data.edges, *r.offset_after_fit_s, tw, moved);
       double s2 = 0;
-      for (size_t i = 0; i < tw.size(); ++i) s2 += (moved[i] - sim[i0 + i]) * (moved[i] - sim[i0 + i]);
+      for (size_t i = 0; i < tw.size(); ++i)
+        s2 += (moved[i] - sim[i0 + i]) * (moved[i] - sim[i0 + i]);
       sug[k] = {cands[k].first, tw.empty() ? 0.0 : std::sqrt(s2 / static_cast<double>(tw.size()))};
     });
   });

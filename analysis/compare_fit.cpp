@@ -230,7 +230,8 @@ void covariance(const Eigen::MatrixXd& J, double sse, LsqResult& out) {
     for (Eigen::Index j = 0; j < n; ++j) {
       const double d = inv(i, i) * inv(j, j);
       const double c = i == j ? 1.0 : d > 0 ? inv(i, j) / std::sqrt(d) : 0.0;
-      out.correlation[static_cast<size_t>(i * n + j)] = std::isfinite(c) ? std::clamp(c, -1.0, 1.0) : 0.0;
+      out.correlation[static_cast<size_t>(i * n + j)] =
+          std::isfinite(c) ? std::clamp(c, -1.0, 1.0) : 0.0;
     }
 }
 

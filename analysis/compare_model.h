@@ -112,9 +112,8 @@ void report_fit(const CompareOptions& opt, const std::vector<DesignValue>& desig
 // After a fit whose residual stays over the threshold: r.unexplained, where the residual
 // (capture minus `sim`, both at data.t) is largest, and the spec keys (not fitted) that move
 // the simulation there most when each changes by +10 % from the fitted link.
-Status locate_residual(LinkModel& model, const link::LinkSpec& spec,
-                       const link::PartLibrary& parts, const CompareOptions& opt,
-                       const std::vector<double>& fitted, const FitData& data,
-                       std::span<const double> sim, CompareResult& r);
+Status locate_residual(LinkModel& model, const link::LinkSpec& spec, const link::PartLibrary& parts,
+                       const CompareOptions& opt, const std::vector<double>& fitted,
+                       const FitData& data, std::span<const double> sim, CompareResult& r);
 
 }  // namespace isolink::analysis::compare_detail

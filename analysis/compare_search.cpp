@@ -16,7 +16,7 @@
 namespace isolink::analysis::compare_detail {
 namespace {
 
-constexpr double kOffsetRangeNs = 50;      // a refinement's offset: +/- this around its start
+constexpr double kOffsetRangeNs = 50;       // a refinement's offset: +/- this around its start
 constexpr double kScanAlignRange = 0.6e-6;  // a scan point's offset: +/- this around the design's
 constexpr double kAtBound = 0.01;           // within 1 % of a bound: at it
 
@@ -62,8 +62,7 @@ struct Problem {
     if (!e) return e.status();
     res.resize(data.t.size());
     synth_at(**e, *data.edges, offset, data.t, res);
-    for (size_t i = 0; i < res.size(); ++i)
-      res[i] = data.clipping->difference(data.v[i], res[i]);
+    for (size_t i = 0; i < res.size(); ++i) res[i] = data.clipping->difference(data.v[i], res[i]);
     return Status::Ok();
   }
   // The key at its lower (-1) or upper (+1) bound, or 0.
@@ -108,9 +107,10 @@ std::string unexplained_why(const Problem& p, const FitSolution& s, const Compar
     return fmt::format("the refinement from the design leaves {:.1f} mV rms (threshold {:.1f} mV)",
                        rms * 1e3, r.threshold_rms_v * 1e3);
   if (s.lsq.max_abs_residual > r.threshold_max_v)
-    return fmt::format("the refinement from the design leaves a {:.0f} mV deviation (threshold "
-                       "{:.0f} mV)",
-                       s.lsq.max_abs_residual * 1e3, r.threshold_max_v * 1e3);
+    return fmt::format(
+        "the refinement from the design leaves a {:.0f} mV deviation (threshold "
+        "{:.0f} mV)",
+        s.lsq.max_abs_residual * 1e3, r.threshold_max_v * 1e3);
   for (size_t j = 0; j < s.x.size(); ++j)
     if (p.at_bound(j, s.x[j]) != 0)
       return fmt::format("the refinement from the design ends on a bound of {}", p.opt.fit[j]);
@@ -132,7 +132,8 @@ std::vector<ScanPoint> scan(const Problem& p, int count) {
   for (const std::vector<double>& u : unit_scan(nk, count)) {
     ScanPoint s;
     for (size_t j = 0; j < nk; ++j)
-      s.x.push_back(p.log_bounds[j].first + u[j] * (p.log_bounds[j].second - p.log_bounds[j].first));
+      s.x.push_back(p.log_bounds[j].first +
+                    u[j] * (p.log_bounds[j].second - p.log_bounds[j].first));
     pts.push_back(s);
   }
   const size_t w = p.data.first_window >= 16 ? p.data.first_window : p.data.t.size();
@@ -211,9 +212,9 @@ void global_search(const Problem& p, FitSolution& best, CompareResult& r) {
     }
   }
   if (r.search.failed > 0)
-    r.notes.push_back(fmt::format(
-        "{} of the scan's {} points left out: their model did not build or settle", r.search.failed,
-        count));
+    r.notes.push_back(
+        fmt::format("{} of the scan's {} points left out: their model did not build or settle",
+                    r.search.failed, count));
 }
 
 }  // namespace

@@ -193,11 +193,11 @@ std::string compare_text(const CompareResult& r) {
                      c.separable() ? "" : "  (too correlated to separate)");
   if (!r.fit.empty() && !r.search.why.empty())
     s += fmt::format("  search: {}{}\n", r.search.why,
-                     r.search.scanned ? fmt::format(" ({} points, {} refinements; kept: {})",
-                                                    r.search.points, r.search.starts,
-                                                    r.search.from_scan ? "a scan start"
-                                                                       : "the design's valley")
-                                      : "");
+                     r.search.scanned
+                         ? fmt::format(" ({} points, {} refinements; kept: {})", r.search.points,
+                                       r.search.starts,
+                                       r.search.from_scan ? "a scan start" : "the design's valley")
+                         : "");
   if (r.residual_after_fit)
     s += fmt::format("  after the fit: residual rms {:.1f} mV, max {:.0f} mV\n",
                      r.residual_after_fit->rms_v * 1e3, r.residual_after_fit->max_v * 1e3);

@@ -203,7 +203,8 @@ CaseResult run_case(uint64_t seed) {
   CaseResult out;
   std::string line = fmt::format("seed {:2} {:8} {:4} {:9}", seed, c.link->name,
                                  c.up ? "up" : "down", c.scope.layout);
-  if (!r.ok() || r->fit.size() != c.keys.size()) return {Outcome::kUnexplainedMiss, line + " error"};
+  if (!r.ok() || r->fit.size() != c.keys.size())
+    return {Outcome::kUnexplainedMiss, line + " error"};
   bool all = true, explained = true;
   for (size_t j = 0; j < c.keys.size(); ++j) {
     const FitKey& k = r->fit[j];
@@ -252,9 +253,10 @@ TEST(CompareCorpus, SixtySeededCapturesAreRecoveredOrHonestlyMissed) {
   run_corpus(seeds, 0.95);
 }
 
-// The fixed subset of the default suite: one far-from-design key on each of two links.
+// The fixed subset of the default suite: one far-from-design key on a cap link (up) and on a
+// transformer link (down), two scope layouts.
 TEST(CompareCorpus, FixedSubsetIsRecovered) {
-  run_corpus({0, 2}, 1.0);
+  run_corpus({4, 18}, 1.0);
 }
 
 }  // namespace

@@ -45,7 +45,8 @@ Status write_synthetic_capture(const std::string& spec_text, const std::string& 
   if (!spec) return spec.status();
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
   if (!parts) return parts.status();
-  StatusOr<link::ExpandedLink> x = link::expand_link(*spec, *parts, scope.up ? link::Direction::kUp : link::Direction::kDown);
+  StatusOr<link::ExpandedLink> x =
+      link::expand_link(*spec, *parts, scope.up ? link::Direction::kUp : link::Direction::kDown);
   if (!x) return x.status();
   analysis::SimulationRequest req;
   req.probes = {"v(rxp)", "v(rxn)"};
