@@ -226,9 +226,9 @@ double first_edge(std::span<const double> t, std::span<const double> v) {
 
 // Alignment: squared error over integer lags of a 1 ns grid within +/-range of offset0, then a
 // golden-section search of the continuous offset over +/-1.5 grid steps of the best lag.
-double align(const EdgeResponse& e, const cd::EdgeList& edges, std::span<const double> ts,
-             std::span<const double> vs, double offset0, double before, double after,
-             const Clipping& clip) {
+double align_offset(const EdgeResponse& e, const cd::EdgeList& edges, std::span<const double> ts,
+                    std::span<const double> vs, double offset0, double before, double after,
+                    const Clipping& clip) {
   const double dt = 1e-9;
   // The capture on the grid offset0 + k dt inside its sample span.
   std::vector<double> cg, tg;
@@ -411,6 +411,21 @@ StatusOr<cd::EdgeList> traffic_of(const Prepared& p, const CompareOptions& opt, 
   return drive_traffic(*d);
 }
 
+// The sentence on a residual the fitted keys leave: where it is largest, and what moves it.
+std::string unexplained_sentence(const ResidualPlace& pl) {
+  std::string keys;
+  for (const ResidualPlace::Suggestion& s : pl.suggested)
+    keys += fmt::format("{}{} ({:.0f} mV per +10 %)", keys.empty() ? "" : ", ", s.key,
+                        s.sensitivity_v * 1e3);
+  return fmt::format(
+      "the fitted keys do not explain the capture: the residual is largest in frame {} at "
+      "{:.4f} us ({}{:+.0f} mV, {:.0f} mV rms within 200 ns); the spec keys that move the "
+      "waveform most there: {} (or another topology, the wrong direction or channels)",
+      pl.window + 1, pl.time * 1e6,
+      pl.pulse ? fmt::format("pulse {}, ", *pl.pulse + 1) : std::string(), pl.residual_v * 1e3,
+      pl.window_rms_v * 1e3, keys.empty() ? "none found" : keys);
+}
+
 void judge(const CompareOptions& opt, CompareResult& r) {
   const Residual& res = r.residual_after_fit ? *r.residual_after_fit : r.residual;
   if (res.rms_v > r.threshold_rms_v)
@@ -422,7 +437,10 @@ void judge(const CompareOptions& opt, CompareResult& r) {
         "the residual's largest deviation {:.0f} mV{} exceeds {:.0f} mV", res.max_v * 1e3,
         r.residual_after_fit ? " after the fit" : "", r.threshold_max_v * 1e3));
   for (const Finding& f : r.findings) r.reasons.push_back(f.text);
-  if (r.residual_after_fit && res.rms_v > r.threshold_rms_v && !opt.fit.empty())
+  if (r.unexplained)
+    r.reasons.push_back(unexplained_sentence(*r.unexplained));
+  else if (r.residual_after_fit && !opt.fit.empty() &&
+           (res.rms_v > r.threshold_rms_v || res.max_v > r.threshold_max_v))
     r.reasons.push_back(
         "the fitted keys do not explain the capture: another topology, a part not fitted, or "
         "the wrong direction or channels");
@@ -496,7 +514,7 @@ StatusOr<CompareResult> compare_capture(const CompareInput& in, const link::Part
     r.reasons.push_back("the traffic's frames do not overlap the record");
     return r;
   }
-  r.offset_s = align(**e, *edges, ts, vs, offset0, before, after, r.clipping);
+  r.offset_s = align_offset(**e, *edges, ts, vs, offset0, before, after, r.clipping);
   if (!decoded) {  // the windows follow the traffic: place them at the aligned offset
     r.windows = residual_windows(r.check, *edges, decoded, r.offset_s, t.front(), t.back());
     idx = window_samples(t, r.windows);
@@ -525,7 +543,9 @@ StatusOr<CompareResult> compare_capture(const CompareInput& in, const link::Part
 
   if (!opt.fit.empty()) {
     std::vector<double> fitted;
-    cd::FitData data{ts, vs, &*edges, r.offset_s, &r.clipping};
+    const size_t first_window = static_cast<size_t>(
+        std::upper_bound(ts.begin(), ts.end(), r.windows.front().second) - ts.begin());
+    cd::FitData data{ts, vs, &*edges, r.offset_s, &r.clipping, first_window};
     if (Status s = cd::run_fit(model, p->spec, parts, opt, data, r, fitted); !s.ok()) return s;
     StatusOr<std::shared_ptr<const EdgeResponse>> ef = model.response(opt.fit, fitted);
     if (!ef) return ef.status();
@@ -533,6 +553,10 @@ StatusOr<CompareResult> compare_capture(const CompareInput& in, const link::Part
     cd::synth_at(**ef, *edges, *r.offset_after_fit_s, t, r.sim_after_fit);
     cd::synth_at(**ef, *edges, *r.offset_after_fit_s, ts, sw);
     r.residual_after_fit = residual_of(vs, sw, r.clipping);
+    if (r.residual_after_fit->rms_v > r.threshold_rms_v ||
+        r.residual_after_fit->max_v > r.threshold_max_v)
+      if (Status s = cd::locate_residual(model, p->spec, parts, opt, fitted, data, sw, r); !s.ok())
+        return s;
     StatusOr<eye::CheckResult> sf = eye::check_samples(t, r.sim_after_fit, p->rules);
     if (sf) r.metrics_after_fit = metric_summaries(r.check, *sf);
   }
@@ -541,6 +565,12 @@ StatusOr<CompareResult> compare_capture(const CompareInput& in, const link::Part
   r.evaluations = model.evaluations();
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
+}
+
+double cd::align(const EdgeResponse& e, const EdgeList& edges, std::span<const double> ts,
+                 std::span<const double> vs, double offset0, double before, double after,
+                 const Clipping& clip) {
+  return align_offset(e, edges, ts, vs, offset0, before, after, clip);
 }
 
 StatusOr<DesignValue> design_value(const link::LinkSpec& spec, const link::PartLibrary& parts,

@@ -34,8 +34,18 @@
 //    the offset, Jacobian by forward differences while iterating and central ones at the solution
 //    (1 % steps; its points evaluated in parallel); standard errors from J^T J at the solution
 //    scaled by the residual variance; rank deficiency reported per key.
+// 5. Global search (issue 43): when the refinement from the design leaves a residual over what
+//    the noise explains, or a key on its bound, a space-filling scan of the bounds (a log grid
+//    for one key, a Halton sequence for more; each point's offset aligned again), then the same
+//    refinement from the best few distinct points; the lowest residual wins. Default bounds:
+//    R and C 1/10..10x the design, L 1/10..2x, cable.length 0.1..100 m.
+// 6. Honesty: a key within 1 % of a bound is "at its bound", never a finding; keys whose
+//    correlation (from the fit's covariance) is over 0.95 are reported as a pair that cannot be
+//    separated, never as two findings; a residual still over the threshold is located (window,
+//    pulse, time) with the spec keys that move that part of the waveform most.
 #pragma once
 
+#include <cmath>
 #include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -66,8 +76,15 @@ struct CompareOptions {
   // A stimulus script (netlists/traffic/stimulus.h) used when nothing in the capture decodes;
   // empty: the spec's own stimulus.
   std::string frames;
-  std::vector<std::string> fit;                             // keys, dotted paths as in sweeps
-  std::map<std::string, std::pair<double, double>> bounds;  // key -> [low, high], SI
+  std::vector<std::string> fit;  // keys, dotted paths as in sweeps
+  // key -> [low, high], SI. Default (fit_bounds in compare_model.h): resistors and capacitors
+  // 1/10..10x the design value (a wrong multiplier digit), inductances 1/10..2x (a wrong part, a
+  // saturated core), cable.length 0.1..100 m (widened to hold the design).
+  std::map<std::string, std::pair<double, double>> bounds;
+  // Scan the bounds when the refinement from the design does not explain the capture (or ends on
+  // a bound); false: the refinement from the design only.
+  bool global_search = true;
+  int scan_points = 0;            // points of that scan; 0: 24 for one key, 32 per key for more
   double model_floor_rel = 0.01;  // model floor of the verdict, a fraction of the peak |v|
   int max_iterations = 30;        // Levenberg-Marquardt iterations
   int threads = 0;                // the fit's Jacobian columns evaluated at once (0: all cores)
@@ -119,6 +136,46 @@ struct FitKey {
   double tolerance = 0.10;  // the design's band, relative (part or default)
   std::string tolerance_from;
   bool identifiable = true;  // false: only a combination with other keys is determined
+  // "low" / "high" when the value is within 1 % of that bound: the data want a value the bounds
+  // do not allow, so `value` is the bound, not a measurement (no finding is made on it).
+  std::string at_bound;
+};
+
+// The correlation of two fitted keys' estimates, from the fit's covariance (the offset's
+// uncertainty included). Over kInseparable, the capture determines a combination of the two,
+// not each: no finding is made on either, and a reason says so.
+struct KeyCorrelation {
+  static constexpr double kInseparable = 0.95;
+  std::string a, b;
+  double r = 0;
+  bool separable() const { return std::abs(r) <= kInseparable; }
+};
+
+// Where a residual the fitted keys do not explain is largest, and the spec keys that move the
+// waveform there most.
+struct ResidualPlace {
+  size_t window = 0;            // index in CompareResult::windows (the frame)
+  std::optional<size_t> pulse;  // the capture's pulse nearest to it (index in check.pulses)
+  double time = 0;              // capture time of the largest |capture - simulation|
+  double residual_v = 0;        // capture - simulation there
+  double window_rms_v = 0;      // rms of the residual within +/-200 ns of it
+  struct Suggestion {
+    std::string key;
+    double sensitivity_v = 0;  // rms change there when the key moves by +10 % (V)
+  };
+  std::vector<Suggestion> suggested;  // largest sensitivity first (at most 4)
+};
+
+// What the global search did.
+struct SearchSummary {
+  bool scanned = false;
+  std::string why;          // why it scanned, or why not
+  int points = 0;           // scan points evaluated
+  int failed = 0;           // scan points whose model did not build (left out)
+  int starts = 0;           // refinements run from scan points
+  double local_rms_v = 0;   // the refinement from the design's residual rms
+  double chosen_rms_v = 0;  // the kept solution's
+  bool from_scan = false;   // the kept solution started from a scan point
 };
 
 struct Finding {
@@ -137,10 +194,12 @@ struct LsqResult {
   std::vector<double> stderr_x;  // sqrt(diag(sigma^2 (J^T J)^+)), sigma^2 = SSE / (m - n)
   double sse = 0;                // sum of squared residuals at x
   int iterations = 0;
-  int evaluations = 0;             // residual evaluations, derivatives included
-  std::string report;              // Ceres' brief report
-  std::vector<bool> identifiable;  // per parameter
-  std::vector<double> singular;    // of J with columns scaled to unit norm, decreasing
+  int evaluations = 0;              // residual evaluations, derivatives included
+  std::string report;               // Ceres' brief report
+  std::vector<bool> identifiable;   // per parameter
+  std::vector<double> singular;     // of J with columns scaled to unit norm, decreasing
+  std::vector<double> correlation;  // n x n, row-major, from sigma^2 (J^T J)^+ (0 where unknown)
+  double max_abs_residual = 0;      // largest |r_i| at x
 };
 // Residuals at x; an error stops the fit. Called from several threads at once (the Jacobian's
 // n + 1 points, 2n + 1 at the solution, are evaluated in parallel, `threads` at most, 0: all
@@ -168,7 +227,10 @@ struct CompareResult {
   double threshold_max_v = 0;  // 6 noise + q + 5 floor
   Clipping clipping;           // the capture's rails, if it clips
   std::vector<FitKey> fit;
-  std::vector<std::string> unidentifiable;  // sentences about rank deficiency
+  std::vector<std::string> unidentifiable;   // sentences about rank deficiency
+  std::vector<KeyCorrelation> correlations;  // every pair of fitted keys
+  SearchSummary search;
+  std::optional<ResidualPlace> unexplained;  // after a fit whose residual is over the threshold
   std::vector<Finding> findings;
   std::vector<MetricSummary> metrics;  // before the fit
   std::vector<MetricSummary> metrics_after_fit;

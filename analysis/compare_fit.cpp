@@ -97,8 +97,8 @@ StatusOr<std::shared_ptr<const EdgeResponse>> LinkModel::response(
     const std::vector<std::string>& keys, const std::vector<double>& values) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    for (const auto& [v, e] : kept_)
-      if (v == values) return e;
+    for (const auto& [k, v, e] : kept_)
+      if (v == values && k == keys) return e;
   }
   std::vector<sweep::Assignment> assign;
   for (size_t i = 0; i < keys.size(); ++i)
@@ -120,7 +120,7 @@ StatusOr<std::shared_ptr<const EdgeResponse>> LinkModel::response(
   std::lock_guard<std::mutex> lock(mutex_);
   if (start_points_.empty()) start_points_ = kept->expansion_points;  // the design's, normally
   if (kept_.size() >= kKept) kept_.pop_front();
-  kept_.push_back({values, kept});
+  kept_.push_back({keys, values, kept});
   return kept;
 }
 
@@ -224,6 +224,15 @@ void covariance(const Eigen::MatrixXd& J, double sse, LsqResult& out) {
   for (Eigen::Index j = 0; j < n; ++j)
     if (norms(j) > 0)
       out.stderr_x[static_cast<size_t>(j)] = std::sqrt(sigma2 * inv(j, j)) / norms(j);
+  // Correlation: the column scaling cancels, inv(i, j) / sqrt(inv(i, i) inv(j, j)).
+  out.correlation.assign(static_cast<size_t>(n * n), 0.0);
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (Eigen::Index j = 0; j < n; ++j) {
+      const double d = inv(i, i) * inv(j, j);
+      const double c = i == j ? 1.0 : d > 0 ? inv(i, j) / std::sqrt(d) : 0.0;
+      out.correlation[static_cast<size_t>(i * n + j)] =
+          std::isfinite(c) ? std::clamp(c, -1.0, 1.0) : 0.0;
+    }
 }
 
 }  // namespace
@@ -276,120 +285,15 @@ StatusOr<LsqResult> fit_least_squares(const ResidualFn& f, size_t residuals,
                                    : cost->last_error();
   out.evaluations = cost->evaluations();
   out.sse = 0;
-  for (double v : r) out.sse += v * v;
+  out.max_abs_residual = 0;
+  for (double v : r) {
+    out.sse += v * v;
+    out.max_abs_residual = std::max(out.max_abs_residual, std::abs(v));
+  }
   Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J(
       jac.data(), static_cast<Eigen::Index>(residuals), static_cast<Eigen::Index>(n));
   cd::covariance(J, out.sse, out);
   return out;
 }
 
-namespace compare_detail {
-namespace {
-
-std::string label_of(const std::string& key) {
-  std::string s = key;
-  if (s.rfind("ends.", 0) == 0) s = "both ends' " + s.substr(5);
-  std::replace(s.begin(), s.end(), '.', ' ');
-  std::replace(s.begin(), s.end(), '_', ' ');
-  return s;
-}
-
-std::string advice_of(const std::string& key) {
-  const std::string last = key.substr(key.rfind('.') + 1);
-  if (last == "cap" || last == "bypass_c" || last == "cable_side_c" || last == "esd")
-    return "check the part, its value and its solder joint";
-  if (last == "length")
-    return "check the cable's length, its type (material, gauge) and the "
-           "connectors on the way";
-  if (last == "termination" || last == "series_r")
-    return "check the resistor's value, its placement and its solder joints";
-  if (last == "inductance" || last == "leakage" || last == "dcr" || last == "winding_c")
-    return "check the transformer's part number, its orientation and its solder joints";
-  return "check the part and its assembly";
-}
-
-}  // namespace
-
-StatusOr<std::pair<double, double>> fit_bounds(const CompareOptions& opt, const std::string& key,
-                                               double design) {
-  double lo = 0.2 * design, hi = 5 * design;
-  if (auto b = opt.bounds.find(key); b != opt.bounds.end()) std::tie(lo, hi) = b->second;
-  if (!(lo > 0 && lo <= design && design <= hi))
-    return Status::Error(
-        fmt::format("--bounds: error: {}={:g}:{:g} must hold the design value {:g} and be above 0",
-                    key, lo, hi, design));
-  return std::pair<double, double>{lo, hi};
-}
-
-Status run_fit(LinkModel& model, const link::LinkSpec& spec, const link::PartLibrary& parts,
-               const CompareOptions& opt, const FitData& data, CompareResult& r,
-               std::vector<double>& fitted) {
-  const size_t nk = opt.fit.size();
-  std::vector<LsqParam> params;
-  std::vector<DesignValue> design;
-  for (const std::string& key : opt.fit) {
-    StatusOr<DesignValue> d = design_value(spec, parts, key);
-    if (!d) return d.status();
-    StatusOr<std::pair<double, double>> b = fit_bounds(opt, key, d->value);
-    if (!b) return b.status();
-    const auto [lo, hi] = *b;
-    params.push_back({0.0, std::log(lo / d->value), std::log(hi / d->value), 0.01});
-    design.push_back(*d);
-  }
-  params.push_back({0.0, -50.0, 50.0, 0.05});  // the offset, ns from the aligned one
-  const std::span<const double> t = data.t, v = data.v;
-  // Called from several threads at once (the Jacobian's columns): everything it writes is its own.
-  const ResidualFn f = [&](std::span<const double> x, std::vector<double>& res) -> Status {
-    std::vector<double> values(nk);
-    for (size_t j = 0; j < nk; ++j) values[j] = design[j].value * std::exp(x[j]);
-    StatusOr<std::shared_ptr<const EdgeResponse>> e = model.response(opt.fit, values);
-    if (!e) return e.status();
-    res.resize(t.size());
-    synth_at(**e, *data.edges, data.offset + x[nk] * 1e-9, t, res);
-    for (size_t i = 0; i < t.size(); ++i) res[i] = data.clipping->difference(v[i], res[i]);
-    return Status::Ok();
-  };
-  StatusOr<LsqResult> fit = fit_least_squares(f, t.size(), params, opt.max_iterations, opt.threads);
-  if (!fit) return fit.status();
-  fitted.resize(nk);
-  std::vector<std::string> unident;
-  for (size_t j = 0; j < nk; ++j) {
-    FitKey k;
-    k.key = opt.fit[j];
-    k.initial = design[j].value;
-    k.value = fitted[j] = design[j].value * std::exp(fit->x[j]);
-    k.low = design[j].value * std::exp(params[j].low);
-    k.high = design[j].value * std::exp(params[j].high);
-    k.stderr_value = k.value * fit->stderr_x[j];
-    k.tolerance = std::max(design[j].tol_low, design[j].tol_high);
-    k.tolerance_from = design[j].tolerance_from;
-    k.identifiable = fit->identifiable[j];
-    if (!k.identifiable) unident.push_back(k.key);
-    r.fit.push_back(k);
-    const double rel = k.value / k.initial - 1;
-    if (k.identifiable && (rel < -design[j].tol_low || rel > design[j].tol_high)) {
-      const config::Unit u = sweep::key_unit(key_paths(k.key).front());
-      const char* sym = config::unit_symbol(u);
-      r.findings.push_back(
-          {k.key, k.initial, k.value, rel,
-           fmt::format("{} behaves like {} against {} in the design ({:+.0f} %): {}",
-                       label_of(k.key), link::format_si(k.value, sym),
-                       link::format_si(k.initial, sym), rel * 100, advice_of(k.key))});
-    }
-  }
-  if (!unident.empty()) {
-    std::string keys;
-    for (const std::string& k : unident) keys += (keys.empty() ? "" : ", ") + k;
-    r.unidentifiable.push_back(fmt::format(
-        "{} {} not separately identifiable from this capture (the fit's Jacobian is rank "
-        "deficient): only a combination is determined (two isolation caps in series show only "
-        "their series value); fit one of them, or hold the others at the design",
-        keys, unident.size() > 1 ? "are" : "is"));
-  }
-  r.offset_after_fit_s = data.offset + fit->x[nk] * 1e-9;
-  r.notes.push_back(fmt::format("fit: {} ({} simulations)", fit->report, model.evaluations()));
-  return Status::Ok();
-}
-
-}  // namespace compare_detail
 }  // namespace isolink::analysis

@@ -14,6 +14,7 @@
 #include <mutex>
 #include <span>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "analysis/compare.h"
@@ -58,29 +59,61 @@ class LinkModel {
   WorstOptions wopt_;
   std::mutex mutex_;                  // guards kept_ and start_points_
   std::vector<double> start_points_;  // Hz, the first response's expansion points
-  std::deque<std::pair<std::vector<double>, std::shared_ptr<const EdgeResponse>>> kept_;
+  std::deque<std::tuple<std::vector<std::string>, std::vector<double>,
+                        std::shared_ptr<const EdgeResponse>>>
+      kept_;  // keys, values, response
   std::atomic<int> evaluations_{0};
 };
 
 // "ends.x" -> {"tx.x", "rx.x"}, anything else -> {key}.
 std::vector<std::string> key_paths(const std::string& key);
 
-// A fitted key's bounds: CompareOptions::bounds, else 0.2x..5x the design value; an error when
-// they do not hold the design value or reach 0.
+// A fitted key's bounds: CompareOptions::bounds, else the defaults: cable.length 0.1..100 m
+// (widened to hold the design), inductances 1/10..2x the design value, everything else (R, C)
+// 1/10..10x; an error when they do not hold the design value or reach 0.
 StatusOr<std::pair<double, double>> fit_bounds(const CompareOptions& opt, const std::string& key,
                                                double design);
 
+// Capture time minus drive time that best lays the simulation on (ts, vs): a squared-error scan
+// of integer lags of a 1 ns grid within [offset0 - before, offset0 + after], then a
+// golden-section search of the continuous offset within +/-1.5 grid steps of the best lag.
+double align(const EdgeResponse& e, const EdgeList& edges, std::span<const double> ts,
+             std::span<const double> vs, double offset0, double before, double after,
+             const Clipping& clip);
+
 // The fit of CompareOptions::fit on the aligned capture: fills r.fit, r.unidentifiable,
-// r.findings, r.offset_after_fit_s and returns the simulation at `t` after the fit.
+// r.correlations, r.search, r.findings, r.offset_after_fit_s (and reasons for keys at their
+// bounds or inseparable) and returns the fitted values. Uses r.threshold_rms_v / _max_v to decide
+// whether the refinement from the design explains the capture (else the global search runs).
 struct FitData {
   std::span<const double> t;  // residual samples (capture time)
   std::span<const double> v;  // capture at t
   const EdgeList* edges = nullptr;
   double offset = 0;                   // aligned offset before the fit
   const Clipping* clipping = nullptr;  // the capture's rails (CompareResult::clipping)
+  size_t first_window = 0;             // t[0 .. first_window) is the first residual window
 };
 Status run_fit(LinkModel& model, const link::LinkSpec& spec, const link::PartLibrary& parts,
                const CompareOptions& opt, const FitData& data, CompareResult& r,
                std::vector<double>& fitted_values);
+
+// One fitted solution: per key log(value / design), the offset, and the fit that found it.
+struct FitSolution {
+  std::vector<double> x;  // log(value / design) per key
+  double offset = 0;      // capture time - drive time (s)
+  LsqResult lsq;
+};
+// r.fit, r.findings, r.correlations, r.unidentifiable and the reasons on keys at their bounds or
+// inseparable, from the kept solution.
+void report_fit(const CompareOptions& opt, const std::vector<DesignValue>& design,
+                const std::vector<std::pair<double, double>>& bounds, const FitSolution& best,
+                CompareResult& r);
+
+// After a fit whose residual stays over the threshold: r.unexplained, where the residual
+// (capture minus `sim`, both at data.t) is largest, and the spec keys (not fitted) that move
+// the simulation there most when each changes by +10 % from the fitted link.
+Status locate_residual(LinkModel& model, const link::LinkSpec& spec, const link::PartLibrary& parts,
+                       const CompareOptions& opt, const std::vector<double>& fitted,
+                       const FitData& data, std::span<const double> sim, CompareResult& r);
 
 }  // namespace isolink::analysis::compare_detail

@@ -35,6 +35,7 @@ struct CompareArgs {
   std::string out_dir;
   std::vector<std::string> part_dirs;
   int jobs = 0;
+  bool local = false;
 };
 
 int fail(const std::string& message) {
@@ -87,6 +88,7 @@ int run_compare(const CompareArgs& a) {
   if (a.jobs < 0)
     return fail(fmt::format("error: option -j = {}: must be >= 0 (0: all cores)", a.jobs));
   opt.threads = a.jobs;
+  opt.global_search = !a.local;
   for (size_t i = 0; i < a.fit.size();) {
     const size_t c = std::min(a.fit.find(',', i), a.fit.size());
     if (c > i) opt.fit.push_back(a.fit.substr(i, c - i));
@@ -134,8 +136,11 @@ void add_compare_command(CLI::App& app, int* exit_code) {
                   "keys to fit, comma-separated dotted paths as in sweeps: cable.length, "
                   "rx.isolation.cap, tx.isolation.leakage, ends.termination, ...");
   cmd->add_option("--bounds", args->bounds,
-                  "KEY=LO:HI bounds of a fitted key (default 0.2x..5x its design value); "
-                  "repeatable");
+                  "KEY=LO:HI bounds of a fitted key (default: R and C 1/10..10x the design value, "
+                  "L 1/10..2x, cable.length 0.1..100 m); repeatable");
+  cmd->add_flag("--local", args->local,
+                "refine from the design only: no scan of the bounds when that leaves the capture "
+                "unexplained");
   cmd->add_option("-j,--jobs", args->jobs,
                   "simulations the fit runs at once (its Jacobian's columns; default: all cores)");
   cmd->add_flag("--json", args->json, "print one JSON object instead of the summary");

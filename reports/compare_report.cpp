@@ -94,8 +94,33 @@ nlohmann::ordered_json compare_json(const CompareResult& r) {
                   {"stderr", num(k.stderr_value)},
                   {"tolerance_rel", num(k.tolerance)},
                   {"tolerance_from", k.tolerance_from},
-                  {"identifiable", k.identifiable}};
+                  {"identifiable", k.identifiable},
+                  {"at_bound", k.at_bound.empty() ? json(nullptr) : json(k.at_bound)}};
   j["fit"] = fit;
+  json corr = json::array();
+  for (const analysis::KeyCorrelation& c : r.correlations)
+    corr.push_back({{"a", c.a}, {"b", c.b}, {"r", num(c.r)}, {"separable", c.separable()}});
+  j["correlations"] = corr;
+  if (!r.fit.empty())
+    j["search"] = {{"scanned", r.search.scanned},
+                   {"why", r.search.why},
+                   {"points", r.search.points},
+                   {"failed", r.search.failed},
+                   {"starts", r.search.starts},
+                   {"from_scan", r.search.from_scan},
+                   {"local_rms_v", num(r.search.local_rms_v)},
+                   {"chosen_rms_v", num(r.search.chosen_rms_v)}};
+  if (r.unexplained) {
+    json sug = json::array();
+    for (const auto& x : r.unexplained->suggested)
+      sug.push_back({{"key", x.key}, {"sensitivity_v", num(x.sensitivity_v)}});
+    j["unexplained"] = {{"frame", r.unexplained->window + 1},
+                        {"pulse", r.unexplained->pulse ? json(*r.unexplained->pulse + 1) : json()},
+                        {"time_s", num(r.unexplained->time)},
+                        {"residual_v", num(r.unexplained->residual_v)},
+                        {"window_rms_v", num(r.unexplained->window_rms_v)},
+                        {"suggested", sug}};
+  }
   j["residual_after_fit"] = r.residual_after_fit ? residual_json(*r.residual_after_fit) : json();
   if (r.offset_after_fit_s) j["offset_after_fit_s"] = num(*r.offset_after_fit_s);
   json findings = json::array();
@@ -159,8 +184,20 @@ std::string compare_text(const CompareResult& r) {
     s += fmt::format("  fit {} = {} +/- {} (design {}, bounds {} .. {}){}\n", k.key,
                      si(k.value, u.c_str()), si(k.stderr_value, u.c_str()),
                      si(k.initial, u.c_str()), si(k.low, u.c_str()), si(k.high, u.c_str()),
-                     k.identifiable ? "" : "  not identifiable");
+                     !k.at_bound.empty() ? "  at its bound (not a measurement)"
+                     : k.identifiable    ? ""
+                                         : "  not identifiable");
   }
+  for (const analysis::KeyCorrelation& c : r.correlations)
+    s += fmt::format("  correlation {} / {}: {:+.3f}{}\n", c.a, c.b, c.r,
+                     c.separable() ? "" : "  (too correlated to separate)");
+  if (!r.fit.empty() && !r.search.why.empty())
+    s += fmt::format("  search: {}{}\n", r.search.why,
+                     r.search.scanned
+                         ? fmt::format(" ({} points, {} refinements; kept: {})", r.search.points,
+                                       r.search.starts,
+                                       r.search.from_scan ? "a scan start" : "the design's valley")
+                         : "");
   if (r.residual_after_fit)
     s += fmt::format("  after the fit: residual rms {:.1f} mV, max {:.0f} mV\n",
                      r.residual_after_fit->rms_v * 1e3, r.residual_after_fit->max_v * 1e3);
@@ -193,14 +230,15 @@ std::string compare_markdown(const CompareResult& r) {
       r.noise_rms_v * 1e3, r.quant_step_v * 1e3, r.model_floor_v * 1e3, r.offset_s * 1e6);
   if (const std::string c = clipping_sentence(r); !c.empty()) s += "Note: " + c + ".\n\n";
   if (!r.fit.empty()) {
-    s += "| key | fitted | stderr | design | bounds | tolerance | identifiable |\n";
-    s += "|---|---|---|---|---|---|---|\n";
+    s += "| key | fitted | stderr | design | bounds | tolerance | identifiable | at bound |\n";
+    s += "|---|---|---|---|---|---|---|---|\n";
     for (const FitKey& k : r.fit) {
       const std::string u = key_unit_symbol(k.key);
-      s += fmt::format("| {} | {} | {} | {} | {} .. {} | {:.0f} % ({}) | {} |\n", k.key,
+      s += fmt::format("| {} | {} | {} | {} | {} .. {} | {:.0f} % ({}) | {} | {} |\n", k.key,
                        si(k.value, u.c_str()), si(k.stderr_value, u.c_str()),
                        si(k.initial, u.c_str()), si(k.low, u.c_str()), si(k.high, u.c_str()),
-                       k.tolerance * 100, k.tolerance_from, k.identifiable ? "yes" : "no");
+                       k.tolerance * 100, k.tolerance_from, k.identifiable ? "yes" : "no",
+                       k.at_bound.empty() ? "no" : k.at_bound);
     }
     s += "\n";
   }

@@ -45,7 +45,8 @@ Status write_synthetic_capture(const std::string& spec_text, const std::string& 
   if (!spec) return spec.status();
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
   if (!parts) return parts.status();
-  StatusOr<link::ExpandedLink> x = link::expand_link(*spec, *parts, link::Direction::kDown);
+  StatusOr<link::ExpandedLink> x =
+      link::expand_link(*spec, *parts, scope.up ? link::Direction::kUp : link::Direction::kDown);
   if (!x) return x.status();
   analysis::SimulationRequest req;
   req.probes = {"v(rxp)", "v(rxn)"};
@@ -70,13 +71,24 @@ Status write_synthetic_capture(const std::string& spec_text, const std::string& 
   if (scope.layout == "rigol")
     out = fmt::format("X,CH1,CH2,Start,Increment,\nSequence,Volt,Volt,{:.9e},{:.9e}\n",
                       t.front() + scope.trigger, dt);
-  else
+  else if (scope.layout == "picoscope")
+    out = "Time,Channel A,Channel B\n(us),(V),(V)\n\n";
+  else if (scope.layout == "saleae")
+    out = "Time [s],Channel 0,Channel 1\n";
+  else if (scope.layout == "keysight")
     out = "x-axis,1\nsecond,Volt\n";
+  else
+    return Status::Error("synthetic capture: unknown layout '" + scope.layout + "'");
   for (long k = 0; k < count; ++k) {
     const double ts = t.front() + static_cast<double>(k) * dt;
     const double vp = interp(t, p, ts) + noise(rng), vn = interp(t, n, ts) + noise(rng);
     if (scope.layout == "rigol")
       out += fmt::format("{},{:.6e},{:.6e},\n", k, quantise(vp), quantise(vn));
+    else if (scope.layout == "picoscope")
+      out += fmt::format("{:.9f},{:.6e},{:.6e}\n", (ts + scope.trigger) * 1e6, quantise(vp),
+                         quantise(vn));
+    else if (scope.layout == "saleae")
+      out += fmt::format("{:.12e},{:.6e},{:.6e}\n", ts + scope.trigger, quantise(vp), quantise(vn));
     else
       out += fmt::format("{:.12e},{:.6e}\n", ts + scope.trigger, quantise(vp - vn));
   }

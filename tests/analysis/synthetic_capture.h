@@ -25,12 +25,16 @@ struct ScopeModel {
   double trigger = 3.3e-6;  // capture time of the simulation's t = 0 (s)
   uint64_t seed = 1;
   // keysight: "x-axis,1" with a units row, one differential channel (a differential probe);
-  // rigol: DS1000Z "X,CH1,CH2,Start,Increment," with P and N single-ended.
+  // rigol: DS1000Z "X,CH1,CH2,Start,Increment," with P and N single-ended (--p CH1 --n CH2);
+  // picoscope: "Time,Channel A,Channel B" over a units row "(us),(V),(V)" and a blank line, P and
+  // N (--p "Channel A" --n "Channel B"); saleae: Logic 2 analog "Time [s],Channel 0,Channel 1",
+  // P and N (--p "Channel 0" --n "Channel 1").
   std::string layout = "keysight";
+  bool up = false;  // the receiver probed: false the rx end (direction down), true the tx end
 };
 
-// Simulates spec_text (named name) with `truth` applied, direction down, its own stimulus, and
-// writes the capture to path.
+// Simulates spec_text (named name) with `truth` applied, in the scope's direction, its own
+// stimulus, and writes the capture to path.
 Status write_synthetic_capture(const std::string& spec_text, const std::string& name,
                                const std::vector<analysis::sweep::Assignment>& truth,
                                const ScopeModel& scope, const std::string& path);
