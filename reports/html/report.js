@@ -95,7 +95,7 @@
     const v = decode(wave.v, Float32Array);
     const n = v.length;
     let t;
-    if (wave.t) { const off = decode(wave.t, Float32Array); t = new Float64Array(n); for (let i = 0; i < n; ++i) t[i] = wave.t0 + off[i]; }
+    if (wave.t || wave.t64) { const off = wave.t ? decode(wave.t, Float32Array) : decode(wave.t64, Float64Array); t = new Float64Array(n); for (let i = 0; i < n; ++i) t[i] = wave.t0 + off[i]; }
     else { t = new Float64Array(n); for (let i = 0; i < n; ++i) t[i] = wave.t0 + i * wave.dt; t[n - 1] = wave.t_last; }
     const pulses = (check && check.pulses) || [];
     const frames = (check && check.decoded && check.decoded.frames) || [];
@@ -289,7 +289,9 @@
       box.append(el('h3', {}, [w.direction + ' ', verdictBadge(d.verdict)]));
       if (w.kept < w.samples)
         box.append(el('p', {cls: 'note', text: 'The record has ' + w.samples + ' samples; the page keeps ' + w.kept +
-          ' (the lowest and highest of each bucket) to stay small. wave.csv has every sample.'}));
+          (w.tolerance ? ', those that linear interpolation needs to stay within ' + fmt(w.tolerance * 1e3, 3) + ' mV of every sample,'
+                       : ' (the lowest and highest of each bucket)') +
+          ' to stay small. isolink run --wave rows writes every sample to wave.csv.'}));
       waves.append(box);
       const rules = d.check || d.tones;
       const p = wavePlot(box, w, rules, (x.vth || [])[i] || 1.2);
