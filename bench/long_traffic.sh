@@ -28,7 +28,7 @@ for n in "${counts[@]}"; do
   /usr/bin/time -f '%e %M' -o "$work/time" "$exe" run "$spec" -o "$out" -q ${EXTRA:-} 2>"$work/err"
   rc=$?
   set -e
-  read -r secs kb <"$work/time"
+  read -r secs kb < <(tail -n 1 "$work/time")
   size() { [ -f "$out/$1" ] && awk -v b="$(stat -c %s "$out/$1")" 'BEGIN{printf "%.1f", b / 1e6}' || echo -; }
   facts=$(python3 - "$out/report.json" <<'PY' 2>/dev/null || echo "- | - | - | -"
 import json, sys
