@@ -232,7 +232,9 @@
       s.addEventListener('change', () => {
         if (s.value === '') return;
         const f = p.frames[+s.value], last = p.pulses[f.last_pulse];
-        const end = last ? last.end_s : f.start_s + 5e-6, pad = (end - f.start_s) * 0.08;
+        // A frame past report.json's first kMaxJsonPulses pulses has no end listed: one byte frame
+        // (13 bit times of 500 ns, 6.5 us) and a little more.
+        const end = last ? last.end_s : f.start_s + 7e-6, pad = (end - f.start_s) * 0.08;
         p.show(f.start_s - pad, end + pad);
       });
       bar.append(s);
