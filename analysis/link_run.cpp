@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <chrono>
 #include <functional>
+#include <limits>
 #include <optional>
+#include <span>
 
 namespace isolink::analysis {
 
@@ -20,10 +22,16 @@ void filter(const Waveform& w, const std::vector<std::pair<double, double>>& win
     if (!inside) t = w.time, v = col;
     return;
   }
+  // One pass: the windows sorted by start, and the latest end among those started so far (they
+  // may overlap), so the cost is samples + windows, not their product.
+  std::vector<std::pair<double, double>> sorted = windows;
+  std::sort(sorted.begin(), sorted.end());
+  size_t k = 0;
+  double reach = -std::numeric_limits<double>::infinity();  // end of the windows started
   for (size_t i = 0; i < w.time.size(); ++i) {
-    bool in = false;
-    for (const auto& [a, b] : windows)
-      if (w.time[i] >= a && w.time[i] < b) in = true;
+    while (k < sorted.size() && sorted[k].first <= w.time[i])
+      reach = std::max(reach, sorted[k++].second);
+    const bool in = w.time[i] < reach;
     if (in == inside) t.push_back(w.time[i]), v.push_back(col[i]);
   }
 }
@@ -89,10 +97,13 @@ Status score_direction(DirectionRun& dr) {
   std::vector<double> t, v;
   dr.pass = true;
   if (any_data) {
-    filter(dr.sim.wave, tone_windows, false, t, v);
+    // Without tones the data check reads the waveform itself (a long record is not copied).
+    if (!tone_windows.empty()) filter(dr.sim.wave, tone_windows, false, t, v);
+    const std::span<const double> dt = tone_windows.empty() ? dr.sim.wave.time : t;
+    const std::span<const double> dv = tone_windows.empty() ? dr.sim.wave.columns[0] : v;
     eye::CheckOptions co;
     co.expect = dr.link.expected;
-    StatusOr<eye::CheckResult> r = eye::check_samples(t, v, dr.rules, co);
+    StatusOr<eye::CheckResult> r = eye::check_samples(dt, dv, dr.rules, co);
     if (!r) return r.status().with_context(dr.link.description + ", data check");
     dr.data = std::move(*r);
     dr.pass = dr.pass && dr.data->pass;

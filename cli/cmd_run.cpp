@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "analysis/link_run.h"
+#include "analysis/link_run_wave.h"
 #include "analysis/pack_spec.h"
 #include "analysis/worst.h"
 #include "base/file_io.h"
@@ -35,6 +36,7 @@ struct RunArgs {
   std::vector<std::string> part_dirs;
   std::optional<std::vector<link::Direction>> directions;  // --direction
   Engine engine = Engine::Auto;
+  WaveRows wave = WaveRows::Thinned;  // --wave: the rows of wave.csv
   bool no_images = false;
   bool no_worst = false;
   bool quiet = false;
@@ -119,10 +121,15 @@ int run_run(const RunArgs& a) {
     if (Status s = render_run_images(*spec, *run, bundle->staging(), &images); !s.ok())
       return fail(s);
   }
-  const Waveform wave = run_waveforms(*run, spec->sim.tstep);
-  if (Status s = write_waveform_csv(wave, bundle->path("wave.csv")); !s.ok()) return fail(s);
+  const WaveFile wave = run_wave_file(*run, {.rows = a.wave, .grid_step = spec->sim.tstep});
+  if (Status s = write_waveform_csv(wave.wave, bundle->path("wave.csv")); !s.ok()) return fail(s);
   nlohmann::ordered_json json = run_report_json(*spec, *run);
+  json["wave_csv"] = {{"rows", wave.wave.time.size()},
+                      {"engine_rows", wave.engine_rows},
+                      {"mode", wave_rows_name(wave.rows)},
+                      {"tolerance_v", wave.tolerance}};
   std::string md = run_report_markdown(*spec, *run, images);
+  md += "\n" + wave_file_note(wave) + ".\n";
   if (worst) {
     json["worst_case"] = reports::worst_json(*worst);
     md += "\n## Worst case over all traffic\n\n" + reports::worst_markdown(*worst);
@@ -178,6 +185,15 @@ void add_run_command(CLI::App& app, int* exit_code) {
   add_parts_option(*cmd, &args->part_dirs);
   add_directions_option(*cmd, &args->directions);
   add_engine_option(*cmd, &args->engine);
+  cmd->add_option_function<std::string>(
+         "--wave",
+         // CLI11 has checked the name against the choices, so parse_wave_rows succeeds.
+         [args](const std::string& v) { args->wave = *parse_wave_rows(v); },
+         "rows of wave.csv: thinned (the engine's rows that linear interpolation needs to stay "
+         "within 1 mV of every engine row; the default), rows (every engine row), grid (every "
+         "probe resampled onto the spec's sim.tstep)")
+      ->check(CLI::IsMember({"thinned", "rows", "grid"}))
+      ->default_str("thinned");
   cmd->add_flag("--no-images", args->no_images, "Skip eye.png and wave.png");
   cmd->add_flag("--no-worst", args->no_worst,
                 "Skip the worst case over all traffic (its report section and verdict)");

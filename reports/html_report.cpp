@@ -8,6 +8,7 @@
 #include <limits>
 #include <optional>
 
+#include "analysis/link_run_wave.h"
 #include "reports/sweep_report.h"
 
 namespace isolink::reports {
@@ -150,31 +151,72 @@ bool uniform_grid(std::span<const double> t, double* dt) {
 
 }  // namespace
 
+size_t wave_samples_for(size_t bytes, double span) {
+  return span > kFloat32TimeSpan ? bytes * 3 / 48 : bytes * 3 / 32;
+}
+
+namespace {
+
+// The samples kept of a record longer than max_samples: thinned with the finest tolerance that
+// fits (*tolerance set), else min/max buckets (*tolerance 0).
+std::vector<size_t> reduce_wave(std::span<const double> t, std::span<const double> v,
+                                size_t max_samples, double* tolerance) {
+  for (double tol : kHtmlThinTolerances) {
+    std::vector<size_t> keep = analysis::thin_rows(t, {v}, tol);
+    if (keep.size() <= max_samples) {
+      *tolerance = tol;
+      return keep;
+    }
+  }
+  *tolerance = 0;
+  return minmax_keep(v, max_samples);
+}
+
+}  // namespace
+
 ordered_json wave_json(const HtmlWave& w, size_t max_samples) {
   const size_t n = std::min(w.time.size(), w.values.size());
   if (n == 0) return {{"direction", w.direction}, {"samples", 0}, {"kept", 0}};
   const std::span<const double> t = w.time.first(n), v = w.values.first(n);
-  const std::vector<size_t> keep = minmax_keep(v, max_samples);
+  double tolerance = 0;
+  std::vector<size_t> keep;
+  if (n <= max_samples) {
+    keep.resize(n);
+    for (size_t i = 0; i < n; ++i) keep[i] = i;
+  } else {
+    keep = reduce_wave(t, v, max_samples, &tolerance);
+  }
   std::vector<float> vf(keep.size());
   for (size_t k = 0; k < keep.size(); ++k)
     vf[k] = std::isfinite(v[keep[k]]) ? static_cast<float>(v[keep[k]])
                                       : std::numeric_limits<float>::quiet_NaN();
   ordered_json j{{"direction", w.direction}, {"samples", n}, {"kept", keep.size()}};
   double dt = 0;
+  const double t0 = t[keep.front()];
   if (keep.size() == n && uniform_grid(t, &dt)) {
     j["t0"] = t.front();
     j["dt"] = dt;
     j["t_last"] = t.back();
-  } else {
+  } else if (t.back() - t0 <= kFloat32TimeSpan) {
     // Times as Float32 offsets from the first: 6 ps resolution over 100 us, half the bytes of
     // Float64.
-    const double t0 = t[keep.front()];
     std::vector<float> tk(keep.size());
     for (size_t k = 0; k < keep.size(); ++k) tk[k] = static_cast<float>(t[keep[k]] - t0);
     j["t0"] = t0;
     j["t"] = base64_of(tk);
+  } else {
+    std::vector<double> tk(keep.size());
+    for (size_t k = 0; k < keep.size(); ++k) tk[k] = t[keep[k]] - t0;
+    j["t0"] = t0;
+    j["t64"] = base64_of(tk);
   }
   j["v"] = base64_of(vf);
+  if (keep.size() < n) {
+    if (tolerance > 0)
+      j["tolerance"] = tolerance;
+    else
+      j["buckets"] = true;
+  }
   return j;
 }
 
@@ -203,7 +245,8 @@ std::string run_report_html(const ordered_json& report, const ordered_json& extr
     double dt = 0;
     const size_t whole = share * 3 / 16;  // samples a uniform grid may keep whole
     const bool fits = w.time.size() <= whole && uniform_grid(w.time, &dt);
-    wj.push_back(wave_json(w, fits ? whole : share * 3 / 32));
+    const double span = w.time.empty() ? 0.0 : w.time.back() - w.time.front();
+    wj.push_back(wave_json(w, fits ? whole : wave_samples_for(share, span)));
   }
   data["waves"] = std::move(wj);
   data["eye"] = png_data_uri(eye_png);

@@ -51,17 +51,27 @@ struct HtmlWave {
   std::span<const double> values;  // V (not owned)
 };
 // The base64 bytes a page spends on its waves at most (all distinct directions together): with the
-// rest (the library ~130 kB, report.json ~150 kB, the eye image ~1 MB) a page stays under 8 MB. A
-// uniform grid costs 16/3 bytes a sample (Float32 values), another 16/3 for Float32 time offsets
-// otherwise; a longer record is reduced by min/max buckets (every excursion kept) and the page
-// says so.
-inline constexpr size_t kHtmlWaveBytes = 6'000'000;
+// rest (the library ~130 kB, report.json up to a few MB, the eye image ~1 MB) a page stays under
+// 40 MB. A uniform grid costs 16/3 bytes a sample (Float32 values), another 16/3 for Float32 time
+// offsets (records up to kFloat32TimeSpan) or 32/3 for Float64 ones (longer records, where a
+// Float32 offset would round to more than 6 ps). A longer record is thinned (below) and the page
+// says within what; min/max buckets only when even the coarsest thinning does not fit.
+inline constexpr size_t kHtmlWaveBytes = 32'000'000;
+inline constexpr double kFloat32TimeSpan = 100e-6;
+// The tolerances a record is thinned with, finest first (V): analysis/link_run_wave.h thin_rows,
+// linear interpolation between the kept samples within the tolerance of every sample.
+inline constexpr double kHtmlThinTolerances[] = {1e-3, 2e-3, 5e-3, 10e-3, 20e-3};
 // A wave as JSON: {direction, samples, kept, t0, and dt, t_last (a uniform grid: times t0 + i dt
-// within 1e-6 of dt, the last sample at t_last) or t (base64 Float32 offsets from t0), v (base64
-// Float32)}. At most max_samples are kept: a longer record is cut into max_samples / 2 buckets and
-// each keeps its lowest and highest sample (in time order). Non-finite values are written as NaN
-// (drawn as gaps).
+// within 1e-6 of dt, the last sample at t_last), or t (base64 Float32 offsets from t0) or t64
+// (base64 Float64 offsets, records longer than kFloat32TimeSpan), v (base64 Float32), and
+// tolerance (V) when thinned or buckets: true when reduced by min/max}. At most max_samples are
+// kept: a longer record is thinned with the finest of kHtmlThinTolerances that fits; when none
+// does, cut into max_samples / 2 buckets that each keep their lowest and highest sample (in time
+// order). Non-finite values are written as NaN (drawn as gaps).
 nlohmann::ordered_json wave_json(const HtmlWave& w, size_t max_samples);
+// The samples a wave of this span may keep within a byte budget (base64 of Float32 values and
+// Float32 or Float64 time offsets).
+size_t wave_samples_for(size_t bytes, double span);
 // The sample indices a record of n samples keeps at most max_samples of (all when n fits): per
 // bucket the index of the lowest and of the highest value, in time order.
 std::vector<size_t> minmax_keep(std::span<const double> v, size_t max_samples);

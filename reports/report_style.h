@@ -76,9 +76,13 @@ inline void draw_panel_header(Canvas& c, const Rect& panel, const std::string& d
     for (const std::string& why : r.reasons) line2 += (line2.empty() ? "" : "; ") + why;
     col = kFail;
   }
-  // Keep it on one line.
+  // Keep it on one line. Cut first to what could fit (no glyph is narrower than 3 px at this
+  // size): measuring the whole text once per character dropped was quadratic in its length, and
+  // a long record's reasons run to megabytes (minutes in FreeType on 2,000 frames).
   const int max_w = c.width() - 60;
   std::string shown = ascii_text(line2);
+  if (const size_t most = static_cast<size_t>(std::max(max_w, 0)) / 3 + 4; shown.size() > most)
+    shown = shown.substr(0, most - 3) + "...";
   while (shown.size() > 4 && c.measure(shown, kLabelSize).width > max_w)
     shown = shown.substr(0, shown.size() - 4) + "...";
   c.text(30, panel.y0 + 52, shown, kLabelSize, col, FontFace::kSans, HAlign::kLeft, VAlign::kTop);

@@ -95,7 +95,7 @@
     const v = decode(wave.v, Float32Array);
     const n = v.length;
     let t;
-    if (wave.t) { const off = decode(wave.t, Float32Array); t = new Float64Array(n); for (let i = 0; i < n; ++i) t[i] = wave.t0 + off[i]; }
+    if (wave.t || wave.t64) { const off = wave.t ? decode(wave.t, Float32Array) : decode(wave.t64, Float64Array); t = new Float64Array(n); for (let i = 0; i < n; ++i) t[i] = wave.t0 + off[i]; }
     else { t = new Float64Array(n); for (let i = 0; i < n; ++i) t[i] = wave.t0 + i * wave.dt; t[n - 1] = wave.t_last; }
     const pulses = (check && check.pulses) || [];
     const frames = (check && check.decoded && check.decoded.frames) || [];
@@ -232,7 +232,9 @@
       s.addEventListener('change', () => {
         if (s.value === '') return;
         const f = p.frames[+s.value], last = p.pulses[f.last_pulse];
-        const end = last ? last.end_s : f.start_s + 5e-6, pad = (end - f.start_s) * 0.08;
+        // A frame past report.json's first kMaxJsonPulses pulses has no end listed: one byte frame
+        // (13 bit times of 500 ns, 6.5 us) and a little more.
+        const end = last ? last.end_s : f.start_s + 7e-6, pad = (end - f.start_s) * 0.08;
         p.show(f.start_s - pad, end + pad);
       });
       bar.append(s);
@@ -289,7 +291,9 @@
       box.append(el('h3', {}, [w.direction + ' ', verdictBadge(d.verdict)]));
       if (w.kept < w.samples)
         box.append(el('p', {cls: 'note', text: 'The record has ' + w.samples + ' samples; the page keeps ' + w.kept +
-          ' (the lowest and highest of each bucket) to stay small. wave.csv has every sample.'}));
+          (w.tolerance ? ', those that linear interpolation needs to stay within ' + fmt(w.tolerance * 1e3, 3) + ' mV of every sample,'
+                       : ' (the lowest and highest of each bucket)') +
+          ' to stay small. isolink run --wave rows writes every sample to wave.csv.'}));
       waves.append(box);
       const rules = d.check || d.tones;
       const p = wavePlot(box, w, rules, (x.vth || [])[i] || 1.2);

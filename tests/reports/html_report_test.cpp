@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "analysis/link_run_wave.h"
+
 namespace isolink::reports {
 namespace {
 
@@ -135,12 +137,46 @@ TEST(HtmlReport, WaveJsonRoundTrips) {
   ASSERT_EQ(tt.size(), 1000u);
   for (size_t i = 0; i < t.size(); ++i)  // within 1 ps here
     ASSERT_NEAR(j["t0"].get<double>() + tt[i], t[i], 1e-12) << i;
-  // Reduced: at most the budget, the extremes kept.
+  // Reduced: at most the budget, thinned with the finest tolerance that fits. 1.7 sin(0.01 i): a
+  // chord of k samples errs by up to 1.7 (0.01 k)^2 / 8 (at a crest), so 1 mV allows chords of 6.9
+  // samples there; over the record 1 mV keeps more than 100 samples and 2 mV fewer.
+  EXPECT_GT(analysis::thin_rows(t, {v}, 1e-3).size(), 100u);
   j = wave_json({"down", t, v}, 100);
   EXPECT_LE(j["kept"].get<size_t>(), 100u);
+  EXPECT_GE(j["kept"].get<size_t>(), 60u);
+  EXPECT_DOUBLE_EQ(j["tolerance"].get<double>(), 2e-3);
   vf = decode<float>(j["v"].get<std::string>());
-  EXPECT_NEAR(*std::max_element(vf.begin(), vf.end()), 1.7, 1e-3);
-  EXPECT_NEAR(*std::min_element(vf.begin(), vf.end()), -1.7, 1e-3);
+  std::vector<float> off = decode<float>(j["t"].get<std::string>());
+  ASSERT_EQ(off.size(), vf.size());
+  for (size_t i = 0, k = 0; i < t.size(); ++i) {  // every sample within 2 mV of the kept line
+    const double x = t[i] - j["t0"].get<double>();
+    while (k + 2 < off.size() && off[k + 1] <= x) ++k;
+    const double f = std::clamp((x - off[k]) / (off[k + 1] - off[k]), 0.0, 1.0);
+    ASSERT_NEAR(vf[k] + f * (vf[k + 1] - vf[k]), v[i], 2e-3 + 1e-5) << i;
+  }
+  // Noise of 1 V that no tolerance up to 20 mV thins enough: min/max buckets, the extremes kept.
+  for (size_t i = 0; i < v.size(); ++i)
+    v[i] = static_cast<double>(i * 7919 % 1000) * 1e-3 - 0.5 + (i == 321 ? 3 : 0);
+  j = wave_json({"down", t, v}, 100);
+  EXPECT_LE(j["kept"].get<size_t>(), 100u);
+  EXPECT_TRUE(j["buckets"].get<bool>());
+  EXPECT_FALSE(j.contains("tolerance"));
+  vf = decode<float>(j["v"].get<std::string>());
+  // The spike at 321: 0.999 - 0.5 + 3 V.
+  EXPECT_NEAR(*std::max_element(vf.begin(), vf.end()), 3.499, 1e-6);
+}
+
+// A record longer than 100 us carries Float64 time offsets: a 200 ms record resolves 1 ps.
+TEST(HtmlReport, LongRecordsKeepTheirTimesToAPicosecond) {
+  std::vector<double> t{0.0, 0.05, 0.2 - 1e-12, 0.2}, v{0, 1, 1, 0};
+  const ordered_json j = wave_json({"down", t, v}, 100);
+  ASSERT_TRUE(j.contains("t64"));
+  const std::vector<double> off = decode<double>(j["t64"].get<std::string>());
+  ASSERT_EQ(off.size(), 4u);
+  EXPECT_NEAR(off[2], 0.2 - 1e-12, 1e-16);
+  EXPECT_LT(off[2], off[3]);
+  EXPECT_EQ(wave_samples_for(48'000, 1.0), 3000u);   // 16 base64 bytes a sample
+  EXPECT_EQ(wave_samples_for(32'000, 1e-5), 3000u);  // 32/3
 }
 
 // The page is one file: the library and the script inlined, no network address of any kind, the

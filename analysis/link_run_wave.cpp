@@ -1,0 +1,209 @@
+#include "analysis/link_run_wave.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace isolink::analysis {
+
+const char* wave_rows_name(WaveRows r) {
+  switch (r) {
+    case WaveRows::Thinned:
+      return "thinned";
+    case WaveRows::Rows:
+      return "rows";
+    case WaveRows::Grid:
+      return "grid";
+  }
+  return "thinned";
+}
+
+StatusOr<WaveRows> parse_wave_rows(const std::string& text) {
+  for (WaveRows r : {WaveRows::Thinned, WaveRows::Rows, WaveRows::Grid})
+    if (text == wave_rows_name(r)) return r;
+  return Status::Error("wave rows '" + text + "' is none of thinned, rows, grid");
+}
+
+std::vector<size_t> thin_rows(std::span<const double> time,
+                              const std::vector<std::span<const double>>& columns,
+                              double tolerance) {
+  const size_t n = time.size();
+  std::vector<size_t> keep;
+  if (n == 0) return keep;
+  const size_t nc = columns.size();
+  auto finite_row = [&](size_t i) {
+    for (const auto& c : columns)
+      if (!std::isfinite(c[i])) return false;
+    return std::isfinite(time[i]);
+  };
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  std::vector<double> lo(nc), hi(nc);
+  size_t a = 0;  // the last row kept
+  keep.push_back(0);
+  bool anchor_finite = finite_row(0);
+  std::fill(lo.begin(), lo.end(), -kInf);
+  std::fill(hi.begin(), hi.end(), kInf);
+  for (size_t j = 1; j < n; ++j) {
+    const double dt = time[j] - time[a];
+    bool reach = anchor_finite && finite_row(j) && dt > 0;
+    for (size_t c = 0; c < nc && reach; ++c) {
+      const double s = (columns[c][j] - columns[c][a]) / dt;
+      reach = s >= lo[c] && s <= hi[c];
+    }
+    if (!reach && j - 1 > a) {
+      // Row j cannot be reached from a in one straight line: j - 1 (which could) is kept and
+      // becomes the anchor, and j is tried again from there.
+      a = j - 1;
+      keep.push_back(a);
+      std::fill(lo.begin(), lo.end(), -kInf);
+      std::fill(hi.begin(), hi.end(), kInf);
+      anchor_finite = finite_row(a);
+      --j;
+      continue;
+    }
+    if (!reach) {  // j = a + 1 with a non-finite value on either side: both rows kept
+      a = j;
+      keep.push_back(a);
+      anchor_finite = finite_row(a);
+      continue;
+    }
+    const double dtj = time[j] - time[a];
+    for (size_t c = 0; c < nc; ++c) {
+      const double d = columns[c][j] - columns[c][a];
+      lo[c] = std::max(lo[c], (d - tolerance) / dtj);
+      hi[c] = std::min(hi[c], (d + tolerance) / dtj);
+    }
+  }
+  if (keep.back() != n - 1) keep.push_back(n - 1);
+  return keep;
+}
+
+namespace {
+
+// Column c of direction d at the merged times, linearly between its kept rows.
+std::vector<double> on_axis(const std::vector<double>& t, const std::vector<double>& v,
+                            const std::vector<size_t>& kept, const std::vector<double>& axis) {
+  std::vector<double> out(axis.size());
+  size_t k = 0;  // kept[k] <= the present time's row
+  for (size_t i = 0; i < axis.size(); ++i) {
+    const double x = axis[i];
+    while (k + 1 < kept.size() && t[kept[k + 1]] <= x) ++k;
+    const size_t a = kept[k];
+    if (k + 1 >= kept.size() || t[a] == x || x < t[a]) {
+      out[i] = v[a];
+      continue;
+    }
+    const size_t b = kept[k + 1];
+    out[i] = v[a] + (x - t[a]) / (t[b] - t[a]) * (v[b] - v[a]);
+  }
+  return out;
+}
+
+}  // namespace
+
+double wave_file_bytes(size_t rows, size_t columns) {
+  return static_cast<double>(rows) * (14.0 + 11.0 * static_cast<double>(columns));
+}
+
+namespace {
+
+// The union of each direction's kept times (up to t_end), and every column on it.
+Waveform merged(const LinkRun& run, const std::vector<std::vector<size_t>>& kept, double t_end) {
+  Waveform out;
+  for (size_t k = 0; k < kept.size(); ++k) {
+    const std::vector<double>& t = run.directions[k].sim.wave.time;
+    std::vector<double> mine;
+    mine.reserve(kept[k].size());
+    for (size_t i : kept[k])
+      if (t[i] <= t_end) mine.push_back(t[i]);
+    std::vector<double> both;
+    both.reserve(out.time.size() + mine.size());
+    std::set_union(out.time.begin(), out.time.end(), mine.begin(), mine.end(),
+                   std::back_inserter(both));
+    out.time = std::move(both);
+  }
+  for (size_t k = 0; k < kept.size(); ++k) {
+    const DirectionRun& d = run.directions[k];
+    const char* dir = link::direction_name(d.link.direction);
+    for (size_t c = 0; c < d.sim.wave.columns.size(); ++c)
+      out.add_column(fmt::format("{} {}", dir, d.sim.wave.names[c]),
+                     on_axis(d.sim.wave.time, d.sim.wave.columns[c], kept[k], out.time));
+  }
+  return out;
+}
+
+// Per direction, the rows thinned with tol; *rows the most the merged axis can have (their sum).
+std::vector<std::vector<size_t>> thin_each(const LinkRun& run, double tol, size_t* rows) {
+  std::vector<std::vector<size_t>> kept;
+  *rows = 0;
+  for (const DirectionRun& d : run.directions) {
+    const Waveform& w = d.sim.wave;
+    std::vector<std::span<const double>> cols(w.columns.begin(), w.columns.end());
+    kept.push_back(thin_rows(w.time, cols, tol));
+    *rows += kept.back().size();
+  }
+  return kept;
+}
+
+}  // namespace
+
+WaveFile run_wave_file(const LinkRun& run, const WaveFileOptions& opt) {
+  WaveFile f;
+  f.rows = opt.rows;
+  double t_end = std::numeric_limits<double>::infinity();
+  size_t columns = 0;
+  for (const DirectionRun& d : run.directions) {
+    const Waveform& w = d.sim.wave;
+    t_end = std::min(t_end, w.time.empty() ? 0.0 : w.time.back());
+    f.engine_rows += w.time.size();
+    columns += w.columns.size();
+  }
+  if (run.directions.empty()) return f;
+  if (opt.rows == WaveRows::Grid) {
+    f.wave = run_waveforms(run, opt.grid_step);
+    return f;
+  }
+  std::vector<std::vector<size_t>> kept;
+  if (opt.rows == WaveRows::Rows) {
+    for (const DirectionRun& d : run.directions) {
+      std::vector<size_t> all(d.sim.wave.time.size());
+      for (size_t i = 0; i < all.size(); ++i) all[i] = i;
+      kept.push_back(std::move(all));
+    }
+  } else {
+    std::vector<double> ladder(std::begin(kWaveTolerances), std::end(kWaveTolerances));
+    if (opt.tolerance > 0) ladder = {opt.tolerance};
+    for (double tol : ladder) {
+      size_t rows = 0;
+      kept = thin_each(run, tol, &rows);
+      f.tolerance = tol;
+      f.over_budget = wave_file_bytes(rows, columns) > kWaveFileBytes;
+      if (!f.over_budget) break;
+    }
+  }
+  f.wave = merged(run, kept, t_end);
+  return f;
+}
+
+std::string wave_file_note(const WaveFile& f) {
+  switch (f.rows) {
+    case WaveRows::Rows:
+      return fmt::format("wave.csv: every engine row ({} rows)", f.wave.time.size());
+    case WaveRows::Grid:
+      return fmt::format("wave.csv: every probe resampled linearly onto a uniform grid ({} rows)",
+                         f.wave.time.size());
+    case WaveRows::Thinned:
+      break;
+  }
+  return fmt::format(
+      "wave.csv: {} of the engine's {} rows, those that linear interpolation needs to stay within "
+      "{:g} mV of every engine row on every probe{} (`isolink run --wave rows` writes them all)",
+      f.wave.time.size(), f.engine_rows, f.tolerance * 1e3,
+      f.over_budget ? fmt::format(", still over the {:g} MB the file is meant to stay under",
+                                  kWaveFileBytes / 1e6)
+                    : "");
+}
+
+}  // namespace isolink::analysis

@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Scaling of `isolink run` with the length of the traffic (issue 45): the default link spec (2 m,
+# capacitor isolation) with N repeated stack-write commands, down direction, worst case included,
+# for each N given. Prints one Markdown row per N: wall time, peak memory (max RSS) and the size of
+# every bundle file over 1 MB.
+#
+#   bash bench/long_traffic.sh [build/cli/isolink] [N ...]        # default N: 1 10 100 1000 2000
+#   EXTRA="--wave rows" bash bench/long_traffic.sh build/cli/isolink 100
+set -euo pipefail
+exe=${1:-build/cli/isolink}
+shift || true
+counts=("$@")
+[ ${#counts[@]} -eq 0 ] && counts=(1 10 100 1000 2000)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+echo "| frames | traffic (ms) | isolink run (s) | engine (s) | engine rows | max RSS (MB) | wave.csv (MB) | wave.csv rows, tolerance | report.html (MB) | report.json (MB) | exit |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|"
+for n in "${counts[@]}"; do
+  spec="$work/cap_$n.yaml"
+  {
+    echo "name: cap-$n"
+    echo "cable: {length: 2}"
+    printf 'stimulus:\n  direction: down\n  frames:\n'
+    for ((i = 0; i < n; ++i)); do echo '    - "stack-write reg=0x0100 data=02B778BC"'; done
+  } >"$spec"
+  out="$work/out_$n"
+  set +e
+  /usr/bin/time -f '%e %M' -o "$work/time" "$exe" run "$spec" -o "$out" -q ${EXTRA:-} 2>"$work/err"
+  rc=$?
+  set -e
+  read -r secs kb < <(tail -n 1 "$work/time")
+  size() { [ -f "$out/$1" ] && awk -v b="$(stat -c %s "$out/$1")" 'BEGIN{printf "%.1f", b / 1e6}' || echo -; }
+  facts=$(python3 - "$out/report.json" <<'PY' 2>/dev/null || echo "- | - | - | -"
+import json, sys
+j = json.load(open(sys.argv[1]))
+d = j["directions"][0]
+c, s, w = d.get("check") or {}, d["solver"], j.get("wave_csv", {})
+span = (c.get("t_end_s", 0) - c.get("t_begin_s", 0)) * 1e3
+tol = w.get("tolerance_v", 0)
+print(f"{span:.2f} | {s['seconds']:.1f} | {s.get('rows', '-')} | "
+      f"{w.get('rows', '-')}, {tol * 1e3:g} mV" if tol else f"{span:.2f} | {s['seconds']:.1f} | {s.get('rows', '-')} | {w.get('rows', '-')}")
+PY
+)
+  IFS='|' read -r traffic engine rows wrows <<<"$facts"
+  echo "| $n |$traffic| $secs |$engine|$rows| $((kb / 1024)) | $(size wave.csv) |$wrows| $(size report.html) | $(size report.json) | $rc |"
+done
