@@ -207,3 +207,26 @@ def test_long_calls_release_the_gil():
     gaps = np.diff([start] + ticks + [time.monotonic()])
     assert min(calls) > 0.03, calls  # else a held GIL would not show
     assert gaps.max() < min(calls) / 2, (gaps.max(), calls, len(ticks))
+
+
+CLIPPER = """* clipper: a 0 -> 5 V ramp over 1 ms through 1 kohm into a diode to ground
+V1 in 0 PWL(0 0 1m 5)
+R1 in out 1k
+D1 out 0 DM
+.model DM D(IS=1e-14)
+.tran 10u 1m
+.end
+"""
+
+
+def test_sim_takes_a_diode_and_lands_on_its_knee():
+    """The SPICE diode from Python: each row solves (vin - v) / 1 kohm = is (e^(v / vt) - 1)."""
+    got = isolink.sim(CLIPPER, ["v(in)", "v(out)"])
+    vt = 1.38064852e-23 * 300.15 / 1.6021766208e-19
+    vin, vout = got["v(in)"], got["v(out)"]
+    assert len(vout) > 50
+    residual = (vin - vout) / 1e3 - 1e-14 * np.expm1(vout / vt) - 1e-12 * vout
+    assert np.max(np.abs(residual)) < 1e-9  # amperes, against up to 4.3 mA
+    assert vout[-1] == pytest.approx(0.6929, abs=1e-3)
+    with pytest.raises(isolink.Error, match="LTI engine cannot simulate it"):
+        isolink.sim(CLIPPER, ["v(out)"], engine="lti")
