@@ -65,7 +65,7 @@ std::string engine_accuracy(const SimulationResult& r) {
   if (r.convergence && !r.convergence->deviations.empty()) {
     const TransientConvergence& c = *r.convergence;
     return fmt::format(
-        "transient, checked by tightening (auto's fallback): reltol {:g} -> {:g} and largest "
+        "transient, checked by tightening: reltol {:g} -> {:g} and largest "
         "step {:g} -> {:g} s in {} runs; the kept run is {:.3g} m from the run before it (V or "
         "A, the probe nearest its allowance){}",
         c.reltols.front(), c.reltols.back(), c.tmaxes.front(), c.tmaxes.back(), c.reltols.size(),
@@ -324,8 +324,14 @@ Status run_transient_engine(const Netlist& netlist, const EngineRun& run,
         fmt::format("{} ({} steps: {} rows of {} values are what the 1 GB memory limit allows)",
                     wave.status().message(), opt.max_steps, opt.max_steps, run.probes.size() + 1));
   if (!wave) return wave.status();
-  if (req.engine == Engine::Auto && !result.engine_note.empty() && !req.reltol) {
-    // auto fell back: the run checks its own convergence (transient_check.h).
+  bool netlist_reltol = false;
+  for (const NetlistOption& o : netlist.options)
+    netlist_reltol = netlist_reltol || o.key == "reltol";
+  const bool auto_fell_back = req.engine == Engine::Auto && !result.engine_note.empty();
+  const bool forced_at_defaults = req.engine == Engine::Transient && !netlist_reltol;
+  if ((auto_fell_back || forced_at_defaults) && !req.reltol) {
+    // auto fell back, or the transient was asked for without a tolerance of the user's: the run
+    // checks its own convergence (transient_check.h), so the defaults are within its 5 mV.
     TransientConvergence conv;
     wave = converge_transient(run.circuit, opt, run.probes, std::move(*wave), &result.stats, &conv);
     result.reltol = conv.reltols.back();

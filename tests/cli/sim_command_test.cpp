@@ -131,13 +131,22 @@ TEST(SimCommand, StatesTheEngineWhyHowLongAndTheAccuracyItPromises) {
   EXPECT_NE(r.err.find("(the LTI attempt took 0.0"), std::string::npos) << r.err;
   // auto's fallback checks itself (analysis/transient_check.h): reltol 1e-3 and TSTEP 10 ns, then
   // 1e-4 and 5 ns agree within 5 mV (the 1 V sine's 0.1 % is 1 mV, less than 5 mV).
-  EXPECT_NE(r.err.find("accuracy: transient, checked by tightening (auto's fallback): reltol "
+  EXPECT_NE(r.err.find("accuracy: transient, checked by tightening: reltol "
                        "0.001 -> 0.0001 and largest step 1e-08 -> 5e-09 s in 2 runs"),
             std::string::npos)
       << r.err;
   EXPECT_NE(r.err.find("within its allowance of 5 m (5 mV"), std::string::npos) << r.err;
-  // --engine transient: as asked, trtol 0.1 x reltol 1e-3; then with --reltol 1e-5.
+  // --engine transient at the defaults checks itself as auto's fallback does; with a reltol of
+  // the user's (--reltol, or .options reltol in the netlist) it runs once, as asked.
   r = run("sim " + sin + " -p 'v(a)' -o /dev/null --engine transient");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("accuracy: transient, checked by tightening: reltol 0.001 -> 0.0001"),
+            std::string::npos)
+      << r.err;
+  const std::string sin_tol = write_temp("sin_rc_tol.cir",
+                                         "sin\nV1 in 0 SIN(0 1 1meg)\nR1 in a 1k\nC1 a 0 1n\n"
+                                         ".options reltol=1e-3\n.tran 10n 5u\n.end\n");
+  r = run("sim " + sin_tol + " -p 'v(a)' -o /dev/null --engine transient");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("accuracy: transient: local truncation error per step within trtol x "
                        "reltol = 0.0001 of each unknown's peak (reltol 0.001)"),
