@@ -42,7 +42,9 @@ Deviation compare(const Netlist& netlist, const std::string& path, double tstop)
   auto lti = analysis::simulate_netlist(netlist, req);
   EXPECT_TRUE(lti.ok()) << lti.status().message();
   req.engine = analysis::Engine::Transient;
+  req.reltol = 1e-3;  // one run at the netlist's tolerance (at the defaults it would check itself)
   auto transient = analysis::simulate_netlist(netlist, req);
+  req.reltol.reset();
   EXPECT_TRUE(transient.ok()) << transient.status().message();
   const std::string work = ::testing::TempDir() + "/lti_compare";
   // trtol 1: at reltol 1e-6 ngspice's default trtol 7 leaves 2.4 mV of its own error on the 15 m
@@ -172,11 +174,19 @@ TEST(LtiEngineChoice, AutoTransientFallbackTightensUntilTwoRunsAgree) {
     }
     return e;
   };
-  analysis::SimulationRequest req{.probes = {"v(c)"}, .engine = analysis::Engine::Transient};
+  analysis::SimulationRequest req{
+      .probes = {"v(c)"}, .reltol = 1e-3, .engine = analysis::Engine::Transient};
   auto plain = analysis::simulate_netlist(*netlist, req);
   ASSERT_TRUE(plain.ok()) << plain.status().message();
-  EXPECT_FALSE(plain->convergence);  // asked for: no tightening
+  EXPECT_FALSE(plain->convergence);  // a tolerance asked for: no tightening
   EXPECT_GT(worst(plain->wave), 5e-3);
+  // --engine transient at the defaults tightens itself too (issue 41).
+  req.reltol.reset();
+  auto forced = analysis::simulate_netlist(*netlist, req);
+  ASSERT_TRUE(forced.ok()) << forced.status().message();
+  ASSERT_TRUE(forced->convergence);
+  EXPECT_TRUE(forced->convergence->agreed);
+  EXPECT_LE(worst(forced->wave), forced->convergence->allowed.back());
   req.engine = analysis::Engine::Auto;
   auto r = analysis::simulate_netlist(*netlist, req);
   ASSERT_TRUE(r.ok()) << r.status().message();
