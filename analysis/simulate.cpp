@@ -109,6 +109,35 @@ Status check_transient_memory(const Netlist& netlist, const TransientOptions& op
                   static_cast<int>(row_bytes / 8), bytes / kMemoryLimitBytes));
 }
 
+// The sources' corners over the run, counted before either engine lists them (the transient's
+// breakpoints, the LTI engine's ramps, a row at each corner in both): refused over the memory
+// limit at the .tran card. PULSE(0 1 0 1n 1n 1u 2u) over 1000 s has 2e9 corners (it took 8 GB and
+// ended in std::bad_alloc). The sources are bound to the run's TSTEP and TSTOP first (a PULSE's
+// default period is TSTOP), as the engines bind them.
+Status check_corner_memory(const Netlist& netlist, Circuit& circuit, const TransientOptions& opt,
+                           double row_bytes) {
+  double corners = 0, most = 0;
+  std::string most_name;
+  for (const auto& e : circuit.elements()) {
+    e->bind_time(opt.tstep, opt.tstop);
+    const SourceFunction* f = e->source_function();
+    if (!f) continue;
+    const double n = f->corner_count(opt.tstop);
+    corners += n;
+    if (n > most) most = n, most_name = e->name();
+  }
+  const double bytes = corners * (4 * row_bytes + kCornerListBytes);
+  if (bytes <= kMemoryLimitBytes) return Status::Ok();
+  return run_error(
+      netlist,
+      fmt::format("the sources have {:.3g} corners in the {:g} s run ({:.3g} of them {}'s), "
+                  "and either engine keeps about 4 rows of {} values and {:g} bytes of corner "
+                  "lists a corner: {:.3g} GB, over the 1 GB memory limit; shorten the run or give "
+                  "the source fewer corners (a PULSE's NP, fewer PWL repeats)",
+                  corners, opt.tstop, most, most_name, static_cast<int>(row_bytes / 8),
+                  kCornerListBytes, bytes / kMemoryLimitBytes));
+}
+
 // The transient options: the .tran card, the netlist's .options (unknown ones a warning), the
 // request's overrides; refused when there is nothing to simulate or the output grid is too fine.
 Status run_options(const Netlist& netlist, const SimulationRequest& req, TransientOptions* opt,
@@ -355,6 +384,7 @@ StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequ
   // Memory (kMemoryLimitBytes): a row is the time plus every probe.
   const double row_bytes = 8.0 * static_cast<double>(1 + probes->size());
   if (Status s = check_grid_memory(req, opt, probes->size(), row_bytes); !s.ok()) return s;
+  if (Status s = check_corner_memory(netlist, circuit, opt, row_bytes); !s.ok()) return s;
   opt.max_steps =
       std::min<long>(opt.max_steps, static_cast<long>(kMemoryLimitBytes / (2 * row_bytes)));
   result.nodes = circuit.node_count() - 1;

@@ -9,7 +9,8 @@
 // - Units: SI (s, V, A); probes as in the netlist ("v(a,b)", "i(Vname)").
 // - Ownership: the result owns its waveform and texts; the netlist is read, not kept.
 // - Errors: a Status, never thrown: a card or .ic that does not build (file:line:col), a probe
-//   that names nothing, a run over kMemoryLimitBytes or kMaxGridRows (at the .tran card), a
+//   that names nothing, a run over kMemoryLimitBytes or kMaxGridRows (at the .tran card: its rows
+//   or its sources' corners), a
 //   forced `lti` the circuit does not allow, an engine that fails. simulate_netlist puts the
 //   netlist's and the circuit's warnings before the message.
 #pragma once
@@ -62,8 +63,18 @@ inline constexpr size_t kMaxGridRows = 10'000'000;
 // - the LTI output grid: at most GridOptions::max_rows rows, lowered so that four copies of
 //   them fit (rows, midpoints, the next pass);
 // - the LTI march: 1 + 2 x sources x probes values a step, max_steps lowered so twice that fits;
-// - the reduced model's basis: at most 384 MB (solver/reduced_model.cpp, kMaxBasisBytes).
+// - the reduced model's basis: at most 384 MB (solver/reduced_model.cpp, kMaxBasisBytes);
+// - the sources' corners, counted before either engine lists them: about 4 rows a corner plus
+//   kCornerListBytes (below).
 inline constexpr double kMemoryLimitBytes = 1024.0 * 1024.0 * 1024.0;
+// A source corner's memory besides its rows: its entries in the engines' lists of corners (the
+// transient's sorted breakpoints, the LTI engine's corner times and ramps). With 4 rows a corner
+// (the transient steps onto each corner and once more just after it, two rows, which a vector's
+// growth can double; the LTI grid has a row at each corner and refines after it, with the
+// midpoints and the next pass beside it), an RC under PULSE(0 1 0 1n 1n 1u 2u) recording one
+// probe is estimated at 112 bytes a corner; measured on the LTI engine, peak memory: 10 million
+// corners 1.16e9 bytes (estimate 1.12e9), 2 million 3.6e8 (2.2e8: more rows where it bends).
+inline constexpr double kCornerListBytes = 48;
 
 struct SimulationRequest {
   std::vector<std::string> probes;           // v(a), v(a,b), i(name)

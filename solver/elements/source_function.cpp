@@ -238,6 +238,47 @@ void SourceFunction::breakpoints(double tstop, std::vector<double>& out) const {
   }
 }
 
+namespace {
+// How many k >= 0 have base + k * period <= limit (one at most when period is not positive).
+double steps_up_to(double base, double period, double limit) {
+  if (!(base <= limit)) return 0.0;
+  return period > 0 ? std::floor((limit - base) / period) + 1 : 1.0;
+}
+}  // namespace
+
+double SourceFunction::corner_count(double tstop) const {
+  switch (kind_) {
+    case Kind::Dc:
+      return 0;
+    case Kind::Pulse: {
+      double periods = steps_up_to(td_, per_, tstop);
+      if (np_ > 0) periods = std::min(periods, std::ceil(np_));
+      double n = 0;
+      for (double c : {td_, td_ + tr_, td_ + tr_ + pw_, td_ + tr_ + pw_ + tf_})
+        n += std::min(periods, steps_up_to(c, per_, tstop)) -
+             std::min(periods, steps_up_to(c, per_, 0.0));  // those in (0, tstop]
+      return n;
+    }
+    case Kind::Pwl: {
+      double n = 0;
+      for (double t : pwl_t_) n += t + pwl_td_ > 0 && t + pwl_td_ <= tstop ? 1 : 0;
+      if (pwl_repeat_ < 0) return n;
+      const double from = pwl_t_[pwl_repeat_], period = pwl_t_.back() - from;
+      if (!(period > 0)) return n;
+      for (size_t k = pwl_repeat_ + 1; k < pwl_t_.size(); ++k)
+        n += steps_up_to(pwl_t_.back() + pwl_td_ + (pwl_t_[k] - from), period, tstop);
+      return n;
+    }
+    case Kind::Exp:
+    case Kind::Sin: {  // two corners at most
+      std::vector<double> out;
+      breakpoints(tstop, out);
+      return static_cast<double>(out.size());
+    }
+  }
+  return 0;
+}
+
 std::vector<Ramp> SourceFunction::ramps(double tstop) const {
   std::vector<Ramp> out;
   if (kind_ == Kind::Dc || !piecewise_linear() || !(tstop > 0)) return out;

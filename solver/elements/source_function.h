@@ -30,6 +30,11 @@ class SourceFunction {
   double value(double t) const;
   double dc_value() const { return value(0.0); }
   void breakpoints(double tstop, std::vector<double>& out) const;
+  // How many corners breakpoints(tstop, out) lists, counted in closed form without listing them:
+  // a long run of a periodic source has billions (PULSE(0 1 0 1n 1n 1u 2u) over 1000 s: 2e9),
+  // so callers bound them before an engine lists them. Exact but for rounding at a corner that
+  // falls on 0 or tstop.
+  double corner_count(double tstop) const;
   Kind kind() const { return kind_; }
   // DC, PULSE and PWL are piecewise linear in t; SIN is not.
   // Piecewise linear and continuous (a sum of ramps): DC, PULSE, and PWL unless its r= repeat

@@ -78,6 +78,55 @@ TEST(SourceFunction, PwlDelayAndRepeat) {
   EXPECT_NE(bad.status().message().find("must be one of the PWL's times"), std::string::npos);
 }
 
+// corner_count: the length of breakpoints' list, counted in closed form (the engines are refused a
+// run whose corners do not fit before they list them: analysis/simulate.cpp). Each case by hand.
+TEST(SourceFunction, CornerCountIsTheBreakpointsUncounted) {
+  auto listed = [](const SourceFunction& f, double tstop) {
+    std::vector<double> bp;
+    f.breakpoints(tstop, bp);
+    return static_cast<double>(bp.size());
+  };
+  struct Case {
+    std::vector<double> pulse;
+    double tstop;
+    double corners;  // by hand
+  };
+  const std::vector<Case> cases{
+      // 2 whole periods of 4 corners (PulseShapeAndCorners' list).
+      {{0, 5, 10e-9, 2e-9, 4e-9, 20e-9, 50e-9}, 100e-9, 8},
+      // The third period starts at 110 ns, before tstop, its rise ends after it: 8 + 1.
+      {{0, 5, 10e-9, 2e-9, 4e-9, 20e-9, 50e-9}, 111e-9, 9},
+      // TD 0: periods at 0, 2, 4, 6 us, the corner at 0 is not one of the run: 3 + 3 x 4.
+      {{0, 1, 0, 1e-9, 1e-9, 1e-6, 2e-6}, 7.3e-6, 15},
+      // NP 3 stops it after 3 periods: 3 + 2 x 4.
+      {{0, 1, 0, 1e-9, 1e-9, 1e-6, 2e-6, 3}, 100e-6, 11},
+      // Nothing before TD.
+      {{0, 1, 5e-6, 1e-9, 1e-9, 1e-6, 2e-6}, 4e-6, 0},
+  };
+  for (const Case& c : cases) {
+    SourceFunction f = parse({call("pulse", c.pulse)});
+    f.bind_time(1e-9, c.tstop);
+    EXPECT_EQ(f.corner_count(c.tstop), c.corners) << c.tstop;
+    EXPECT_EQ(f.corner_count(c.tstop), listed(f, c.tstop)) << c.tstop;
+  }
+  // PWL with td= and an r= repeat (PwlDelayAndRepeat's list: 0.5, 1.5, 2.5, then 3.5, 4.5 us).
+  auto pwl = card("v1", {"a", "0"}, {call("pwl", {0, 0, 1e-6, 1, 2e-6, 0})});
+  pwl.params.emplace_back("td", num(0.5e-6));
+  pwl.params.emplace_back("r", num(0));
+  auto p = SourceFunction::Parse(pwl);
+  ASSERT_TRUE(p) << p.status().message();
+  EXPECT_EQ(p->corner_count(5e-6), 5);
+  EXPECT_EQ(p->corner_count(5e-6), listed(*p, 5e-6));
+  // 100 us: 3, then 3.5 + 2 j us for j = 0..48 (49) and 4.5 + 2 j us for j = 0..47 (48).
+  EXPECT_EQ(p->corner_count(100e-6), 100);
+  EXPECT_EQ(p->corner_count(100e-6), listed(*p, 100e-6));
+  // Issue 41's source over 1000 s: 5e8 periods of 4 corners (the one at 0 is not a corner of the
+  // run, the one at 1000 s is), counted without the 16 GB list.
+  SourceFunction big = parse({call("pulse", {0, 1, 0, 1e-9, 1e-9, 1e-6, 2e-6})});
+  big.bind_time(1e-12, 1000);
+  EXPECT_NEAR(big.corner_count(1000), 2e9, 2);
+}
+
 TEST(SourceFunction, PwlInterpolatesAndHoldsEnds) {
   SourceFunction f = parse({call("pwl", {1e-9, 1, 3e-9, 5})});
   EXPECT_DOUBLE_EQ(f.value(0), 1.0);
