@@ -134,7 +134,6 @@ constexpr RefusedLetter kRefusedLetters[] = {
     {'d', "diode (D)", kSemiconductor},
     {'e', "voltage-controlled voltage source (E)", "controlled sources are out of scope"},
     {'f', "current-controlled current source (F)", "controlled sources are out of scope"},
-    {'g', "voltage-controlled current source (G)", "controlled sources are out of scope"},
     {'h', "current-controlled voltage source (H)", "controlled sources are out of scope"},
     {'j', "JFET (J)", kSemiconductor},
     {'m', "MOSFET (M)", kSemiconductor},

@@ -11,5 +11,6 @@ const ElementKind& inductor_kind();
 const ElementKind& mutual_inductance_kind();
 const ElementKind& voltage_source_kind();
 const ElementKind& current_source_kind();
+const ElementKind& vccs_kind();
 
 }  // namespace isolink

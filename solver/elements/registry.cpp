@@ -10,8 +10,8 @@
 namespace isolink {
 
 std::span<const ElementKind> element_kinds() {
-  static const std::array<ElementKind, 6> kKinds = {
-      capacitor_kind(), current_source_kind(), mutual_inductance_kind(),
+  static const std::array<ElementKind, 7> kKinds = {
+      capacitor_kind(), current_source_kind(), vccs_kind(),          mutual_inductance_kind(),
       inductor_kind(),  resistor_kind(),       voltage_source_kind(),
   };
   return kKinds;

@@ -1,0 +1,168 @@
+#include "netlists/link/touchstone_cable.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <functional>
+#include <map>
+#include <mutex>
+
+#include "base/file_io.h"
+#include "netlists/link/cards.h"
+
+namespace isolink::link {
+
+namespace {
+
+using cd = std::complex<double>;
+
+Card card(char letter, std::string name, std::vector<std::string> nodes, double value) {
+  return make_card(letter, std::move(name), std::move(nodes), {number_arg(value)});
+}
+
+}  // namespace
+
+StatusOr<std::shared_ptr<const TouchstoneCable>> fit_touchstone_cable(const Touchstone& data,
+                                                                      std::vector<int> ports,
+                                                                      double tolerance) {
+  auto out = std::make_shared<TouchstoneCable>();
+  out->data = data;
+  const std::string& name = data.source;
+  if (data.ports == 2) {
+    if (!ports.empty())
+      return Status::Error(fmt::format("{}: a 2-port (differential) file takes no ports mapping",
+                                       name));
+    out->differential = true;
+    ports = {1, 2};
+  } else if (data.ports == 4) {
+    if (ports.empty()) ports = {1, 2, 3, 4};
+    if (ports.size() != 4)
+      return Status::Error(fmt::format("{}: ports names 4 file ports (tx P, tx N, rx P, rx N)",
+                                       name));
+    for (size_t i = 0; i < 4; ++i) {
+      if (ports[i] < 1 || ports[i] > 4)
+        return Status::Error(fmt::format("{}: port {} is not a port of this 4-port", name, ports[i]));
+      for (size_t j = 0; j < i; ++j)
+        if (ports[j] == ports[i])
+          return Status::Error(fmt::format("{}: port {} is named twice in ports", name, ports[i]));
+    }
+  } else {
+    return Status::Error(fmt::format(
+        "{}: a {}-port file; the cable is a 4-port (single-ended) or a 2-port (differential)",
+        name, data.ports));
+  }
+  out->ports = ports;
+  const int n = static_cast<int>(ports.size());
+  std::vector<Eigen::MatrixXcd> y;
+  for (size_t k = 0; k < data.freqs.size(); ++k) {
+    Eigen::MatrixXcd s(n, n);
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) s(i, j) = data.s[k](ports[i] - 1, ports[j] - 1);
+    const Eigen::MatrixXcd yk = y_from_s(s, data.z0);
+    if (!yk.allFinite())
+      return Status::Error(fmt::format(
+          "{}: at {:g} Hz the S matrix has no admittance (I + S is singular)", name, data.freqs[k]));
+    y.push_back(yk);
+  }
+  std::vector<double> freqs = data.freqs;
+  if (!freqs.empty() && freqs.front() == 0) {  // a DC point: the fit's basis is at j w, w > 0
+    freqs.erase(freqs.begin());
+    y.erase(y.begin());
+  }
+  FitOptions opt;
+  opt.tolerance = tolerance;
+  opt.z0 = data.z0;
+  StatusOr<FitResult> fit = vector_fit(freqs, y, opt);
+  if (!fit) return Status::Error(fmt::format("{}: {}", name, fit.status().message()));
+  out->fit = std::move(*fit);
+  out->passivity = enforce_passivity(out->fit.model, freqs, data.z0);
+  out->dc_conductance = out->fit.model.eval(cd(0, 0)).real();
+  if (!out->fit.model.d.allFinite() || !out->dc_conductance.allFinite())
+    return Status::Error(fmt::format("{}: the fit is not finite", name));
+  return std::shared_ptr<const TouchstoneCable>(std::move(out));
+}
+
+StatusOr<std::shared_ptr<const TouchstoneCable>> touchstone_cable(const CableSpec& spec) {
+  StatusOr<std::string> text = read_input_file(spec.touchstone);
+  if (!text) return text.status();
+  std::string key = fmt::format("{:x}|{}|{:a}|", std::hash<std::string>{}(*text), spec.touchstone,
+                                spec.fit_tolerance);
+  for (int p : spec.ports) key += fmt::format("{},", p);
+  static std::mutex mutex;
+  static std::map<std::string, std::shared_ptr<const TouchstoneCable>> kept;
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (auto it = kept.find(key); it != kept.end()) return it->second;
+  }
+  StatusOr<Touchstone> data = read_touchstone_text(*text, spec.touchstone);
+  if (!data) return data.status();
+  auto fit = fit_touchstone_cable(*data, spec.ports, spec.fit_tolerance);
+  if (!fit) return fit.status();
+  std::lock_guard<std::mutex> lock(mutex);
+  if (kept.size() >= 16) kept.clear();
+  kept.emplace(key, *fit);
+  return *fit;
+}
+
+void add_rational_cards(std::vector<Card>& cards, const std::string& prefix,
+                        const RationalModel& m,
+                        const std::vector<std::pair<std::string, std::string>>& port_nodes) {
+  const int n = m.ports;
+  auto g = [&](const std::string& name, const std::pair<std::string, std::string>& out,
+               const std::pair<std::string, std::string>& in, double gm) {
+    if (gm == 0) return;
+    cards.push_back(make_card('g', "g" + prefix + "_" + name,
+                              {out.first, out.second, in.first, in.second}, {number_arg(gm)}));
+  };
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      g(fmt::format("d{}{}", i + 1, j + 1), port_nodes[i], port_nodes[j], m.d(i, j));
+  for (size_t k = 0; k < m.poles.size(); ++k) {
+    const cd p = m.poles[k];
+    const double w = std::abs(p);
+    const bool pair = p.imag() > 0;
+    for (int j = 0; j < n; ++j) {
+      // State nodes of pole k driven by port j: z (real pole) or zr, zi (pair).
+      const std::string base = fmt::format("{}_y{}_{}", prefix, k, j + 1);
+      const std::vector<std::string> states =
+          pair ? std::vector<std::string>{base + "r", base + "i"} : std::vector<std::string>{base};
+      for (const std::string& z : states) {
+        const std::string tail = z.substr(prefix.size() + 1);
+        cards.push_back(card('c', "c" + prefix + "_" + tail, {z, "0"}, 1.0 / w));
+        cards.push_back(card('r', "r" + prefix + "_" + tail, {z, "0"}, w / -p.real()));
+      }
+      const std::string t0 = states[0].substr(prefix.size() + 1);
+      g(t0 + "_in", {states[0], "0"}, port_nodes[j], -1.0);
+      if (pair) {
+        const std::string t1 = states[1].substr(prefix.size() + 1);
+        g(t0 + "_x", {states[0], "0"}, {states[1], "0"}, p.imag() / w);
+        g(t1 + "_x", {states[1], "0"}, {states[0], "0"}, -p.imag() / w);
+      }
+      for (int i = 0; i < n; ++i) {
+        const cd r = m.residues[k](i, j);
+        if (pair) {
+          g(fmt::format("{}_o{}", t0, i + 1), port_nodes[i], {states[0], "0"}, 2 * r.real() / w);
+          g(fmt::format("{}_o{}", states[1].substr(prefix.size() + 1), i + 1), port_nodes[i],
+            {states[1], "0"}, -2 * r.imag() / w);
+        } else {
+          g(fmt::format("{}_o{}", t0, i + 1), port_nodes[i], {states[0], "0"}, r.real() / w);
+        }
+      }
+    }
+  }
+}
+
+Status add_touchstone_cable(std::vector<Card>& cards, const std::string& prefix,
+                            const std::string& a_p, const std::string& a_n, const std::string& b_p,
+                            const std::string& b_n, const CableSpec& spec) {
+  auto cable = touchstone_cable(spec);
+  if (!cable) return cable.status();
+  const TouchstoneCable& c = **cable;
+  if (c.differential)
+    add_rational_cards(cards, prefix, c.fit.model, {{a_p, a_n}, {b_p, b_n}});
+  else
+    add_rational_cards(cards, prefix, c.fit.model, {{a_p, "0"}, {a_n, "0"}, {b_p, "0"}, {b_n, "0"}});
+  return Status::Ok();
+}
+
+}  // namespace isolink::link
