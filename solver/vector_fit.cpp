@@ -245,8 +245,8 @@ StatusOr<FitResult> vector_fit(const std::vector<double>& freqs,
   const double f_max = freqs.back();
   std::vector<Eigen::MatrixXcd> s_data;
   for (int i = 0; i < ns; ++i) {
-    if (!(freqs[i] > 0) || (i > 0 && !(freqs[i] > freqs[i - 1])))
-      return Status::Error("vector fit: frequencies must be > 0 and increasing");
+    if (!(freqs[i] >= 0) || (i > 0 && !(freqs[i] > freqs[i - 1])) || !std::isfinite(freqs[i]))
+      return Status::Error("vector fit: frequencies must be >= 0 and increasing");
     const Eigen::MatrixXcd ys = (y[i] + y[i].transpose()) / 2.0;
     if (!ys.allFinite()) return Status::Error("vector fit: non-finite data");
     d.s.push_back(cd(0, freqs[i] / f_max));
@@ -257,21 +257,26 @@ StatusOr<FitResult> vector_fit(const std::vector<double>& freqs,
   const double w0 = kTwoPi * f_max;
   FitResult best;
   best.error = best.rms_error = INFINITY;
+  int stalled = 0;
   for (int n = opt.min_order; n <= opt.max_order; n += opt.order_step) {
     if (n + 1 > ns) break;  // more unknowns than data
-    Poles poles = starting_poles(n, freqs.front() / f_max);
+    Poles poles = starting_poles(n, (freqs[0] > 0 ? freqs[0] : freqs[1]) / f_max);
     for (int it = 0; it < opt.iterations; ++it) poles = relocate(d, poles);
     FitResult r;
     r.model = to_model(d, poles, residues(d, poles), w0);
     score(r.model, freqs, s_data, opt.z0, r);
     best.orders_tried.push_back(n);
     best.errors.push_back(r.rms_error);
+    // Raise the order while it pays: down to the target, or, once within the tolerance, until
+    // two steps in a row gain less than a fifth (the data's noise floor, or the model's).
+    stalled = r.rms_error < 0.8 * best.rms_error ? 0 : stalled + 1;
+    if (std::min(r.rms_error, best.rms_error) > opt.tolerance) stalled = 0;
     if (r.rms_error < best.rms_error) {
       r.orders_tried = best.orders_tried;
       r.errors = best.errors;
       best = std::move(r);
     }
-    if (best.rms_error <= opt.tolerance) break;
+    if (best.rms_error <= opt.target || stalled >= 2) break;
   }
   if (best.model.ports == 0)
     return Status::Error(fmt::format(
@@ -412,6 +417,7 @@ PassivityReport enforce_passivity(RationalModel& m, const std::vector<double>& f
     const std::vector<Violation> v = violations(m, sweep, &now);
     if (now.passive) {
       first.perturbation_iterations = it;
+      first.enforced_min_eigenvalue = now.min_eigenvalue;
       return first;
     }
     for (const Violation& x : v)
@@ -434,6 +440,7 @@ PassivityReport enforce_passivity(RationalModel& m, const std::vector<double>& f
     m.d += add * Eigen::MatrixXd::Identity(m.ports, m.ports);
     first.added_conductance = add;
   }
+  first.enforced_min_eigenvalue = check_passivity(m, f_top).min_eigenvalue;
   return first;
 }
 

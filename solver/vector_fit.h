@@ -15,7 +15,9 @@
 //   parts 1/100 of them (resonant data), plus real poles log-spaced below the band's first point
 //   (the DC extrapolation: a cable's series R-L corner often lies below a VNA's first point).
 // - The order rises in steps until the fit error (below) is at most the tolerance, or the
-//   largest order is reached (then the best fit is returned, marked not converged). The fit
+//   largest order is reached, or, once within the tolerance, until two steps in a row each gain
+//   less than a fifth of the error (the data's noise floor); the best fit is returned, marked converged when its error is
+//   within the tolerance. The fit
 //   error is the RMS of |S_fit - S| over the entries and the band (robust to a measurement's
 //   noise); the largest |S_fit - S| is reported beside it.
 // - Rows are weighted per frequency by 1 / (1/z0 + max |Y_ij|): the error that matters is in the
@@ -51,6 +53,7 @@ struct RationalModel {
 
 struct FitOptions {
   double tolerance = 1e-3;  // the RMS of |S_fit - S| over the entries and the band, accepted
+  double target = 1e-7;     // the order rises until the RMS error is below this, or stalls
   double z0 = 50;           // ohm, the reference of the S error and of the weighting
   int min_order = 8;        // poles (a pair counts 2)
   int order_step = 8;
@@ -69,7 +72,7 @@ struct FitResult {
   std::vector<double> errors;      // the RMS error of each
 };
 
-// freqs strictly increasing, > 0 (Hz); y one N x N matrix per frequency (averaged with its
+// freqs strictly increasing, >= 0 (Hz; a DC point is taken); y one N x N matrix per frequency (averaged with its
 // transpose: the model is reciprocal). Errors: fewer points than needed for the smallest order,
 // non-finite data.
 StatusOr<FitResult> vector_fit(const std::vector<double>& freqs,
@@ -85,6 +88,7 @@ struct PassivityReport {
   bool passive = true;        // before enforcement
   int perturbation_iterations = 0;  // residue perturbations enforce_passivity needed
   double added_conductance = 0;  // S added to D's diagonal as the last resort (0: none)
+  double enforced_min_eigenvalue = 0;  // S, the smallest eigenvalue after enforcement
   int sweep_points = 0;
 };
 // The check alone; f_top (Hz) the band's top (the sweep goes to 10 f_top).

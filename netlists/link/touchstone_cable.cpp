@@ -6,6 +6,7 @@
 #include <functional>
 #include <map>
 #include <mutex>
+#include <numbers>
 
 #include "base/file_io.h"
 #include "netlists/link/cards.h"
@@ -18,6 +19,66 @@ using cd = std::complex<double>;
 
 Card card(char letter, std::string name, std::vector<std::string> nodes, double value) {
   return make_card(letter, std::move(name), std::move(nodes), {number_arg(value)});
+}
+
+// a + b f^2 fitted (least squares) to v over the lowest points (up to 5, at most 4 times the
+// first frequency): a quantity even in f, at DC.
+double even_extrapolation(const std::vector<double>& freqs, const std::vector<double>& v) {
+  const int k = static_cast<int>(v.size());
+  if (k < 2) return v[0];
+  Eigen::MatrixXd m(k, 2);
+  Eigen::VectorXd b(k);
+  for (int q = 0; q < k; ++q) {
+    const double f = freqs[q] / freqs[0];
+    m(q, 0) = 1, m(q, 1) = f * f, b[q] = v[q];
+  }
+  return m.colPivHouseholderQr().solve(b)[0];
+}
+
+// Below the first frequency a VNA does not measure: the cable as its lumped pi section, exact
+// as f -> 0 for any line. From the lowest points (up to 5, at most 4 times the first frequency):
+// the series impedance Z(f) = -(Y_tx,rx)^-1 (2 x 2 single-ended, 1 x 1 differential; exact for a
+// pi section, Z_c sinh(gamma l) for a line) as R + j w L, and each end's shunt admittance
+// Y_end + Y_tx,rx as j w C (loss-free), with R, L, C extrapolated to DC as a + b f^2. At DC: R alone, no conductance to the chassis or
+// between the lines. Points at DC and 1e-3 .. 0.3 of the first frequency join the data.
+// Extrapolating S instead is ill-conditioned here: through an ohm against 50 ohm, a 1e-4 error
+// of S(0) is a 100 ohm path between P and N.
+Status low_frequency_points(std::vector<double>& freqs, std::vector<Eigen::MatrixXcd>& y,
+                            Eigen::MatrixXd* r_dc) {
+  const int n = static_cast<int>(y[0].rows()), h = n / 2;
+  int k = 0;
+  while (k < 5 && k < static_cast<int>(freqs.size()) && freqs[k] <= 4 * freqs[0]) ++k;
+  Eigen::MatrixXd r(h, h), l(h, h), c1(h, h), c2(h, h);
+  for (int i = 0; i < h; ++i)
+    for (int j = 0; j < h; ++j) {
+      std::vector<double> vr, vl, va, vb;
+      for (int q = 0; q < k; ++q) {
+        const double w = 2 * std::numbers::pi * freqs[q];
+        const Eigen::MatrixXcd z = (-y[q].block(0, h, h, h)).inverse();
+        vr.push_back(z(i, j).real());
+        vl.push_back(z(i, j).imag() / w);
+        va.push_back((y[q].block(0, 0, h, h) + y[q].block(0, h, h, h))(i, j).imag() / w);
+        vb.push_back((y[q].block(h, h, h, h) + y[q].block(h, 0, h, h))(i, j).imag() / w);
+      }
+      r(i, j) = even_extrapolation(freqs, vr), l(i, j) = even_extrapolation(freqs, vl);
+      c1(i, j) = even_extrapolation(freqs, va), c2(i, j) = even_extrapolation(freqs, vb);
+    }
+  r = (r + r.transpose()) / 2;
+  *r_dc = r;
+  if (!r.allFinite() || !(r.diagonal().minCoeff() > 0)) return Status::Error("");
+  std::vector<double> fs = {0.0};
+  for (double x : {1e-3, 3e-3, 1e-2, 3e-2, 0.1, 0.3}) fs.push_back(x * freqs[0]);
+  std::vector<Eigen::MatrixXcd> ys;
+  for (double f : fs) {
+    const double w = 2 * std::numbers::pi * f;
+    const Eigen::MatrixXcd zi = (r.cast<cd>() + cd(0, w) * l.cast<cd>()).inverse();
+    Eigen::MatrixXcd m(n, n);
+    m << zi + cd(0, w) * c1, -zi, -zi, zi + cd(0, w) * c2;
+    ys.push_back((m + m.transpose()) / 2.0);
+  }
+  freqs.insert(freqs.begin(), fs.begin(), fs.end());
+  y.insert(y.begin(), ys.begin(), ys.end());
+  return Status::Ok();
 }
 
 }  // namespace
@@ -65,17 +126,35 @@ StatusOr<std::shared_ptr<const TouchstoneCable>> fit_touchstone_cable(const Touc
     y.push_back(yk);
   }
   std::vector<double> freqs = data.freqs;
-  if (!freqs.empty() && freqs.front() == 0) {  // a DC point: the fit's basis is at j w, w > 0
-    freqs.erase(freqs.begin());
-    y.erase(y.begin());
+  if (freqs.front() > 0) {
+    if (!low_frequency_points(freqs, y, &out->dc_resistance).ok())
+      return Status::Error(fmt::format(
+          "{}: the series resistance extrapolated to DC is not positive (a cable conducts each "
+          "line end to end)",
+          name));
+    out->dc_extrapolated = true;
   }
   FitOptions opt;
   opt.tolerance = tolerance;
   opt.z0 = data.z0;
   StatusOr<FitResult> fit = vector_fit(freqs, y, opt);
   if (!fit) return Status::Error(fmt::format("{}: {}", name, fit.status().message()));
+  if (!fit->converged)
+    return Status::Error(fmt::format(
+        "{}: the rational fit reached {} poles with an RMS S error of {:.3g}, above the tolerance "
+        "{:.3g} (a long line over a wide band needs more poles than isolink fits; give a narrower "
+        "band or a larger cable.tolerance)",
+        name, fit->model.poles.size(), fit->rms_error, tolerance));
   out->fit = std::move(*fit);
   out->passivity = enforce_passivity(out->fit.model, freqs, data.z0);
+  // The last resort's shunt conductance changes the link (a 1 uS shunt is 1 Mohm at each port,
+  // against the cable's 10 Mohm bleed): refused beyond a nanosiemens.
+  if (out->passivity.added_conductance > 1e-9)
+    return Status::Error(fmt::format(
+        "{}: the fit is not passive (Re Y has an eigenvalue of {:.3g} S at {:.4g} Hz) and the "
+        "residue perturbation did not make it so; a measurement's noise is the usual cause "
+        "(a larger cable.tolerance lets a lower order smooth it)",
+        name, out->passivity.min_eigenvalue, out->passivity.at_frequency));
   out->dc_conductance = out->fit.model.eval(cd(0, 0)).real();
   if (!out->fit.model.d.allFinite() || !out->dc_conductance.allFinite())
     return Status::Error(fmt::format("{}: the fit is not finite", name));
@@ -119,7 +198,9 @@ void add_rational_cards(std::vector<Card>& cards, const std::string& prefix,
       g(fmt::format("d{}{}", i + 1, j + 1), port_nodes[i], port_nodes[j], m.d(i, j));
   for (size_t k = 0; k < m.poles.size(); ++k) {
     const cd p = m.poles[k];
-    const double w = std::abs(p);
+    // States scaled by |Re p|: z = |Re p| v / (s - p) peaks at |v| at the pole's own frequency
+    // (the reduced model's Krylov vectors then see node voltages and states alike).
+    const double w = std::abs(p.real());
     const bool pair = p.imag() > 0;
     for (int j = 0; j < n; ++j) {
       // State nodes of pole k driven by port j: z (real pole) or zr, zi (pair).

@@ -15,14 +15,17 @@
 //
 // Fit (solver/vector_fit.h): Y = y_from_s(S) over the file's band, relaxed vector fitting with
 // common poles, the order raised until the RMS S error is under the tolerance; then passivity
-// enforced. Below the first frequency the model is the fit's own rational continuation down to
-// DC (stated in `isolink touchstone`'s output with the DC conductances).
+// enforced. Below the first frequency: a file without a DC point gets one, the conductors'
+// series resistance extrapolated to DC and nothing else (touchstone_cable.cpp,
+// dc_extrapolation), and the fit passes through it
+// (stated in `isolink touchstone`'s output with the DC conductances). A fit that does not reach
+// the tolerance is an error naming the error reached.
 //
 // Realization (docs/touchstone.md): Y(s) = D + sum_k R_k / (s - p_k). For each pole and each
-// port j a state node z with C = 1/|p| and G = -Re p / |p| to ground, driven by a G card with
-// the port's voltage (so z = |p| v_j / (s - p)); a pair's two states are coupled by G cards
-// with Im p / |p|. Each port's current is D v plus G cards from the states with the residues
-// over |p|. Values stay near 1, whatever the frequency scale.
+// port j a state node z with C = 1/|Re p| and 1 ohm to ground, driven by a G card with the
+// port's voltage (so z = |Re p| v_j / (s - p), at most |v_j|); a pair's two states are coupled
+// by G cards with Im p / |Re p|. Each port's current is D v plus G cards from the states with
+// the residues over |Re p|. The states stay the size of the port voltages at any frequency.
 #pragma once
 
 #include <memory>
@@ -44,6 +47,8 @@ struct TouchstoneCable {
   FitResult fit;                  // of Y in the link's port order
   PassivityReport passivity;
   Eigen::MatrixXd dc_conductance;  // Y(0) of the fitted model, S
+  bool dc_extrapolated = false;    // the file has no DC point: Y(0) from dc_resistance
+  Eigen::MatrixXd dc_resistance;   // ohm, the conductors' series R extrapolated to DC (P, N)
 };
 
 // Reads and fits a spec's file (spec.touchstone, spec.ports, spec.fit_tolerance). Fits are
