@@ -331,14 +331,15 @@ std::vector<Violation> violations(const RationalModel& m, const std::vector<doub
   return out;
 }
 
-// One residue perturbation: the smallest change of the residues and D, measured as the fit
-// measures its error (weighted least squares) over the passivity sweep (DC to 10 f_top: the
+// One residue perturbation: the smallest change of the residues and D, in absolute siemens (a
+// small conductance between P and N moves a waveform as much as a large one) over the
+// passivity sweep (DC to 10 f_top: the
 // band alone would let the poles below it trade their residues against D, and move DC), that
 // lifts each violation's eigenvalue
 // to a small positive margin (the eigenvector held fixed: the first-order change of the
 // eigenvalue). Gustavsen, "Fast passivity enforcement ... residue perturbation", 2008, with the
 // constraints as heavily weighted equations.
-void perturb(RationalModel& m, const std::vector<double>& freqs, double f_top, double z0,
+void perturb(RationalModel& m, const std::vector<double>& freqs, double f_top,
              const std::vector<Violation>& v, double margin) {
   Poles poles;
   const double w0 = kTwoPi * f_top;
@@ -352,10 +353,9 @@ void perturb(RationalModel& m, const std::vector<double>& freqs, double f_top, d
   Eigen::MatrixXd a(2 * ns, cols);
   std::vector<cd> phi(n);
   for (int i = 0; i < ns; ++i) {
-    const double w = 1.0 / (1.0 / z0 + m.eval(cd(0, kTwoPi * freqs[i])).cwiseAbs().maxCoeff());
     basis(cd(0, freqs[i] / f_top), poles, phi.data());
     for (int k = 0; k < cols; ++k) {
-      const cd b = w * (k < n ? phi[k] : cd(1, 0));
+      const cd b = k < n ? phi[k] : cd(1, 0);
       a(2 * i, k) = b.real(), a(2 * i + 1, k) = b.imag();
     }
   }
@@ -402,7 +402,7 @@ PassivityReport check_passivity(const RationalModel& m, double f_top) {
   return r;
 }
 
-PassivityReport enforce_passivity(RationalModel& m, const std::vector<double>& freqs, double z0) {
+PassivityReport enforce_passivity(RationalModel& m, const std::vector<double>& freqs) {
   const double f_top = freqs.back();
   PassivityReport first = check_passivity(m, f_top);
   if (first.passive) return first;
@@ -430,7 +430,7 @@ PassivityReport enforce_passivity(RationalModel& m, const std::vector<double>& f
       Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es((g + g.transpose()) / 2);
       c.push_back({f, std::min(es.eigenvalues()[0], margin), es.eigenvectors().col(0)});
     }
-    perturb(m, sweep, f_top, z0, c, margin);
+    perturb(m, sweep, f_top, c, margin);
   }
   // Not passive after the perturbations: the shunt conductance that lifts every eigenvalue.
   PassivityReport now = check_passivity(m, f_top);

@@ -4,7 +4,7 @@
 //   std::vector<Eigen::MatrixXcd> y = ...;          // Y(j 2 pi f_i), one N x N matrix per f
 //   StatusOr<FitResult> fit = vector_fit(freqs, y, FitOptions{});
 //   fit->model.eval(s);                             // D + sum_k R_k / (s - p_k) (+ conjugates)
-//   PassivityReport p = enforce_passivity(fit->model, freqs, 50);
+//   PassivityReport p = enforce_passivity(fit->model, freqs);
 //
 // Method (docs/touchstone.md has the derivation and the guarantees):
 // - Relaxed vector fitting (Gustavsen and Semlyen 1999; the relaxation of Gustavsen 2006) with
@@ -94,9 +94,9 @@ struct PassivityReport {
 // The check alone; f_top (Hz) the band's top (the sweep goes to 10 f_top).
 PassivityReport check_passivity(const RationalModel& m, double f_top);
 // The check, then, while it fails (at most 20 times), the residue perturbation: the smallest
-// change of the residues and D (weighted over freqs as the fit) that lifts each violation's
+// change of the residues and D (absolute, over DC .. 10 f_top) that lifts each violation's
 // eigenvalue to a small margin. As the last resort D += (violation + margin) I. The report is the
 // first check's, with the perturbations and any added conductance.
-PassivityReport enforce_passivity(RationalModel& m, const std::vector<double>& freqs, double z0);
+PassivityReport enforce_passivity(RationalModel& m, const std::vector<double>& freqs);
 
 }  // namespace isolink

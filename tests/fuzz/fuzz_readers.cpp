@@ -25,6 +25,8 @@
 #include <cstdio>
 
 #include "eye/scope_binary.h"
+#elif ISOLINK_FUZZ_READER == 9
+#include "netlists/touchstone.h"
 #endif
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -53,6 +55,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::fclose(f);
     if (wrote == size) (void)isolink::eye::read_binary(path);
   }
+#elif ISOLINK_FUZZ_READER == 9
+  // The port count of a version 1 file comes from its name: the first byte picks one.
+  const char* names[] = {"fuzz.s1p", "fuzz.s2p", "fuzz.s4p", "fuzz.s16p"};
+  (void)isolink::read_touchstone_text(text, names[size > 0 ? data[0] % 4 : 0]);
 #endif
   return 0;
 }
