@@ -13,9 +13,10 @@ namespace isolink::analysis {
 StatusOr<Touchstone> cable_touchstone(const link::CableSpec& cable,
                                       const TouchstoneExportOptions& opt) {
   if (!(opt.f_start > 0) || !(opt.f_stop > opt.f_start) || !std::isfinite(opt.f_stop))
-    return Status::Error(fmt::format("export-touchstone: the band {:g}..{:g} Hz must be > 0 and "
-                                     "rising",
-                                     opt.f_start, opt.f_stop));
+    return Status::Error(
+        fmt::format("export-touchstone: the band {:g}..{:g} Hz must be > 0 and "
+                    "rising",
+                    opt.f_start, opt.f_stop));
   if (opt.points < 2 || opt.points > 100000)
     return Status::Error(fmt::format("export-touchstone: {} points (2..100000)", opt.points));
   if (!(opt.z0 > 0) || !std::isfinite(opt.z0))
@@ -57,8 +58,7 @@ StatusOr<Touchstone> cable_touchstone(const link::CableSpec& cable,
       if (Status s = ac->add_excitation(fmt::format("vport{}", j + 1), 1.0, b); !s.ok()) return s;
       const AcAnalysis::Vector x_sol = ac->solve_factored(b);
       // i(v) flows from the port node through the source: the current into the cable is -i(v).
-      for (int i = 0; i < 4; ++i)
-        y(i, j) = -(x_sol[current[i].a] - x_sol[current[i].b]);
+      for (int i = 0; i < 4; ++i) y(i, j) = -(x_sol[current[i].a] - x_sol[current[i].b]);
     }
     t.freqs.push_back(f);
     t.s.push_back(s_from_y(y, opt.z0));

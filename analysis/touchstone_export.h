@@ -24,7 +24,7 @@ struct TouchstoneExportOptions {
   double f_stop = 500e6;  // Hz, > f_start
   int points = 500;       // 2 .. 100000
   bool log_spacing = false;
-  double z0 = 50;          // ohm
+  double z0 = 50;            // ohm
   double edge_time = 10e-9;  // s: sets the native cable's segment count as `run` does
 };
 

@@ -86,21 +86,22 @@ int run_touchstone(const TouchstoneArgs& a) {
   }
   const FitResult& f = cable.fit;
   std::printf("%s: %d-port %s, %zu points %.4g Hz .. %.4g Hz, reference %g ohm\n", a.file.c_str(),
-              t->ports, cable.differential ? "(differential)" : "(single-ended)",
-              t->freqs.size(), t->freqs.front(), t->freqs.back(), t->z0);
+              t->ports, cable.differential ? "(differential)" : "(single-ended)", t->freqs.size(),
+              t->freqs.front(), t->freqs.back(), t->z0);
   std::printf("fit: %zu poles (%d states), RMS |S_fit - S| %.3g, largest %.3g at %.4g Hz\n",
               f.model.poles.size(), f.model.order(), f.rms_error, f.error, f.error_frequency);
-  std::printf("passivity: %s (smallest eigenvalue of Re Y %.3g S at %.4g Hz); after %d "
-              "perturbations %.3g S\n",
-              cable.passivity.passive ? "passive as fitted" : "enforced",
-              cable.passivity.min_eigenvalue, cable.passivity.at_frequency,
-              cable.passivity.perturbation_iterations, cable.passivity.enforced_min_eigenvalue);
+  std::printf(
+      "passivity: %s (smallest eigenvalue of Re Y %.3g S at %.4g Hz); after %d "
+      "perturbations %.3g S\n",
+      cable.passivity.passive ? "passive as fitted" : "enforced", cable.passivity.min_eigenvalue,
+      cable.passivity.at_frequency, cable.passivity.perturbation_iterations,
+      cable.passivity.enforced_min_eigenvalue);
   if (cable.dc_extrapolated)
-    std::printf("below %.4g Hz: extrapolated as a lumped pi section, DC series R %.4g ohm (P), "
-                "%.4g ohm (N)\n",
-                t->freqs.front(), cable.dc_resistance(0, 0),
-                cable.dc_resistance(cable.dc_resistance.rows() - 1,
-                                    cable.dc_resistance.cols() - 1));
+    std::printf(
+        "below %.4g Hz: extrapolated as a lumped pi section, DC series R %.4g ohm (P), "
+        "%.4g ohm (N)\n",
+        t->freqs.front(), cable.dc_resistance(0, 0),
+        cable.dc_resistance(cable.dc_resistance.rows() - 1, cable.dc_resistance.cols() - 1));
   std::printf("delay: not extracted (the fit is rational)\n");
   return 0;
 }
@@ -139,9 +140,10 @@ int run_export_touchstone(const ExportArgs& a) {
 
 void add_touchstone_command(CLI::App& app, int* exit_code) {
   auto args = std::make_shared<TouchstoneArgs>();
-  CLI::App* cmd = app.add_subcommand(
-      "touchstone", "Read a Touchstone file (.s2p, .s4p) and fit it as a cable: order, error, "
-                    "passivity, DC extrapolation");
+  CLI::App* cmd =
+      app.add_subcommand("touchstone",
+                         "Read a Touchstone file (.s2p, .s4p) and fit it as a cable: order, error, "
+                         "passivity, DC extrapolation");
   cmd->add_option("file", args->file, "Touchstone file")->required();
   cmd->add_option("--ports", args->ports,
                   "A 4-port's file ports for tx P, tx N, rx P, rx N (default 1 2 3 4)")

@@ -124,8 +124,8 @@ Status Reader::option_line(const std::vector<Token>& toks) {
     } else if (w == "s" || w == "y" || w == "z") {
       param_ = w;
     } else if (w == "h" || w == "g") {
-      return error(toks[i], fmt::format("{} parameters are not supported (S, Y or Z)",
-                                        toks[i].text));
+      return error(toks[i],
+                   fmt::format("{} parameters are not supported (S, Y or Z)", toks[i].text));
     } else if (w == "db" || w == "ma" || w == "ri") {
       format_ = w;
     } else if (w == "r") {
@@ -294,8 +294,10 @@ Status Reader::finish_point() {
       if ((matrix_ == "lower" && j > i) || (matrix_ == "upper" && j < i)) continue;
       const bool swap = n == 2 && (out_.version == 1 || order_21_12_);
       const cd x = value();
-      if (swap) m(j, i) = x;
-      else m(i, j) = x;
+      if (swap)
+        m(j, i) = x;
+      else
+        m(i, j) = x;
       if (matrix_ != "full") m(j, i) = m(i, j) = x;
     }
   if (!m.allFinite()) return error(point_[1], "a value overflows to a non-finite number");
@@ -323,8 +325,9 @@ StatusOr<Touchstone> Reader::read() {
       if (out_.version == 1 && out_.ports == 0) {
         const int n = ports_from_name(ext_name);
         if (n == 0)
-          return error(line_no, 1, "a version 1 file's port count comes from its name (.s2p, "
-                                   ".s4p); this name has none");
+          return error(line_no, 1,
+                       "a version 1 file's port count comes from its name (.s2p, "
+                       ".s4p); this name has none");
         if (Status s = set_ports(n, Token{"", line_no, 1}); !s.ok()) return s;
       }
       if (Status s = option_line(split(line, line_no)); !s.ok()) return s;
@@ -344,8 +347,9 @@ StatusOr<Touchstone> Reader::read() {
                                         point_.size(), values_per_point()));
   if (out_.freqs.empty()) return error(last, 1, "no network data");
   if (declared_freqs_ >= 0 && declared_freqs_ != static_cast<int>(out_.freqs.size()))
-    return error(last, 1, fmt::format("[Number of Frequencies] says {}, the data has {}",
-                                      declared_freqs_, out_.freqs.size()));
+    return error(last, 1,
+                 fmt::format("[Number of Frequencies] says {}, the data has {}", declared_freqs_,
+                             out_.freqs.size()));
   out_.parameter = param_ == "s" ? "S" : param_ == "y" ? "Y" : "Z";
   out_.format = format_ == "ri" ? "RI" : format_ == "ma" ? "MA" : "DB";
   // To S at one reference. Version 1's Y and Z are normalised to R; version 2's are not.
@@ -367,7 +371,8 @@ StatusOr<Touchstone> Reader::read() {
     } else {
       bool same = (z.array() == z[0]).all();
       if (same) continue;  // already S at z0
-      // Per-port references: S' = D^-1 S D with D = diag(1 / (2 sqrt z)); Y = Zr^-1 (I + S')^-1 (I - S').
+      // Per-port references: S' = D^-1 S D with D = diag(1 / (2 sqrt z)); Y = Zr^-1 (I + S')^-1 (I
+      // - S').
       Eigen::MatrixXcd sp(n, n);
       for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j) sp(i, j) = m(i, j) * std::sqrt(z[i] / z[j]);
@@ -408,7 +413,8 @@ std::string write_touchstone(const Touchstone& t, const std::string& comment) {
     out += fmt::format("{:.12g}", t.freqs[k]);
     if (n <= 2) {
       for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i) out += fmt::format(" {:.12g} {:.12g}", s(i, j).real(), s(i, j).imag());
+        for (int i = 0; i < n; ++i)
+          out += fmt::format(" {:.12g} {:.12g}", s(i, j).real(), s(i, j).imag());
       out += "\n";
       continue;
     }

@@ -34,14 +34,14 @@ namespace isolink {
 inline constexpr int kMaxTouchstonePorts = 16;
 
 struct Touchstone {
-  std::string source;                // the path (or name) it was read from
-  int version = 1;                   // 1 or 2
+  std::string source;  // the path (or name) it was read from
+  int version = 1;     // 1 or 2
   int ports = 0;
-  double z0 = 50;                    // ohm, the reference of every port
-  std::vector<double> freqs;         // Hz, strictly increasing
-  std::vector<Eigen::MatrixXcd> s;   // one N x N scattering matrix per frequency
-  std::string parameter = "S";       // as written in the file (S, Y, Z)
-  std::string format = "MA";         // as written (DB, MA, RI)
+  double z0 = 50;                   // ohm, the reference of every port
+  std::vector<double> freqs;        // Hz, strictly increasing
+  std::vector<Eigen::MatrixXcd> s;  // one N x N scattering matrix per frequency
+  std::string parameter = "S";      // as written in the file (S, Y, Z)
+  std::string format = "MA";        // as written (DB, MA, RI)
   int noise_lines_skipped = 0;
 };
 

@@ -54,9 +54,9 @@ Poles starting_poles(int n, double f_lo) {
 }
 
 struct Data {
-  std::vector<cd> s;                 // scaled: j f / f_max
-  std::vector<double> w;             // row weights
-  std::vector<std::vector<cd>> f;    // [entry][frequency], upper triangle row-major
+  std::vector<cd> s;               // scaled: j f / f_max
+  std::vector<double> w;           // row weights
+  std::vector<std::vector<cd>> f;  // [entry][frequency], upper triangle row-major
   std::vector<std::pair<int, int>> ij;
   int ports = 0;
 };
@@ -279,8 +279,8 @@ StatusOr<FitResult> vector_fit(const std::vector<double>& freqs,
     if (best.rms_error <= opt.target || stalled >= 2) break;
   }
   if (best.model.ports == 0)
-    return Status::Error(fmt::format(
-        "vector fit: {} frequencies are too few for a fit of order {}", ns, opt.min_order));
+    return Status::Error(fmt::format("vector fit: {} frequencies are too few for a fit of order {}",
+                                     ns, opt.min_order));
   best.converged = best.rms_error <= opt.tolerance;
   return best;
 }
@@ -425,8 +425,8 @@ PassivityReport enforce_passivity(RationalModel& m, const std::vector<double>& f
     const double margin = 1e-9 * scale + 0.01 * std::abs(now.min_eigenvalue);
     std::vector<Violation> c;
     for (double f : held) {
-      const Eigen::MatrixXd g = std::isfinite(f) ? Eigen::MatrixXd(m.eval(cd(0, kTwoPi * f)).real())
-                                                 : m.d;
+      const Eigen::MatrixXd g =
+          std::isfinite(f) ? Eigen::MatrixXd(m.eval(cd(0, kTwoPi * f)).real()) : m.d;
       Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es((g + g.transpose()) / 2);
       c.push_back({f, std::min(es.eigenvalues()[0], margin), es.eigenvectors().col(0)});
     }

@@ -16,10 +16,10 @@
 //   (the DC extrapolation: a cable's series R-L corner often lies below a VNA's first point).
 // - The order rises in steps until the fit error (below) is at most the tolerance, or the
 //   largest order is reached, or, once within the tolerance, until two steps in a row each gain
-//   less than a fifth of the error (the data's noise floor); the best fit is returned, marked converged when its error is
-//   within the tolerance. The fit
-//   error is the RMS of |S_fit - S| over the entries and the band (robust to a measurement's
-//   noise); the largest |S_fit - S| is reported beside it.
+//   less than a fifth of the error (the data's noise floor); the best fit is returned, marked
+//   converged when its error is within the tolerance. The fit error is the RMS of |S_fit - S| over
+//   the entries and the band (robust to a measurement's noise); the largest |S_fit - S| is reported
+//   beside it.
 // - Rows are weighted per frequency by 1 / (1/z0 + max |Y_ij|): the error that matters is in the
 //   scattering parameters, and dS ~ dY / (1 + z0 |Y|).
 // - The error reported is in S (reference z0): max over the band of |S_fit - S| per entry.
@@ -63,18 +63,18 @@ struct FitOptions {
 
 struct FitResult {
   RationalModel model;
-  double error = 0;                // max |S_fit - S| over entries and the band
-  double rms_error = 0;            // RMS of |S_fit - S| over entries and the band
-  Eigen::MatrixXd entry_error;     // N x N, max |S_fit - S|_ij over the band
-  double error_frequency = 0;      // Hz, where the largest error is
-  bool converged = false;          // rms_error <= tolerance
-  std::vector<int> orders_tried;   // pole counts, in order
-  std::vector<double> errors;      // the RMS error of each
+  double error = 0;               // max |S_fit - S| over entries and the band
+  double rms_error = 0;           // RMS of |S_fit - S| over entries and the band
+  Eigen::MatrixXd entry_error;    // N x N, max |S_fit - S|_ij over the band
+  double error_frequency = 0;     // Hz, where the largest error is
+  bool converged = false;         // rms_error <= tolerance
+  std::vector<int> orders_tried;  // pole counts, in order
+  std::vector<double> errors;     // the RMS error of each
 };
 
-// freqs strictly increasing, >= 0 (Hz; a DC point is taken); y one N x N matrix per frequency (averaged with its
-// transpose: the model is reciprocal). Errors: fewer points than needed for the smallest order,
-// non-finite data.
+// freqs strictly increasing, >= 0 (Hz; a DC point is taken); y one N x N matrix per frequency
+// (averaged with its transpose: the model is reciprocal). Errors: fewer points than needed for the
+// smallest order, non-finite data.
 StatusOr<FitResult> vector_fit(const std::vector<double>& freqs,
                                const std::vector<Eigen::MatrixXcd>& y, const FitOptions& opt);
 
@@ -83,11 +83,11 @@ Eigen::MatrixXcd s_from_y(const Eigen::MatrixXcd& y, double z0);
 Eigen::MatrixXcd y_from_s(const Eigen::MatrixXcd& s, double z0);
 
 struct PassivityReport {
-  double min_eigenvalue = 0;  // S, the smallest eigenvalue of Re Y over the sweep (before)
-  double at_frequency = 0;    // Hz, where it is (infinity: D itself)
-  bool passive = true;        // before enforcement
-  int perturbation_iterations = 0;  // residue perturbations enforce_passivity needed
-  double added_conductance = 0;  // S added to D's diagonal as the last resort (0: none)
+  double min_eigenvalue = 0;           // S, the smallest eigenvalue of Re Y over the sweep (before)
+  double at_frequency = 0;             // Hz, where it is (infinity: D itself)
+  bool passive = true;                 // before enforcement
+  int perturbation_iterations = 0;     // residue perturbations enforce_passivity needed
+  double added_conductance = 0;        // S added to D's diagonal as the last resort (0: none)
   double enforced_min_eigenvalue = 0;  // S, the smallest eigenvalue after enforcement
   int sweep_points = 0;
 };

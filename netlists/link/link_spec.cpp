@@ -200,8 +200,7 @@ Status read_cable(const YamlDoc& doc, const YAML::Node& node, CableSpec* cable) 
           {"dielectric_loss", read_bool(doc, &cable->dielectric_loss)},
           {"touchstone", read_text(doc, &cable->touchstone)},
           {"ports", read_text_list(doc, &ports)},
-          {"tolerance",
-           read_quantity(doc, Unit::kNone, Rule::kPositive, &cable->fit_tolerance)},
+          {"tolerance", read_quantity(doc, Unit::kNone, Rule::kPositive, &cable->fit_tolerance)},
       });
   if (!s.ok()) return s;
   if (Status t = read_touchstone_keys(doc, node, ports, cable); !t.ok()) return t;

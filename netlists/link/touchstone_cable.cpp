@@ -39,10 +39,10 @@ double even_extrapolation(const std::vector<double>& freqs, const std::vector<do
 // as f -> 0 for any line. From the lowest points (up to 5, at most 4 times the first frequency):
 // the series impedance Z(f) = -(Y_tx,rx)^-1 (2 x 2 single-ended, 1 x 1 differential; exact for a
 // pi section, Z_c sinh(gamma l) for a line) as R + j w L, and each end's shunt admittance
-// Y_end + Y_tx,rx as j w C (loss-free), with R, L, C extrapolated to DC as a + b f^2. At DC: R alone, no conductance to the chassis or
-// between the lines. Points at DC and 1e-3 .. 0.3 of the first frequency join the data.
-// Extrapolating S instead is ill-conditioned here: through an ohm against 50 ohm, a 1e-4 error
-// of S(0) is a 100 ohm path between P and N.
+// Y_end + Y_tx,rx as j w C (loss-free), with R, L, C extrapolated to DC as a + b f^2. At DC: R
+// alone, no conductance to the chassis or between the lines. Points at DC and 1e-3 .. 0.3 of the
+// first frequency join the data. Extrapolating S instead is ill-conditioned here: through an ohm
+// against 50 ohm, a 1e-4 error of S(0) is a 100 ohm path between P and N.
 Status low_frequency_points(std::vector<double>& freqs, std::vector<Eigen::MatrixXcd>& y,
                             Eigen::MatrixXd* r_dc) {
   const int n = static_cast<int>(y[0].rows()), h = n / 2;
@@ -91,26 +91,27 @@ StatusOr<std::shared_ptr<const TouchstoneCable>> fit_touchstone_cable(const Touc
   const std::string& name = data.source;
   if (data.ports == 2) {
     if (!ports.empty())
-      return Status::Error(fmt::format("{}: a 2-port (differential) file takes no ports mapping",
-                                       name));
+      return Status::Error(
+          fmt::format("{}: a 2-port (differential) file takes no ports mapping", name));
     out->differential = true;
     ports = {1, 2};
   } else if (data.ports == 4) {
     if (ports.empty()) ports = {1, 2, 3, 4};
     if (ports.size() != 4)
-      return Status::Error(fmt::format("{}: ports names 4 file ports (tx P, tx N, rx P, rx N)",
-                                       name));
+      return Status::Error(
+          fmt::format("{}: ports names 4 file ports (tx P, tx N, rx P, rx N)", name));
     for (size_t i = 0; i < 4; ++i) {
       if (ports[i] < 1 || ports[i] > 4)
-        return Status::Error(fmt::format("{}: port {} is not a port of this 4-port", name, ports[i]));
+        return Status::Error(
+            fmt::format("{}: port {} is not a port of this 4-port", name, ports[i]));
       for (size_t j = 0; j < i; ++j)
         if (ports[j] == ports[i])
           return Status::Error(fmt::format("{}: port {} is named twice in ports", name, ports[i]));
     }
   } else {
     return Status::Error(fmt::format(
-        "{}: a {}-port file; the cable is a 4-port (single-ended) or a 2-port (differential)",
-        name, data.ports));
+        "{}: a {}-port file; the cable is a 4-port (single-ended) or a 2-port (differential)", name,
+        data.ports));
   }
   out->ports = ports;
   const int n = static_cast<int>(ports.size());
@@ -121,8 +122,9 @@ StatusOr<std::shared_ptr<const TouchstoneCable>> fit_touchstone_cable(const Touc
       for (int j = 0; j < n; ++j) s(i, j) = data.s[k](ports[i] - 1, ports[j] - 1);
     const Eigen::MatrixXcd yk = y_from_s(s, data.z0);
     if (!yk.allFinite())
-      return Status::Error(fmt::format(
-          "{}: at {:g} Hz the S matrix has no admittance (I + S is singular)", name, data.freqs[k]));
+      return Status::Error(
+          fmt::format("{}: at {:g} Hz the S matrix has no admittance (I + S is singular)", name,
+                      data.freqs[k]));
     y.push_back(yk);
   }
   std::vector<double> freqs = data.freqs;
@@ -195,8 +197,7 @@ StatusOr<std::shared_ptr<const TouchstoneCable>> touchstone_cable(const CableSpe
   return *fit;
 }
 
-void add_rational_cards(std::vector<Card>& cards, const std::string& prefix,
-                        const RationalModel& m,
+void add_rational_cards(std::vector<Card>& cards, const std::string& prefix, const RationalModel& m,
                         const std::vector<std::pair<std::string, std::string>>& port_nodes) {
   const int n = m.ports;
   auto g = [&](const std::string& name, const std::pair<std::string, std::string>& out,
@@ -254,7 +255,8 @@ Status add_touchstone_cable(std::vector<Card>& cards, const std::string& prefix,
   if (c.differential)
     add_rational_cards(cards, prefix, c.fit.model, {{a_p, a_n}, {b_p, b_n}});
   else
-    add_rational_cards(cards, prefix, c.fit.model, {{a_p, "0"}, {a_n, "0"}, {b_p, "0"}, {b_n, "0"}});
+    add_rational_cards(cards, prefix, c.fit.model,
+                       {{a_p, "0"}, {a_n, "0"}, {b_p, "0"}, {b_n, "0"}});
   return Status::Ok();
 }
 

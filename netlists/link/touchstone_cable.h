@@ -41,10 +41,10 @@
 namespace isolink::link {
 
 struct TouchstoneCable {
-  Touchstone data;                // as read, ports in the file's order
-  std::vector<int> ports;         // file ports (1-based) for tx P, tx N, rx P, rx N (4-port)
-  bool differential = false;      // a 2-port: ports across the pairs
-  FitResult fit;                  // of Y in the link's port order
+  Touchstone data;            // as read, ports in the file's order
+  std::vector<int> ports;     // file ports (1-based) for tx P, tx N, rx P, rx N (4-port)
+  bool differential = false;  // a 2-port: ports across the pairs
+  FitResult fit;              // of Y in the link's port order
   PassivityReport passivity;
   Eigen::MatrixXd dc_conductance;  // Y(0) of the fitted model, S
   bool dc_extrapolated = false;    // the file has no DC point: Y(0) from dc_resistance
@@ -61,8 +61,7 @@ StatusOr<std::shared_ptr<const TouchstoneCable>> fit_touchstone_cable(const Touc
 
 // The equivalent network of a fitted model between port node pairs (plus, minus): minus "0" for
 // a single-ended port. Element and node names start with prefix as add_cable's do.
-void add_rational_cards(std::vector<Card>& cards, const std::string& prefix,
-                        const RationalModel& m,
+void add_rational_cards(std::vector<Card>& cards, const std::string& prefix, const RationalModel& m,
                         const std::vector<std::pair<std::string, std::string>>& port_nodes);
 
 // The cable's cards between the ends (a_p, a_n) and (b_p, b_n).

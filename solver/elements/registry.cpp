@@ -11,8 +11,8 @@ namespace isolink {
 
 std::span<const ElementKind> element_kinds() {
   static const std::array<ElementKind, 7> kKinds = {
-      capacitor_kind(), current_source_kind(), vccs_kind(),          mutual_inductance_kind(),
-      inductor_kind(),  resistor_kind(),       voltage_source_kind(),
+      capacitor_kind(), vccs_kind(),     current_source_kind(), mutual_inductance_kind(),
+      inductor_kind(),  resistor_kind(), voltage_source_kind(),
   };
   return kKinds;
 }

@@ -51,8 +51,7 @@ StatusOr<std::unique_ptr<Element>> parse(const Card& card) {
 }  // namespace
 
 const ElementKind& vccs_kind() {
-  static const ElementKind kind{'g',     "vccs", "Gname n+ n- nc+ nc- gm [m=N]", 4, 0,
-                                kParams, parse};
+  static const ElementKind kind{'g', "vccs", "Gname n+ n- nc+ nc- gm [m=N]", 4, 0, kParams, parse};
   return kind;
 }
 

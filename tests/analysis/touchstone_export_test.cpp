@@ -70,34 +70,46 @@ void check_case(const Case& c, double limit_mv) {
   measured.cable.touchstone = path;
   auto fit = link::touchstone_cable(measured.cable);
   ASSERT_TRUE(fit.ok()) << c.spec << " " << c.f_start << " " << fit.status().message();
-  std::printf("fit: %zu poles, order %d, rms %.3g max %.3g at %.3g Hz, passive %d (min eig %.3g at %g Hz, "
-              "%d perturbations, added %.3g S)\n",
-              (*fit)->fit.model.poles.size(), (*fit)->fit.model.order(), (*fit)->fit.rms_error,
-              (*fit)->fit.error, (*fit)->fit.error_frequency, (*fit)->passivity.passive,
-              (*fit)->passivity.min_eigenvalue, (*fit)->passivity.at_frequency, (*fit)->passivity.perturbation_iterations, (*fit)->passivity.added_conductance);
+  std::printf(
+      "fit: %zu poles, order %d, rms %.3g max %.3g at %.3g Hz, passive %d (min eig %.3g at %g Hz, "
+      "%d perturbations, added %.3g S)\n",
+      (*fit)->fit.model.poles.size(), (*fit)->fit.model.order(), (*fit)->fit.rms_error,
+      (*fit)->fit.error, (*fit)->fit.error_frequency, (*fit)->passivity.passive,
+      (*fit)->passivity.min_eigenvalue, (*fit)->passivity.at_frequency,
+      (*fit)->passivity.perturbation_iterations, (*fit)->passivity.added_conductance);
   StatusOr<LinkRun> run = run_link(measured, *parts, ro);
   ASSERT_TRUE(run.ok()) << run.status().message();
-  std::printf("native %s %.2f s, fitted %s %.2f s (method %s, note %s, model %.2f s order %d)\n", engine_name(native->directions[0].sim.engine), native->directions[0].sim.seconds, engine_name(run->directions[0].sim.engine), run->directions[0].sim.seconds, run->directions[0].sim.lti.method.c_str(), run->directions[0].sim.lti.note.c_str(), run->directions[0].sim.lti.model_seconds, run->directions[0].sim.lti.model.order);
+  std::printf("native %s %.2f s, fitted %s %.2f s (method %s, note %s, model %.2f s order %d)\n",
+              engine_name(native->directions[0].sim.engine), native->directions[0].sim.seconds,
+              engine_name(run->directions[0].sim.engine), run->directions[0].sim.seconds,
+              run->directions[0].sim.lti.method.c_str(), run->directions[0].sim.lti.note.c_str(),
+              run->directions[0].sim.lti.model_seconds, run->directions[0].sim.lti.model.order);
   std::cout << "Y0 fit\n" << (*fit)->dc_conductance.row(0) << "\n";
   ASSERT_TRUE(run.ok()) << run.status().message();
   const Waveform& a = native->directions[0].sim.wave;
   const Waveform& b = run->directions[0].sim.wave;
   const double diff = max_difference(a, b, 0);
-  std::printf("%s from %g Hz, noise %g: |dv(rxp,rxn)| <= %.3f mV (engine %s)\n", c.spec,
-              c.f_start, c.noise, diff * 1e3, engine_name(run->directions[0].sim.engine));
+  std::printf("%s from %g Hz, noise %g: |dv(rxp,rxn)| <= %.3f mV (engine %s)\n", c.spec, c.f_start,
+              c.noise, diff * 1e3, engine_name(run->directions[0].sim.engine));
   EXPECT_LT(diff, limit_mv * 1e-3);
   std::remove(path.c_str());
 }
 
 // The issue's figure: within 2 mV of the native cable (measured 1.30 mV, fit RMS 3.4e-7, 29 poles).
-TEST(TouchstoneExport, CapLink2mReadBackWithin2mV) { check_case({"cap_2m.yaml", 10e3, 0}, 2); }
+TEST(TouchstoneExport, CapLink2mReadBackWithin2mV) {
+  check_case({"cap_2m.yaml", 10e3, 0}, 2);
+}
 
 // Known gaps, asserted at the figures measured today so that a change that worsens them fails:
 // a file starting at 300 kHz (the DC side then rests on the pi-section extrapolation) measured
 // 13.2 mV; a 5 m link with chokes (its common mode is sensitive below the first point) 24.8 mV.
 // The issue asks for 2 mV in both (docs/touchstone.md, "Limits").
-TEST(TouchstoneExport, CapLink2mFrom300kHz) { check_case({"cap_2m.yaml", 300e3, 0}, 15); }
-TEST(TouchstoneExport, Capchoke5m) { check_case({"capchoke_5m.yaml", 10e3, 0}, 30); }
+TEST(TouchstoneExport, CapLink2mFrom300kHz) {
+  check_case({"cap_2m.yaml", 300e3, 0}, 15);
+}
+TEST(TouchstoneExport, Capchoke5m) {
+  check_case({"capchoke_5m.yaml", 10e3, 0}, 30);
+}
 
 // Noise of 1e-5 RMS (-100 dB) on every S entry: the fit follows it into a model that is not
 // passive at 306 kHz, the residue perturbation does not repair it, and the cable is refused

@@ -38,12 +38,11 @@ TEST(Touchstone, TwoPortMaInMhzIsOrdered11_21_12_22) {
 TEST(Touchstone, DbAndRiAndDefaultsGhz) {
   StatusOr<Touchstone> db = read_touchstone_text("# hz s db\n100 -20 0\n", "x.s1p");
   ASSERT_TRUE(db.ok()) << db.status().message();
-  EXPECT_NEAR(db->s[0](0, 0).real(), 0.1, 1e-15);  // -20 dB = 0.1
+  EXPECT_NEAR(db->s[0](0, 0).real(), 0.1, 1e-15);                              // -20 dB = 0.1
   StatusOr<Touchstone> ri = read_touchstone_text("0.5 0.25 -0.5\n", "x.s1p");  // GHz S MA R 50
   ASSERT_TRUE(ri.ok()) << ri.status().message();
   EXPECT_DOUBLE_EQ(ri->freqs[0], 0.5e9);
-  EXPECT_NEAR(std::abs(ri->s[0](0, 0) - std::polar(0.25, -0.5 * std::numbers::pi / 180)), 0,
-              1e-15);
+  EXPECT_NEAR(std::abs(ri->s[0](0, 0) - std::polar(0.25, -0.5 * std::numbers::pi / 180)), 0, 1e-15);
 }
 
 TEST(Touchstone, FourPortRowsOverLinesAndYNormalisedInVersion1) {
@@ -104,8 +103,7 @@ TEST(Touchstone, ErrorsNameLineAndColumn) {
                 .rfind("a.s2p:2:1: error: 8 values for 2-port data", 0),
             0u);
   EXPECT_EQ(error_of("# MHz H RI\n", "a.s2p").rfind("a.s2p:1:7: error: H parameters", 0), 0u);
-  EXPECT_EQ(error_of("[Version] 2.0\n[Number of Ports] 4\n[Mixed-Mode Order] D2,1 D4,3\n",
-                     "m.ts")
+  EXPECT_EQ(error_of("[Version] 2.0\n[Number of Ports] 4\n[Mixed-Mode Order] D2,1 D4,3\n", "m.ts")
                 .rfind("m.ts:3:1: error: [Mixed-Mode Order]", 0),
             0u);
   EXPECT_EQ(error_of("[Version] 2.0\n[Number of Ports] 2\n[Foo] 1\n", "m.ts")

@@ -19,9 +19,9 @@ TEST(Vccs, TransconductanceIntoResistor) {
   // gm V(in) flows from out through the source to ground: V(out) = -gm R V(in) = -2 at gm 1 mS,
   // R 2 kohm, with a second G controlled the other way round adding nothing (V(0, in) * 0).
   Circuit c;
-  for (const Card& k : {card("vin", {"in", "0"}, {num(0)}), card("g1", {"out", "0", "in", "0"},
-                                                                 {num(1e-3)}),
-                        card("r1", {"out", "0"}, {num(2e3)})})
+  for (const Card& k :
+       {card("vin", {"in", "0"}, {num(0)}), card("g1", {"out", "0", "in", "0"}, {num(1e-3)}),
+        card("r1", {"out", "0"}, {num(2e3)})})
     ASSERT_TRUE(c.add(k).ok()) << k.name;
   ASSERT_TRUE(c.finalize().ok());
   auto ac = AcAnalysis::create(c);
