@@ -21,6 +21,8 @@ void add_noise_command(CLI::App& app, int* exit_code);
 void add_worst_command(CLI::App& app, int* exit_code);
 void add_pack_command(CLI::App& app, int* exit_code);
 void add_compare_command(CLI::App& app, int* exit_code);
+// isolink touchstone and isolink export-touchstone.
+void add_touchstone_command(CLI::App& app, int* exit_code);
 
 // isolink pack's options; `isolink run` passes a pack spec on with its own -o, --parts, -q.
 struct PackArgs {

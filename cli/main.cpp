@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   isolink::cli::add_worst_command(app, &exit_code);
   isolink::cli::add_pack_command(app, &exit_code);
   isolink::cli::add_compare_command(app, &exit_code);
+  isolink::cli::add_touchstone_command(app, &exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -142,7 +142,6 @@ constexpr RefusedLetter kRefusedLetters[] = {
      "write the waveform as PULSE, PWL, SIN or EXP on a V or I source"},
     {'e', "voltage-controlled voltage source (E)", "controlled sources are out of scope"},
     {'f', "current-controlled current source (F)", "controlled sources are out of scope"},
-    {'g', "voltage-controlled current source (G)", "controlled sources are out of scope"},
     {'h', "current-controlled voltage source (H)", "controlled sources are out of scope"},
     {'j', "JFET (J)", kSemiconductor},
     {'m', "MOSFET (M)", kSemiconductor},

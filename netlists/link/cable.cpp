@@ -11,6 +11,7 @@
 #include <string>
 
 #include "netlists/link/cards.h"
+#include "netlists/link/touchstone_cable.h"
 
 namespace isolink::link {
 
@@ -267,6 +268,8 @@ Status CableSpec::validate() const {
     return field_error("chassis_c", *chassis_c, "must be > 0 (F/m per conductor)");
   if (segments < 0 || segments > 1000)
     return field_error("segments", segments, "must be 0 (automatic) or 1..1000");
+  if (!(fit_tolerance > 0 && fit_tolerance <= 0.5))
+    return field_error("tolerance", fit_tolerance, "must be in (0, 0.5] (RMS of |S_fit - S|)");
   return Status::Ok();
 }
 
@@ -496,6 +499,10 @@ Status add_cable(std::vector<Card>& cards, const std::string& prefix, const std:
                  const CableSpec& spec, double edge_time, int* segments) {
   if (!(edge_time > 0) || !std::isfinite(edge_time))
     return Status::Error(fmt::format("cable {}: edge time {:g} s must be > 0", prefix, edge_time));
+  if (!spec.touchstone.empty()) {
+    if (segments != nullptr) *segments = 0;
+    return add_touchstone_cable(cards, prefix, a_p, a_n, b_p, b_n, spec);
+  }
   StatusOr<CableModel> model = cable_model(spec);
   if (!model) return model.status();
   const CableModel& m = *model;

@@ -62,6 +62,13 @@ struct CableSpec {
   int loss_stride = 0;      // segments per loss section; 0: automatic (loss_stride()); else 1..1000
   bool skin_effect = true;  // false: DC resistance only, no internal inductance
   bool dielectric_loss = true;  // false: loss-free dielectric, capacitances constant
+  // A measured cable instead of the model above (netlists/link/touchstone_cable.h): a Touchstone
+  // file (.s4p single-ended, .s2p differential), the file's ports for tx P, tx N, rx P, rx N
+  // (empty: 1 2 3 4) and the fit's tolerance (RMS of |S_fit - S|). `length` then only names the
+  // hop's length for the pack's timing; no other key of the model applies.
+  std::string touchstone;
+  std::vector<int> ports;
+  double fit_tolerance = 1e-3;
 
   // Names the field, its value and the rule: "cable.length = -1: must be > 0".
   Status validate() const;
@@ -173,7 +180,8 @@ int loss_stride(const CableSpec& spec, int segments);  // spec.loss_stride when 
 // reference (chassis). Element names are the element letter, then prefix, then "_..." (SPICE
 // style, as the pin models: "lcab_p3", "kcab_3", "ccab_pn0"); internal nodes are
 // "<prefix>_...". edge_time (s, > 0) sets the segment count when spec.segments is 0; the count
-// used goes to *segments when given.
+// used goes to *segments when given. A spec with a touchstone file adds its fitted network
+// (add_touchstone_cable) and reports 0 segments.
 Status add_cable(std::vector<Card>& cards, const std::string& prefix, const std::string& a_p,
                  const std::string& a_n, const std::string& b_p, const std::string& b_n,
                  const CableSpec& spec, double edge_time = 10e-9, int* segments = nullptr);

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "netlists/link/touchstone_cable.h"
 #include "netlists/traffic/stimulus.h"
 
 namespace isolink::link {
@@ -150,7 +151,38 @@ Status read_end(const YamlDoc& doc, const YAML::Node& node, const std::string& p
   return Status::Ok();
 }
 
+// The measured cable's keys: the file (relative to the spec's folder), its ports, and no key of
+// the native model beside it (they would be ignored).
+Status read_touchstone_keys(const YamlDoc& doc, const YAML::Node& node,
+                            const std::vector<std::string>& ports, CableSpec* cable) {
+  if (cable->touchstone.empty()) {
+    for (const char* k : {"ports", "tolerance"})
+      if (node.IsMap() && node[k])
+        return doc.error(node[k], fmt::format("key 'cable.{}' needs cable.touchstone", k));
+    return Status::Ok();
+  }
+  for (const char* k : {"material", "gauge", "temperature", "r", "l", "c", "g", "segments",
+                        "chassis_c", "skin_effect", "dielectric_loss"})
+    if (node[k])
+      return doc.error(node[k], fmt::format("key 'cable.{}' does not apply to a measured cable "
+                                            "(cable.touchstone): the file is the cable",
+                                            k));
+  for (const std::string& p : ports) {
+    if (p.size() != 1 || p[0] < '1' || p[0] > '4')
+      return doc.error(node["ports"], fmt::format("key 'cable.ports': '{}' is not a port 1..4", p));
+    cable->ports.push_back(p[0] - '0');
+  }
+  if (!ports.empty() && ports.size() != 4)
+    return doc.error(node["ports"], "key 'cable.ports' names 4 file ports: tx P, tx N, rx P, rx N");
+  const std::string& dir = doc.path();
+  if (cable->touchstone[0] != '/' && dir.find('/') != std::string::npos)
+    cable->touchstone = dir.substr(0, dir.rfind('/') + 1) + cable->touchstone;
+  if (auto fit = touchstone_cable(*cable); !fit) return fit.status();
+  return Status::Ok();
+}
+
 Status read_cable(const YamlDoc& doc, const YAML::Node& node, CableSpec* cable) {
+  std::vector<std::string> ports;
   Status s = read_map(
       doc, node, "cable",
       {
@@ -166,8 +198,12 @@ Status read_cable(const YamlDoc& doc, const YAML::Node& node, CableSpec* cable) 
           {"chassis_c", read_quantity(doc, Unit::kFarad, Rule::kPositive, &cable->chassis_c)},
           {"skin_effect", read_bool(doc, &cable->skin_effect)},
           {"dielectric_loss", read_bool(doc, &cable->dielectric_loss)},
+          {"touchstone", read_text(doc, &cable->touchstone)},
+          {"ports", read_text_list(doc, &ports)},
+          {"tolerance", read_quantity(doc, Unit::kNone, Rule::kPositive, &cable->fit_tolerance)},
       });
   if (!s.ok()) return s;
+  if (Status t = read_touchstone_keys(doc, node, ports, cable); !t.ok()) return t;
   if (cable->temperature < -55 || cable->temperature > 150)
     return doc.error(node["temperature"],
                      fmt::format("key 'cable.temperature' = {:g}: must be in -55..150 degC",

@@ -12,5 +12,6 @@ const ElementKind& mutual_inductance_kind();
 const ElementKind& voltage_source_kind();
 const ElementKind& current_source_kind();
 const ElementKind& diode_kind();
+const ElementKind& vccs_kind();
 
 }  // namespace isolink

@@ -10,9 +10,9 @@
 namespace isolink {
 
 std::span<const ElementKind> element_kinds() {
-  static const std::array<ElementKind, 7> kKinds = {
-      capacitor_kind(), current_source_kind(), diode_kind(),          mutual_inductance_kind(),
-      inductor_kind(),  resistor_kind(),       voltage_source_kind(),
+  static const std::array<ElementKind, 8> kKinds = {
+      capacitor_kind(),         diode_kind(),    vccs_kind(),     current_source_kind(),
+      mutual_inductance_kind(), inductor_kind(), resistor_kind(), voltage_source_kind(),
   };
   return kKinds;
 }

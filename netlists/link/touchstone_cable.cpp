@@ -1,0 +1,263 @@
+#include "netlists/link/touchstone_cable.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <functional>
+#include <map>
+#include <mutex>
+#include <numbers>
+
+#include "base/file_io.h"
+#include "netlists/link/cards.h"
+
+namespace isolink::link {
+
+namespace {
+
+using cd = std::complex<double>;
+
+Card card(char letter, std::string name, std::vector<std::string> nodes, double value) {
+  return make_card(letter, std::move(name), std::move(nodes), {number_arg(value)});
+}
+
+// a + b f^2 fitted (least squares) to v over the lowest points (up to 5, at most 4 times the
+// first frequency): a quantity even in f, at DC.
+double even_extrapolation(const std::vector<double>& freqs, const std::vector<double>& v) {
+  const int k = static_cast<int>(v.size());
+  if (k < 2) return v[0];
+  Eigen::MatrixXd m(k, 2);
+  Eigen::VectorXd b(k);
+  for (int q = 0; q < k; ++q) {
+    const double f = freqs[q] / freqs[0];
+    m(q, 0) = 1, m(q, 1) = f * f, b[q] = v[q];
+  }
+  return m.colPivHouseholderQr().solve(b)[0];
+}
+
+// Below the first frequency a VNA does not measure: the cable as its lumped pi section, exact
+// as f -> 0 for any line. From the lowest points (up to 5, at most 4 times the first frequency):
+// the series impedance Z(f) = -(Y_tx,rx)^-1 (2 x 2 single-ended, 1 x 1 differential; exact for a
+// pi section, Z_c sinh(gamma l) for a line) as R + j w L, and each end's shunt admittance
+// Y_end + Y_tx,rx as j w C (loss-free), with R, L, C extrapolated to DC as a + b f^2. At DC: R
+// alone, no conductance to the chassis or between the lines. Points at DC and 1e-3 .. 0.3 of the
+// first frequency join the data. Extrapolating S instead is ill-conditioned here: through an ohm
+// against 50 ohm, a 1e-4 error of S(0) is a 100 ohm path between P and N.
+Status low_frequency_points(std::vector<double>& freqs, std::vector<Eigen::MatrixXcd>& y,
+                            Eigen::MatrixXd* r_dc) {
+  const int n = static_cast<int>(y[0].rows()), h = n / 2;
+  int k = 0;
+  while (k < 5 && k < static_cast<int>(freqs.size()) && freqs[k] <= 4 * freqs[0]) ++k;
+  Eigen::MatrixXd r(h, h), l(h, h), c1(h, h), c2(h, h);
+  for (int i = 0; i < h; ++i)
+    for (int j = 0; j < h; ++j) {
+      std::vector<double> vr, vl, va, vb;
+      for (int q = 0; q < k; ++q) {
+        const double w = 2 * std::numbers::pi * freqs[q];
+        const Eigen::MatrixXcd z = (-y[q].block(0, h, h, h)).inverse();
+        vr.push_back(z(i, j).real());
+        vl.push_back(z(i, j).imag() / w);
+        va.push_back((y[q].block(0, 0, h, h) + y[q].block(0, h, h, h))(i, j).imag() / w);
+        vb.push_back((y[q].block(h, h, h, h) + y[q].block(h, 0, h, h))(i, j).imag() / w);
+      }
+      r(i, j) = even_extrapolation(freqs, vr), l(i, j) = even_extrapolation(freqs, vl);
+      c1(i, j) = even_extrapolation(freqs, va), c2(i, j) = even_extrapolation(freqs, vb);
+    }
+  r = (r + r.transpose()) / 2;
+  *r_dc = r;
+  if (!r.allFinite() || !(r.diagonal().minCoeff() > 0)) return Status::Error("");
+  std::vector<double> fs = {0.0};
+  for (double x : {1e-3, 1e-2, 0.1}) fs.push_back(x * freqs[0]);
+  std::vector<Eigen::MatrixXcd> ys;
+  for (double f : fs) {
+    const double w = 2 * std::numbers::pi * f;
+    const Eigen::MatrixXcd zi = (r.cast<cd>() + cd(0, w) * l.cast<cd>()).inverse();
+    Eigen::MatrixXcd m(n, n);
+    m << zi + cd(0, w) * c1, -zi, -zi, zi + cd(0, w) * c2;
+    ys.push_back((m + m.transpose()) / 2.0);
+  }
+  freqs.insert(freqs.begin(), fs.begin(), fs.end());
+  y.insert(y.begin(), ys.begin(), ys.end());
+  return Status::Ok();
+}
+
+}  // namespace
+
+StatusOr<std::shared_ptr<const TouchstoneCable>> fit_touchstone_cable(const Touchstone& data,
+                                                                      std::vector<int> ports,
+                                                                      double tolerance) {
+  auto out = std::make_shared<TouchstoneCable>();
+  out->data = data;
+  const std::string& name = data.source;
+  if (data.ports == 2) {
+    if (!ports.empty())
+      return Status::Error(
+          fmt::format("{}: a 2-port (differential) file takes no ports mapping", name));
+    out->differential = true;
+    ports = {1, 2};
+  } else if (data.ports == 4) {
+    if (ports.empty()) ports = {1, 2, 3, 4};
+    if (ports.size() != 4)
+      return Status::Error(
+          fmt::format("{}: ports names 4 file ports (tx P, tx N, rx P, rx N)", name));
+    for (size_t i = 0; i < 4; ++i) {
+      if (ports[i] < 1 || ports[i] > 4)
+        return Status::Error(
+            fmt::format("{}: port {} is not a port of this 4-port", name, ports[i]));
+      for (size_t j = 0; j < i; ++j)
+        if (ports[j] == ports[i])
+          return Status::Error(fmt::format("{}: port {} is named twice in ports", name, ports[i]));
+    }
+  } else {
+    return Status::Error(fmt::format(
+        "{}: a {}-port file; the cable is a 4-port (single-ended) or a 2-port (differential)", name,
+        data.ports));
+  }
+  out->ports = ports;
+  const int n = static_cast<int>(ports.size());
+  std::vector<Eigen::MatrixXcd> y;
+  for (size_t k = 0; k < data.freqs.size(); ++k) {
+    Eigen::MatrixXcd s(n, n);
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) s(i, j) = data.s[k](ports[i] - 1, ports[j] - 1);
+    const Eigen::MatrixXcd yk = y_from_s(s, data.z0);
+    if (!yk.allFinite())
+      return Status::Error(
+          fmt::format("{}: at {:g} Hz the S matrix has no admittance (I + S is singular)", name,
+                      data.freqs[k]));
+    y.push_back(yk);
+  }
+  std::vector<double> freqs = data.freqs;
+  // The fit's cost grows with the points: a file of more than kMaxFitPoints is fitted on every
+  // k-th of them (the last kept), and scored on those.
+  constexpr size_t kMaxFitPoints = 1000;
+  if (freqs.size() > kMaxFitPoints) {
+    const size_t step = (freqs.size() + kMaxFitPoints - 1) / kMaxFitPoints;
+    std::vector<double> f2;
+    std::vector<Eigen::MatrixXcd> y2;
+    for (size_t k = 0; k < freqs.size(); k += step) f2.push_back(freqs[k]), y2.push_back(y[k]);
+    if (f2.back() != freqs.back()) f2.push_back(freqs.back()), y2.push_back(y.back());
+    freqs = std::move(f2);
+    y = std::move(y2);
+  }
+  if (freqs.front() > 0) {
+    if (!low_frequency_points(freqs, y, &out->dc_resistance).ok())
+      return Status::Error(fmt::format(
+          "{}: the series resistance extrapolated to DC is not positive (a cable conducts each "
+          "line end to end)",
+          name));
+    out->dc_extrapolated = true;
+  }
+  FitOptions opt;
+  opt.tolerance = tolerance;
+  opt.z0 = data.z0;
+  StatusOr<FitResult> fit = vector_fit(freqs, y, opt);
+  if (!fit) return Status::Error(fmt::format("{}: {}", name, fit.status().message()));
+  if (!fit->converged)
+    return Status::Error(fmt::format(
+        "{}: the rational fit reached {} poles with an RMS S error of {:.3g}, above the tolerance "
+        "{:.3g} (a long line over a wide band needs more poles than isolink fits; give a narrower "
+        "band or a larger cable.tolerance)",
+        name, fit->model.poles.size(), fit->rms_error, tolerance));
+  out->fit = std::move(*fit);
+  out->passivity = enforce_passivity(out->fit.model, freqs);
+  // The last resort's shunt conductance changes the link (a 1 uS shunt is 1 Mohm at each port,
+  // against the cable's 10 Mohm bleed): refused beyond a nanosiemens.
+  if (out->passivity.added_conductance > 1e-9)
+    return Status::Error(fmt::format(
+        "{}: the fit is not passive (Re Y has an eigenvalue of {:.3g} S at {:.4g} Hz) and the "
+        "residue perturbation did not make it so; a measurement's noise is the usual cause "
+        "(a larger cable.tolerance lets a lower order smooth it)",
+        name, out->passivity.min_eigenvalue, out->passivity.at_frequency));
+  out->dc_conductance = out->fit.model.eval(cd(0, 0)).real();
+  if (!out->fit.model.d.allFinite() || !out->dc_conductance.allFinite())
+    return Status::Error(fmt::format("{}: the fit is not finite", name));
+  return std::shared_ptr<const TouchstoneCable>(std::move(out));
+}
+
+StatusOr<std::shared_ptr<const TouchstoneCable>> touchstone_cable(const CableSpec& spec) {
+  StatusOr<std::string> text = read_input_file(spec.touchstone);
+  if (!text) return text.status();
+  std::string key = fmt::format("{:x}|{}|{:a}|", std::hash<std::string>{}(*text), spec.touchstone,
+                                spec.fit_tolerance);
+  for (int p : spec.ports) key += fmt::format("{},", p);
+  static std::mutex mutex;
+  static std::map<std::string, std::shared_ptr<const TouchstoneCable>> kept;
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (auto it = kept.find(key); it != kept.end()) return it->second;
+  }
+  StatusOr<Touchstone> data = read_touchstone_text(*text, spec.touchstone);
+  if (!data) return data.status();
+  auto fit = fit_touchstone_cable(*data, spec.ports, spec.fit_tolerance);
+  if (!fit) return fit.status();
+  std::lock_guard<std::mutex> lock(mutex);
+  if (kept.size() >= 16) kept.clear();
+  kept.emplace(key, *fit);
+  return *fit;
+}
+
+void add_rational_cards(std::vector<Card>& cards, const std::string& prefix, const RationalModel& m,
+                        const std::vector<std::pair<std::string, std::string>>& port_nodes) {
+  const int n = m.ports;
+  auto g = [&](const std::string& name, const std::pair<std::string, std::string>& out,
+               const std::pair<std::string, std::string>& in, double gm) {
+    if (gm == 0) return;
+    cards.push_back(make_card('g', "g" + prefix + "_" + name,
+                              {out.first, out.second, in.first, in.second}, {number_arg(gm)}));
+  };
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      g(fmt::format("d{}{}", i + 1, j + 1), port_nodes[i], port_nodes[j], m.d(i, j));
+  for (size_t k = 0; k < m.poles.size(); ++k) {
+    const cd p = m.poles[k];
+    // States scaled by |Re p|: z = |Re p| v / (s - p) peaks at |v| at the pole's own frequency
+    // (the reduced model's Krylov vectors then see node voltages and states alike).
+    const double w = std::abs(p.real());
+    const bool pair = p.imag() > 0;
+    for (int j = 0; j < n; ++j) {
+      // State nodes of pole k driven by port j: z (real pole) or zr, zi (pair).
+      const std::string base = fmt::format("{}_y{}_{}", prefix, k, j + 1);
+      const std::vector<std::string> states =
+          pair ? std::vector<std::string>{base + "r", base + "i"} : std::vector<std::string>{base};
+      for (const std::string& z : states) {
+        const std::string tail = z.substr(prefix.size() + 1);
+        cards.push_back(card('c', "c" + prefix + "_" + tail, {z, "0"}, 1.0 / w));
+        cards.push_back(card('r', "r" + prefix + "_" + tail, {z, "0"}, w / -p.real()));
+      }
+      const std::string t0 = states[0].substr(prefix.size() + 1);
+      g(t0 + "_in", {states[0], "0"}, port_nodes[j], -1.0);
+      if (pair) {
+        const std::string t1 = states[1].substr(prefix.size() + 1);
+        g(t0 + "_x", {states[0], "0"}, {states[1], "0"}, p.imag() / w);
+        g(t1 + "_x", {states[1], "0"}, {states[0], "0"}, -p.imag() / w);
+      }
+      for (int i = 0; i < n; ++i) {
+        const cd r = m.residues[k](i, j);
+        if (pair) {
+          g(fmt::format("{}_o{}", t0, i + 1), port_nodes[i], {states[0], "0"}, 2 * r.real() / w);
+          g(fmt::format("{}_o{}", states[1].substr(prefix.size() + 1), i + 1), port_nodes[i],
+            {states[1], "0"}, -2 * r.imag() / w);
+        } else {
+          g(fmt::format("{}_o{}", t0, i + 1), port_nodes[i], {states[0], "0"}, r.real() / w);
+        }
+      }
+    }
+  }
+}
+
+Status add_touchstone_cable(std::vector<Card>& cards, const std::string& prefix,
+                            const std::string& a_p, const std::string& a_n, const std::string& b_p,
+                            const std::string& b_n, const CableSpec& spec) {
+  auto cable = touchstone_cable(spec);
+  if (!cable) return cable.status();
+  const TouchstoneCable& c = **cable;
+  if (c.differential)
+    add_rational_cards(cards, prefix, c.fit.model, {{a_p, a_n}, {b_p, b_n}});
+  else
+    add_rational_cards(cards, prefix, c.fit.model,
+                       {{a_p, "0"}, {a_n, "0"}, {b_p, "0"}, {b_n, "0"}});
+  return Status::Ok();
+}
+
+}  // namespace isolink::link

@@ -1,0 +1,72 @@
+// A measured cable: a Touchstone file's S-parameters fitted with a rational admittance and built
+// into the circuit as an equivalent network of R, C and G (VCCS) cards, which the transient
+// engine, the LTI engine's reduced model, the AC analysis and ngspice all take unchanged.
+//
+//   link spec:  cable: {touchstone: harness.s4p, ports: [1, 2, 3, 4], tolerance: 1e-3}
+//   StatusOr<std::shared_ptr<const TouchstoneCable>> c = touchstone_cable(spec);  // cached
+//   add_touchstone_cable(cards, "cab", "ap", "an", "bp", "bn", spec);
+//
+// Ports. A 4-port is single-ended to the chassis reference (node 0): by default port 1 = tx P,
+// 2 = tx N, 3 = rx P, 4 = rx N; `ports: [a, b, c, d]` names the file's ports for those four. A
+// 2-port is differential (port 1 across tx P-N, port 2 across rx P-N, at the file's reference,
+// 100 ohm for a mixed-mode export); its common mode is assumed open: the cable joins no
+// common-mode current between the ends and adds no capacitance to the chassis (a question about
+// the common mode, isolink noise, needs the 4-port).
+//
+// Fit (solver/vector_fit.h): Y = y_from_s(S) over the file's band, relaxed vector fitting with
+// common poles, the order raised until the RMS S error is under the tolerance; then passivity
+// enforced. Below the first frequency: a file without a DC point gets one, the conductors'
+// series resistance extrapolated to DC and nothing else (touchstone_cable.cpp,
+// dc_extrapolation), and the fit passes through it
+// (stated in `isolink touchstone`'s output with the DC conductances). A fit that does not reach
+// the tolerance is an error naming the error reached.
+//
+// Realization (docs/touchstone.md): Y(s) = D + sum_k R_k / (s - p_k). For each pole and each
+// port j a state node z with C = 1/|Re p| and 1 ohm to ground, driven by a G card with the
+// port's voltage (so z = |Re p| v_j / (s - p), at most |v_j|); a pair's two states are coupled
+// by G cards with Im p / |Re p|. Each port's current is D v plus G cards from the states with
+// the residues over |Re p|. The states stay the size of the port voltages at any frequency.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "base/status.h"
+#include "netlists/link/cable.h"
+#include "netlists/touchstone.h"
+#include "solver/card.h"
+#include "solver/vector_fit.h"
+
+namespace isolink::link {
+
+struct TouchstoneCable {
+  Touchstone data;            // as read, ports in the file's order
+  std::vector<int> ports;     // file ports (1-based) for tx P, tx N, rx P, rx N (4-port)
+  bool differential = false;  // a 2-port: ports across the pairs
+  FitResult fit;              // of Y in the link's port order
+  PassivityReport passivity;
+  Eigen::MatrixXd dc_conductance;  // Y(0) of the fitted model, S
+  bool dc_extrapolated = false;    // the file has no DC point: Y(0) from dc_resistance
+  Eigen::MatrixXd dc_resistance;   // ohm, the conductors' series R extrapolated to DC (P, N)
+};
+
+// Reads and fits a spec's file (spec.touchstone, spec.ports, spec.fit_tolerance). Fits are
+// kept, keyed by the file's bytes, the ports and the tolerance.
+StatusOr<std::shared_ptr<const TouchstoneCable>> touchstone_cable(const CableSpec& spec);
+// The same from data in memory (isolink touchstone, tests).
+StatusOr<std::shared_ptr<const TouchstoneCable>> fit_touchstone_cable(const Touchstone& data,
+                                                                      std::vector<int> ports,
+                                                                      double tolerance);
+
+// The equivalent network of a fitted model between port node pairs (plus, minus): minus "0" for
+// a single-ended port. Element and node names start with prefix as add_cable's do.
+void add_rational_cards(std::vector<Card>& cards, const std::string& prefix, const RationalModel& m,
+                        const std::vector<std::pair<std::string, std::string>>& port_nodes);
+
+// The cable's cards between the ends (a_p, a_n) and (b_p, b_n).
+Status add_touchstone_cable(std::vector<Card>& cards, const std::string& prefix,
+                            const std::string& a_p, const std::string& a_n, const std::string& b_p,
+                            const std::string& b_n, const CableSpec& spec);
+
+}  // namespace isolink::link

@@ -1,0 +1,159 @@
+// A native cable's S-parameters from the AC analysis (analysis/touchstone_export.h), written as
+// .s4p, read back and fitted as the cable: the link's waveform against the native cable's.
+#include "analysis/touchstone_export.h"
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <random>
+
+#include "analysis/link_run.h"
+#include "base/file_io.h"
+#include "netlists/link/touchstone_cable.h"
+#include "solver/vector_fit.h"
+
+namespace isolink::analysis {
+namespace {
+
+std::string temp_path(const std::string& name) {
+  return (std::filesystem::temp_directory_path() /
+          fmt::format("isolink_ts_{}_{}", ::getpid(), name))
+      .string();
+}
+
+// Largest |v_a - v_b| of column k over a's time grid.
+double max_difference(const Waveform& a, const Waveform& b, size_t k) {
+  double worst = 0;
+  for (size_t i = 0; i < a.samples(); ++i)
+    worst = std::max(worst, std::abs(a.columns[k][i] - b.value_at(k, a.time[i])));
+  return worst;
+}
+
+struct Case {
+  const char* spec;
+  double f_start;
+  double noise;  // RMS of complex Gaussian noise added to every S entry
+};
+
+void check_case(const Case& c, double limit_mv) {
+  StatusOr<link::LinkSpec> spec =
+      link::read_link_spec_file(std::string(ISOLINK_EXAMPLES_DIR) + "/" + c.spec);
+  ASSERT_TRUE(spec.ok()) << spec.status().message();
+  spec->stimulus.directions = {link::Direction::kDown};
+  StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
+  ASSERT_TRUE(parts.ok());
+  RunOptions ro;
+  ro.engine = Engine::Lti;
+  StatusOr<LinkRun> native = run_link(*spec, *parts, ro);
+  ASSERT_TRUE(native.ok()) << native.status().message();
+
+  TouchstoneExportOptions o;
+  o.f_start = c.f_start;
+  StatusOr<Touchstone> t = cable_touchstone(spec->cable, o);
+  ASSERT_TRUE(t.ok()) << t.status().message();
+  std::mt19937 rng(7);
+  std::normal_distribution<double> g(0, c.noise / std::sqrt(2.0));
+  if (c.noise > 0)
+    for (auto& s : t->s)
+      for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) s(i, j) += std::complex<double>(g(rng), g(rng));
+  const std::string path = temp_path(fmt::format("{}.s4p", c.f_start));
+  ASSERT_TRUE(write_file_atomic(path, write_touchstone(*t, "test")).ok());
+
+  link::LinkSpec measured = *spec;
+  measured.cable = link::CableSpec{};
+  measured.cable.touchstone = path;
+  auto fit = link::touchstone_cable(measured.cable);
+  ASSERT_TRUE(fit.ok()) << c.spec << " " << c.f_start << " " << fit.status().message();
+  std::printf(
+      "fit: %zu poles, order %d, rms %.3g max %.3g at %.3g Hz, passive %d (min eig %.3g at %g Hz, "
+      "%d perturbations, added %.3g S)\n",
+      (*fit)->fit.model.poles.size(), (*fit)->fit.model.order(), (*fit)->fit.rms_error,
+      (*fit)->fit.error, (*fit)->fit.error_frequency, (*fit)->passivity.passive,
+      (*fit)->passivity.min_eigenvalue, (*fit)->passivity.at_frequency,
+      (*fit)->passivity.perturbation_iterations, (*fit)->passivity.added_conductance);
+  StatusOr<LinkRun> run = run_link(measured, *parts, ro);
+  ASSERT_TRUE(run.ok()) << run.status().message();
+  std::printf("native %s %.2f s, fitted %s %.2f s (method %s, note %s, model %.2f s order %d)\n",
+              engine_name(native->directions[0].sim.engine), native->directions[0].sim.seconds,
+              engine_name(run->directions[0].sim.engine), run->directions[0].sim.seconds,
+              run->directions[0].sim.lti.method.c_str(), run->directions[0].sim.lti.note.c_str(),
+              run->directions[0].sim.lti.model_seconds, run->directions[0].sim.lti.model.order);
+  std::cout << "Y0 fit\n" << (*fit)->dc_conductance.row(0) << "\n";
+  ASSERT_TRUE(run.ok()) << run.status().message();
+  const Waveform& a = native->directions[0].sim.wave;
+  const Waveform& b = run->directions[0].sim.wave;
+  const double diff = max_difference(a, b, 0);
+  std::printf("%s from %g Hz, noise %g: |dv(rxp,rxn)| <= %.3f mV (engine %s)\n", c.spec, c.f_start,
+              c.noise, diff * 1e3, engine_name(run->directions[0].sim.engine));
+  EXPECT_LT(diff, limit_mv * 1e-3);
+  std::remove(path.c_str());
+}
+
+// The issue's figure: within 2 mV of the native cable (measured 1.30 mV, fit RMS 3.4e-7, 29 poles).
+TEST(TouchstoneExport, CapLink2mReadBackWithin2mV) {
+  check_case({"cap_2m.yaml", 10e3, 0}, 2);
+}
+
+// Known gaps, asserted at the figures measured today so that a change that worsens them fails:
+// a file starting at 300 kHz (the DC side then rests on the pi-section extrapolation) measured
+// 13.2 mV; a 5 m link with chokes (its common mode is sensitive below the first point) 24.8 mV.
+// The issue asks for 2 mV in both (docs/touchstone.md, "Limits").
+TEST(TouchstoneExport, CapLink2mFrom300kHz) {
+  check_case({"cap_2m.yaml", 300e3, 0}, 15);
+}
+TEST(TouchstoneExport, Capchoke5m) {
+  check_case({"capchoke_5m.yaml", 10e3, 0}, 30);
+}
+
+// Noise of 1e-5 RMS (-100 dB) on every S entry: the fit follows it into a model that is not
+// passive at 306 kHz, the residue perturbation does not repair it, and the cable is refused
+// with that reason rather than run (the issue asks for 2 mV here: not met).
+TEST(TouchstoneExport, NoisyFileIsRefusedAsNotPassive) {
+  StatusOr<link::LinkSpec> spec =
+      link::read_link_spec_file(std::string(ISOLINK_EXAMPLES_DIR) + "/cap_2m.yaml");
+  ASSERT_TRUE(spec.ok());
+  StatusOr<Touchstone> t = cable_touchstone(spec->cable, {});
+  ASSERT_TRUE(t.ok()) << t.status().message();
+  std::mt19937 rng(7);
+  std::normal_distribution<double> g(0, 1e-5 / std::sqrt(2.0));
+  for (auto& s : t->s)
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) s(i, j) += std::complex<double>(g(rng), g(rng));
+  const std::string path = temp_path("noisy.s4p");
+  ASSERT_TRUE(write_file_atomic(path, write_touchstone(*t, "noisy")).ok());
+  link::CableSpec cable;
+  cable.touchstone = path;
+  auto fit = link::touchstone_cable(cable);
+  std::remove(path.c_str());
+  ASSERT_FALSE(fit.ok());
+  EXPECT_NE(fit.status().message().find("the fit is not passive"), std::string::npos)
+      << fit.status().message();
+}
+
+// The export against the cable's closed form at 100 Hz (far below the series R-L corner): the
+// through admittance -Re Y13 is 1 / (R_dc l) of the conductor to 0.1 %, and P and N have no
+// conductance between them.
+TEST(TouchstoneExport, ThroughConductanceIsTheConductorsResistance) {
+  link::CableSpec cable;
+  cable.length = 2;
+  TouchstoneExportOptions o;
+  o.f_start = 100;
+  o.f_stop = 1e3;
+  o.points = 2;
+  StatusOr<Touchstone> t = cable_touchstone(cable, o);
+  ASSERT_TRUE(t.ok()) << t.status().message();
+  StatusOr<link::CableModel> m = link::cable_model(cable);
+  ASSERT_TRUE(m.ok());
+  const Eigen::MatrixXcd y = y_from_s(t->s[0], 50);
+  EXPECT_NEAR(-y(0, 2).real(), 1 / (m->r_dc * 2), 0.001 / (m->r_dc * 2));
+  EXPECT_NEAR(y(0, 1).real(), 0, 1e-3);  // no conductance between P and N
+}
+
+}  // namespace
+}  // namespace isolink::analysis
