@@ -52,7 +52,9 @@ TEST(Vccs, GyratorMakesAnInductor) {
     const cd jwl(0, 2 * std::numbers::pi * f * l);
     auto x = ac->solve("vin", f);
     ASSERT_TRUE(x.ok());
-    EXPECT_NEAR(std::abs(x->voltage(*p) - jwl / (r + jwl)), 0, 1e-9) << f;
+    // Node b has no DC path: its 1e-12 S tie (Circuit) against w C (6e-6 S at 1 kHz) is the
+    // 1e-7 allowed.
+    EXPECT_NEAR(std::abs(x->voltage(*p) - jwl / (r + jwl)), 0, 1e-7) << f;
   }
 }
 
