@@ -456,6 +456,9 @@ StatusOr<CompareResult> compare_capture(const CompareInput& in, const link::Part
   r.direction = link::direction_name(opt.direction);
   StatusOr<Prepared> p = prepare(in, opt, r);
   if (!p) return p.status();
+  // The design's waveform is synthesized from its edge response: a nonlinear link has none.
+  if (std::string why = link::linear_only(p->spec, "compare"); !why.empty())
+    return Status::Error(fmt::format("{}: {}", p->spec.source, why));
   for (const std::string& k : opt.fit) {  // bad keys and bounds are bad input, before any work
     StatusOr<DesignValue> dv = design_value(p->spec, parts, k);
     if (!dv) return dv.status();

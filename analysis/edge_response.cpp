@@ -373,6 +373,12 @@ void EdgeResponseBuilder::sample_transient(const Waveform& w, double span) {
 StatusOr<EdgeResponse> edge_response(const link::LinkSpec& spec, const link::PartLibrary& parts,
                                      link::Direction d, const EdgeResponseOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
+  if (std::string why = link::linear_only(spec, "the edge response"); !why.empty())
+    return Status::Error(why);
+  if (opt.expand.driver.clamps.enabled || opt.expand.load.clamps.enabled)
+    return Status::Error(
+        "the edge response needs a linear link (it superposes the link's responses), and the "
+        "expansion adds the pins' clamp diodes");
   EdgeResponse out;
   EdgeResponseBuilder builder(spec, parts, d, opt, out);
   bool done = false;

@@ -556,6 +556,11 @@ StatusOr<NoiseResult> analyze_noise(const link::LinkSpec& spec, const link::Part
                                     std::span<const NoiseDirectionInput> inputs,
                                     const NoiseOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
+  // Noise immunity is a small-signal (AC) analysis around the operating point; a TVS or a clamp
+  // that conducts under the injected level is outside it, and one that does not is its
+  // capacitance: the user says which by giving esd a capacitance.
+  if (std::string why = link::linear_only(spec, "noise (a small-signal analysis)"); !why.empty())
+    return Status::Error(why);
   NoiseResult r;
   r.spec = spec.noise;
   r.peak_factor = noise_peak_factor(spec.noise);
@@ -590,6 +595,9 @@ StatusOr<NoiseResult> analyze_noise_of_run(const link::LinkSpec& spec,
 }
 
 StatusOr<NoiseRun> run_noise(const link::LinkSpec& spec, const link::PartLibrary& parts) {
+  // Refused before the (long) run of a nonlinear link's traffic, as analyze_noise would after.
+  if (std::string why = link::linear_only(spec, "noise (a small-signal analysis)"); !why.empty())
+    return Status::Error(why);
   NoiseRun out;
   StatusOr<LinkRun> run = run_link(spec, parts);
   if (!run) return run.status();

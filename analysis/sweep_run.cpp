@@ -349,6 +349,7 @@ namespace {
 std::string fast_path_refused(const link::LinkSpec& spec, const PointOptions& opt, double dt) {
   if (opt.simulate) return "--simulate";
   if (opt.run.engine == Engine::Transient) return "--engine transient";
+  if (!link::nonlinear_parts(spec).empty()) return "nonlinear link (superposition does not hold)";
   // Waveform files at sim.tstep: the synthesis grid (dt) resampled, exact on a multiple of it.
   const double k = spec.sim.tstep / dt;
   if (!opt.waves_dir.empty() && (k < 1 - 1e-9 || std::abs(k - std::round(k)) > 1e-6))

@@ -65,6 +65,10 @@ std::string values_text(const Part& p) {
       if (!p.dielectric.empty()) s += " " + p.dielectric;
       return s;
     }
+    case PartKind::Tvs:
+      return fmt::format("{}, VRWM {:g} V, VBR {:g} V, VCL {:g} V @ {:g} A, {} @ 0 V",
+                         p.tvs.bidirectional ? "bidir" : "unidir", p.tvs.standoff, p.tvs.breakdown,
+                         p.tvs.clamp, p.tvs.clamp_current, format_si(p.tvs.capacitance, "F"));
   }
   return "";
 }
@@ -74,6 +78,10 @@ std::string rating_text(const Part& p) {
   if (p.rated_current) r.push_back(format_si(*p.rated_current, "A"));
   if (p.rated_voltage) r.push_back(format_si(*p.rated_voltage, "V"));
   if (p.isolation_voltage) r.push_back(format_si(*p.isolation_voltage, "V") + " isolation");
+  if (p.kind == PartKind::Tvs) {
+    if (p.tvs.peak_power > 0) r.push_back(format_si(p.tvs.peak_power, "W") + " 8/20us");
+    if (p.tvs.esd_contact > 0) r.push_back(format_si(p.tvs.esd_contact, "V") + " ESD");
+  }
   std::string s;
   for (const std::string& x : r) s += (s.empty() ? "" : ", ") + x;
   return s.empty() ? "-" : s;
@@ -131,6 +139,27 @@ nlohmann::json to_json(const Part& p) {
       m = {{"capacitance", p.capacitor.capacitance},
            {"tolerance", p.capacitor.tolerance},
            {"voltage_rating", p.capacitor.voltage_rating}};
+      break;
+    case PartKind::Tvs:
+      m = {{"polarity", p.tvs.bidirectional ? "bidirectional" : "unidirectional"},
+           {"standoff", p.tvs.standoff},
+           {"breakdown", p.tvs.breakdown},
+           {"breakdown_current", p.tvs.breakdown_current},
+           {"clamp", p.tvs.clamp},
+           {"clamp_current", p.tvs.clamp_current},
+           {"capacitance", p.tvs.capacitance},
+           {"peak_current", p.tvs.peak_current},
+           {"peak_power", p.tvs.peak_power},
+           {"esd_contact", p.tvs.esd_contact},
+           {"spice",
+            {{"is", p.tvs.is},
+             {"n", 1},
+             {"bv", p.tvs.bv},
+             {"ibv", p.tvs.ibv},
+             {"rs", p.tvs.rs},
+             {"cjo", p.tvs.cjo},
+             {"vj", p.tvs.vj},
+             {"m", p.tvs.grading}}}};
       break;
   }
   j["model"] = m;
@@ -194,6 +223,14 @@ void print_part(const Part& p) {
                                          : "none");
       break;
     case PartKind::Capacitor:
+      break;
+    case PartKind::Tvs:
+      std::printf(
+          "  model: %s, per junction: .model D(IS=%g N=1 BV=%.6g IBV=%g RS=%.6g CJO=%g VJ=%g "
+          "M=%g)%s\n",
+          p.tvs.bidirectional ? "two junctions in anti-series per line" : "one junction per line",
+          p.tvs.is, p.tvs.bv, p.tvs.ibv, p.tvs.rs, p.tvs.cjo, p.tvs.vj, p.tvs.grading,
+          p.tvs.bidirectional ? " (CJO twice the part's: in series they are its capacitance)" : "");
       break;
   }
 }

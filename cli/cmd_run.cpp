@@ -105,7 +105,12 @@ int run_run(const RunArgs& a) {
   if (!run) return fail(run.status().with_context(a.spec));
   // The worst case over all legal traffic, beside the spec's traffic (its own verdict).
   std::optional<analysis::WorstResult> worst;
-  if (!a.no_worst) {
+  // The worst case superposes edge responses: a nonlinear link (a TVS, the pins' clamps) has
+  // none to superpose, so its run is the exact transient of the spec's traffic alone, and the
+  // report says why the worst case is missing.
+  const std::string no_worst_why =
+      link::linear_only(*spec, "the worst case over all legal traffic");
+  if (!a.no_worst && no_worst_why.empty()) {
     analysis::WorstOptions wopt;
     wopt.progress = [&](const std::string& what, double f) {
       line.show_fraction("worst case, " + what, f);
@@ -140,6 +145,10 @@ int run_run(const RunArgs& a) {
         return fail(s);
       for (const std::string& f : files) md += fmt::format("![{}]({})\n\n", f, f);
     }
+  } else if (!a.no_worst) {
+    json["worst_case"] = {{"computed", false}, {"why", no_worst_why}};
+    md += "\n## Worst case over all traffic\n\nNot computed: " + no_worst_why + ".\n";
+    std::fprintf(stderr, "isolink run: note: no worst case: %s\n", no_worst_why.c_str());
   }
   if (Status s = write_file_atomic(bundle->path("report.json"), json.dump(2) + "\n"); !s.ok())
     return fail(s);

@@ -51,6 +51,8 @@ std::vector<std::string> unit_words(Unit unit) {
       return {"c", "degc"};
     case Unit::kSiemens:
       return {"s"};
+    case Unit::kWatt:
+      return {"w"};
     case Unit::kNone:
       return {};
   }
@@ -99,6 +101,8 @@ const char* unit_symbol(Unit unit) {
       return "degC";
     case Unit::kSiemens:
       return "S";
+    case Unit::kWatt:
+      return "W";
     case Unit::kNone:
       return "";
   }

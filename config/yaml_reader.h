@@ -40,7 +40,8 @@ enum class Unit {
   kHertz,
   kMetre,
   kCelsius,
-  kSiemens
+  kSiemens,
+  kWatt
 };
 enum class Rule { kAny, kPositive, kNonNegative };
 

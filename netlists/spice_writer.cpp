@@ -2,6 +2,10 @@
 
 #include <fmt/format.h>
 
+#include <memory>
+#include <utility>
+#include <vector>
+
 namespace isolink {
 namespace {
 
@@ -37,13 +41,60 @@ std::string element_name(const Card& c) {
   return fmt::format("{}.{}", c.letter, c.name);
 }
 
+// The .model cards the elements name, each written once. Two different models of one name
+// (flattened from two subcircuits' scopes) get distinct names ("dmod", "dmod_2").
+class ModelNames {
+ public:
+  const std::string& name_of(const std::shared_ptr<const CardModel>& m) {
+    for (const auto& [model, name] : models_)
+      if (model == m.get() || same(*model, *m)) return name;
+    std::string name = m->name;
+    for (int k = 2; taken(name); ++k) name = fmt::format("{}_{}", m->name, k);
+    models_.emplace_back(m.get(), name);
+    return models_.back().second;
+  }
+  std::string cards() const {
+    std::string out;
+    for (const auto& [m, name] : models_) {
+      out += fmt::format(".model {} {}(", name, m->type);
+      for (std::size_t i = 0; i < m->params.size(); ++i) {
+        out += i ? " " : "";
+        out += m->params[i].first + "=";
+        write_arg(out, m->params[i].second);
+      }
+      out += ")\n";
+    }
+    return out;
+  }
+
+ private:
+  static bool same(const CardModel& a, const CardModel& b) {
+    if (a.name != b.name || a.type != b.type || a.params.size() != b.params.size()) return false;
+    for (std::size_t i = 0; i < a.params.size(); ++i) {
+      const CardArg &x = a.params[i].second, &y = b.params[i].second;
+      if (a.params[i].first != b.params[i].first || x.kind != y.kind || x.number != y.number ||
+          x.word != y.word)
+        return false;
+    }
+    return true;
+  }
+  bool taken(const std::string& name) const {
+    for (const auto& [m, n] : models_)
+      if (n == name) return true;
+    return false;
+  }
+  std::vector<std::pair<const CardModel*, std::string>> models_;
+};
+
 }  // namespace
 
 std::string write_spice(const Netlist& n) {
   std::string out = n.title + "\n";
+  ModelNames models;
   for (const Card& c : n.cards) {
     out += element_name(c);
     for (const auto& node : c.nodes) out.append(" ").append(node);
+    if (c.model) out.append(" ").append(models.name_of(c.model));
     // K names inductors: a hierarchical one by its flattened name too ("x1.l3" -> "l.x1.l3").
     for (const auto& ref : c.refs)
       out.append(" ").append(ref.find('.') == std::string::npos ? ref : "l." + ref);
@@ -57,6 +108,7 @@ std::string write_spice(const Netlist& n) {
     }
     out += '\n';
   }
+  out += models.cards();
   for (const auto& o : n.options) {
     out.append(".options ").append(o.key);
     if (o.value.kind != CardArg::Kind::Word || !o.value.word.empty()) {

@@ -4,7 +4,8 @@
 //   std::string text = write_spice(netlist);   // read_spice_text(text) gives the same cards
 //
 // Numbers are written with %.12g; PWL/PULSE/SIN arguments as calls, broken into '+'
-// continuation lines of 8 values; then .options, .tran and .end.
+// continuation lines of 8 values; then the .model cards the elements name (each once), .options,
+// .tran and .end.
 #pragma once
 
 #include <string>

@@ -107,7 +107,8 @@ py::dict run(const py::object& spec_obj, const std::optional<std::string>& direc
     if (spec) set_direction(*spec, direction);
     if (spec) parts = link::PartLibrary::load(parts_dirs);
     if (spec && parts) lr = analysis::run_link(*spec, *parts, ro);
-    if (lr && worst) wr = analysis::worst_case(*spec, *parts);
+    if (lr && worst && link::nonlinear_parts(*spec).empty())
+      wr = analysis::worst_case(*spec, *parts);
   }
   if (pack)
     raise(Status::Error(arg.where() + ": error: a pack spec (hops:); isolink.run takes a link "
@@ -118,6 +119,9 @@ py::dict run(const py::object& spec_obj, const std::optional<std::string>& direc
   if (wr && !*wr) raise(wr->status().with_context(arg.where() + ", worst case"));
   nlohmann::ordered_json j = reports::run_report_json(*spec, *lr);
   if (wr) j["worst_case"] = reports::worst_json(**wr);  // as cmd_run.cpp
+  if (worst && !wr)  // a nonlinear link: no superposition (as cmd_run.cpp)
+    j["worst_case"] = {{"computed", false},
+                       {"why", link::linear_only(*spec, "the worst case over all legal traffic")}};
   py::dict out = to_python(j);
   out["pass"] = lr->pass;
   py::list dirs = out["directions"];

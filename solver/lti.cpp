@@ -49,10 +49,13 @@ SourceInput pwl_input(const std::vector<double>& t, const std::vector<double>& v
 
 Status check_lti(const Circuit& circuit) {
   for (const auto& e : circuit.elements()) {
-    if (!e->linear_time_invariant())
-      return error_at(e->loc(), "element '" + e->name() +
-                                    "' is not linear and time-invariant: the LTI engine cannot "
-                                    "simulate it (use --engine transient)");
+    if (!e->linear_time_invariant()) {
+      const std::string why = "element '" + e->name() +
+                              "' is not linear and time-invariant: the LTI engine cannot "
+                              "simulate it (use --engine transient)";
+      // Elements built in code (a link spec's TVS, the pins' clamps) have no netlist location.
+      return e->loc().valid() ? error_at(e->loc(), why) : Status::Error(why);
+    }
     const SourceFunction* f = e->source_function();
     if (f && !f->piecewise_linear())
       return error_at(e->loc(), "source '" + e->name() +

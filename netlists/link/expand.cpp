@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <cctype>
+#include <utility>
+
 #include "base/hex.h"
 #include "netlists/link/board.h"
 #include "netlists/link/cable.h"
@@ -72,6 +75,38 @@ double cable_side_c_of(const IsolationSpec& iso) {
   return iso.type.rfind("transformer", 0) == 0 ? 100e-12 : 0.0;
 }
 
+// The ESD part of an end on each line (ep, en) to ground: a capacitance, or a TVS part from the
+// library as diodes (add_tvs), whose model is named after the part.
+Status add_esd(std::vector<Card>& cards, const IsolationSpec& iso, const std::string& side,
+               const std::string& ep, const std::string& en, const PartLibrary& parts,
+               const std::string& where, std::string* bom) {
+  if (iso.esd_part.empty()) {
+    *bom += "; ESD " + format_si(iso.esd, "F") + " per line";
+    cards.push_back(make_card('c', "c" + side + "esdp", {ep, "0"}, {number_arg(iso.esd)}));
+    cards.push_back(make_card('c', "c" + side + "esdn", {en, "0"}, {number_arg(iso.esd)}));
+    return Status::Ok();
+  }
+  const Part* part = parts.find(iso.esd_part);
+  if (part == nullptr)
+    return at(iso.esd_loc, fmt::format("{}.isolation.esd: '{}' is neither a capacitance (20p) nor "
+                                       "a part of the library (see `isolink parts`)",
+                                       where, iso.esd_part));
+  if (part->kind != PartKind::Tvs)
+    return at(iso.esd_loc, fmt::format("{}.isolation.esd: '{}' is a {}, not a TVS", where,
+                                       part->number, part_kind_name(part->kind)));
+  const TvsModel& m = part->tvs;
+  *bom += fmt::format("; TVS {} per line ({}, VBR {:g} V, VCL {:g} V at {:g} A, {} at 0 V)",
+                      part->number, m.bidirectional ? "bidirectional" : "unidirectional",
+                      m.breakdown, m.clamp, m.clamp_current, format_si(m.capacitance, "F"));
+  std::string model_name;
+  for (char c : part->number) model_name += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+  for (auto [line, tag] : {std::pair{ep, "p"}, std::pair{en, "n"}})
+    if (Status s = add_tvs(cards, "d" + side + "esd" + tag, line, "0", "tvs_" + model_name, m);
+        !s.ok())
+      return at(iso.esd_loc, fmt::format("{}.isolation.esd: {}", where, s.message()));
+  return Status::Ok();
+}
+
 // One end's board and isolation between its device pins (pin_p/pin_n) and its cable connector
 // nodes; returns the connector node names.
 StatusOr<std::pair<std::string, std::string>> add_end(std::vector<Card>& cards, const EndSpec& end,
@@ -139,13 +174,11 @@ StatusOr<std::pair<std::string, std::string>> add_end(std::vector<Card>& cards, 
     cards.push_back(make_card('c', "c" + side + "cabp", {p, "0"}, {number_arg(cable_side_c)}));
     cards.push_back(make_card('c', "c" + side + "cabn", {n, "0"}, {number_arg(cable_side_c)}));
   }
-  if (iso.esd > 0) {
+  if (iso.esd > 0 || !iso.esd_part.empty()) {
     // The ESD part sits at the board's ESD node when it has one (BQ79606A), else at the connector.
     const bool esd_node = board->r_pin > 0;
-    *bom += "; ESD " + format_si(iso.esd, "F") + " per line";
     const std::string ep = esd_node ? side + "b_esdp" : p, en = esd_node ? side + "b_esdn" : n;
-    cards.push_back(make_card('c', "c" + side + "esdp", {ep, "0"}, {number_arg(iso.esd)}));
-    cards.push_back(make_card('c', "c" + side + "esdn", {en, "0"}, {number_arg(iso.esd)}));
+    if (Status s = add_esd(cards, iso, side, ep, en, parts, where, bom); !s.ok()) return s;
   }
   if (type != "none") {
     // Behind the isolation the cable has no DC path of its own: give each line the leakage a real
@@ -228,7 +261,12 @@ StatusOr<ExpandedLink> expand_link(const LinkSpec& spec, const PartLibrary& part
     out.expected.insert(out.expected.end(), f.bytes.begin(), f.bytes.end());
 
   std::vector<Card>& cards = out.netlist.cards;
-  if (Status s = add_tx_driver(cards, "tx", "txp", "txn", out.drive, opt.driver); !s.ok())
+  // The pins' clamps come from the spec's ends (the device at each pin), the rest from opt.
+  TxDriverModel driver = opt.driver;
+  RxLoadModel load = opt.load;
+  driver.clamps.enabled = driver.clamps.enabled || from.pin_clamps == "rails";
+  load.clamps.enabled = load.clamps.enabled || to.pin_clamps == "rails";
+  if (Status s = add_tx_driver(cards, "tx", "txp", "txn", out.drive, driver); !s.ok())
     return s.with_context("tx driver");
   std::string* from_bom = down ? &out.tx_bom : &out.rx_bom;
   std::string* to_bom = down ? &out.rx_bom : &out.tx_bom;
@@ -246,7 +284,7 @@ StatusOr<ExpandedLink> expand_link(const LinkSpec& spec, const PartLibrary& part
       !s.ok())
     return at(spec.cable_loc, "cable: " + s.message());
   const size_t load_start = cards.size();
-  if (Status s = add_rx_load(cards, "rx", "rxp", "rxn", opt.load); !s.ok())
+  if (Status s = add_rx_load(cards, "rx", "rxp", "rxn", load); !s.ok())
     return s.with_context("rx load");
   reground(cards, load_start, opt.rx_ground);
 

@@ -33,6 +33,30 @@ std::string device_rules(const std::string& device) {
   return device == "bq79600" ? "bq79600" : "bq7961x";
 }
 
+std::vector<std::string> nonlinear_parts(const LinkSpec& spec) {
+  std::vector<std::string> out;
+  for (auto [key, end] : {std::pair{"tx", &spec.tx}, std::pair{"rx", &spec.rx}}) {
+    if (!end->isolation.esd_part.empty())
+      out.push_back(fmt::format("{}.isolation.esd: TVS {}", key, end->isolation.esd_part));
+    if (end->pin_clamps != "none")
+      out.push_back(fmt::format("{}.pin_clamps: {}", key, end->pin_clamps));
+  }
+  return out;
+}
+
+std::string linear_only(const LinkSpec& spec, const std::string& what) {
+  const std::vector<std::string> parts = nonlinear_parts(spec);
+  if (parts.empty()) return "";
+  std::string list;
+  for (const std::string& p : parts) list += (list.empty() ? "" : "; ") + p;
+  return fmt::format(
+      "{} needs a linear link (it superposes the link's responses or linearises them), and "
+      "this one has nonlinear parts ({}): `isolink run` simulates it exactly "
+      "(the nonlinear transient), or give esd a capacitance (the TVS's at 0 V) and "
+      "pin_clamps none for the linear approximation",
+      what, list);
+}
+
 std::string StimulusSpec::to_script() const {
   std::string s;
   auto add = [&s](const std::string& item) { s += (s.empty() ? "" : "; ") + item; };
@@ -68,7 +92,25 @@ Status read_isolation(const YamlDoc& doc, const YAML::Node& node, const std::str
            read_quantity(doc, Unit::kFarad, Rule::kNonNegative, &iso->centre_tap_c)},
           {"cable_side_c",
            read_quantity(doc, Unit::kFarad, Rule::kNonNegative, &iso->cable_side_c)},
-          {"esd", read_quantity(doc, Unit::kFarad, Rule::kNonNegative, &iso->esd)},
+          {"esd",
+           [&](const YAML::Node& n, const std::string& p) -> Status {
+             iso->esd_loc = doc.loc(n);
+             double c = 0;
+             // A capacitance (today's linear ESD part) or a TVS part number from the library.
+             if (n.IsScalar() && config::parse_quantity(n.Scalar(), Unit::kFarad, &c)) {
+               if (!(c >= 0) || !std::isfinite(c))
+                 return doc.error(n, fmt::format("key '{}' = {}: a capacitance must be >= 0", p,
+                                                 config::node_text(n)));
+               iso->esd = c;
+               return Status::Ok();
+             }
+             if (!n.IsScalar() || n.Scalar().empty())
+               return doc.error(n, fmt::format("key '{}': expected a capacitance per line (20p) "
+                                               "or a TVS part number (PESD2CAN), found {}",
+                                               p, config::node_text(n)));
+             iso->esd_part = n.Scalar();
+             return Status::Ok();
+           }},
           {"cable_side_return", read_choice(doc, {"board", "chassis"}, &iso->cable_side_return)},
           {"choke_loss",
            [&](const YAML::Node& n, const std::string& p) -> Status {
@@ -141,6 +183,11 @@ Status read_end(const YamlDoc& doc, const YAML::Node& node, const std::string& p
           {"chassis_c", read_quantity(doc, Unit::kFarad, Rule::kPositive, &end->chassis_c)},
           {"chassis_r", read_quantity(doc, Unit::kOhm, Rule::kPositive, &end->chassis_r)},
           {"chassis_l", read_quantity(doc, Unit::kHenry, Rule::kPositive, &end->chassis_l)},
+          {"pin_clamps",
+           [&](const YAML::Node& n, const std::string& p) {
+             end->pin_clamps_loc = doc.loc(n);
+             return read_choice(doc, {"none", "rails"}, &end->pin_clamps)(n, p);
+           }},
       });
   if (!s.ok()) return s;
   if (node.IsMap() && node["chassis_l"] && !node["chassis_r"])

@@ -46,7 +46,9 @@ struct IsolationSpec {
   // at the rated frequency), "none" (lossless), or a resistance across each winding (choke_loss_r).
   std::string choke_loss = "fitted";
   double choke_loss_r = 0;  // ohm, when choke_loss is "resistance"
-  double esd = 0;           // F per line to ground (ESD part), 0: none
+  double esd = 0;           // F per line to ground (ESD part as a capacitance), 0: none
+  std::string esd_part;     // or a TVS part number (nonlinear: diodes), "" when not
+  SourceLoc esd_loc;        // where `esd` is written
   SourceLoc loc;            // the isolation map (or its end)
 };
 
@@ -63,6 +65,10 @@ struct EndSpec {
   double chassis_r = 0;     // ohm, a DC bond of the board's ground to the chassis (strap,
                             // screw) in parallel with chassis_c; 0: none (the board floats)
   double chassis_l = 0;     // H, the bond's inductance, in series with chassis_r
+  // The device pins' internal ESD clamps: "none" (linear pins, the default) or "rails" (a diode
+  // from each COM pin to CVDD and one from CVSS to it: nonlinear, netlists/link/pins.h).
+  std::string pin_clamps = "none";
+  SourceLoc pin_clamps_loc;
   SourceLoc loc;
 };
 
@@ -142,6 +148,14 @@ StatusOr<LinkSpec> read_link_spec_file(const std::string& path);
 StatusOr<LinkSpec> read_link_spec_text(const std::string& text, const std::string& name);
 // Reads a spec from a parsed document (sweeps edit the tree, then read it).
 StatusOr<LinkSpec> read_link_spec(const config::YamlDoc& doc);
+
+// The spec's nonlinear parts, in words with their keys ("tx.isolation.esd: TVS PESD2CAN",
+// "rx.pin_clamps: rails"); empty for a linear link. Analyses that superpose responses (worst,
+// the sweep's fast path, compare) or linearise (noise) refuse or step aside on them.
+std::vector<std::string> nonlinear_parts(const LinkSpec& spec);
+// "" for a linear link, else why `what` (e.g. "the worst case") cannot take it, naming the parts
+// and the way out.
+std::string linear_only(const LinkSpec& spec, const std::string& what);
 
 // Devices and their receiver rule sets: bq79600 -> bq79600 (bridge), bq7961x and bq79606a ->
 // bq7961x.

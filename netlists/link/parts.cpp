@@ -8,6 +8,7 @@
 #include <complex>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <numbers>
 #include <utility>
 
@@ -75,6 +76,7 @@ struct FigureSpec {
   bool measured = false;   // leakage: needs measured: shorted | differential
   bool frequency = false;  // cm_impedance: needs frequency
   bool fit = false;        // loss_r: may be "fit"
+  bool current = false;    // tvs breakdown, clamp: needs current (the test current)
 };
 
 const FigureSpec kInductance{"inductance", Unit::kHenry, Rule::kPositive};
@@ -88,6 +90,15 @@ const FigureSpec kCapacitance{"capacitance", Unit::kFarad, Rule::kPositive};
 const FigureSpec kRatedCurrent{"current", Unit::kAmpere, Rule::kPositive};
 const FigureSpec kRatedVoltage{"voltage", Unit::kVolt, Rule::kPositive};
 const FigureSpec kIsolationVoltage{"isolation", Unit::kVolt, Rule::kPositive};
+const FigureSpec kStandoff{"standoff", Unit::kVolt, Rule::kPositive};
+const FigureSpec kBreakdown{"breakdown", Unit::kVolt, Rule::kPositive, false, false, false, true};
+const FigureSpec kClamp{"clamp", Unit::kVolt, Rule::kPositive, false, false, false, true};
+const FigureSpec kGrading{"grading", Unit::kNone, Rule::kPositive};
+const FigureSpec kRatedPower{"power", Unit::kWatt, Rule::kPositive};
+const FigureSpec kRatedEsd{"esd", Unit::kVolt, Rule::kPositive};
+const std::vector<std::string> kKindNames = {"choke", "transformer", "capacitor", "tvs"};
+constexpr PartKind kKinds[] = {PartKind::Choke, PartKind::Transformer, PartKind::Capacitor,
+                               PartKind::Tvs};
 
 // Keys per kind (top level of a part). Required ones first, marked in required_keys().
 const std::vector<std::string>& keys_for(PartKind kind) {
@@ -99,6 +110,9 @@ const std::vector<std::string>& keys_for(PartKind kind) {
       "leakage", "dcr",   "winding_c", "centre_tap_c", "rating"};
   static const std::vector<std::string> capacitor = {
       "part", "maker", "kind", "description", "datasheet", "capacitance", "dielectric", "rating"};
+  static const std::vector<std::string> tvs = {
+      "part",     "maker",     "kind",  "description", "datasheet", "polarity",
+      "standoff", "breakdown", "clamp", "capacitance", "grading",   "rating"};
   switch (kind) {
     case PartKind::Choke:
       return choke;
@@ -106,6 +120,8 @@ const std::vector<std::string>& keys_for(PartKind kind) {
       return transformer;
     case PartKind::Capacitor:
       return capacitor;
+    case PartKind::Tvs:
+      return tvs;
   }
   return choke;
 }
@@ -118,6 +134,8 @@ std::vector<std::string> required_keys(PartKind kind) {
       return {"inductance", "leakage", "dcr", "winding_c"};
     case PartKind::Capacitor:
       return {"capacitance"};
+    case PartKind::Tvs:
+      return {"polarity", "standoff", "breakdown", "clamp", "capacitance"};
   }
   return {};
 }
@@ -173,16 +191,14 @@ class PartReader {
     const YAML::Node kind_node = node["kind"];
     if (!kind_node)
       return doc_.error(node, fmt::format("{}: missing key 'kind' (choke | transformer | "
-                                          "capacitor)",
+                                          "capacitor | tvs)",
                                           where));
     std::string kind;
-    if (Status s = config::read_choice(doc_, {"choke", "transformer", "capacitor"}, &kind)(
-            kind_node, key(path, "kind"));
+    if (Status s = config::read_choice(doc_, kKindNames, &kind)(kind_node, key(path, "kind"));
         !s.ok())
       return s;
-    part.kind = kind == "choke"         ? PartKind::Choke
-                : kind == "transformer" ? PartKind::Transformer
-                                        : PartKind::Capacitor;
+    for (PartKind k : kKinds)
+      if (kind == part_kind_name(k)) part.kind = k;
     if (const YAML::Node n = node["part"]; n && n.IsScalar()) part.number = trim(n.Scalar());
     const std::string label = part.number.empty() ? where : "part '" + part.number + "'";
 
@@ -191,7 +207,7 @@ class PartReader {
     for (auto it = node.begin(); it != node.end(); ++it) {
       const std::string k = it->first.Scalar();
       if (std::find(known.begin(), known.end(), k) != known.end()) continue;
-      for (PartKind other : {PartKind::Choke, PartKind::Transformer, PartKind::Capacitor}) {
+      for (PartKind other : kKinds) {
         const std::vector<std::string>& ok = keys_for(other);
         if (std::find(ok.begin(), ok.end(), k) != ok.end())
           return doc_.error(it->first,
@@ -210,32 +226,45 @@ class PartReader {
         return Status::Ok();
       };
     };
+    // A TVS is rated for its surge (IPP, PPP) and ESD; the others for current and voltage.
+    const bool tvs = part.kind == PartKind::Tvs;
     auto rating = [&](const YAML::Node& n, const std::string& full) -> Status {
       if (!n.IsMap())
-        return doc_.error(n, fmt::format("key '{}': expected a map (current, voltage, "
-                                         "isolation), found a {}",
-                                         full, config::node_kind(n)));
+        return doc_.error(n,
+                          fmt::format("key '{}': expected a map ({}), found a {}", full,
+                                      tvs ? "current, power, esd" : "current, voltage, isolation",
+                                      config::node_kind(n)));
+      if (tvs)
+        return config::read_map(doc_, n, full,
+                                {{"current", figure(kRatedCurrent, "rating.current")},
+                                 {"power", figure(kRatedPower, "rating.power")},
+                                 {"esd", figure(kRatedEsd, "rating.esd")}});
       return config::read_map(doc_, n, full,
                               {{"current", figure(kRatedCurrent, "rating.current")},
                                {"voltage", figure(kRatedVoltage, "rating.voltage")},
                                {"isolation", figure(kIsolationVoltage, "rating.isolation")}});
     };
+    std::string polarity;
     std::string kind_again;
     std::vector<Field> fields = {
         {"part", config::read_text(doc_, &part.number)},
         {"maker", config::read_text(doc_, &part.maker)},
-        {"kind", config::read_choice(doc_, {"choke", "transformer", "capacitor"}, &kind_again)},
+        {"kind", config::read_choice(doc_, kKindNames, &kind_again)},
         {"description", config::read_text(doc_, &part.description)},
         {"datasheet", config::read_text(doc_, &part.datasheet)},
         {"rating", rating},
     };
-    for (const FigureSpec* spec : {&kInductance, &kLeakage, &kDcr, &kWindingC, &kLossR,
-                                   &kCentreTapC, &kCmImpedance, &kCapacitance}) {
+    for (const FigureSpec* spec :
+         {&kInductance, &kLeakage, &kDcr, &kWindingC, &kLossR, &kCentreTapC, &kCmImpedance,
+          &kCapacitance, &kStandoff, &kBreakdown, &kClamp, &kGrading}) {
       if (std::find(known.begin(), known.end(), spec->key) != known.end())
         fields.push_back({spec->key, figure(*spec, spec->key)});
     }
     if (part.kind == PartKind::Capacitor)
       fields.push_back({"dielectric", config::read_text(doc_, &part.dielectric)});
+    if (tvs)
+      fields.push_back(
+          {"polarity", config::read_choice(doc_, {"bidirectional", "unidirectional"}, &polarity)});
     if (Status s = config::read_map(doc_, node, path, fields); !s.ok()) return s;
 
     part.number = trim(part.number);
@@ -246,8 +275,9 @@ class PartReader {
     if (part.number.empty())
       return doc_.error(node["part"],
                         fmt::format("key '{}': the part number is empty", key(path, "part")));
+    part.tvs.bidirectional = polarity != "unidirectional";
     for (const std::string& r : required_keys(part.kind))
-      if (!figs.count(r))
+      if (!figs.count(r) && !(r == "polarity" && node["polarity"]))
         return doc_.error(node,
                           fmt::format("part '{}': missing key '{}' (a {} needs {})", part.number,
                                       key(path, r), kind, join(required_keys(part.kind))));
@@ -285,6 +315,11 @@ class PartReader {
         return doc_.error(n, fmt::format("key '{}': give {{value: ..., frequency: ..., "
                                          "source: ...}}: an impedance needs its frequency",
                                          full));
+      if (spec.current)
+        return doc_.error(n, fmt::format("key '{}': give {{value: ..., current: ..., "
+                                         "source: ...}}: a TVS voltage needs the current it is "
+                                         "given at",
+                                         full));
       return read_value(n, full, spec, &f->value, &f->fitted);
     }
     if (!n.IsMap())
@@ -321,6 +356,10 @@ class PartReader {
     if (spec.frequency)
       fields.push_back(
           {"frequency", config::read_quantity(doc_, Unit::kHertz, Rule::kPositive, &frequency)});
+    std::optional<double> current;
+    if (spec.current)
+      fields.push_back(
+          {"current", config::read_quantity(doc_, Unit::kAmpere, Rule::kPositive, &current)});
     // Check the scalar keys for the SPICE mega trap before read_map converts them.
     for (const char* k : {"value", "min", "max", "frequency"})
       if (const YAML::Node v = n[k]; v && v.IsScalar())
@@ -338,6 +377,10 @@ class PartReader {
     if (spec.frequency && !frequency)
       return doc_.error(n, fmt::format("key '{}': missing key 'frequency' (where the data sheet "
                                        "rates the impedance, e.g. 10meg)",
+                                       full));
+    if (spec.current && !current)
+      return doc_.error(n, fmt::format("key '{}': missing key 'current' (the data sheet's test "
+                                       "current, e.g. 1m for VBR, the IPP for a clamping voltage)",
                                        full));
     if (tolerance && (min || max))
       return doc_.error(n["tolerance"], fmt::format("key '{}': give either tolerance or "
@@ -364,6 +407,7 @@ class PartReader {
     f->min = min;
     f->max = max;
     f->frequency = frequency;
+    f->current = current;
     f->tolerance = tolerance;
     return Status::Ok();
   }
@@ -409,6 +453,7 @@ class PartReader {
       part.cm_frequency = f->frequency;
     }
 
+    if (part.kind == PartKind::Tvs) return build_tvs(part, figs);
     if (part.kind == PartKind::Capacitor) {
       const Figure& c = *get("capacitance");
       part.capacitor.capacitance = c.value;
@@ -476,6 +521,26 @@ class PartReader {
     return Status::Ok();
   }
 
+  // A TVS from its figures; derive() errors point at the clamp figure (it decides RS).
+  Status build_tvs(Part& part, std::map<std::string, Figure>& figs) {
+    TvsModel& m = part.tvs;
+    const Figure& br = figs.at("breakdown");
+    const Figure& cl = figs.at("clamp");
+    m.standoff = figs.at("standoff").value;
+    m.breakdown = br.value;
+    m.breakdown_current = *br.current;
+    m.clamp = cl.value;
+    m.clamp_current = *cl.current;
+    m.capacitance = figs.at("capacitance").value;
+    if (auto g = figs.find("grading"); g != figs.end()) m.grading = g->second.value;
+    if (auto r = figs.find("rating.current"); r != figs.end()) m.peak_current = r->second.value;
+    if (auto r = figs.find("rating.power"); r != figs.end()) m.peak_power = r->second.value;
+    if (auto r = figs.find("rating.esd"); r != figs.end()) m.esd_contact = r->second.value;
+    if (Status s = m.validate(); !s.ok()) return error_at(part.loc, s.message());
+    if (Status s = m.derive(); !s.ok()) return error_at(cl.loc, s.message());
+    return Status::Ok();
+  }
+
  public:
   // The per-winding loss R that makes the paralleled common-mode impedance |Z| at f: the two
   // windings in parallel are (DCR/2 + j w L (1+k)/2) || 2 Cw || R/2, as the circuit builds them.
@@ -513,6 +578,8 @@ const char* part_kind_name(PartKind kind) {
       return "transformer";
     case PartKind::Capacitor:
       return "capacitor";
+    case PartKind::Tvs:
+      return "tvs";
   }
   return "?";
 }
@@ -530,6 +597,68 @@ Status ChokeModel::validate() const {
   if (!(loss_r >= 0) || !std::isfinite(loss_r))
     return bad("loss_r", loss_r, "must be >= 0 (0: no loss resistor)");
   return Status::Ok();
+}
+
+namespace {
+// kT/q at the diode's nominal temperature (27 degC, TNOM), as solver/elements/diode.cpp uses it.
+constexpr double kThermalVoltage = 1.380649e-23 * 300.15 / 1.602176634e-19;
+}  // namespace
+
+Status TvsModel::validate() const {
+  auto bad = [](const char* field, double v, const std::string& rule) {
+    return Status::Error(fmt::format("tvs.{} = {:g}: {}", field, v, rule));
+  };
+  for (auto [field, v] : {std::pair{"standoff", standoff},
+                          {"breakdown", breakdown},
+                          {"breakdown_current", breakdown_current},
+                          {"clamp", clamp},
+                          {"clamp_current", clamp_current},
+                          {"capacitance", capacitance},
+                          {"grading", grading},
+                          {"vj", vj}})
+    if (!(v > 0) || !std::isfinite(v)) return bad(field, v, "must be > 0");
+  if (!(breakdown > standoff))
+    return bad("breakdown", breakdown, fmt::format("must be above the standoff {:g} V", standoff));
+  if (!(clamp > breakdown))
+    return bad("clamp", clamp, fmt::format("must be above the breakdown {:g} V", breakdown));
+  if (!(clamp_current > breakdown_current))
+    return bad("clamp_current", clamp_current,
+               fmt::format("must be above the breakdown's test current {:g} A", breakdown_current));
+  if (!(grading < 1)) return bad("grading", grading, "must be < 1 (0.5: abrupt junction)");
+  return Status::Ok();
+}
+
+Status TvsModel::derive() {
+  if (Status s = validate(); !s.ok()) return s;
+  const double vt = kThermalVoltage;
+  // The part's voltage at current I: the forward junction (bidirectional), the breakdown
+  // junction's BV plus its exponential rise above IBV (ngspice: IBV e^((|v| - BV)/vt)), and I R.
+  auto junctions = [&](double i) {
+    return (bidirectional ? vt * std::log(i / is + 1) : 0.0) + vt * std::log(i / breakdown_current);
+  };
+  const double r =
+      ((clamp - junctions(clamp_current)) - (breakdown - junctions(breakdown_current))) /
+      (clamp_current - breakdown_current);
+  if (!(r >= 0))
+    return Status::Error(fmt::format(
+        "tvs.clamp = {:g} V at {:g} A: below what the junctions alone give ({:.4g} V); the "
+        "clamping voltage must be at least the breakdown plus the junctions' rise",
+        clamp, clamp_current, breakdown + junctions(clamp_current) - junctions(breakdown_current)));
+  bv = breakdown - junctions(breakdown_current) - breakdown_current * r;
+  ibv = breakdown_current;
+  rs = bidirectional ? r / 2 : r;  // in anti-series both junctions carry the current
+  cjo = bidirectional ? 2 * capacitance : capacitance;
+  if (!(bv > 0))
+    return Status::Error(
+        fmt::format("tvs.breakdown = {:g}: too low for a junction "
+                    "model (BV {:g} V)",
+                    breakdown, bv));
+  return Status::Ok();
+}
+
+std::vector<std::pair<std::string, double>> TvsModel::spice_params() const {
+  return {{"is", is}, {"n", 1},     {"bv", bv}, {"ibv", ibv},
+          {"rs", rs}, {"cjo", cjo}, {"vj", vj}, {"m", grading}};
 }
 
 double TransformerModel::k() const {
@@ -707,6 +836,29 @@ Status add_transformer(std::vector<Card>& cards, const std::string& prefix, cons
     out.push_back(make_card('c', x + ".cin", {an, bn}, {number_arg(m.winding_c / 2)}));
   }
   cards.insert(cards.end(), out.begin(), out.end());
+  return Status::Ok();
+}
+
+Status add_tvs(std::vector<Card>& cards, const std::string& prefix, const std::string& line,
+               const std::string& ground, const std::string& model_name, const TvsModel& m) {
+  if (Status s = m.validate(); !s.ok()) return s.with_context("tvs " + prefix);
+  auto model = std::make_shared<CardModel>();
+  model->name = lower(model_name);
+  model->type = "d";
+  for (const auto& [k, v] : m.spice_params()) model->params.emplace_back(k, number_arg(v));
+  auto diode = [&](const std::string& name, std::string anode, std::string cathode) {
+    Card c = make_card('d', lower(name), {std::move(anode), std::move(cathode)}, {});
+    c.model = model;
+    return c;
+  };
+  const std::string x = lower(prefix), l = lower(line), g = lower(ground);
+  if (!m.bidirectional) {
+    cards.push_back(diode(x, g, l));  // cathode at the line: breaks down for a positive line
+    return Status::Ok();
+  }
+  const std::string mid = x + "_mid";
+  cards.push_back(diode(x + "a", l, mid));  // forward for a positive line
+  cards.push_back(diode(x + "b", g, mid));  // breaks down for a positive line
   return Status::Ok();
 }
 

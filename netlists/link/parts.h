@@ -21,6 +21,11 @@
 //                centre tap the secondary is two coupled halves and the tap goes to ground ("0")
 //                through centre_tap_c.
 //   capacitor    capacitance, tolerance and voltage rating (the link builder places it).
+//   tvs          (nonlinear) an ESD / TVS diode per line to ground as SPICE level-1 diodes:
+//                unidirectional one junction (cathode at the line), bidirectional two in
+//                anti-series through an internal node. Breakdown voltage and series resistance
+//                are solved so the model meets the data sheet's VBR at its test current and its
+//                clamping voltage at IPP exactly; the capacitance at 0 V is the data sheet's.
 #pragma once
 
 #include <optional>
@@ -34,8 +39,9 @@
 
 namespace isolink::link {
 
-enum class PartKind { Choke, Transformer, Capacitor };
-const char* part_kind_name(PartKind kind);  // "choke" | "transformer" | "capacitor"
+enum class PartKind { Choke, Transformer, Capacitor, Tvs };
+// "choke" | "transformer" | "capacitor" | "tvs"
+const char* part_kind_name(PartKind kind);
 
 // A common-mode choke: two coupled windings.
 struct ChokeModel {
@@ -61,6 +67,34 @@ struct TransformerModel {
   Status validate() const;  // 0 < leakage < inductance, the rest >= 0
 };
 
+// A TVS / ESD protection diode on one line, as its data sheet gives it, and the SPICE level-1
+// junction parameters derived from those figures (derive()).
+struct TvsModel {
+  bool bidirectional = true;        // two junctions in anti-series (else one, cathode at the line)
+  double standoff = 0;              // V, VRWM: the largest working voltage
+  double breakdown = 0;             // V, VBR at breakdown_current (the whole part, line to ground)
+  double breakdown_current = 1e-3;  // A, the test current of VBR
+  double clamp = 0;                 // V, VCL at clamp_current (8/20 us)
+  double clamp_current = 0;         // A, the IPP of VCL
+  double capacitance = 0;           // F, line to ground at 0 V
+  double grading = 0.3;             // M: C(V) = C0 / (1 + V/VJ)^M per junction
+  double vj = 0.7;                  // V, junction potential
+  double peak_current = 0;          // A, rated IPP (8/20 us), 0: not given
+  double peak_power = 0;            // W, rated PPP (8/20 us), 0: not given
+  double esd_contact = 0;           // V, IEC 61000-4-2 contact discharge rating, 0: not given
+  // Per junction, filled by derive(): saturation current (ngspice's default), emission 1,
+  // breakdown BV at IBV = breakdown_current, series RS, zero-bias capacitance CJO.
+  double is = 1e-14, bv = 0, ibv = 0, rs = 0, cjo = 0;
+
+  // Names the field, its value and the rule: "tvs.clamp = 20: must be above the breakdown ...".
+  Status validate() const;
+  // Solves bv and rs so that the part's DC voltage at breakdown_current is `breakdown` and at
+  // clamp_current is `clamp`; cjo from the capacitance (twice it per junction in anti-series).
+  Status derive();
+  // The model card's parameters ("is=1e-14 n=1 bv=... ibv=... rs=... cjo=... vj=... m=...").
+  std::vector<std::pair<std::string, double>> spice_params() const;
+};
+
 struct CapacitorModel {
   double capacitance = 0;     // F
   double voltage_rating = 0;  // V (0: not given)
@@ -75,6 +109,7 @@ struct Figure {
   std::optional<double> min, max;   // range (from min/max or tolerance)
   std::optional<double> tolerance;  // relative (0.1 = +/-10 %), when given as a tolerance
   std::optional<double> frequency;  // Hz: the frequency a cm_impedance is rated at
+  std::optional<double> current;    // A: the current a TVS voltage (breakdown, clamp) is given at
   std::string measured;             // leakage: "shorted" | "differential"
   bool fitted = false;              // loss_r: derived from cm_impedance ("fit")
   std::string source;               // "data sheet: ...", "assumed: ...", "fitted: ..."
@@ -93,6 +128,7 @@ struct Part {
   ChokeModel choke;                                  // kind == Choke
   TransformerModel transformer;                      // kind == Transformer
   CapacitorModel capacitor;                          // kind == Capacitor
+  TvsModel tvs;                                      // kind == Tvs
   std::optional<double> cm_impedance, cm_frequency;  // ohm at Hz: the data sheet's rating
   std::optional<double> rated_current;               // A
   std::optional<double> rated_voltage;               // V, working / rated
@@ -137,6 +173,11 @@ class PartLibrary {
 Status add_choke(std::vector<Card>& cards, const std::string& prefix, const std::string& a_p,
                  const std::string& a_n, const std::string& b_p, const std::string& b_n,
                  const ChokeModel& m);
+
+// Appends Cards for a TVS from `line` to `ground`: diodes "<prefix>a" (and "<prefix>b" with
+// the internal node "<prefix>.mid" when bidirectional) sharing one .model named model_name.
+Status add_tvs(std::vector<Card>& cards, const std::string& prefix, const std::string& line,
+               const std::string& ground, const std::string& model_name, const TvsModel& m);
 
 // Appends Cards for a 1:1 transformer, primary (a_p, a_n) (device side), secondary (b_p, b_n)
 // (cable side), dots on a_p and b_p. Names (prefix "t1"): t1.lpri, t1.rpri; without centre tap

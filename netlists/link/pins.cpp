@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <memory>
+#include <utility>
 
 #include "netlists/link/cards.h"
 
@@ -14,15 +16,43 @@ Status positive(const char* model, const char* field, double v) {
   return Status::Error(fmt::format("{}.{} = {:g}: must be positive", model, field, v));
 }
 
+// The pins' clamp diodes and their rail (pins.h).
+void add_clamps(std::vector<Card>& cards, const std::string& prefix, const std::string& p,
+                const std::string& n, const PinClampModel& m) {
+  if (!m.enabled) return;
+  const std::string rail = prefix + "_cvdd";
+  cards.push_back(make_card('v', "v" + prefix + "cvdd", {rail, "0"}, {number_arg(m.vdd)}));
+  auto model = std::make_shared<CardModel>();
+  model->name = prefix + "_clamp";
+  model->type = "d";
+  model->params = {{"is", number_arg(m.is)}, {"n", number_arg(1)}, {"rs", number_arg(m.rs)}};
+  for (auto [pin, side] : {std::pair{p, "p"}, std::pair{n, "n"}}) {
+    Card hi = make_card('d', "d" + prefix + "h" + side, {pin, rail}, {});
+    Card lo = make_card('d', "d" + prefix + "l" + side, {"0", pin}, {});
+    hi.model = lo.model = model;
+    cards.push_back(std::move(hi));
+    cards.push_back(std::move(lo));
+  }
+}
+
 }  // namespace
 
+Status PinClampModel::validate() const {
+  if (!enabled) return Status::Ok();
+  if (Status s = positive("pin_clamps", "vdd", vdd); !s.ok()) return s;
+  if (Status s = positive("pin_clamps", "is", is); !s.ok()) return s;
+  return positive("pin_clamps", "rs", rs);
+}
+
 Status TxDriverModel::validate() const {
+  if (Status s = clamps.validate(); !s.ok()) return s;
   if (Status s = positive("tx_driver", "vdd", vdd); !s.ok()) return s;
   if (Status s = positive("tx_driver", "edge", edge); !s.ok()) return s;
   return positive("tx_driver", "r_out", r_out);
 }
 
 Status RxLoadModel::validate() const {
+  if (Status s = clamps.validate(); !s.ok()) return s;
   if (Status s = positive("rx_load", "r_in", r_in); !s.ok()) return s;
   return positive("rx_load", "c_in", c_in);
 }
@@ -44,6 +74,7 @@ Status add_tx_driver(std::vector<Card>& cards, const std::string& prefix, const 
     cards.push_back(make_card('r', "r" + prefix + side, {internal, sign > 0 ? p : n},
                               {number_arg(model.r_out)}));
   }
+  add_clamps(cards, prefix, p, n, model.clamps);
   return Status::Ok();
 }
 
@@ -59,6 +90,7 @@ Status add_rx_load(std::vector<Card>& cards, const std::string& prefix, const st
            make_card('c', "c" + prefix + "inn", {n, "0"}, {number_arg(model.c_in)}),
        })
     cards.push_back(std::move(c));
+  add_clamps(cards, prefix, p, n, model.clamps);
   return Status::Ok();
 }
 

@@ -260,7 +260,8 @@
     const head = el('header', {}, [el('h1', {}, ['isolink report: ' + r.name + ' ', verdictBadge(r.verdict, 'verdict')])]);
     const wc = r.worst_case;
     head.append(el('p', {cls: 'sub', text: 'spec ' + (r.spec && r.spec.source || '') + ', simulated in ' + fmt(r.run_time_s, 3) + ' s' +
-      (wc ? '; worst case over all traffic: ' + (wc.verdict || '-').toUpperCase() : '')}));
+      (wc && wc.computed !== false ? '; worst case over all traffic: ' + (wc.verdict || '-').toUpperCase() : '')}));
+    if (wc && wc.computed === false) head.append(el('p', {cls: 'note', text: 'No worst case over all traffic: ' + wc.why + '.'}));
     app.append(head);
     const why = section('Verdict', 'reasons');
     const dirRows = r.directions.map(d => {
@@ -303,7 +304,7 @@
       const s = section('Eye diagram', 'eye');
       s.append(image(data.eye, 'eye diagram'));
     }
-    if (wc) worstSection(wc);
+    if (wc && wc.computed !== false) worstSection(wc);
     const bom = section('Bill of materials and cable', 'bom');
     bom.append(table(['end', 'as simulated'], [{cells: ['tx', x.bom && x.bom.tx]}, {cells: ['rx', x.bom && x.bom.rx]}]));
     if (x.cable) bom.append(el('p', {text: 'Cable: ' + x.cable}));

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -35,7 +36,11 @@ std::vector<std::string> link_specs() {
     for (const auto& e : fs::directory_iterator(kSource + "/" + dir)) {
       if (e.path().extension() != ".yaml") continue;
       StatusOr<std::string> text = read_input_file(e.path().string());
-      if (!text || !link::read_link_spec_text(*text, e.path().string()).ok()) continue;
+      StatusOr<link::LinkSpec> spec =
+          text ? link::read_link_spec_text(*text, e.path().string()) : Status::Error("");
+      // A nonlinear link (TVS parts, pin clamps) has no edge response: compare refuses it
+      // (CompareOnTheRepo.NonlinearLinkIsRefusedWithTheReason).
+      if (!spec || !link::nonlinear_parts(*spec).empty()) continue;
       out.push_back(fs::relative(e.path(), kSource).string());
     }
   std::sort(out.begin(), out.end());
@@ -57,6 +62,18 @@ const std::vector<std::string> kLinkSpecs = {"bench/links/bridge_xfmr_12m_two_fr
                                              "netlists/examples/transformer_15m.yaml"};
 TEST(CompareOnTheRepo, TheListOfLinkSpecsIsComplete) {
   EXPECT_EQ(link_specs(), kLinkSpecs) << "a link spec was added or removed: update kLinkSpecs";
+}
+
+TEST(CompareOnTheRepo, NonlinearLinkIsRefusedWithTheReason) {
+  const std::string spec = kSource + "/netlists/examples/bq79606a_tvs_2m.yaml";
+  // Any capture will do: the spec is refused before the capture is compared with it.
+  const std::string capture = testing::test_dir() + "/any.csv";
+  std::ofstream(capture) << "time,v\n0,0\n1e-9,0\n2e-9,0\n";
+  testing::CliResult r =
+      testing::run_isolink(ISOLINK_BINARY, "compare " + capture + " " + spec, "nonlinear");
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find("needs a linear link"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("TVS PESD2CAN"), std::string::npos) << r.err;
 }
 
 class CompareLinkSpecs : public ::testing::TestWithParam<std::string> {};

@@ -116,12 +116,59 @@ INSTANTIATE_TEST_SUITE_P(
       return s;
     });
 
+// The nonlinear example (PESD2CAN TVS diodes and the pins' rail clamps on bq79606a_cap_2m's
+// link) on the nonlinear transient: about a minute of CPU, so in the slow label.
+TEST(RunExamplesSlow, NonlinearTvsExamplePassesBothWays) {
+  const std::string dir = ::testing::TempDir() + "/run_tvs_example";
+  fs::remove_all(dir);
+  Result r = run("run " + kExamples + "/bq79606a_tvs_2m.yaml -o " + dir + " -q", "tvs_example");
+  EXPECT_EQ(r.code, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(slurp(dir + "/report.json"));
+  EXPECT_EQ(j["verdict"], "pass");
+  ASSERT_EQ(j["directions"].size(), 2u);
+  for (const auto& d : j["directions"]) {
+    EXPECT_EQ(d["verdict"], "pass");
+    EXPECT_EQ(d["solver"]["engine"], "transient");
+  }
+  EXPECT_EQ(j["worst_case"]["computed"], false);
+}
+
 TEST(RunExamples, EveryExampleSpecIsListed) {
   int specs = 0;
   for (const auto& e : fs::directory_iterator(kExamples))
     if (e.path().extension() == ".yaml" && e.path().filename().string().rfind("sweep", 0) != 0)
       ++specs;
-  EXPECT_EQ(specs, 9);
+  EXPECT_EQ(specs, 10);
+}
+
+// A nonlinear link (TVS parts, pin clamps) runs on the nonlinear transient, and the worst case,
+// which superposes edge responses, is reported as not computed with the reason; `isolink worst`
+// refuses it (exit 2) with the same reason.
+TEST(RunCommand, NonlinearLinkSaysWhyItHasNoWorstCase) {
+  const std::string dir = ::testing::TempDir() + "/run_tvs_worst";
+  fs::remove_all(dir);
+  // One byte down a 1 m cap link with a PESD2CAN at the transmitter and rail clamps at the
+  // receiver's pins: a few seconds on the nonlinear transient.
+  const std::string spec = ::testing::TempDir() + "/tvs_one_byte.yaml";
+  std::ofstream(spec) << "name: tvs-one-byte\n"
+                         "tx: {isolation: {esd: PESD2CAN}}\n"
+                         "rx: {pin_clamps: rails}\n"
+                         "cable: {length: 1}\n"
+                         "stimulus: {frames: [\"raw 5A nocrc\"], direction: down}\n";
+  Result r = run("run " + spec + " -o " + dir + " -q", "tvs_worst");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("note: no worst case"), std::string::npos) << r.err;
+  nlohmann::json j = nlohmann::json::parse(slurp(dir + "/report.json"));
+  ASSERT_TRUE(j.contains("worst_case"));
+  EXPECT_EQ(j["worst_case"]["computed"], false);
+  const std::string why = j["worst_case"]["why"];
+  EXPECT_NE(why.find("tx.isolation.esd: TVS PESD2CAN"), std::string::npos) << why;
+  EXPECT_NE(why.find("rx.pin_clamps: rails"), std::string::npos) << why;
+  for (const auto& d : j["directions"]) EXPECT_EQ(d["solver"]["engine"], "transient");
+  EXPECT_NE(slurp(dir + "/report.md").find("Not computed: the worst case"), std::string::npos);
+  Result w = run("worst " + spec, "tvs_worst_cmd");
+  EXPECT_EQ(w.code, 2);
+  EXPECT_NE(w.err.find("needs a linear link"), std::string::npos) << w.err;
 }
 
 TEST(RunCommand, BadSpecExitsTwoAndWritesNothing) {

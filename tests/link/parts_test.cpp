@@ -90,16 +90,17 @@ std::vector<const Part*> of_kind(PartKind kind) {
 
 TEST(Parts, EveryBuiltinPartLoadsWithASourcePerFigure) {
   const PartLibrary& lib = builtin();
-  for (const char* number :
-       {"HMU1228NL", "HM2147NL", "SM91502AL", "CDEP99-102", "ACT45B-510-2P-TL003",
-        "ACT45B-101-2P-TL003", "744242471", "1206J2K00222KXR"})
+  for (const char* number : {"HMU1228NL", "HM2147NL", "SM91502AL", "CDEP99-102",
+                             "ACT45B-510-2P-TL003", "ACT45B-101-2P-TL003", "744242471",
+                             "1206J2K00222KXR", "PESD2CAN", "ESD24VS2U", "ESDCAN24-2BLY"})
     EXPECT_NE(lib.find(number), nullptr) << number;
-  EXPECT_EQ(lib.parts().size(), 8u);
+  EXPECT_EQ(lib.parts().size(), 11u);
   EXPECT_TRUE(lib.notes().empty());
   EXPECT_EQ(of_kind(PartKind::Choke).size(), 3u);
   EXPECT_EQ(of_kind(PartKind::Transformer).size(), 4u);
   EXPECT_EQ(of_kind(PartKind::Capacitor).size(), 1u);
-  EXPECT_EQ(PartLibrary::builtin_files().size(), 6u);
+  EXPECT_EQ(of_kind(PartKind::Tvs).size(), 3u);
+  EXPECT_EQ(PartLibrary::builtin_files().size(), 9u);
   for (const Part& p : lib.parts()) {
     EXPECT_FALSE(p.maker.empty()) << p.number;
     EXPECT_TRUE(p.loc.valid() && p.loc.line > 0) << p.number;
@@ -332,7 +333,8 @@ TEST(Parts, LoadErrorsNameFileLineColumnAndKey) {
   has(load_error(with("winding_c: 2p\n", "")),
       "bad.yaml:1:1: error: part 'MY-CHOKE': missing key 'winding_c'");
   has(load_error(with("kind: choke", "kind: chokes")),
-      "bad.yaml:3:7: error: key 'kind': expected choke | transformer | capacitor, found 'chokes'");
+      "bad.yaml:3:7: error: key 'kind': expected choke | transformer | capacitor | tvs, found "
+      "'chokes'");
   has(load_error(with("measured: shorted, ", "")),
       "bad.yaml:5:10: error: key 'leakage': missing key 'measured'");
   has(load_error(with("leakage: {value: 0.3u,", "leakage: {value: 60u,")),
@@ -403,7 +405,7 @@ TEST(Parts, UserFolderAddsPartsAndOverridesBuiltinOnes) {
   dir.write("notes.txt", "not a part file");
   StatusOr<PartLibrary> lib = PartLibrary::load({dir.str()});
   ASSERT_TRUE(lib.ok()) << lib.status().message();
-  EXPECT_EQ(lib->parts().size(), 9u);
+  EXPECT_EQ(lib->parts().size(), 12u);
   const Part* act = lib->find("ACT45B-510-2P-TL003");
   ASSERT_NE(act, nullptr);
   EXPECT_DOUBLE_EQ(act->choke.inductance, 60e-6);
