@@ -12,6 +12,7 @@
 #include "base/si_number.h"
 #include "netlists/traffic/command.h"
 #include "netlists/traffic/patterns.h"
+#include "netlists/traffic/sequences.h"
 
 namespace isolink::traffic {
 namespace {
@@ -135,6 +136,29 @@ Status add_item(DriveBuilder& b, std::string_view item, const StimulusOptions& o
     }
     return b.add_frame(pattern_bytes(*p, n), std::string(pattern_name(*p)));
   }
+  if (kw == "auto-address") {  // sequences.h: TI's auto-addressing of a stack
+    if (rest.size() != 1 || lower(rest[0]).rfind("devices=", 0) != 0)
+      return Status::Error("auto-address: expected devices=N, e.g. 'auto-address devices=16'");
+    const std::string n(rest[0].substr(8));
+    const std::optional<SiNumber> v = scan_si_number(n, {.scale = false, .unit_letters = false});
+    if (!v || v->length != n.size() || v->value != static_cast<int>(v->value))
+      return Status::Error(fmt::format("auto-address: devices={} is not an integer", n));
+    StatusOr<std::vector<std::string>> cmds = auto_address_commands(static_cast<int>(v->value));
+    if (!cmds) return cmds.status();
+    for (const std::string& c : *cmds)
+      if (Status s = b.add_frame(*command_bytes(c), c); !s.ok()) return s;
+    return Status::Ok();
+  }
+  if (kw == "responses") {  // sequences.h: the frames a stack sends back to a read
+    StatusOr<std::vector<std::vector<uint8_t>>> frames = response_frames(rest);
+    if (!frames) return frames.status();
+    for (size_t k = 0; k < frames->size(); ++k)
+      if (Status s =
+              b.add_frame((*frames)[k], fmt::format("response {} of {}", k + 1, frames->size()));
+          !s.ok())
+        return s;
+    return Status::Ok();
+  }
   // `raw ... err`: the bytes go out with the byte-error bit set (as a resent byte).
   int error_bit = -1;
   std::string command(item);
@@ -153,7 +177,8 @@ Status add_item(DriveBuilder& b, std::string_view item, const StimulusOptions& o
     if (bytes.status().message().rfind("unknown command", 0) == 0) {
       return Status::Error(
           fmt::format("unknown item '{}': expected a command (single-read ... raw), a tone (wake, "
-                      "sleep-to-active, shutdown, heartbeat, fault), 'pattern NAME', 'idle T' or "
+                      "sleep-to-active, shutdown, heartbeat, fault), 'pattern NAME', "
+                      "'auto-address devices=N', 'responses reg=R n=B devices=D', 'idle T' or "
                       "'gap T'",
                       tok[0]));
     }

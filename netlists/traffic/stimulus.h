@@ -14,6 +14,8 @@
 //   gap T                              the idle before the next item is T exactly (instead of
 //                                      the 1 us lead / 12 us frame gap; `idle` still adds)
 //   raw HEX... [nocrc] [err]           err: the bytes carry the byte-error bit (a resent byte)
+//   auto-address devices=N             TI's auto-addressing commands (sequences.h)
+//   responses reg=R n=B devices=D [first=A]   the response frames of a read (sequences.h)
 // Times take SPICE suffixes with an optional trailing "s": 250n, 250ns, 1u, 1us, 2.5e-7, 20us.
 #pragma once
 

@@ -59,6 +59,7 @@ const std::vector<std::string> kLinkSpecs = {"bench/links/bridge_xfmr_12m_two_fr
                                              "netlists/examples/capdualchoke_10m.yaml",
                                              "netlists/examples/hybrid_xfmr_cap_12m.yaml",
                                              "netlists/examples/same_pcb.yaml",
+                                             "netlists/examples/startup_16.yaml",
                                              "netlists/examples/transformer_15m.yaml"};
 TEST(CompareOnTheRepo, TheListOfLinkSpecsIsComplete) {
   EXPECT_EQ(link_specs(), kLinkSpecs) << "a link spec was added or removed: update kLinkSpecs";
