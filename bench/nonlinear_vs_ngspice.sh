@@ -91,7 +91,7 @@ cases+=("tests/cli/data/nonlinear/clipper_zener.cir|v(out)"
   "tests/cli/data/nonlinear/esd_pulse.cir|v(pin)"
   "tests/cli/data/nonlinear/link_clamp_cm_step.cir|v(rxp,rxn)")
 
-echo "<!-- $(date -u +%Y-%m-%d %H:%M) UTC, $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg), N=$N -->"
+echo "<!-- $(date -u "+%Y-%m-%d %H:%M") UTC, $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg), N=$N -->"
 printf '| circuit | unknowns | port model ms | transient ms | ngspice ms | ngspice / port model | port model dev (mV) | transient dev (mV) | ngspice dev (mV) | port model steps |\n'
 printf '|---|---|---|---|---|---|---|---|---|---|\n'
 for c in "${cases[@]}"; do

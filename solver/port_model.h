@@ -85,9 +85,13 @@ struct PortModelOptions {
   // current): bounds each port's self-impedance by 1 / port_shunt.
   double port_shunt = 1e-2;
   // The model's check. No edge weighting: the ports' currents can switch faster than any source.
+  // 48 check points, refined between them as the reduced model's check is: 128 took 0.15 s of
+  // a 12 m link's 0.21 s, the model at full order either way.
   ReducedModelOptions reduced = [] {
     ReducedModelOptions r;
     r.tol = 2e-6;
+    r.check_points = 48;
+    r.full_order_at_most = 200;
     return r;
   }();
 };
