@@ -230,8 +230,9 @@ class PortMarch {
   int worst_port_ = 0;
   // Newton's scratch.
   Eigen::MatrixXd jac_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
   Eigen::VectorXd f_, dv_;
-  std::vector<double> dd_;
+  std::vector<double> dd_, v_oc_, v_;
 };
 
 PortMarch::PortMarch(const Circuit& circuit, const PortModel& pm, const TransientOptions& opt)
@@ -251,6 +252,9 @@ PortMarch::PortMarch(const Circuit& circuit, const PortModel& pm, const Transien
     sources_.push_back(circuit.find_element(name)->source_function());
   for (const std::string& name : pm.port_elements) port_el_.push_back(circuit.find_element(name));
   jac_.resize(np_, np_);
+  lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(np_);
+  v_oc_.assign(np_, 0.0);
+  v_.assign(np_, 0.0);
   f_.resize(np_);
   dv_.resize(np_);
   dd_.assign(np_, 0.0);
@@ -398,7 +402,9 @@ bool PortMarch::newton(const StepCoefs& c, double h, bool euler, const std::vect
     if (it == tol.max_iterations) break;
     for (int mi = 0; mi < np_; ++mi) jac_.col(mi) = -z.col(mi) * dd_[mi];
     jac_.diagonal().array() += 1.0;
-    dv_ = jac_.partialPivLu().solve(-f_);
+    lu_.compute(jac_);
+    f_ = -f_;
+    dv_ = lu_.solve(f_);
     ++stats_.newton_iterations;
     small = true, limited = false;
     for (int m = 0; m < np_; ++m) {
@@ -433,7 +439,8 @@ Status PortMarch::advance(double h, bool euler, bool* converged) {
     s1.x[i] = c.e[i] * s0.x[i] + c.a[i] * s0.su[i] + c.b[i] * s1.su[i];
     if (!euler) s1.x[i] += c.a[i] * s0.sd[i];
   }
-  std::vector<double> v_oc(np_), v(np_);
+  std::vector<double>& v_oc = v_oc_;
+  std::vector<double>& v = v_;
   for (int m = 0; m < np_; ++m) {
     const Cplx* out = m_.output[ny_ + m].data();
     double y = 0;
