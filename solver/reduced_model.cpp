@@ -471,8 +471,10 @@ Status Reducer::build() {
   // (opt_.start_points: a sweep's or a fit's next circuit) usually passes at once, so staging it
   // would add the evaluations to the eigendecomposition. (4-point bridge-to-stack sweep, order
   // about 150: 13.17 G instructions with every step staged, 12.54 G before staging.)
+  // The full basis (opt_.full_order_at_most) passes at once too: diagonalised directly.
   const bool small = basis_.q < static_cast<int>(freqs_.size());
-  modal_ = modal_each_step_ || small || (st_.steps == 1 && !opt_.start_points.empty());
+  const bool full = n_ <= opt_.full_order_at_most;
+  modal_ = modal_each_step_ || small || full || (st_.steps == 1 && !opt_.start_points.empty());
   // q = 0: nothing reaches the probes (no source drives anything): H = 0
   if (modal_ && basis_.q != 0)
     if (Status s = modal_form(&mod); !s.ok()) return s;
