@@ -73,7 +73,8 @@ void print_sim_stats(const SimulationResult& r, size_t rows, const std::string& 
         r.lti.note, r.lti.model_seconds, r.lti.march_seconds);
   if (r.engine == Engine::PortModel)
     std::cerr << fmt::format(
-        "isolink sim: port model engine: {} nodes, {} unknowns; {} ports, {} modes (order {}, "
+        "isolink sim: port model engine (the circuit has diodes; the full transient is its "
+        "fallback): {} nodes, {} unknowns; {} ports, {} modes (order {}, "
         "{} expansion points), transfer within {:.1e} of the peak at {} check frequencies, DC "
         "state within {:.1e} V; model {:.3f} s; {} steps accepted, {} rejected, {} Newton "
         "iterations on the ports; {:.3f} s; {} rows{}\n",
