@@ -15,6 +15,8 @@ const char* engine_name(Engine e) {
       return "auto";
     case Engine::Lti:
       return "lti";
+    case Engine::PortModel:
+      return "port";
     case Engine::Transient:
       return "transient";
   }
@@ -24,10 +26,14 @@ const char* engine_name(Engine e) {
 const char* engine_summary(Engine e) {
   switch (e) {
     case Engine::Auto:
-      return "the default: LTI where the circuit allows it and it is the cheaper engine, else "
-             "transient";
+      return "the default: with diodes the port model where it passes its check, else "
+             "transient; without, LTI where the circuit allows it and it is the cheaper engine, "
+             "else transient";
     case Engine::Lti:
       return "exact superposition of edge responses; an error if the circuit does not allow it";
+    case Engine::PortModel:
+      return "circuits with diodes: the linear network as a checked reduced model seen from the "
+             "diodes' ports, Newton on the ports alone; an error if it does not apply";
     case Engine::Transient:
       return "time stepping, any circuit";
   }
@@ -51,6 +57,17 @@ std::string engine_accuracy(const SimulationResult& r) {
         "the edges' spectrum): each source edge's response within {:.2g} mV per volt of edge "
         "({:.2g} mV for 5 V); rows exact, linear interpolation between them within 1 mV",
         r.lti.model.error, ReducedModelOptions{}.tol, 1e3 * bound, 5e3 * bound);
+  }
+  if (r.engine == Engine::PortModel) {
+    const PortModelOptions po;
+    return fmt::format(
+        "port model: the linear network's transfer (port impedances, sources to ports and "
+        "probes) within {:.1e} of each pair's peak (check {:.0e}; an edge's response within "
+        "{:.2g} of its amplitude times the pair's peak gain); time steps under the transient's "
+        "truncation-error control (trtol x reltol = {:.2g} of each port voltage's, charge's and "
+        "probe's peak), the port currents linear over a step, charge conserved; within 3 mV of "
+        "the converged full transient on the nonlinear test circuits",
+        r.port.model.error, po.reduced.tol, po.reduced.edge_error_bound(), r.trtol * r.reltol);
   }
   if (r.engine == Engine::Lti && r.lti.method.empty())  // a waveform synthesized, not simulated
     return "that of the response it was synthesized from (" + r.engine_note + ")";
@@ -325,6 +342,12 @@ Status run_lti(const EngineRun& run, SimulationResult& result, bool* done) {
   return Status::Ok();
 }
 
+bool netlist_sets_reltol(const Netlist& netlist) {
+  for (const NetlistOption& o : netlist.options)
+    if (o.key == "reltol") return true;
+  return false;
+}
+
 // The transient engine, within the memory limit (an error names the LTI engine's refusal too).
 Status run_transient_engine(const Netlist& netlist, const EngineRun& run,
                             SimulationResult& result) {
@@ -353,9 +376,7 @@ Status run_transient_engine(const Netlist& netlist, const EngineRun& run,
         fmt::format("{} ({} steps: {} rows of {} values are what the 1 GB memory limit allows)",
                     wave.status().message(), opt.max_steps, opt.max_steps, run.probes.size() + 1));
   if (!wave) return wave.status();
-  bool netlist_reltol = false;
-  for (const NetlistOption& o : netlist.options)
-    netlist_reltol = netlist_reltol || o.key == "reltol";
+  const bool netlist_reltol = netlist_sets_reltol(netlist);
   const bool auto_fell_back = req.engine == Engine::Auto && !result.engine_note.empty();
   const bool forced_at_defaults = req.engine == Engine::Transient && !netlist_reltol;
   if ((auto_fell_back || forced_at_defaults) && !req.reltol) {
@@ -370,6 +391,47 @@ Status run_transient_engine(const Netlist& netlist, const EngineRun& run,
   }
   result.wave = std::move(*wave);
   result.engine = Engine::Transient;
+  return Status::Ok();
+}
+
+bool has_nonlinear(const Circuit& circuit) {
+  for (const auto& e : circuit.elements())
+    if (e->nonlinear_port_count() > 0) return true;
+  return false;
+}
+
+// The port model engine (nonlinear circuits): *done when result holds its waveform; otherwise
+// result.engine_note says why not (auto falls back to the transient). Errors: a forced `port`
+// that cannot run.
+Status run_port(const Netlist& netlist, const EngineRun& run, SimulationResult& result,
+                bool* done) {
+  const SimulationRequest& req = run.req;
+  const TransientOptions& opt = run.opt;
+  const bool forced = req.engine == Engine::PortModel;
+  auto refuse = [&](const Status& why) {
+    if (forced) return why;
+    result.engine_note = "the port model did not apply: " + why.message();
+    return Status::Ok();
+  };
+  if (opt.uic || !opt.node_ic.empty())
+    return refuse(Status::Error(
+        ".ic / .tran uic: the port model starts from the circuit's own DC operating point"));
+  if (Status s = check_transient_memory(netlist, opt, run.row_bytes); !s.ok()) return refuse(s);
+  const PortModelOptions po;
+  StatusOr<PortModel> model =
+      build_port_model(netlist.cards, run.circuit, run.probes, opt.tstop, po);
+  if (!model) return refuse(model.status());
+  TransientOptions port_opt = opt;
+  if (!req.reltol && !netlist_sets_reltol(netlist)) port_opt.reltol = po.default_reltol;
+  StatusOr<Waveform> wave = run_port_model(run.circuit, *model, port_opt, &result.port);
+  if (!wave) return refuse(wave.status());
+  result.wave = std::move(*wave);
+  result.engine = Engine::PortModel;
+  result.reltol = port_opt.reltol;
+  result.trtol = opt.trtol;
+  result.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - run.start).count();
+  *done = true;
   return Status::Ok();
 }
 
@@ -392,7 +454,17 @@ StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequ
   result.elements = static_cast<int>(circuit.elements().size());
 
   const EngineRun run{circuit, *probes, req, opt, row_bytes, std::chrono::steady_clock::now()};
-  if (req.engine != Engine::Transient) {
+  const bool nonlinear = has_nonlinear(circuit);
+  if (req.engine == Engine::PortModel && !nonlinear)
+    return Status::Error(
+        "--engine port: the circuit has no nonlinear element (diode); use auto, lti or "
+        "transient");
+  if (nonlinear && (req.engine == Engine::Auto || req.engine == Engine::PortModel)) {
+    bool done = false;
+    if (Status s = run_port(netlist, run, result, &done); !s.ok()) return s;
+    if (done) return result;
+  }
+  if (req.engine != Engine::Transient && (!nonlinear || req.engine == Engine::Lti)) {
     bool done = false;
     if (Status s = run_lti(run, result, &done); !s.ok()) return s;
     if (done) return result;

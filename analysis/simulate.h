@@ -25,17 +25,22 @@
 #include "base/waveform.h"
 #include "netlists/spice_reader.h"
 #include "solver/lti.h"
+#include "solver/port_model.h"
 #include "solver/transient.h"
 
 namespace isolink::analysis {
 
-// auto: the LTI engine when the circuit allows it (check_lti: every element LTI, every source DC,
-// PULSE or PWL, no .tran uic) and it is the cheaper engine (responses settled within a quarter
-// of the run, kAutoLtiMaxSteps, kAutoLtiBudget), else the transient; lti: the LTI engine or an
-// error naming the element; transient: always the transient.
-enum class Engine { Auto, Lti, Transient };
+// auto: for a circuit with nonlinear elements (diodes), the port model (solver/port_model.h)
+// when it builds and passes its check, else the transient (self-checked); for a linear one, the
+// LTI engine when the circuit allows it (check_lti: every element LTI, every source DC, PULSE or
+// PWL, no .tran uic) and it is the cheaper engine (responses settled within a quarter of the
+// run, kAutoLtiMaxSteps, kAutoLtiBudget), else the transient; lti: the LTI engine or an error
+// naming the element; port: the port model or an error saying why not; transient: always the
+// transient.
+enum class Engine { Auto, Lti, PortModel, Transient };
 // Every engine, in the order the choices are listed (parse_engine, the CLI's --engine, Python).
-inline constexpr std::array<Engine, 3> kEngines = {Engine::Auto, Engine::Lti, Engine::Transient};
+inline constexpr std::array<Engine, 4> kEngines = {Engine::Auto, Engine::Lti, Engine::PortModel,
+                                                   Engine::Transient};
 const char* engine_name(Engine e);
 // What the engine does, in a few words for --engine's help ("LTI where ...").
 const char* engine_summary(Engine e);
@@ -95,10 +100,11 @@ struct SimulationRequest {
 
 struct SimulationResult {
   Waveform wave;
-  Engine engine = Engine::Transient;  // the engine that produced the waveform (lti or transient)
+  Engine engine = Engine::Transient;  // the engine that produced the waveform (not auto)
   std::string engine_note;            // why auto chose the transient, when it did
   TransientStats stats;               // transient engine
   LtiStats lti;                       // LTI engine
+  PortModelStats port;                // port model engine
   LtiResponses::GridInfo grid;        // LTI engine: the output grid
   std::vector<std::string> warnings;  // formatted, for stderr
   int nodes = 0, unknowns = 0, elements = 0;

@@ -1,5 +1,5 @@
-// isolink sim NETLIST.cir --probe 'v(rxp,rxn)' [-o wave.csv] [--engine auto|lti|transient]: the
-// response of a SPICE netlist, by the LTI engine where it is the cheaper engine, else the
+// isolink sim NETLIST.cir --probe 'v(rxp,rxn)' [-o wave.csv] [--engine auto|lti|port|transient]:
+// the response of a SPICE netlist, by the LTI engine where it is the cheaper engine, else the
 // transient (see analysis/simulate.h).
 #include <fmt/format.h>
 
@@ -71,7 +71,22 @@ void print_sim_stats(const SimulationResult& r, size_t rows, const std::string& 
         "isolink sim: the march ran because the reduced model did not pass its check ({}); the "
         "model took {:.3f} s, the march {:.3f} s\n",
         r.lti.note, r.lti.model_seconds, r.lti.march_seconds);
-  if (r.engine == Engine::Transient && !r.engine_note.empty())
+  if (r.engine == Engine::PortModel)
+    std::cerr << fmt::format(
+        "isolink sim: port model engine (the circuit has diodes; the full transient is its "
+        "fallback): {} nodes, {} unknowns; {} ports, {} modes (order {}, "
+        "{} expansion points), transfer within {:.1e} of the peak at {} check frequencies, DC "
+        "state within {:.1e} V; model {:.3f} s; {} steps accepted, {} rejected, {} Newton "
+        "iterations on the ports; {:.3f} s; {} rows{}\n",
+        r.nodes, r.unknowns, r.port.ports, r.port.modes, r.port.model.order,
+        r.port.model.expansion_points, r.port.model.error, r.port.model.check_points,
+        r.port.dc_mismatch, r.port.model_seconds, r.port.accepted, r.port.rejected,
+        r.port.newton_iterations, r.seconds, rows, target);
+  if (r.engine == Engine::Transient && r.engine_note.rfind("the port model", 0) == 0)
+    std::cerr << fmt::format(
+        "isolink sim: transient engine, because {} (the attempt took {:.3f} s)\n", r.engine_note,
+        r.lti_attempt_seconds);
+  else if (r.engine == Engine::Transient && !r.engine_note.empty())
     std::cerr << fmt::format(
         "isolink sim: transient engine, not LTI: {} (the LTI attempt took {:.3f} s)\n",
         r.engine_note, r.lti_attempt_seconds);
@@ -129,7 +144,7 @@ int run_sim(const SimArgs& a) {
     }
   }
   // The LTI engine already wrote its rows on the --step grid.
-  const Waveform out = step && r->engine == Engine::Transient ? r->wave.resampled(*step) : r->wave;
+  const Waveform out = step && r->engine != Engine::Lti ? r->wave.resampled(*step) : r->wave;
   if (Status s = write_waveform_csv(out, a.output.empty() ? "-" : a.output); !s.ok()) {
     const std::string& m = s.message();
     std::cerr << (m.find(": error: ") == std::string::npos ? "isolink sim: error: " : "") << m

@@ -220,8 +220,7 @@ py::dict sim(const py::object& netlist, const Strings& probes, const std::string
   warn_once(r->warnings);
   // With a step, the LTI engine already wrote that grid; the transient's steps are resampled onto
   // it (as cmd_sim.cpp; simulate_netlist refused a grid of too many rows).
-  return wave_dict(dt && r->engine == analysis::Engine::Transient ? r->wave.resampled(*dt)
-                                                                  : r->wave);
+  return wave_dict(dt && r->engine != analysis::Engine::Lti ? r->wave.resampled(*dt) : r->wave);
 }
 
 // A results.csv cell as Python: "" -> None, true/false -> bool, a number -> float (the point

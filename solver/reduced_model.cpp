@@ -283,6 +283,8 @@ void Reducer::seed_basis() {
     for (int i = 0; i < n; ++i) x[i] = dc_solutions_[k][i + 1];
     basis_.add(x, g_, c_);
   }
+  if (n <= opt_.full_order_at_most)  // the full basis: every unknown's unit vector
+    for (int i = 0; i < n; ++i) basis_.add(Eigen::VectorXd::Unit(n, i), g_, c_);
   // A voltage source's excitation is its own branch unknown (unit at its branch row). The
   // Galerkin projection tests each equation only along the basis, and the source's equation
   // v_a - v_b = u only along a basis direction that moves the source's current on its own.
@@ -352,9 +354,26 @@ double Reducer::error_at(size_t f) const {
   const Cplx jw(0.0, 2 * std::numbers::pi * freqs_[f]);
   Eigen::MatrixXcd h;
   if (modal_) {
+    // ReducedModel::transfer's sum, each mode's 1 / (jw - p) computed once for every pair.
+    const size_t q = model_.poles.size();
+    std::vector<Cplx> w1(q), w2(q);
+    for (size_t i = 0; i < q; ++i) {
+      const Cplx z = jw - model_.poles[i], zc = jw - std::conj(model_.poles[i]);
+      w1[i] = std::conj(z) / std::norm(z);
+      w2[i] = std::conj(zc) / std::norm(zc);
+    }
     h.resize(nk_, np_);
     for (size_t k = 0; k < nk_; ++k)
-      for (size_t p = 0; p < np_; ++p) h(k, p) = model_.transfer(k, p, jw);
+      for (size_t p = 0; p < np_; ++p) {
+        Cplx sum = model_.direct[k][p];
+        const Cplx* in = model_.input[k].data();
+        const Cplx* out = model_.output[p].data();
+        for (size_t i = 0; i < q; ++i) {
+          const Cplx r = out[i] * in[i];
+          sum += model_.paired[i] ? 0.5 * (r * w1[i] + std::conj(r) * w2[i]) : r * w1[i];
+        }
+        h(k, p) = sum;
+      }
   } else {
     h = projected_.at(jw);
   }
@@ -452,8 +471,10 @@ Status Reducer::build() {
   // (opt_.start_points: a sweep's or a fit's next circuit) usually passes at once, so staging it
   // would add the evaluations to the eigendecomposition. (4-point bridge-to-stack sweep, order
   // about 150: 13.17 G instructions with every step staged, 12.54 G before staging.)
+  // The full basis (opt_.full_order_at_most) passes at once too: diagonalised directly.
   const bool small = basis_.q < static_cast<int>(freqs_.size());
-  modal_ = modal_each_step_ || small || (st_.steps == 1 && !opt_.start_points.empty());
+  const bool full = n_ <= opt_.full_order_at_most;
+  modal_ = modal_each_step_ || small || full || (st_.steps == 1 && !opt_.start_points.empty());
   // q = 0: nothing reaches the probes (no source drives anything): H = 0
   if (modal_ && basis_.q != 0)
     if (Status s = modal_form(&mod); !s.ok()) return s;

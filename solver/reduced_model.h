@@ -85,6 +85,11 @@ struct ReducedModelOptions {
   // Basis size before giving up; lower on large circuits, where the basis (three dense
   // unknowns x order arrays, grown by doubling) would pass 384 MB (32,000 unknowns: order 524).
   int max_order = 1200;
+  // A circuit of at most this many unknowns starts from the full basis (every unknown's unit
+  // vector): the model is the circuit itself in modal form, still checked as any other. The
+  // port model (solver/port_model.h) sets it: with one input per port, the Krylov search of a
+  // small link reached full order anyway, after 6-7 expansion points and their checks.
+  int full_order_at_most = 0;
   double horizon = 0.0;  // s, the longest time the model is evaluated over (step 4); > 0
   // s; > 0: the inputs' fastest edge (their shortest linear piece), and the check's error at f is
   // weighted by that edge's spectrum envelope, W(f) = min(1, 1 / (pi f edge_time)) (below).

@@ -69,7 +69,7 @@ TEST(EngineOption, EveryCommandRefusesAnUnknownEngineBeforeRunning) {
     const std::string out = test_dir() + "/out_" + first_word(cmd);
     CliResult r = run_isolink(kBinary, cmd + " --engine bogus -o " + out, "bogus");
     EXPECT_EQ(r.code, 2) << cmd;
-    EXPECT_NE(r.err.find("--engine: bogus not in {auto,lti,transient}"), std::string::npos)
+    EXPECT_NE(r.err.find("--engine: bogus not in {auto,lti,port,transient}"), std::string::npos)
         << cmd << ": " << r.err;
     EXPECT_FALSE(std::filesystem::exists(out)) << cmd << " wrote " << out;
   }

@@ -169,3 +169,39 @@ TEST(SimCommand, StatesTheEngineWhyHowLongAndTheAccuracyItPromises) {
 }
 
 }  // namespace
+
+// Issue 41: a circuit with a diode runs on the port model (solver/port_model.h), and the
+// statistics say so; where it does not apply (.ic) auto runs the full transient and says why;
+// --engine port on a circuit without a diode is an error before any run.
+TEST(SimCommand, DiodeCircuitsRunOnThePortModelOrSayWhyNot) {
+  const std::string clip = write_temp("clip.cir",
+                                      "clip\nV1 in 0 SIN(0 5 1meg)\nR1 in out 1k\nC1 out 0 10p\n"
+                                      "D1 out 0 dm\n.model dm D(is=1e-14 cjo=2p)\n"
+                                      ".tran 10n 2u\n.end\n");
+  Result r = run("sim " + clip + " -p 'v(out)' -o /dev/null");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("port model engine (the circuit has diodes"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("1 ports"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("accuracy: port model: "), std::string::npos) << r.err;
+  EXPECT_EQ(run("sim " + clip + " -p 'v(out)' --engine port -o /dev/null").code, 0);
+
+  const std::string held = write_temp("clip_ic.cir",
+                                      "clip\nV1 in 0 SIN(0 5 1meg)\nR1 in out 1k\nC1 out 0 10p\n"
+                                      "D1 out 0 dm\n.model dm D(is=1e-14 cjo=2p)\n.ic v(out)=0.1\n"
+                                      ".tran 10n 2u\n.end\n");
+  r = run("sim " + held + " -p 'v(out)' -o /dev/null");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("transient engine, because the port model did not apply: .ic"),
+            std::string::npos)
+      << r.err;
+  r = run("sim " + held + " -p 'v(out)' --engine port -o /dev/null");
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find(".ic / .tran uic"), std::string::npos) << r.err;
+
+  const std::string rc = write_temp("rc_port.cir",
+                                    "rc\nV1 a 0 PULSE(0 1 0 1n)\nR1 a b 1k\n"
+                                    "C1 b 0 1n\n.tran 1n 1u\n.end\n");
+  r = run("sim " + rc + " -p 'v(b)' --engine port -o /dev/null");
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("no nonlinear element"), std::string::npos) << r.err;
+}

@@ -1,0 +1,651 @@
+#include "solver/port_model.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <map>
+
+#include "solver/elements/source_function.h"
+#include "solver/mna.h"
+#include "solver/mna_system.h"
+#include "solver/step_control.h"
+
+namespace isolink {
+
+namespace {
+
+using Cplx = std::complex<double>;
+
+// A constant conductance between two nodes: the shunt across a port in the linear network.
+class PortShunt final : public Element {
+ public:
+  PortShunt(std::string name, std::string p, std::string n, double g)
+      : Element(std::move(name), SourceLoc{}), g_(g) {
+    set_node_names({std::move(p), std::move(n)});
+  }
+  void stamp(MnaStamp& m) const override {
+    const int a = nodes_[0], b = nodes_[1];
+    m.g(a, a, g_), m.g(b, b, g_), m.g(a, b, -g_), m.g(b, a, -g_);
+  }
+  void dc_edges(std::vector<DcEdge>& out) const override {
+    out.push_back({nodes_[0], nodes_[1], DcLink::Conductive});
+  }
+
+ private:
+  double g_;
+};
+
+// The name of unknown `u` among an element's nodes ("0" for ground).
+std::string node_name_of(const Element& e, int u) {
+  if (u == 0) return "0";
+  for (size_t j = 0; j < e.nodes().size() && j < e.node_names().size(); ++j)
+    if (e.nodes()[j] == u) return e.node_names()[j];
+  return "";
+}
+
+struct PortRef {
+  const Element* element = nullptr;
+  int index = 0;
+  int p = 0, n = 0;
+};
+
+std::vector<PortRef> collect_ports(const Circuit& circuit) {
+  std::vector<PortRef> ports;
+  for (const auto& e : circuit.elements())
+    for (int k = 0; k < e->nonlinear_port_count(); ++k) {
+      const NonlinearPort np = e->nonlinear_port(k);
+      ports.push_back({e.get(), k, np.p, np.n});
+    }
+  return ports;
+}
+
+// The linear network of method step 1: the cards again, each port shunted.
+StatusOr<std::unique_ptr<Circuit>> linear_network(const std::vector<Card>& cards,
+                                                  const Circuit& circuit,
+                                                  const std::vector<PortRef>& ports, double gs) {
+  auto lin = std::make_unique<Circuit>();
+  for (const Card& card : cards)
+    if (Status s = lin->add(card); !s.ok()) return s;
+  for (size_t m = 0; m < ports.size(); ++m) {
+    const PortRef& pr = ports[m];
+    std::string p = node_name_of(*pr.element, pr.p), n = node_name_of(*pr.element, pr.n);
+    if ((pr.p != 0 && p.empty()) || (pr.n != 0 && n.empty()))
+      return Status::Error("port model: a port's nodes are not the element's own");
+    auto shunt = std::make_unique<PortShunt>(fmt::format("port#{}#{}", pr.element->name(), m),
+                                             std::move(p), std::move(n), gs);
+    if (Status s = lin->add(std::move(shunt)); !s.ok()) return s;
+  }
+  if (Status s = lin->finalize(); !s.ok()) return s;
+  if (lin->unknown_count() != circuit.unknown_count())
+    return Status::Error("port model: the linear network's unknowns differ from the circuit's");
+  return lin;
+}
+
+}  // namespace
+
+StatusOr<PortModel> build_port_model(const std::vector<Card>& cards, const Circuit& circuit,
+                                     const std::vector<Probe>& probes, double horizon,
+                                     const PortModelOptions& options) {
+  const auto started = std::chrono::steady_clock::now();
+  const std::vector<PortRef> ports = collect_ports(circuit);
+  if (ports.empty()) return Status::Error("the circuit has no nonlinear element: no ports");
+  if (!circuit.dc_open_branches().empty())
+    return Status::Error(
+        "an inductor closes a loop of voltage sources and inductors and is opened for the DC "
+        "point: the port model needs the linear network's DC solution");
+  if (!(options.port_shunt > 0) || !std::isfinite(options.port_shunt))
+    return Status::Error(
+        fmt::format("port model: port_shunt = {:g}: must be positive", options.port_shunt));
+  StatusOr<std::unique_ptr<Circuit>> lin =
+      linear_network(cards, circuit, ports, options.port_shunt);
+  if (!lin) return lin.status();
+  const Circuit& net = **lin;
+  PortModel pm;
+  pm.port_shunt = options.port_shunt;
+  std::vector<std::vector<double>> unit;
+  const int n = net.unknown_count();
+  for (const auto& e : net.elements()) {
+    if (!e->has_excitation()) continue;
+    if (!e->source_function())
+      return error_at(e->loc(), "port model: source '" + e->name() + "' has no time function");
+    pm.source_names.push_back(e->name());
+    unit.emplace_back(n + 1, 0.0);
+    e->stamp_unit(unit.back().data());
+    unit.back()[0] = 0.0;
+  }
+  pm.sources = static_cast<int>(unit.size());
+  std::vector<Probe> outputs = probes;
+  for (const PortRef& pr : ports) {
+    unit.emplace_back(n + 1, 0.0);
+    unit.back()[pr.p] -= 1.0;  // the port's current leaves p through the element into n
+    unit.back()[pr.n] += 1.0;
+    unit.back()[0] = 0.0;
+    pm.port_elements.push_back(pr.element->name());
+    pm.port_index.push_back(pr.index);
+    outputs.push_back({"port(" + pr.element->name() + ")", pr.p, pr.n});
+  }
+  pm.ports = static_cast<int>(ports.size());
+  pm.probes = static_cast<int>(probes.size());
+  for (const Probe& p : probes) pm.labels.push_back(p.label);
+
+  MnaSystem sys;
+  if (Status s = sys.build(net); !s.ok()) return s;
+  KluSolver dc_klu;
+  if (Status s = sys.factor_dc(net, dc_klu); !s.ok())
+    return s.with_context("port model: the linear network's DC solution");
+  std::vector<std::vector<double>> dc = unit;
+  for (auto& x : dc) {
+    if (Status s = dc_klu.solve(x.data() + 1); !s.ok()) return s;
+    x[0] = 0.0;
+  }
+  ReducedModelOptions ro = options.reduced;
+  ro.horizon = horizon;
+  ro.edge_time = 0.0;
+  StatusOr<ReducedModel> model = reduce_circuit(net, unit, dc, outputs, ro);
+  if (!model) return model.status().with_context("port model");
+  for (const Cplx& p : model->poles)
+    if (!(std::abs(p) > 0))
+      return Status::Error("port model: a mode with a pole at 0 (no DC steady state)");
+  pm.model = std::move(*model);
+  pm.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return pm;
+}
+
+namespace {
+
+// Exact integration coefficients of the modes over a step h (method step 3): for an input
+// linear in t from w0 to w1, x1 = e x0 + a w0 + b w1; for an input constant at w1, x1 = e x0 +
+// be w1. With z = p h: e = e^z, be = h (e^z - 1) / z, b = h (e^z - 1 - z) / z^2, a = be - b.
+struct StepCoefs {
+  std::vector<Cplx> e, a, b, be;
+  Eigen::MatrixXd z_trap, z_euler;  // port voltages per unit of end port current
+};
+
+void phi12(Cplx z, Cplx* phi1, Cplx* phi2) {
+  if (std::abs(z) < 0.05) {  // series: the closed forms cancel there
+    *phi1 = 1.0 + z * (0.5 + z * (1.0 / 6 + z * (1.0 / 24 + z * (1.0 / 120 + z / 720.0))));
+    *phi2 = 0.5 + z * (1.0 / 6 + z * (1.0 / 24 + z * (1.0 / 120 + z * (1.0 / 720 + z / 5040.0))));
+    return;
+  }
+  const Cplx ez = std::exp(z);
+  *phi1 = (ez - 1.0) / z;
+  *phi2 = (ez - 1.0 - z) / (z * z);
+}
+
+// The marching state at one accepted time point.
+struct PortState {
+  double t = 0;
+  std::vector<Cplx> x;              // modes
+  std::vector<Cplx> su, sd;         // in.u and in.d at t (per mode)
+  std::vector<double> u;            // sources at t
+  std::vector<double> v, d, q, jq;  // per port: voltage, current, charge, charge current
+  std::vector<double> y;            // probes
+  std::vector<double> watched;      // v, q, y: what the error control watches
+  void fill_watched() {
+    watched.clear();
+    watched.insert(watched.end(), v.begin(), v.end());
+    watched.insert(watched.end(), q.begin(), q.end());
+    watched.insert(watched.end(), y.begin(), y.end());
+  }
+};
+
+class PortMarch {
+ public:
+  PortMarch(const Circuit& circuit, const PortModel& pm, const TransientOptions& opt);
+  StatusOr<Waveform> run(PortModelStats* stats);
+
+ private:
+  Status initial_state();
+  const StepCoefs& coefs(double h);
+  // One step of h from cur_ into next_; *converged false when Newton did not converge.
+  Status advance(double h, bool euler, bool* converged);
+  bool newton(const StepCoefs& c, double h, bool euler, const std::vector<double>& v_oc,
+              std::vector<double>& v);
+  double truncation_ratio(const PortState& s1) const;
+  double euler_start_ratio(const PortState& s1) const;
+  void update_tolerances(const PortState& s);
+  void record(const PortState& s);
+  Status newton_failed(double t, double h) const;
+
+  const Circuit& circuit_;
+  const PortModel& pm_;
+  const ReducedModel& m_;
+  const TransientOptions& opt_;
+  const int q_, ns_, np_, ny_;
+  const double tiny_;
+  const StepControl control_;
+  std::vector<const SourceFunction*> sources_;
+  std::vector<const Element*> port_el_;
+  std::map<double, StepCoefs> cache_;
+  PortState cur_, next_;
+  std::array<PortState, 3> hist_;  // points since the last breakpoint, oldest first
+  int hist_count_ = 0;
+  std::vector<double> peak_, inv_tol_, abs_tol_;
+  PortModelStats stats_;
+  Waveform w_;
+  int worst_port_ = 0;
+  // Newton's scratch.
+  Eigen::MatrixXd jac_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
+  Eigen::VectorXd f_, dv_;
+  std::vector<double> dd_, v_oc_, v_;
+};
+
+PortMarch::PortMarch(const Circuit& circuit, const PortModel& pm, const TransientOptions& opt)
+    : circuit_(circuit),
+      pm_(pm),
+      m_(pm.model),
+      opt_(opt),
+      q_(static_cast<int>(pm.model.poles.size())),
+      ns_(pm.sources),
+      np_(pm.ports),
+      ny_(pm.probes),
+      tiny_(opt.tstop * 1e-12),
+      control_{.hmax = opt.effective_tmax(),
+               .hmin = std::max(1e-18, opt.tstop * 1e-13),
+               .error_order = 3} {
+  for (const std::string& name : pm.source_names)
+    sources_.push_back(circuit.find_element(name)->source_function());
+  for (const std::string& name : pm.port_elements) port_el_.push_back(circuit.find_element(name));
+  jac_.resize(np_, np_);
+  lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(np_);
+  v_oc_.assign(np_, 0.0);
+  v_.assign(np_, 0.0);
+  f_.resize(np_);
+  dv_.resize(np_);
+  dd_.assign(np_, 0.0);
+  // Absolute tolerances of the watched values: port voltages, charges, probes.
+  for (int m = 0; m < np_; ++m) abs_tol_.push_back(opt.vntol);
+  for (int m = 0; m < np_; ++m) abs_tol_.push_back(opt.chgtol);
+  for (const std::string& l : pm.labels)
+    abs_tol_.push_back(l.rfind("i(", 0) == 0 ? opt.abstol : opt.vntol);
+}
+
+const StepCoefs& PortMarch::coefs(double h) {
+  auto it = cache_.find(h);
+  if (it != cache_.end()) return it->second;
+  if (cache_.size() > 256) cache_.clear();
+  StepCoefs c;
+  c.e.resize(q_), c.a.resize(q_), c.b.resize(q_), c.be.resize(q_);
+  for (int i = 0; i < q_; ++i) {
+    const Cplx z = m_.poles[i] * h;
+    Cplx p1, p2;
+    phi12(z, &p1, &p2);
+    c.e[i] = std::exp(z);
+    c.be[i] = h * p1;
+    c.b[i] = h * p2;
+    c.a[i] = c.be[i] - c.b[i];
+  }
+  c.z_trap.setZero(np_, np_);
+  c.z_euler.setZero(np_, np_);
+  for (int mo = 0; mo < np_; ++mo)
+    for (int mi = 0; mi < np_; ++mi) {
+      const auto& out = m_.output[ny_ + mo];
+      const auto& in = m_.input[ns_ + mi];
+      Cplx st = 0, se = 0;
+      for (int i = 0; i < q_; ++i) {
+        const Cplx oi = out[i] * in[i];
+        st += oi * c.b[i];
+        se += oi * c.be[i];
+      }
+      const double dir = m_.direct[ns_ + mi][ny_ + mo];
+      c.z_trap(mo, mi) = st.real() + dir;
+      c.z_euler(mo, mi) = se.real() + dir;
+    }
+  ++stats_.step_sizes;
+  return cache_.emplace(h, std::move(c)).first->second;
+}
+
+Status PortMarch::initial_state() {
+  MnaSystem sys;
+  if (Status s = sys.build(circuit_); !s.ok()) return s;
+  std::vector<double> x(sys.n + 1, 0.0);
+  if (Status s = sys.dc(circuit_, x); !s.ok()) return s.with_context("DC operating point");
+  PortState& s = cur_;
+  s.t = 0;
+  s.u.resize(ns_);
+  for (int k = 0; k < ns_; ++k) s.u[k] = sources_[k]->value(0.0);
+  s.v.resize(np_), s.d.resize(np_), s.q.resize(np_), s.jq.assign(np_, 0.0);
+  for (int m = 0; m < np_; ++m) {
+    const NonlinearPort np = port_el_[m]->nonlinear_port(pm_.port_index[m]);
+    s.v[m] = x[np.p] - x[np.n];
+    const PortEval e = port_el_[m]->eval_port(pm_.port_index[m], s.v[m]);
+    s.d[m] = e.i - pm_.port_shunt * s.v[m];
+    s.q[m] = e.q;
+  }
+  s.x.assign(q_, 0.0), s.su.assign(q_, 0.0), s.sd.assign(q_, 0.0);
+  for (int i = 0; i < q_; ++i) {
+    for (int k = 0; k < ns_; ++k) s.su[i] += m_.input[k][i] * s.u[k];
+    for (int m = 0; m < np_; ++m) s.sd[i] += m_.input[ns_ + m][i] * s.d[m];
+    s.x[i] = -(s.su[i] + s.sd[i]) / m_.poles[i];
+  }
+  // The model's outputs in that steady state against the circuit's operating point.
+  double mismatch = 0, allowed = 0;
+  s.y.resize(ny_);
+  for (int o = 0; o < ny_ + np_; ++o) {
+    double y = 0;
+    for (int i = 0; i < q_; ++i) y += (m_.output[o][i] * s.x[i]).real();
+    for (int k = 0; k < ns_; ++k) y += m_.direct[k][o] * s.u[k];
+    for (int m = 0; m < np_; ++m) y += m_.direct[ns_ + m][o] * s.d[m];
+    if (o < ny_) {
+      s.y[o] = y;
+      continue;
+    }
+    const double exact = s.v[o - ny_];
+    mismatch = std::max(mismatch, std::fabs(y - exact));
+    allowed = std::max(allowed, 1e-6 + 1e-5 * std::fabs(exact));
+  }
+  stats_.dc_mismatch = mismatch;
+  if (!(mismatch <= allowed))
+    return Status::Error(fmt::format(
+        "port model: its DC state is {:.3g} V from the circuit's operating point at a port",
+        mismatch));
+  s.fill_watched();
+  peak_.assign(s.watched.size(), 0.0);
+  update_tolerances(s);
+  return Status::Ok();
+}
+
+void PortMarch::update_tolerances(const PortState& s) {
+  const size_t n = s.watched.size();
+  inv_tol_.resize(n);
+  for (size_t k = 0; k < n; ++k) {
+    peak_[k] = std::max(peak_[k], std::fabs(s.watched[k]));
+    inv_tol_[k] = 1.0 / (opt_.trtol * (opt_.reltol * peak_[k] + abs_tol_[k]));
+  }
+}
+
+void PortMarch::record(const PortState& s) {
+  if (s.t < opt_.tstart - tiny_) return;
+  w_.time.push_back(s.t);
+  for (int p = 0; p < ny_; ++p) w_.columns[p].push_back(s.y[p]);
+}
+
+// Newton on the port voltages: v = v_oc + Z_h d(v), d the port current with its charge's
+// current by the step's formula; v in: the first iterate, out: the solution (into next_ too).
+bool PortMarch::newton(const StepCoefs& c, double h, bool euler, const std::vector<double>& v_oc,
+                       std::vector<double>& v) {
+  const Eigen::MatrixXd& z = euler ? c.z_euler : c.z_trap;
+  const double a0 = euler ? 1.0 / h : 2.0 / h;
+  const double gs = pm_.port_shunt;
+  const NewtonTolerances& tol = opt_.newton;
+  PortState& s1 = next_;
+  std::vector<double>& hq = s1.jq;  // the charge current's history part, then its value
+  for (int m = 0; m < np_; ++m) hq[m] = euler ? -cur_.q[m] / h : -a0 * cur_.q[m] - cur_.jq[m];
+  bool small = false, limited = true;
+  for (int it = 0; it <= tol.max_iterations; ++it) {
+    for (int m = 0; m < np_; ++m) {
+      const PortEval e = port_el_[m]->eval_port(pm_.port_index[m], v[m]);
+      s1.q[m] = e.q;
+      s1.d[m] = e.i - gs * v[m] + a0 * e.q + hq[m];
+      dd_[m] = e.g - gs + a0 * e.c;
+    }
+    bool f_ok = true;
+    for (int mo = 0; mo < np_; ++mo) {
+      double f = v[mo] - v_oc[mo];
+      for (int mi = 0; mi < np_; ++mi) f -= z(mo, mi) * s1.d[mi];
+      f_(mo) = f;
+      if (!(std::fabs(f) <= tol.reltol * std::fabs(v[mo]) + tol.vntol)) {
+        f_ok = false;
+        worst_port_ = mo;
+      }
+    }
+    if (it > 0 && small && !limited && f_ok) {
+      for (int m = 0; m < np_; ++m) s1.jq[m] = a0 * s1.q[m] + hq[m];
+      s1.v = v;
+      return true;
+    }
+    if (it == tol.max_iterations) break;
+    for (int mi = 0; mi < np_; ++mi) jac_.col(mi) = -z.col(mi) * dd_[mi];
+    jac_.diagonal().array() += 1.0;
+    lu_.compute(jac_);
+    f_ = -f_;
+    dv_ = lu_.solve(f_);
+    ++stats_.newton_iterations;
+    small = true, limited = false;
+    for (int m = 0; m < np_; ++m) {
+      const double vn = v[m] + dv_(m);
+      if (!std::isfinite(vn)) return false;
+      if (std::fabs(dv_(m)) > tol.reltol * std::max(std::fabs(vn), std::fabs(v[m])) + tol.vntol)
+        small = false;
+      bool lim = false;
+      v[m] = port_el_[m]->limit_port(pm_.port_index[m], vn, v[m], &lim);
+      limited = limited || lim;
+    }
+  }
+  return false;
+}
+
+Status PortMarch::advance(double h, bool euler, bool* converged) {
+  const StepCoefs& c = coefs(h);
+  const PortState& s0 = cur_;
+  PortState& s1 = next_;
+  s1.t = s0.t + h;
+  s1.u.resize(ns_);
+  for (int k = 0; k < ns_; ++k) s1.u[k] = sources_[k]->value(s1.t);
+  s1.su.assign(q_, 0.0);
+  s1.x.resize(q_);
+  for (int k = 0; k < ns_; ++k) {
+    const Cplx* in = m_.input[k].data();
+    const double u = s1.u[k];
+    if (u != 0.0)
+      for (int i = 0; i < q_; ++i) s1.su[i] += in[i] * u;
+  }
+  for (int i = 0; i < q_; ++i) {
+    s1.x[i] = c.e[i] * s0.x[i] + c.a[i] * s0.su[i] + c.b[i] * s1.su[i];
+    if (!euler) s1.x[i] += c.a[i] * s0.sd[i];
+  }
+  std::vector<double>& v_oc = v_oc_;
+  std::vector<double>& v = v_;
+  for (int m = 0; m < np_; ++m) {
+    const Cplx* out = m_.output[ny_ + m].data();
+    double y = 0;
+    for (int i = 0; i < q_; ++i) y += (out[i] * s1.x[i]).real();
+    for (int k = 0; k < ns_; ++k) y += m_.direct[k][ny_ + m] * s1.u[k];
+    v_oc[m] = y;
+  }
+  // The first iterate: the last point moved along the last step's slope.
+  v = s0.v;
+  if (hist_count_ >= 2) {
+    const PortState& sm = hist_[hist_count_ - 2];
+    const double r = h / (s0.t - sm.t);
+    for (int m = 0; m < np_; ++m) v[m] += r * (s0.v[m] - sm.v[m]);
+  }
+  s1.v.resize(np_), s1.d.resize(np_), s1.q.resize(np_), s1.jq.resize(np_);
+  *converged = newton(c, h, euler, v_oc, v);
+  if (!*converged) {
+    ++stats_.newton_failures;
+    return Status::Ok();
+  }
+  s1.sd.assign(q_, 0.0);
+  for (int m = 0; m < np_; ++m) {
+    const Cplx* in = m_.input[ns_ + m].data();
+    const double d = s1.d[m];
+    for (int i = 0; i < q_; ++i) s1.sd[i] += in[i] * d;
+  }
+  const std::vector<Cplx>& bd = euler ? c.be : c.b;
+  for (int i = 0; i < q_; ++i) s1.x[i] += bd[i] * s1.sd[i];
+  s1.y.resize(ny_);
+  for (int p = 0; p < ny_; ++p) {
+    const Cplx* out = m_.output[p].data();
+    double y = 0;
+    for (int i = 0; i < q_; ++i) y += (out[i] * s1.x[i]).real();
+    for (int k = 0; k < ns_; ++k) y += m_.direct[k][p] * s1.u[k];
+    for (int m = 0; m < np_; ++m) y += m_.direct[ns_ + m][p] * s1.d[m];
+    if (!std::isfinite(y))
+      return Status::Error(
+          fmt::format("port model: non-finite value at t={:g} s ({})", s1.t, pm_.labels[p]));
+    s1.y[p] = y;
+  }
+  s1.fill_watched();
+  return Status::Ok();
+}
+
+// The transient's truncation term (trapezoidal, third divided difference over four points).
+double PortMarch::truncation_ratio(const PortState& s1) const {
+  if (hist_count_ != 3) return 0.0;
+  const double t1 = s1.t, t0 = hist_[2].t, tm1 = hist_[1].t, tm2 = hist_[0].t;
+  const auto &x1 = s1.watched, &x0 = hist_[2].watched, &xm1 = hist_[1].watched,
+             &xm2 = hist_[0].watched;
+  const double coef = (1.0 / 12.0) * 6.0, step = t1 - t0;
+  const double ia = 1.0 / (t1 - t0), ib = 1.0 / (t0 - tm1), ic = 1.0 / (tm1 - tm2);
+  const double ie = 1.0 / (t1 - tm1), iff = 1.0 / (t0 - tm2), ig = 1.0 / (t1 - tm2);
+  const double h3 = step * step * step * coef * ig;
+  const double w1 = h3 * ie * ia, w2 = -h3 * ib * (ie + iff), w3 = h3 * iff * ic;
+  double ratio = 0.0;
+  for (size_t k = 0; k < x1.size(); ++k)
+    ratio = std::max(ratio, inv_tol_[k] * std::fabs(w1 * (x1[k] - x0[k]) + w2 * (x0[k] - xm1[k]) +
+                                                    w3 * (xm1[k] - xm2[k])));
+  return ratio;
+}
+
+// The backward-Euler first step, judged with the second step's point: h1^2 x'' / 2.
+double PortMarch::euler_start_ratio(const PortState& s2) const {
+  const double t0 = hist_[0].t, t1 = hist_[1].t, t2 = s2.t, h1 = t1 - t0;
+  const auto &x0 = hist_[0].watched, &x1 = hist_[1].watched, &x2 = s2.watched;
+  const double i21 = 1.0 / (t2 - t1), i10 = 1.0 / h1, i20 = 1.0 / (t2 - t0);
+  double ratio = 0.0;
+  for (size_t k = 0; k < x2.size(); ++k) {
+    const double dd2 = ((x2[k] - x1[k]) * i21 - (x1[k] - x0[k]) * i10) * i20;
+    ratio = std::max(ratio, inv_tol_[k] * h1 * h1 * std::fabs(dd2));
+  }
+  return ratio;
+}
+
+Status PortMarch::newton_failed(double t, double h) const {
+  return Status::Error(fmt::format(
+      "port model: time step too small at t={:g} s (h={:g} s): Newton's iteration on the ports "
+      "does not converge at {}",
+      t, h, pm_.port_elements[worst_port_]));
+}
+
+StatusOr<Waveform> PortMarch::run(PortModelStats* stats_out) {
+  if (Status s = initial_state(); !s.ok()) return s;
+  const double tstop = opt_.tstop, tiny = tiny_, hmax = control_.hmax, hmin = control_.hmin;
+  std::vector<double> bps;
+  for (const auto& e : circuit_.elements()) e->breakpoints(tstop, bps);
+  bps.push_back(tstop);
+  std::sort(bps.begin(), bps.end());
+  std::vector<double> merged;
+  for (double t : bps)
+    if (t > tiny && (merged.empty() || t - merged.back() > tiny)) merged.push_back(t);
+  bps.swap(merged);
+  for (const std::string& l : pm_.labels) w_.add_column(l, {});
+  record(cur_);
+  hist_[0] = cur_, hist_count_ = 1;
+  size_t next_bp = 0;
+  double h = control_.ladder(0.1 * std::min(hmax, bps[0]));
+  double last_regular_h = hmax;
+  bool after_bp = true;
+  while (cur_.t < tstop - tiny) {
+    if (stats_.accepted + stats_.rejected >= opt_.max_steps)
+      return Status::Error(fmt::format("port model gave up at t={:g} s after {} steps (max_steps)",
+                                       cur_.t, opt_.max_steps));
+    while (next_bp < bps.size() && bps[next_bp] <= cur_.t + tiny) ++next_bp;
+    const double bp = next_bp < bps.size() ? bps[next_bp] : tstop;
+    double step = std::min(h, hmax);
+    bool lands = false;
+    if (cur_.t + step >= bp - tiny) {
+      step = bp - cur_.t;
+      lands = true;
+    } else if (cur_.t + 1.5 * step > bp) {
+      step = 0.5 * (bp - cur_.t);
+    }
+    const bool euler = after_bp || hist_count_ < 2;
+    bool converged = true;
+    if (Status s = advance(step, euler, &converged); !s.ok()) return s;
+    if (!converged) {
+      ++stats_.rejected;
+      h = step / 8;
+      if (h < hmin) return newton_failed(cur_.t, h);
+      h = control_.ladder(h);
+      continue;
+    }
+    const double ratio = euler ? 0.0 : truncation_ratio(next_);
+    if (hist_count_ == 2) {
+      const double ratio1 = euler_start_ratio(next_);
+      if (ratio1 > 1.0) {  // undo the Euler step and this one; retry the first shorter
+        stats_.rejected += 2;
+        --stats_.accepted;
+        const double t0 = hist_[0].t, t1 = hist_[1].t;
+        const double h_retry = StepControl::shrink_by_order(t1 - t0, ratio1, 2, 0.1);
+        if (h_retry < hmin)
+          return Status::Error(
+              fmt::format("port model: time step too small at t={:g} s (h={:g} s)", t0, h_retry));
+        if (!w_.time.empty() && w_.time.back() == t1) {
+          w_.time.pop_back();
+          for (auto& col : w_.columns) col.pop_back();
+        }
+        cur_ = hist_[0];
+        hist_count_ = 1;
+        after_bp = true;
+        h = control_.ladder(h_retry);
+        continue;
+      }
+    }
+    if (ratio > 1.0) {
+      ++stats_.rejected;
+      h = control_.shrink(step, ratio);
+      if (h < hmin)
+        return Status::Error(
+            fmt::format("port model: time step too small at t={:g} s (h={:g} s)", cur_.t, h));
+      h = control_.ladder(h);
+      continue;
+    }
+    ++stats_.accepted;
+    if (lands) next_.t = bp;
+    std::swap(cur_, next_);
+    if (hist_count_ == 3) {
+      std::swap(hist_[0], hist_[1]);
+      std::swap(hist_[1], hist_[2]);
+      --hist_count_;
+    }
+    hist_[hist_count_++] = cur_;
+    record(cur_);
+    update_tolerances(cur_);
+    if (!lands) last_regular_h = step;
+    h = control_.grow(step, ratio);
+    after_bp = false;
+    if (lands) {
+      after_bp = true;
+      const double next = next_bp + 1 < bps.size() ? bps[next_bp + 1] : tstop;
+      h = control_.ladder(0.1 * std::min(last_regular_h, next - cur_.t));
+      hist_[0] = cur_, hist_count_ = 1;
+    }
+  }
+  if (stats_out) *stats_out = stats_;
+  return std::move(w_);
+}
+
+}  // namespace
+
+StatusOr<Waveform> run_port_model(Circuit& circuit, const PortModel& model,
+                                  const TransientOptions& opt, PortModelStats* stats) {
+  if (Status s = opt.validate(); !s.ok()) return s;
+  if (opt.uic || !opt.node_ic.empty())
+    return Status::Error(
+        ".ic / .tran uic: the port model starts from the circuit's own DC operating point");
+  for (const std::string& name : model.source_names)
+    if (!circuit.find_element(name) || !circuit.find_element(name)->source_function())
+      return Status::Error("port model: built from another circuit (source " + name + ")");
+  for (const std::string& name : model.port_elements)
+    if (!circuit.find_element(name))
+      return Status::Error("port model: built from another circuit (element " + name + ")");
+  for (const auto& e : circuit.elements()) e->bind_time(opt.tstep, opt.tstop);
+  PortModelStats st;
+  StatusOr<Waveform> w = PortMarch(circuit, model, opt).run(&st);
+  if (w.ok() && stats) {
+    st.model_seconds = model.seconds;
+    st.model = model.model.stats;
+    st.ports = model.ports;
+    st.modes = static_cast<int>(model.model.poles.size());
+    *stats = st;
+  }
+  return w;
+}
+
+}  // namespace isolink

@@ -1,0 +1,137 @@
+// Port model: a circuit with nonlinear elements (diodes) simulated as its linear network, reduced
+// to a model seen from the nonlinear elements' ports, with Newton's iteration on the port
+// unknowns alone. The fast engine for nonlinear circuits; the full-circuit Newton transient
+// (solver/transient.h) is its checked fallback.
+//
+//   StatusOr<PortModel> m = build_port_model(cards, circuit, probes, tstop, {});
+//   if (!m) ... fall back (m.status() says why)
+//   PortModelStats stats;
+//   StatusOr<Waveform> w = run_port_model(circuit, *m, transient_options, &stats);
+//
+// Contract:
+// - Input: the circuit's cards (the netlist's, in order) and the finalized circuit built from
+//   them; probes parsed on that circuit. Units SI. One Waveform row per accepted step with
+//   t >= tstart, as the transient engine writes them.
+// - Ownership: the model owns its numbers and keeps no reference to the cards or the circuit;
+//   run_port_model reads the circuit's nonlinear elements (eval_port) and sources (values), so
+//   the circuit must be the one the model was built from. run_port_model takes the circuit
+//   non-const to bind the sources' time defaults, as run_transient does.
+// - Errors (a Status, never thrown; each is a reason to fall back to the full transient): no
+//   nonlinear port; .ic / uic; an inductor opened at DC; the reduced model fails its check
+//   against the exact AC solution; the model's DC state differs from the circuit's operating
+//   point; Newton on the ports does not converge above the step floor; max_steps.
+//
+// Method (docs/nonlinear.md, "The port model"):
+// 1. The linear network: every element but the nonlinear ports, each port shunted by a constant
+//    conductance g_s (PortModelOptions::port_shunt) that the port's own current gives back:
+//    the port current is d(v) = i(v) - g_s v + dq(v)/dt, so the circuit is unchanged. The shunt
+//    bounds each port's self-impedance by 1 / g_s (a node that only diodes reach, such as the
+//    junction of a diode and a zener in series, is otherwise floating), which keeps the model's
+//    relative check meaningful at the ports.
+// 2. The model (solver/reduced_model.h, Krylov projection checked against the exact AC solution
+//    of the linear network at the check frequencies, refined between them): inputs = every
+//    source (its unit excitation) and every port (a unit current drawn from p into n); outputs =
+//    every port voltage and every probe. Modes x_i' = p_i x_i + sum_k in_ki w_k, outputs
+//    y = Re sum_i out_i x_i + D w. The check is the reduced model's, at tol
+//    (PortModelOptions::reduced), for every input-output pair: the port impedance matrix, the
+//    source-to-port transfers and the probes' transfers.
+// 3. Time steps: over a step the sources are linear in t (exact for PULSE and PWL between their
+//    corners, which are breakpoints; SIN and EXP within the error control) and the port currents
+//    d are linear in t from the last point to the unknown end value (trapezoidal), or constant at
+//    the end value on the first step after a breakpoint (backward Euler). Each mode is integrated
+//    exactly for such inputs: x1 = e^(ph) x0 + a(h) in.w0 + b(h) in.w1. The end port voltages
+//    are then v1 = v_oc + Z_h d1 with Z_h the model's step impedance (np x np, cached per step
+//    size), and Newton's iteration (SPICE's pnjlim limiting, the transient's tolerances) solves
+//    v1 = v_oc + Z_h d(v1) on the np port voltages alone, a dense np x np system. The junction
+//    and diffusion charges q(v) are integrated as the transient integrates them, by the same
+//    formula as the current's shape (trapezoidal: dq/dt at the end = 2 (q1 - q0) / h - dq/dt at
+//    the start; Euler: (q1 - q0) / h): the integral of the charge current over a step is q1 - q0
+//    exactly, so charge is conserved.
+// 4. Step control: the one StepControl (solver/step_control.h), step sizes on its ladder so the
+//    coefficients and Z_h are reused; the error estimate is the transient's truncation term
+//    (third divided difference) on the port voltages, the ports' charges and the probes, against
+//    trtol (reltol peak + vntol | chgtol | abstol), the Euler start step checked one step late.
+//    Newton's failure retries at 1/8 of the step.
+//
+// Guarantee: the linear network's response is exact to the model's check (its transfer within
+// tol of each input-output pair's peak at every check frequency; for an input edge, the
+// reduced model's time-domain bound tol ln(f_max / f_min) / pi of the edge's amplitude times the
+// pair's peak gain), and the time discretisation is that of the transient at the same
+// tolerances, applied to the port currents only. Tested against the full transient at
+// reltol 1e-6 (tests/solver/port_model_test.cpp, tests/cli/nonlinear_compare_test.cpp).
+#pragma once
+
+#include <complex>
+#include <string>
+#include <vector>
+
+#include "base/status.h"
+#include "base/waveform.h"
+#include "solver/card.h"
+#include "solver/circuit.h"
+#include "solver/probe.h"
+#include "solver/reduced_model.h"
+#include "solver/transient.h"
+
+namespace isolink {
+
+struct PortModelOptions {
+  // The reltol the engine's caller runs it at when the user gave none (analysis/simulate.cpp):
+  // a tenth of the transient's 1e-3, as the transient's own self-check tightens first. At 1e-3
+  // the port currents' linear shape over a step left 2-7 mV on seeded random links with TVS and
+  // clamps (against the full transient at 1e-6); at 1e-4, 0.7-2.0 mV for twice the steps.
+  double default_reltol = 1e-4;
+  // S, the conductance across every port in the linear network (given back by the port's
+  // current): bounds each port's self-impedance by 1 / port_shunt.
+  double port_shunt = 1e-2;
+  // The model's check. No edge weighting: the ports' currents can switch faster than any source.
+  // 48 check points, refined between them as the reduced model's check is: 128 took 0.15 s of
+  // a 12 m link's 0.21 s, the model at full order either way. Up to 500 unknowns the model
+  // starts from the full basis: the 50 m clamp hop (436 unknowns) reached full order through 23
+  // expansion points in 2.5 s, diagonalised in full it takes 0.8 s.
+  ReducedModelOptions reduced = [] {
+    ReducedModelOptions r;
+    r.tol = 2e-6;
+    r.check_points = 48;
+    r.full_order_at_most = 500;
+    return r;
+  }();
+};
+
+// The model and what run_port_model needs to step it.
+struct PortModel {
+  ReducedModel model;  // inputs: sources, then ports; outputs: probes, then port voltages
+  int sources = 0;     // model inputs 0 .. sources - 1
+  int ports = 0;       // model inputs sources .. sources + ports - 1; outputs probes ..
+  int probes = 0;
+  std::vector<std::string> labels;         // the probes' labels
+  std::vector<std::string> source_names;   // the circuit's source elements, in input order
+  std::vector<std::string> port_elements;  // per port: its element's name
+  std::vector<int> port_index;             // per port: the element's port number
+  double port_shunt = 0.0;
+  double seconds = 0.0;  // building the model (DC solves, the reduction and its check)
+};
+
+struct PortModelStats {
+  long accepted = 0, rejected = 0;
+  long newton_iterations = 0, newton_failures = 0;
+  int step_sizes = 0;          // distinct step sizes (coefficient sets computed)
+  double dc_mismatch = 0.0;    // V: the model's port voltages at t = 0 against the DC point
+  double model_seconds = 0.0;  // building the model
+  ReducedModelStats model;     // the check it passed
+  int ports = 0, modes = 0;
+};
+
+// The model of the circuit's linear network seen from its nonlinear ports and probes (method
+// steps 1-2). `cards` are the ones `circuit` was built from, in the same order.
+StatusOr<PortModel> build_port_model(const std::vector<Card>& cards, const Circuit& circuit,
+                                     const std::vector<Probe>& probes, double horizon,
+                                     const PortModelOptions& options);
+
+// The transient of the circuit on the port model (method steps 3-4): DC operating point of the
+// full circuit, then exact modal steps with Newton on the ports. `opt` as for run_transient
+// (uic and node_ic are refused: errors).
+StatusOr<Waveform> run_port_model(Circuit& circuit, const PortModel& model,
+                                  const TransientOptions& opt, PortModelStats* stats = nullptr);
+
+}  // namespace isolink

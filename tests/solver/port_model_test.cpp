@@ -1,0 +1,277 @@
+// The port model (solver/port_model.h): its AC transfer against the closed form of an RC seen
+// from a diode's port, a clipper's knee against the DC equation solved by bisection, and its
+// waveforms against the full-circuit Newton transient at reltol 1e-6 (a rectifier with charge
+// storage, a clipper driven by a sine, seeded random LC ladders with TVS and rail clamps).
+#include "solver/port_model.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <memory>
+#include <numbers>
+#include <random>
+
+#include "solver/transient.h"
+#include "test_cards.h"
+
+namespace isolink {
+namespace {
+using namespace isolink::testing;
+
+constexpr double kVt = 1.38064852e-23 * 300.15 / 1.6021766208e-19;  // kT/q at 27 degC
+constexpr double kGmin = 1e-12;
+
+std::shared_ptr<const CardModel> model(std::vector<std::pair<std::string, double>> params) {
+  auto m = std::make_shared<CardModel>();
+  m->name = "dtest";
+  m->type = "d";
+  for (const auto& [k, v] : params) m->params.emplace_back(k, num(v));
+  return m;
+}
+
+Card diode(std::string name, std::vector<std::string> nodes, std::shared_ptr<const CardModel> m) {
+  Card c = card(std::move(name), std::move(nodes), {});
+  c.model = std::move(m);
+  return c;
+}
+
+std::vector<Probe> probes(const Circuit& c, const std::vector<std::string>& texts) {
+  std::vector<Probe> out;
+  for (const auto& t : texts) {
+    StatusOr<Probe> p = parse_probe(c, t);
+    EXPECT_TRUE(p.ok()) << t;
+    if (p) out.push_back(*p);
+  }
+  return out;
+}
+
+// Max |a - b| over a's times in column k, b interpolated linearly.
+double max_difference(const Waveform& a, const Waveform& b, size_t k) {
+  double worst = 0;
+  size_t j = 0;
+  for (size_t i = 0; i < a.samples(); ++i) {
+    const double t = a.time[i];
+    while (j + 2 < b.samples() && b.time[j + 1] < t) ++j;
+    const double t0 = b.time[j], t1 = b.time[j + 1];
+    const double f = t1 > t0 ? std::clamp((t - t0) / (t1 - t0), 0.0, 1.0) : 0.0;
+    const double v = b.columns[k][j] + f * (b.columns[k][j + 1] - b.columns[k][j]);
+    worst = std::max(worst, std::fabs(a.columns[k][i] - v));
+  }
+  return worst;
+}
+
+struct Runs {
+  Waveform port, full;
+  PortModelStats stats;
+};
+
+// The port model at the engine's default options and the full transient at reltol 1e-6 on the same
+// cards.
+Runs both(const std::vector<Card>& cards, const std::vector<std::string>& texts,
+          TransientOptions opt) {
+  Runs r;
+  Circuit c;
+  EXPECT_EQ(build(c, cards), "");
+  const std::vector<Probe> ps = probes(c, texts);
+  StatusOr<PortModel> m = build_port_model(cards, c, ps, opt.tstop, {});
+  EXPECT_TRUE(m.ok()) << m.status().message();
+  if (!m) return r;
+  TransientOptions po = opt;
+  po.reltol = PortModelOptions{}.default_reltol;  // as analysis/simulate.cpp runs it
+  StatusOr<Waveform> w = run_port_model(c, *m, po, &r.stats);
+  EXPECT_TRUE(w.ok()) << w.status().message();
+  if (w) r.port = std::move(*w);
+  Circuit full;
+  EXPECT_EQ(build(full, cards), "");
+  opt.reltol = 1e-6;
+  StatusOr<Waveform> f = run_transient(full, opt, probes(full, texts));
+  EXPECT_TRUE(f.ok()) << f.status().message();
+  if (f) r.full = std::move(*f);
+  return r;
+}
+
+TEST(PortModel, AcTransferIsTheRcClosedForm) {
+  // V1 -> 1 kohm -> out, 10 pF to ground, a diode from out to ground: the port is out-ground and
+  // the linear network is R || C || the port's shunt g_s. A unit current drawn at the port gives
+  // v = -1 / Y, Y = 1/R + j w C + g_s; the source gives v = (1/R) / Y.
+  const std::vector<Card> cards = {card("v1", {"in", "0"}, {call("pwl", {0, 0, 1e-6, 1})}),
+                                   card("r1", {"in", "out"}, {num(1e3)}),
+                                   card("c1", {"out", "0"}, {num(10e-12)}),
+                                   diode("d1", {"out", "0"}, model({{"is", 1e-14}}))};
+  Circuit c;
+  ASSERT_EQ(build(c, cards), "");
+  const PortModelOptions po;
+  StatusOr<PortModel> m = build_port_model(cards, c, probes(c, {"v(out)"}), 1e-6, po);
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  ASSERT_EQ(m->sources, 1);
+  ASSERT_EQ(m->ports, 1);
+  EXPECT_LE(m->model.stats.error, po.reduced.tol);
+  for (double f : {0.0, 1e3, 1e6, 1.6e7, 1e8, 1e9, 3e9}) {
+    const std::complex<double> s(0, 2 * std::numbers::pi * f);
+    const std::complex<double> y = 1e-3 + s * 10e-12 + po.port_shunt;
+    const std::complex<double> z = -1.0 / y, h = 1e-3 / y;
+    // inputs: 0 the source, 1 the port; outputs: 0 the probe v(out), 1 the port's voltage.
+    for (size_t out : {0u, 1u}) {
+      EXPECT_LT(std::abs(m->model.transfer(1, out, s) - z), 1e-5 * (1.0 / (1e-3 + po.port_shunt)))
+          << f << " Hz, output " << out;
+      EXPECT_LT(std::abs(m->model.transfer(0, out, s) - h), 1e-5) << f << " Hz, output " << out;
+    }
+  }
+}
+
+TEST(PortModel, ClipperFollowsItsKneeOnASlowRamp) {
+  // As tests/solver/diode_test.cpp: each row is the DC solution (vin - vd) / r = i(vd).
+  const std::vector<Card> cards = {card("v1", {"in", "0"}, {call("pwl", {0, 0, 1e-3, 5})}),
+                                   card("r1", {"in", "out"}, {num(1e3)}),
+                                   diode("d1", {"out", "0"}, model({{"is", 1e-14}}))};
+  Circuit c;
+  ASSERT_EQ(build(c, cards), "");
+  const std::vector<Probe> ps = probes(c, {"v(in)", "v(out)"});
+  StatusOr<PortModel> m = build_port_model(cards, c, ps, 1e-3, {});
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  TransientOptions opt{.tstep = 10e-6, .tstop = 1e-3};
+  StatusOr<Waveform> w = run_port_model(c, *m, opt);
+  ASSERT_TRUE(w.ok()) << w.status().message();
+  ASSERT_GT(w->samples(), 50u);
+  double worst = 0;
+  for (size_t k = 0; k < w->samples(); ++k) {
+    const double vin = w->columns[0][k];
+    const double vd = std::fabs(vin) < 1e-12 ? 0.0 : [&] {
+      double a = -1, b = std::max(vin, 0.0) + 1e-9;
+      auto f = [&](double x) {
+        return (vin - x) / 1e3 - 1e-14 * (std::exp(x / kVt) - 1) - kGmin * x;
+      };
+      for (int i = 0; i < 200; ++i) ((f(0.5 * (a + b)) > 0) ? a : b) = 0.5 * (a + b);
+      return 0.5 * (a + b);
+    }();
+    worst = std::max(worst, std::fabs(w->columns[1][k] - vd));
+  }
+  EXPECT_LT(worst, 1e-5);
+  EXPECT_NEAR(w->columns[1].back(), 0.6929, 1e-3);
+}
+
+TEST(PortModel, RectifierWithChargeStorageMatchesTheFullTransient) {
+  const auto d = model({{"is", 1e-8},
+                        {"n", 1.05},
+                        {"rs", 0.3},
+                        {"cjo", 30e-12},
+                        {"vj", 0.5},
+                        {"m", 0.45},
+                        {"tt", 5e-9}});
+  const std::vector<Card> cards = {card("v1", {"in", "0"}, {call("sin", {0, 5, 1e6})}),
+                                   card("rs", {"in", "a"}, {num(10)}), diode("d1", {"a", "out"}, d),
+                                   card("rl", {"out", "0"}, {num(2e3)}),
+                                   card("cl", {"out", "0"}, {num(1e-9)})};
+  Runs r = both(cards, {"v(out)", "v(a)"}, {.tstep = 1e-9, .tstop = 5e-6});
+  ASSERT_GT(r.port.samples(), 100u);
+  for (size_t k = 0; k < 2; ++k) EXPECT_LT(max_difference(r.port, r.full, k), 3e-3) << k;
+}
+
+TEST(PortModel, ZenerClipperInSeriesMatchesTheFullTransient) {
+  // A diode in series with a zener: their junction node is reached by the diodes only.
+  const auto sig = model({{"is", 2.52e-9},
+                          {"n", 1.752},
+                          {"rs", 0.568},
+                          {"cjo", 4e-12},
+                          {"m", 0.4},
+                          {"tt", 20e-9},
+                          {"bv", 100},
+                          {"ibv", 100e-6}});
+  const auto zen = model({{"is", 1e-14},
+                          {"rs", 2},
+                          {"cjo", 50e-12},
+                          {"vj", 0.75},
+                          {"m", 0.33},
+                          {"bv", 5.1},
+                          {"ibv", 5e-3}});
+  const std::vector<Card> cards = {card("v1", {"in", "0"}, {call("sin", {0, 10, 100e3})}),
+                                   card("r1", {"in", "out"}, {num(1e3)}),
+                                   diode("d1", {"out", "mid"}, sig),
+                                   diode("dz", {"0", "mid"}, zen),
+                                   diode("d3", {"0", "out"}, sig),
+                                   card("c1", {"out", "0"}, {num(10e-12)})};
+  Runs r = both(cards, {"v(out)"}, {.tstep = 10e-9, .tstop = 20e-6});
+  ASSERT_GT(r.port.samples(), 100u);
+  EXPECT_LT(max_difference(r.port, r.full, 0), 3e-3);
+}
+
+// A seeded random single-ended link: a pulse source through 50 ohm into an LC ladder (a cable of
+// N sections with some loss), terminated, with TVS to ground and clamps to a 3.3 V rail placed
+// at random nodes; the drive overshoots the rail so the clamps conduct.
+std::vector<Card> random_link(unsigned seed) {
+  std::mt19937 rng(seed);
+  auto uni = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
+  const int sections = std::uniform_int_distribution<int>(4, 10)(rng);
+  const double amp = uni(4, 8), tr = uni(2e-9, 10e-9);
+  std::vector<Card> cards = {
+      card("v1", {"src", "0"}, {call("pulse", {0, amp, 20e-9, tr, tr, 200e-9, 500e-9})}),
+      card("rsrc", {"src", "n0"}, {num(uni(20, 60))}), card("vdd", {"rail", "0"}, {num(3.3)})};
+  const auto tvs = model({{"is", 1e-12},
+                          {"n", 1.1},
+                          {"rs", 0.5},
+                          {"cjo", 12e-12},
+                          {"vj", 0.8},
+                          {"m", 0.35},
+                          {"bv", uni(5, 7)},
+                          {"ibv", 1e-3}});
+  const auto pin = model({{"is", 1e-15},
+                          {"n", 1.05},
+                          {"rs", 5},
+                          {"cjo", 1e-12},
+                          {"vj", 0.7},
+                          {"m", 0.4},
+                          {"tt", 1e-9}});
+  for (int k = 0; k < sections; ++k) {
+    const std::string a = "n" + std::to_string(k), m = "m" + std::to_string(k),
+                      b = "n" + std::to_string(k + 1);
+    cards.push_back(card("l" + std::to_string(k), {a, m}, {num(uni(0.2e-6, 0.5e-6))}));
+    cards.push_back(card("r" + std::to_string(k), {m, b}, {num(uni(0.05, 0.5))}));
+    cards.push_back(card("c" + std::to_string(k), {b, "0"}, {num(uni(15e-12, 40e-12))}));
+  }
+  const std::string end = "n" + std::to_string(sections);
+  cards.push_back(card("rterm", {end, "0"}, {num(uni(80, 200))}));
+  cards.push_back(diode("dtvs0", {"0", "n0"}, tvs));
+  const int mid = std::uniform_int_distribution<int>(1, sections - 1)(rng);
+  cards.push_back(diode("dtvs1", {"0", "n" + std::to_string(mid)}, tvs));
+  cards.push_back(diode("dclp", {end, "rail"}, pin));
+  cards.push_back(diode("dcln", {"0", end}, pin));
+  return cards;
+}
+
+TEST(PortModel, RandomLinksWithDiodesMatchTheFullTransient) {
+  for (unsigned seed : {1u, 2u, 3u}) {
+    const std::vector<Card> cards = random_link(seed);
+    const int sections = static_cast<int>((cards.size() - 3 - 5) / 3);
+    const std::string end = "v(n" + std::to_string(sections) + ")";
+    Runs r = both(cards, {end, "v(n0)"}, {.tstep = 1e-9, .tstop = 1e-6});
+    ASSERT_GT(r.port.samples(), 100u) << seed;
+    for (size_t k = 0; k < 2; ++k)
+      EXPECT_LT(max_difference(r.port, r.full, k), 3e-3) << "seed " << seed << " probe " << k;
+    std::printf("seed %u: %d sections, %d ports, %d modes, %ld steps; %.3f / %.3f mV\n", seed,
+                sections, r.stats.ports, r.stats.modes, r.stats.accepted,
+                1e3 * max_difference(r.port, r.full, 0), 1e3 * max_difference(r.port, r.full, 1));
+  }
+}
+
+TEST(PortModel, RefusesUicAndCircuitsWithoutDiodes) {
+  const std::vector<Card> linear = {card("v1", {"in", "0"}, {num(1)}),
+                                    card("r1", {"in", "out"}, {num(1e3)}),
+                                    card("c1", {"out", "0"}, {num(1e-9)})};
+  Circuit c;
+  ASSERT_EQ(build(c, linear), "");
+  EXPECT_FALSE(build_port_model(linear, c, probes(c, {"v(out)"}), 1e-6, {}).ok());
+  std::vector<Card> cards = linear;
+  cards.push_back(diode("d1", {"out", "0"}, model({{"is", 1e-14}})));
+  Circuit d;
+  ASSERT_EQ(build(d, cards), "");
+  StatusOr<PortModel> m = build_port_model(cards, d, probes(d, {"v(out)"}), 1e-6, {});
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  TransientOptions opt{.tstep = 1e-9, .tstop = 1e-6, .uic = true};
+  StatusOr<Waveform> w = run_port_model(d, *m, opt);
+  ASSERT_FALSE(w.ok());
+  EXPECT_NE(w.status().message().find("uic"), std::string::npos) << w.status().message();
+}
+
+}  // namespace
+}  // namespace isolink
