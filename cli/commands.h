@@ -18,6 +18,7 @@ void add_run_command(CLI::App& app, int* exit_code);
 void add_export_command(CLI::App& app, int* exit_code);
 void add_sweep_command(CLI::App& app, int* exit_code);
 void add_noise_command(CLI::App& app, int* exit_code);
+void add_stress_command(CLI::App& app, int* exit_code);
 void add_worst_command(CLI::App& app, int* exit_code);
 void add_pack_command(CLI::App& app, int* exit_code);
 void add_compare_command(CLI::App& app, int* exit_code);

@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   isolink::cli::add_export_command(app, &exit_code);
   isolink::cli::add_sweep_command(app, &exit_code);
   isolink::cli::add_noise_command(app, &exit_code);
+  isolink::cli::add_stress_command(app, &exit_code);
   isolink::cli::add_worst_command(app, &exit_code);
   isolink::cli::add_pack_command(app, &exit_code);
   isolink::cli::add_compare_command(app, &exit_code);

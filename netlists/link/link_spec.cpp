@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "netlists/link/touchstone_cable.h"
@@ -386,7 +387,63 @@ Status read_noise(const YamlDoc& doc, const YAML::Node& node, NoiseSpec* ns) {
   return Status::Ok();
 }
 
+// Scenario kinds isolink stress runs (analysis/stress.h).
+const std::vector<std::string>& stress_kinds_list() {
+  static const std::vector<std::string> kinds{"cm_step", "esd"};
+  return kinds;
+}
+
+Status read_stress(const YamlDoc& doc, const YAML::Node& node, StressSpec* st) {
+  st->loc = doc.loc(node);
+  st->given = true;
+  Status s = read_map(
+      doc, node, "stress",
+      {
+          {"esd", read_quantity(doc, Unit::kVolt, Rule::kPositive, &st->esd_v)},
+          {"ground_step", read_quantity(doc, Unit::kVolt, Rule::kPositive, &st->step_v)},
+          {"ground_rise", read_quantity(doc, Unit::kSecond, Rule::kPositive, &st->step_rise)},
+          {"pin_abs_max", read_quantity(doc, Unit::kVolt, Rule::kPositive, &st->pin_abs_max)},
+          {"pin_cm_limit", read_quantity(doc, Unit::kVolt, Rule::kPositive, &st->pin_cm_limit)},
+          {"cap_rating", read_quantity(doc, Unit::kVolt, Rule::kPositive, &st->cap_rating)},
+          {"only",
+           [&](const YAML::Node& n, const std::string& p) -> Status {
+             if (Status r = read_text_list(doc, &st->only)(n, p); !r.ok()) return r;
+             for (size_t i = 0; i < st->only.size(); ++i) {
+               const std::vector<std::string>& kinds = stress_kinds_list();
+               if (std::find(kinds.begin(), kinds.end(), st->only[i]) == kinds.end())
+                 return doc.error(n.IsSequence() ? n[i] : n,
+                                  fmt::format("key '{}' = '{}': not a stress scenario (one of "
+                                              "cm_step, esd)",
+                                              p, st->only[i]));
+             }
+             return Status::Ok();
+           }},
+      });
+  if (!s.ok()) return s;
+  // Bounds that keep the scenarios meaningful and their runs short.
+  if (st->esd_v > 30e3)
+    return doc.error(node["esd"], fmt::format("key 'stress.esd' = {:g} V: must be at most 30 kV "
+                                              "(IEC 61000-4-2 contact discharge tops out at "
+                                              "level 4, 8 kV; 30 kV is the highest part rating)",
+                                              st->esd_v));
+  if (st->step_rise < 1e-9 || st->step_rise > 100e-6)
+    return doc.error(node["ground_rise"],
+                     fmt::format("key 'stress.ground_rise' = {:g} s: must be from 1 ns to 100 us "
+                                 "(the scenario simulates a window of a few rise times)",
+                                 st->step_rise));
+  if (st->step_v > 2e3)
+    return doc.error(node["ground_step"],
+                     fmt::format("key 'stress.ground_step' = {:g} V: must be at most 2 kV (a "
+                                 "module's stack voltage)",
+                                 st->step_v));
+  return Status::Ok();
+}
+
 }  // namespace
+
+const std::vector<std::string>& stress_kinds() {
+  return stress_kinds_list();
+}
 
 StatusOr<LinkSpec> read_link_spec(const YamlDoc& doc) {
   LinkSpec spec;
@@ -418,6 +475,8 @@ StatusOr<LinkSpec> read_link_spec(const YamlDoc& doc) {
            }},
           {"noise", [&](const YAML::Node& n,
                         const std::string&) { return read_noise(doc, n, &spec.noise); }},
+          {"stress", [&](const YAML::Node& n,
+                         const std::string&) { return read_stress(doc, n, &spec.stress); }},
           {"sim",
            [&](const YAML::Node& n, const std::string& p) {
              Status st = read_map(

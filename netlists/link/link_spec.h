@@ -10,7 +10,9 @@
 //   cable: {length, material, gauge, temperature, r, l, c, g, segments},
 //   stimulus: {frames, gaps, tones, patterns, script, direction}, sim: {tstep, tmax, method,
 //   reltol}, noise: {injection, level, position, modulation, band, points_per_decade,
-//   pin_limit, time_domain, samples, seed, verdict_on, tolerance: {...}} (isolink noise; tx / rx
+//   pin_limit, time_domain, samples, seed, verdict_on, tolerance: {...}} (isolink noise),
+//   stress: {esd, ground_step, ground_rise, pin_abs_max, pin_cm_limit, cap_rating, only}
+//   (isolink stress; tx / rx
 //   also take x_cap, y_cap, chassis_c, chassis_r, chassis_l, isolation.cable_side_return,
 //   isolation.choke_loss, and cable chassis_c).
 // `tx` is the end that transmits in the down direction (the host / bridge side); `rx` the end
@@ -132,6 +134,20 @@ struct NoiseSpec {
   const char* level_unit() const { return injection == "ground_shift" ? "V" : "A"; }
 };
 
+// The `stress:` block: the levels of isolink stress's scenarios and the limits it checks against
+// (analysis/stress.h; netlists/link/README.md "stress" has the table with the sources).
+struct StressSpec {
+  double esd_v = 8e3;             // V, IEC 61000-4-2 contact discharge (level 4: +-8 kV)
+  double step_v = 60;             // V, module ground step (issue 41's contactor experiment)
+  double step_rise = 1e-6;        // s, its 0-100 % rise
+  double pin_abs_max = 20;        // V, |COM pin to its device ground| (assumed: see README)
+  double pin_cm_limit = 20;       // V, |pin common mode to its device ground| (docs/physics.md 2)
+  double cap_rating = 2e3;        // V, isolation caps (1206J2K00222KXR: 2 kV)
+  std::vector<std::string> only;  // scenario kinds to run (empty: all): esd, cm_step
+  SourceLoc loc;
+  bool given = false;  // the spec has a stress: block
+};
+
 struct LinkSpec {
   std::string name = "link";
   std::string source;  // the file it was read from
@@ -141,6 +157,7 @@ struct LinkSpec {
   StimulusSpec stimulus;
   SimSpec sim;
   NoiseSpec noise;
+  StressSpec stress;
 };
 
 // Reads a spec; errors name the file, line, column and key.
@@ -156,6 +173,9 @@ std::vector<std::string> nonlinear_parts(const LinkSpec& spec);
 // "" for a linear link, else why `what` (e.g. "the worst case") cannot take it, naming the parts
 // and the way out.
 std::string linear_only(const LinkSpec& spec, const std::string& what);
+
+// The scenario kinds of `stress.only` and `isolink stress --only`: "cm_step", "esd".
+const std::vector<std::string>& stress_kinds();
 
 // Devices and their receiver rule sets: bq79600 -> bq79600 (bridge), bq7961x and bq79606a ->
 // bq7961x.

@@ -1,0 +1,138 @@
+// isolink stress: what breaks a daisy chain in the field (analysis/stress.h): module-ground
+// steps during traffic and IEC 61000-4-2 contact discharges, simulated with the pins' clamps and
+// the spec's TVS parts; report.md and report.json, --export-spice each scenario's netlist.
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "analysis/stress.h"
+#include "base/file_io.h"
+#include "base/progress.h"
+#include "cli/commands.h"
+#include "cli/common_options.h"
+#include "netlists/link/link_spec.h"
+#include "netlists/link/parts.h"
+#include "netlists/spice_writer.h"
+#include "reports/stress_report.h"
+
+namespace isolink::cli {
+namespace {
+
+struct StressArgs {
+  std::string spec;
+  std::string out_dir;
+  std::vector<std::string> part_dirs;
+  bool json = false;
+  bool quiet = false;
+  std::string only;  // comma-separated kinds
+  std::string spice_dir;
+};
+
+int fail(const Status& s) {
+  std::fprintf(stderr, "%s\n", s.message().c_str());
+  return 2;
+}
+
+// "--only cm_step,esd" -> its kinds, each checked before any run.
+StatusOr<std::vector<std::string>> parse_only(const std::string& text) {
+  std::vector<std::string> out;
+  if (text.empty()) return out;
+  std::stringstream in(text);
+  std::string item;
+  const std::vector<std::string>& kinds = link::stress_kinds();
+  while (std::getline(in, item, ',')) {
+    if (std::find(kinds.begin(), kinds.end(), item) == kinds.end())
+      return Status::Error(fmt::format(
+          "isolink stress: error: --only = '{}': '{}' is not a scenario kind (one of cm_step, "
+          "esd, comma-separated)",
+          text, item));
+    out.push_back(item);
+  }
+  return out;
+}
+
+int run_stress(const StressArgs& a) {
+  StatusOr<std::vector<std::string>> only = parse_only(a.only);
+  if (!only) return fail(only.status());
+  StatusOr<link::LinkSpec> spec = link::read_link_spec_file(a.spec);
+  if (!spec) return fail(spec.status());
+  StatusOr<link::PartLibrary> parts = link::PartLibrary::load(a.part_dirs);
+  if (!parts) return fail(parts.status());
+  const std::string dir =
+      a.out_dir.empty() ? "reports/out/" + safe_path_component(spec->name) + "-stress" : a.out_dir;
+  // The report folder appears whole or not at all; opened before the (long) runs so a bad -o
+  // is reported at once.
+  StatusOr<OutputBundle> bundle = OutputBundle::open(dir, {"report.md", "report.json"});
+  if (!bundle) return fail(bundle.status());
+  analysis::StressOptions so;
+  so.only = *only;
+  ProgressLine line({.label = "isolink stress", .enabled = !a.quiet && !a.json});
+  so.progress = [&line](const std::string& what, double f) { line.show_fraction(what, f); };
+
+  std::map<std::string, std::string> netlists;
+  if (!a.spice_dir.empty()) {  // written first: a user can replay them even if a run fails
+    StatusOr<std::vector<analysis::StressScenario>> built =
+        analysis::build_stress_scenarios(*spec, *parts, so);
+    if (!built) return fail(built.status().with_context(a.spec));
+    std::error_code ec;
+    std::filesystem::create_directories(a.spice_dir, ec);
+    if (ec)
+      return fail(Status::Error(
+          fmt::format("{}: error: cannot create the folder: {}", a.spice_dir, ec.message())));
+    for (const analysis::StressScenario& s : *built) {
+      const std::string path = a.spice_dir + "/" + s.id + ".cir";
+      if (Status st = write_file_atomic(path, write_spice(s.link.netlist)); !st.ok())
+        return fail(st);
+      netlists[s.id] = path;
+    }
+  }
+  StatusOr<analysis::StressResult> r = analysis::run_stress(*spec, *parts, so);
+  line.finish();
+  if (!r) return fail(r.status().with_context(a.spec));
+  const nlohmann::ordered_json j = reports::stress_json(spec->name, *r, netlists);
+  if (Status s = write_file_atomic(bundle->path("report.json"), j.dump(2) + "\n"); !s.ok())
+    return fail(s);
+  if (Status s = write_file_atomic(bundle->path("report.md"),
+                                   reports::stress_markdown(spec->name, *r, netlists));
+      !s.ok())
+    return fail(s);
+  if (Status s = bundle->commit(); !s.ok()) return fail(s);
+  if (a.json) {
+    std::puts(j.dump(2).c_str());
+  } else {
+    for (const analysis::StressScenario& s : r->scenarios)
+      std::printf("%-4s %-16s %s\n", s.first_broken.empty() ? "ok" : "FAIL", s.id.c_str(),
+                  s.first_broken.empty() ? s.description.c_str() : s.first_broken.c_str());
+    std::printf("%s\nreport: %s/report.md\n", r->verdict.c_str(), dir.c_str());
+  }
+  return r->survives && r->communicates ? 0 : 1;
+}
+
+}  // namespace
+
+void add_stress_command(CLI::App& app, int* exit_code) {
+  auto args = std::make_shared<StressArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "stress",
+      "What breaks a link in the field: module-ground steps during traffic and IEC 61000-4-2 ESD, "
+      "with the pins' clamps and the TVS parts; report.md, report.json; exit 1 when a limit or "
+      "rule breaks");
+  cmd->add_option("spec", args->spec, "Link spec (YAML) with an optional stress: block")
+      ->required();
+  cmd->add_option("-o,--output", args->out_dir,
+                  "Report folder (default reports/out/<name>-stress)");
+  add_parts_option(*cmd, &args->part_dirs);
+  cmd->add_flag("--json", args->json, "Print the stress result as JSON on stdout");
+  cmd->add_flag("-q,--quiet", args->quiet, "No progress line");
+  cmd->add_option("--only", args->only, "Scenario kinds to run, comma-separated: cm_step, esd");
+  cmd->add_option("--export-spice", args->spice_dir,
+                  "Write each scenario's netlist (ngspice dialect) into this folder");
+  cmd->callback([args, exit_code] { *exit_code = run_stress(*args); });
+}
+
+}  // namespace isolink::cli

@@ -1,0 +1,160 @@
+#include "reports/stress_report.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "netlists/link/cards.h"
+
+namespace isolink::reports {
+
+namespace {
+
+using nlohmann::ordered_json;
+
+// A JSON number, or null when it is not finite.
+ordered_json num(double v) {
+  return std::isfinite(v) ? ordered_json(v) : ordered_json(nullptr);
+}
+
+ordered_json scenario_json(const analysis::StressScenario& s, const std::string& netlist) {
+  ordered_json j;
+  j["id"] = s.id;
+  j["kind"] = s.kind;
+  j["end"] = s.end;
+  j["line"] = s.line.empty() ? ordered_json(nullptr) : ordered_json(s.line);
+  ordered_json level = ordered_json::object();
+  for (const auto& [k, v] : s.level) level[k] = num(v);
+  j["level"] = level;
+  j["description"] = s.description;
+  ordered_json pins = ordered_json::object(), grounds = ordered_json::object();
+  for (const auto& [node, p] : s.peak_pin_v)
+    pins[node] = {{"max", num(p.max)}, {"min", num(p.min)}};
+  for (const auto& [node, g] : s.pin_ground) grounds[node] = g;
+  j["peak_pin_v"] = pins;
+  j["pin_ground"] = grounds;
+  j["peak_cm_V"] = num(s.peak_cm_v);
+  ordered_json diodes = ordered_json::array();
+  for (const analysis::DiodePeak& d : s.diodes) {
+    ordered_json o{{"diode", d.diode},
+                   {"what", d.what},
+                   {"probe", "i(" + d.ammeter + ")"},
+                   {"peak_A", num(d.peak_a)}};
+    if (d.energy_j > 0) o["energy_J"] = num(d.energy_j);
+    if (d.rating_a > 0) o["rating_A"] = {{"value", d.rating_a}, {"source", d.rating_source}};
+    diodes.push_back(o);
+  }
+  j["diodes"] = diodes;
+  ordered_json caps = ordered_json::array();
+  for (const analysis::CapPeak& c : s.caps)
+    caps.push_back({{"cap", c.cap}, {"peak_V", num(c.peak_v)}});
+  j["isolation_caps"] = caps;
+  if (s.traffic) {
+    j["receiver"] = {{"p", s.receiver_p}, {"n", s.receiver_n}, {"rules", s.rules}};
+    const analysis::StressTraffic& t = *s.traffic;
+    ordered_json worst = ordered_json::array();
+    for (const eye::WorstMargin& w : t.worst)
+      worst.push_back({{"metric", w.metric}, {"margin", num(w.j.margin)}, {"time_s", num(w.time)}});
+    j["traffic"] = {{"bytes_sent", t.bytes_sent},
+                    {"bytes_decoded", t.bytes_decoded},
+                    {"bytes_during", t.bytes_during},
+                    {"decoded_during", t.decoded_during},
+                    {"pass", t.pass},
+                    {"worst", worst},
+                    {"first_failure", t.first_failure.empty() ? ordered_json(nullptr)
+                                                              : ordered_json(t.first_failure)},
+                    {"recovery_s", t.recovery_s ? num(*t.recovery_s) : ordered_json(nullptr)}};
+  }
+  j["survives"] = s.survives;
+  j["communicates"] = s.communicates ? ordered_json(*s.communicates) : ordered_json(nullptr);
+  j["first_broken"] = s.first_broken.empty() ? ordered_json(nullptr) : ordered_json(s.first_broken);
+  j["broken"] = s.broken;
+  j["engine"] = s.engine;
+  j["seconds"] = num(s.seconds);
+  if (!netlist.empty()) j["netlist"] = netlist;
+  return j;
+}
+
+std::string at(const std::map<std::string, std::string>& m, const std::string& k) {
+  auto it = m.find(k);
+  return it == m.end() ? "" : it->second;
+}
+
+}  // namespace
+
+ordered_json stress_json(const std::string& spec_name, const analysis::StressResult& r,
+                         const std::map<std::string, std::string>& netlists) {
+  ordered_json j;
+  j["spec"] = spec_name;
+  j["verdict"] = r.verdict;
+  j["survives"] = r.survives;
+  j["communicates"] = r.communicates;
+  ordered_json limits = ordered_json::object();
+  for (const analysis::StressLimit& l : r.limits)
+    limits[l.key] = {{"value", num(l.value)}, {"source", l.source}};
+  j["limits"] = limits;
+  ordered_json sc = ordered_json::array();
+  for (const analysis::StressScenario& s : r.scenarios)
+    sc.push_back(scenario_json(s, at(netlists, s.id)));
+  j["scenarios"] = sc;
+  j["seconds"] = num(r.seconds);
+  return j;
+}
+
+std::string stress_markdown(const std::string& spec_name, const analysis::StressResult& r,
+                            const std::map<std::string, std::string>& netlists) {
+  std::string md = fmt::format("# isolink stress: {}\n\n**Verdict:** {}\n\n", spec_name, r.verdict);
+  md += "## Limits\n\n| limit | value | source |\n|---|---|---|\n";
+  for (const analysis::StressLimit& l : r.limits)
+    md += fmt::format("| {} | {:g} | {} |\n", l.key, l.value, l.source);
+  md +=
+      "\n## Scenarios\n\n| scenario | level | peak pin V (max / min) | peak CM V | survives | "
+      "communicates | first broken |\n|---|---|---|---|---|---|---|\n";
+  for (const analysis::StressScenario& s : r.scenarios) {
+    std::string level, pins;
+    for (const auto& [k, v] : s.level)
+      level += fmt::format("{}{} {:g}", level.empty() ? "" : ", ", k, v);
+    for (const auto& [node, p] : s.peak_pin_v)
+      pins += fmt::format("{}{} {:.3g} / {:.3g}", pins.empty() ? "" : "; ", node, p.max, p.min);
+    md += fmt::format("| {} | {} | {} | {:.3g} | {} | {} | {} |\n", s.id, level, pins, s.peak_cm_v,
+                      s.survives ? "yes" : "**no**",
+                      s.communicates ? (*s.communicates ? "yes" : "**no**") : "-",
+                      s.first_broken.empty() ? "-" : s.first_broken);
+  }
+  for (const analysis::StressScenario& s : r.scenarios) {
+    md += fmt::format("\n### {}\n\n{}. Engine: {}, {:.2f} s.", s.id, s.description, s.engine,
+                      s.seconds);
+    const std::string n = at(netlists, s.id);
+    if (!n.empty()) md += fmt::format(" Netlist: `{}`.", n);
+    md += "\n\n";
+    if (!s.diodes.empty()) {
+      md += "| part | peak current | energy | rating |\n|---|---|---|---|\n";
+      for (const analysis::DiodePeak& d : s.diodes)
+        md += fmt::format("| {} (`{}`) | {} | {} | {} |\n", d.what, d.diode,
+                          link::format_si(d.peak_a, "A"),
+                          d.energy_j > 0 ? link::format_si(d.energy_j, "J") : "-",
+                          d.rating_a > 0 ? "IPP " + link::format_si(d.rating_a, "A") : "-");
+      md += "\n";
+    }
+    for (const analysis::CapPeak& c : s.caps)
+      md += fmt::format("- isolation cap `{}`: peak {:.4g} V\n", c.cap, c.peak_v);
+    if (s.traffic) {
+      const analysis::StressTraffic& t = *s.traffic;
+      md += fmt::format(
+          "- traffic at {} / {} ({} rules): {} of {} bytes decoded, {} of {} during the step; {}\n",
+          s.receiver_p, s.receiver_n, s.rules, t.bytes_decoded, t.bytes_sent, t.decoded_during,
+          t.bytes_during, t.pass ? "passes" : "fails: " + t.first_failure);
+      md += t.recovery_s ? fmt::format("- back within the rules {} after the step\n",
+                                       link::format_si(*t.recovery_s, "s"))
+                         : "- still failing at the end of the record\n";
+      for (const eye::WorstMargin& w : t.worst)
+        md += fmt::format("- worst {} margin {:.4g} at {}\n", w.metric, w.j.margin,
+                          link::format_si(w.time, "s"));
+    }
+    for (const std::string& b : s.broken) md += "- broken: " + b + "\n";
+  }
+  md += fmt::format("\nRun time {:.1f} s.\n", r.seconds);
+  return md;
+}
+
+}  // namespace isolink::reports

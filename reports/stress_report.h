@@ -1,0 +1,28 @@
+#pragma once
+// The stress analysis's reports (analysis/stress.h computes it): the JSON of
+// `isolink stress --json` and report.json, and report.md. Pure functions of a StressResult.
+//
+// Contract: pure functions of their arguments, which they only read: no I/O, no errors. Units
+// are SI, named in the JSON keys (`_V`, `_A`, `_J`, `_s`, `_kV`) and the Markdown text.
+// JSON shape (issue 42): {"spec", "verdict", "survives", "communicates", "limits": {KEY:
+// {"value", "source"}}, "scenarios": [{"id", "kind", "end", "line", "level": {KEY_UNIT: v},
+// "description", "peak_pin_v": {NODE: {"max", "min"}}, "pin_ground": {NODE: GROUND},
+// "peak_cm_V", "diodes": [...], "isolation_caps": [...], "receiver": {"p", "n", "rules"},
+// "traffic": {...}, "survives", "communicates", "first_broken", "broken", "engine", "seconds",
+// "netlist"}]}.
+
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "analysis/stress.h"
+
+namespace isolink::reports {
+
+// `netlists`: scenario id -> its exported netlist's path (--export-spice), else empty.
+nlohmann::ordered_json stress_json(const std::string& spec_name, const analysis::StressResult& r,
+                                   const std::map<std::string, std::string>& netlists = {});
+std::string stress_markdown(const std::string& spec_name, const analysis::StressResult& r,
+                            const std::map<std::string, std::string>& netlists = {});
+
+}  // namespace isolink::reports
