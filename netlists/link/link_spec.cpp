@@ -53,7 +53,8 @@ std::string linear_only(const LinkSpec& spec, const std::string& what) {
   return fmt::format(
       "{} needs a linear link (it superposes the link's responses or linearises them), and "
       "this one has nonlinear parts ({}): `isolink run` simulates it exactly "
-      "(the nonlinear transient), or give esd a capacitance (the TVS's at 0 V) and "
+      "(on the port model, or the full nonlinear transient), or give esd a capacitance (the "
+      "TVS's at 0 V) and "
       "pin_clamps none for the linear approximation",
       what, list);
 }

@@ -237,7 +237,7 @@ TVS = dict(ONE_BYTE, name="py-tvs",
 
 
 def test_run_takes_a_tvs_part_and_says_why_it_has_no_worst_case():
-    """esd: a TVS part makes the link nonlinear: the run is the exact transient of its traffic,
+    """esd: a TVS part makes the link nonlinear: the run is its traffic on the port model,
     the worst case is reported as not computed with the reason, and below its standoff voltage
     the TVS acts mostly as its junction capacitance: the same link with a linear capacitor of
     the part's 0 V figure (25 pF) reproduces at least three quarters of what the TVS does to the
@@ -247,7 +247,7 @@ def test_run_takes_a_tvs_part_and_says_why_it_has_no_worst_case():
     assert r["pass"]
     assert r["worst_case"]["computed"] is False
     assert "rx.isolation.esd: TVS PESD2CAN" in r["worst_case"]["why"]
-    assert r["directions"][0]["solver"]["engine"] == "transient"
+    assert r["directions"][0]["solver"]["engine"] == "port"
     lin = isolink.run(dict(TVS, rx={"device": "bq7961x",
                                     "isolation": {"type": "cap", "cap": 2.2e-9, "esd": "25p"}}))
     bare = isolink.run(dict(TVS, rx={"device": "bq7961x",

@@ -117,8 +117,8 @@ INSTANTIATE_TEST_SUITE_P(
     });
 
 // The nonlinear example (PESD2CAN TVS diodes and the pins' rail clamps on bq79606a_cap_2m's
-// link) on the nonlinear transient: about a minute of CPU, so in the slow label.
-TEST(RunExamplesSlow, NonlinearTvsExamplePassesBothWays) {
+// link) on the port model: about 3 s (the full Newton transient took a minute of CPU).
+TEST(RunExamples, NonlinearTvsExamplePassesBothWays) {
   const std::string dir = ::testing::TempDir() + "/run_tvs_example";
   fs::remove_all(dir);
   Result r = run("run " + kExamples + "/bq79606a_tvs_2m.yaml -o " + dir + " -q", "tvs_example");
@@ -128,7 +128,7 @@ TEST(RunExamplesSlow, NonlinearTvsExamplePassesBothWays) {
   ASSERT_EQ(j["directions"].size(), 2u);
   for (const auto& d : j["directions"]) {
     EXPECT_EQ(d["verdict"], "pass");
-    EXPECT_EQ(d["solver"]["engine"], "transient");
+    EXPECT_EQ(d["solver"]["engine"], "port");
   }
   EXPECT_EQ(j["worst_case"]["computed"], false);
 }
@@ -181,7 +181,7 @@ TEST(RunCommand, NonlinearLinkSaysWhyItHasNoWorstCase) {
   const std::string why = j["worst_case"]["why"];
   EXPECT_NE(why.find("tx.isolation.esd: TVS PESD2CAN"), std::string::npos) << why;
   EXPECT_NE(why.find("rx.pin_clamps: rails"), std::string::npos) << why;
-  for (const auto& d : j["directions"]) EXPECT_EQ(d["solver"]["engine"], "transient");
+  for (const auto& d : j["directions"]) EXPECT_EQ(d["solver"]["engine"], "port");
   EXPECT_NE(slurp(dir + "/report.md").find("Not computed: the worst case"), std::string::npos);
   Result w = run("worst " + spec, "tvs_worst_cmd");
   EXPECT_EQ(w.code, 2);
