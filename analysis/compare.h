@@ -149,6 +149,11 @@ struct FitKey {
   // noise as well as the kept one (distinct minima: more than the tolerance band away), SI. Not
   // empty: the value is not a measurement, no finding is made on it (issue 43).
   std::vector<double> alternatives;
+  // With three keys or more: the correlation of this key's estimate with the best combination of
+  // the other keys' (from the fit's covariance; 0 with fewer keys). Over
+  // KeyCorrelation::kInseparable the capture fixes a combination of the keys, not this one,
+  // even when no single pair passes it: identifiable false, no finding (issue 43).
+  double multiple_correlation = 0;
   // "low" / "high" when the value is within 1 % of that bound: the data want a value the bounds
   // do not allow, so `value` is the bound, not a measurement (no finding is made on it).
   std::string at_bound;

@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <set>
@@ -154,6 +155,47 @@ void report_near(const std::vector<DesignValue>& design, const FitSolution& best
     r.reasons.push_back(text);
 }
 
+// With three keys or more, each key's multiple correlation with the others (their estimates'
+// correlation matrix P, keys only, the offset marginalised: r_j^2 = 1 - 1 / (P^-1)_jj). A key over
+// the pairwise limit whose pairs all stay under it is inseparable from the others together.
+void report_group_correlations(const std::vector<DesignValue>& design, const LsqResult& fit,
+                               CompareResult& r, std::set<size_t>& inseparable) {
+  const size_t nk = r.fit.size(), n = nk + 1;
+  if (nk < 3 || fit.correlation.size() != n * n) return;
+  Eigen::MatrixXd P(nk, nk);
+  for (size_t i = 0; i < nk; ++i)
+    for (size_t j = 0; j < nk; ++j)
+      P(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = fit.correlation[i * n + j];
+  Eigen::FullPivLU<Eigen::MatrixXd> lu(P);
+  if (!lu.isInvertible()) return;  // rank deficient: the identifiability test has said so
+  const Eigen::MatrixXd Pi = lu.inverse();
+  for (size_t j = 0; j < nk; ++j) {
+    const double d = Pi(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(j));
+    if (!(d >= 1) || !std::isfinite(d)) continue;
+    FitKey& k = r.fit[j];
+    k.multiple_correlation = std::sqrt(1 - 1 / d);
+    if (k.multiple_correlation <= KeyCorrelation::kInseparable || !k.identifiable ||
+        inseparable.count(j))
+      continue;
+    inseparable.insert(j);
+    k.identifiable = false;
+    std::string others;
+    for (size_t i = 0; i < nk; ++i)
+      if (i != j) others += (others.empty() ? "" : " and ") + label_of(r.fit[i].key);
+    const std::string text = fmt::format(
+        "{} ({}) is correlated with {} together ({:.3f}, no pair alone over {:.2f}): this "
+        "capture fixes a combination of them, not {} alone, so its value is not a "
+        "measurement{}; fit fewer keys, or hold the others at known values",
+        label_of(k.key), si_of(k.key, k.value), others, k.multiple_correlation,
+        KeyCorrelation::kInseparable, label_of(k.key),
+        outside_band(k, design[j]) ? ", and it is not the design's" : "");
+    if (outside_band(k, design[j]))
+      r.reasons.push_back(text);
+    else
+      r.notes.push_back(text);
+  }
+}
+
 }  // namespace
 
 void report_fit(const CompareOptions& opt, const std::vector<DesignValue>& design,
@@ -182,6 +224,7 @@ void report_fit(const CompareOptions& opt, const std::vector<DesignValue>& desig
       r.correlations.push_back({opt.fit[i], opt.fit[j], fit.correlation[i * n + j]});
   std::set<size_t> inseparable;
   report_correlations(design, r, inseparable);  // on the Jacobian's identifiability alone
+  report_group_correlations(design, fit, r, inseparable);
   report_near(design, best, near, r);
   for (size_t j = 0; j < nk; ++j) {
     const FitKey& k = r.fit[j];

@@ -249,6 +249,35 @@ TEST(CompareFit, NearSolutionElsewhereMakesTheKeysItMovesNotSeparable) {
   EXPECT_TRUE(noted);
 }
 
+// Three keys whose pairs all stay under 0.95 except one, and a third key tied to the two together
+// (the corpus's seed 59: multiple correlation 0.953): inseparable from them, no finding.
+TEST(CompareFit, KeyTiedToTheOthersTogetherIsNotSeparable) {
+  CompareOptions opt;
+  opt.fit = {"tx.isolation.inductance", "rx.termination", "rx.isolation.cap"};
+  const std::vector<DesignValue> design = {
+      {260e-6, 0.10, 0.10, "10 %"}, {1000, 0.10, 0.10, "1 %"}, {2.2e-9, 0.10, 0.10, "10 %"}};
+  const std::vector<std::pair<double, double>> bounds = {
+      {26e-6, 520e-6}, {100, 10000}, {0.22e-9, 22e-9}};
+  compare_detail::FitSolution best;
+  best.x = {std::log(352.7 / 260), std::log(0.5904), std::log(3.724 / 2.2)};
+  best.lsq.stderr_x = {0.003, 0.001, 0.002, 0.01};
+  best.lsq.identifiable = {true, true, true, true};
+  const double a = 0.879, b = -0.946, c = -0.962;
+  best.lsq.correlation = {1, a, b, 0, a, 1, c, 0, b, c, 1, 0, 0, 0, 0, 1};
+  CompareResult r;
+  compare_detail::report_fit(opt, design, bounds, best, {}, r);
+  ASSERT_EQ(r.fit.size(), 3u);
+  EXPECT_NEAR(r.fit[0].multiple_correlation, 0.953, 0.001);
+  EXPECT_FALSE(r.fit[0].identifiable);
+  EXPECT_TRUE(r.findings.empty());  // the pair (termination, cap) by its own correlation
+  bool said = false;
+  for (const std::string& s : r.reasons)
+    said = said || s.find(
+                       "tx isolation inductance (352.7 uH) is correlated with rx termination "
+                       "and rx isolation cap together (0.953") != std::string::npos;
+  EXPECT_TRUE(said) << fmt::format("{}", fmt::join(r.reasons, "\n"));
+}
+
 TEST(CompareModel, SuperpositionAtAnyTimeEqualsTheGridSynthesis) {
   StatusOr<link::LinkSpec> spec = link::read_link_spec_text(kCapLink, "cap.yaml");
   ASSERT_TRUE(spec.ok());
