@@ -41,8 +41,8 @@
 //    more than one key, profiles from the best solution (each key alone over a 32-point log
 //    grid, the others held) and refinements from their best points, while that finds a better
 //    answer; the lowest residual wins. Default bounds: R and C 1/10..10x the design, L 1/10..2x,
-//    cable.length 0.1..100 m. With two keys or more the scan always runs: a residual within the
-//    match threshold does not show that no other valley explains the capture better.
+//    cable.length 0.1..100 m. The scan always runs (unless global_search is off): a residual
+//    within the match threshold does not show that no other valley explains the capture better.
 // 6. Honesty: a key within 1 % of a bound is "at its bound", never a finding; keys whose
 //    correlation (from the fit's covariance) is over 0.95 are reported as a pair that cannot be
 //    separated, never as two findings; so are keys on which another point of the bounds (a scan
@@ -88,8 +88,8 @@ struct CompareOptions {
   // 1/10..10x the design value (a wrong multiplier digit), inductances 1/10..2x (a wrong part, a
   // saturated core), cable.length 0.1..100 m (widened to hold the design).
   std::map<std::string, std::pair<double, double>> bounds;
-  // Scan the bounds when the refinement from the design does not explain the capture (or ends on
-  // a bound); false: the refinement from the design only.
+  // Scan the bounds after the refinement from the design (always: a residual within the match
+  // threshold does not rule out a better valley); false: the refinement from the design only.
   bool global_search = true;
   int scan_points = 0;            // points of that scan; 0: 24 for one key, 32 n (n - 1) for n keys
   double model_floor_rel = 0.01;  // model floor of the verdict, a fraction of the peak |v|
