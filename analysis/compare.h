@@ -36,13 +36,20 @@
 //    scaled by the residual variance; rank deficiency reported per key.
 // 5. Global search (issue 43): when the refinement from the design leaves a residual over what
 //    the noise explains, or a key on its bound, a space-filling scan of the bounds (a log grid
-//    for one key, a Halton sequence for more; each point's offset aligned again), then the same
-//    refinement from the best few distinct points; the lowest residual wins. Default bounds:
-//    R and C 1/10..10x the design, L 1/10..2x, cable.length 0.1..100 m.
+//    of 24 points for one key, a Halton sequence of 32 n (n - 1) points for n keys; each point's
+//    offset aligned again), then the same refinement from the best few distinct points; with
+//    more than one key, profiles from the best solution (each key alone over a 32-point log
+//    grid, the others held) and refinements from their best points, while that finds a better
+//    answer; the lowest residual wins. Default bounds: R and C 1/10..10x the design, L 1/10..2x,
+//    cable.length 0.1..100 m. The scan always runs (unless global_search is off): a residual
+//    within the match threshold does not show that no other valley explains the capture better.
 // 6. Honesty: a key within 1 % of a bound is "at its bound", never a finding; keys whose
 //    correlation (from the fit's covariance) is over 0.95 are reported as a pair that cannot be
-//    separated, never as two findings; a residual still over the threshold is located (window,
-//    pulse, time) with the spec keys that move that part of the waveform most.
+//    separated, never as two findings; so are keys on which another point of the bounds (a scan
+//    point or a refinement's solution) explains the capture within its noise of the kept one
+//    and differs by more than the key's tolerance band (distinct minima: not separable, never a
+//    finding); a residual still over the threshold is located (window, pulse, time) with the
+//    spec keys that move that part of the waveform most.
 #pragma once
 
 #include <cmath>
@@ -81,10 +88,10 @@ struct CompareOptions {
   // 1/10..10x the design value (a wrong multiplier digit), inductances 1/10..2x (a wrong part, a
   // saturated core), cable.length 0.1..100 m (widened to hold the design).
   std::map<std::string, std::pair<double, double>> bounds;
-  // Scan the bounds when the refinement from the design does not explain the capture (or ends on
-  // a bound); false: the refinement from the design only.
+  // Scan the bounds after the refinement from the design (always: a residual within the match
+  // threshold does not rule out a better valley); false: the refinement from the design only.
   bool global_search = true;
-  int scan_points = 0;            // points of that scan; 0: 24 for one key, 32 per key for more
+  int scan_points = 0;            // points of that scan; 0: 24 for one key, 32 n (n - 1) for n keys
   double model_floor_rel = 0.01;  // model floor of the verdict, a fraction of the peak |v|
   int max_iterations = 30;        // Levenberg-Marquardt iterations
   int threads = 0;                // the fit's Jacobian columns evaluated at once (0: all cores)
@@ -135,7 +142,18 @@ struct FitKey {
   double stderr_value = 0;  // standard error (SI), from J^T J at the solution
   double tolerance = 0.10;  // the design's band, relative (part or default)
   std::string tolerance_from;
-  bool identifiable = true;  // false: only a combination with other keys is determined
+  // false: only a combination with other keys is determined, either locally (the Jacobian is
+  // rank deficient) or globally (`alternatives` is not empty).
+  bool identifiable = true;
+  // Other values of this key, at other points of the bounds that explain the capture within its
+  // noise as well as the kept one (distinct minima: more than the tolerance band away), SI. Not
+  // empty: the value is not a measurement, no finding is made on it (issue 43).
+  std::vector<double> alternatives;
+  // With three keys or more: the correlation of this key's estimate with the best combination of
+  // the other keys' (from the fit's covariance; 0 with fewer keys). Over
+  // KeyCorrelation::kInseparable the capture fixes a combination of the keys, not this one,
+  // even when no single pair passes it: identifiable false, no finding (issue 43).
+  double multiple_correlation = 0;
   // "low" / "high" when the value is within 1 % of that bound: the data want a value the bounds
   // do not allow, so `value` is the bound, not a measurement (no finding is made on it).
   std::string at_bound;
@@ -169,6 +187,7 @@ struct ResidualPlace {
 // What the global search did.
 struct SearchSummary {
   bool scanned = false;
+  int near = 0;             // points of the bounds found within the noise of the kept solution
   std::string why;          // why it scanned, or why not
   int points = 0;           // scan points evaluated
   int failed = 0;           // scan points whose model did not build (left out)

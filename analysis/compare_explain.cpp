@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <set>
@@ -97,11 +98,109 @@ void report_correlations(const std::vector<DesignValue>& design, CompareResult& 
     }
 }
 
+// Within the design's band on every key.
+bool design_like(const std::vector<DesignValue>& design, const std::vector<double>& x) {
+  for (size_t j = 0; j < x.size(); ++j) {
+    const double rel = std::exp(x[j]) - 1;
+    if (rel < -design[j].tol_low || rel > design[j].tol_high) return false;
+  }
+  return true;
+}
+
+// Keys on which a near solution differs from the kept one by more than their band: their
+// alternatives, identifiable false, and a reason (a note when the design itself is one of the
+// answers) naming the other answer that fits best.
+void report_near(const std::vector<DesignValue>& design, const FitSolution& best,
+                 const std::vector<NearSolution>& near, CompareResult& r) {
+  std::vector<size_t> keys;
+  const NearSolution* closest = nullptr;
+  for (size_t j = 0; j < r.fit.size(); ++j) {
+    FitKey& k = r.fit[j];
+    for (const NearSolution& s : near) {
+      if (std::abs(s.x[j] - best.x[j]) <= separation(design[j])) continue;
+      const double v = design[j].value * std::exp(s.x[j]);
+      bool have = false;  // one value per answer: those within the band of another are one
+      for (double a : k.alternatives)
+        have = have || std::abs(std::log(v / a)) <= separation(design[j]);
+      if (!have) k.alternatives.push_back(v);
+      if (!closest || s.rms_v < closest->rms_v) closest = &s;
+    }
+    if (k.alternatives.empty()) continue;
+    std::sort(k.alternatives.begin(), k.alternatives.end());
+    k.identifiable = false;
+    keys.push_back(j);
+  }
+  if (keys.empty() || !closest) return;
+  std::string names, kept, other;
+  for (size_t j : keys) names += (names.empty() ? "" : ", ") + label_of(r.fit[j].key);
+  for (size_t j = 0; j < r.fit.size(); ++j) {
+    kept += fmt::format("{}{} {}", kept.empty() ? "" : ", ", label_of(r.fit[j].key),
+                        si_of(r.fit[j].key, r.fit[j].value));
+    other += fmt::format("{}{} {}", other.empty() ? "" : ", ", label_of(r.fit[j].key),
+                         si_of(r.fit[j].key, design[j].value * std::exp(closest->x[j])));
+  }
+  bool design_among = design_like(design, best.x);
+  for (const NearSolution& s : near) design_among = design_among || design_like(design, s.x);
+  const std::string text = fmt::format(
+      "{} {} not separable from this capture: {} ({:.1f} mV rms) and {} ({:.1f} mV rms) both "
+      "explain it within its noise ({:.1f} mV rms), so {} a measurement{}; fit fewer keys, hold "
+      "the others at known values, or compare a capture that tells them apart",
+      names, keys.size() > 1 ? "are" : "is", kept, r.search.chosen_rms_v * 1e3, other,
+      closest->rms_v * 1e3, r.noise_rms_v * 1e3,
+      keys.size() > 1 ? "none of their values is" : "its value is not",
+      design_among ? "" : ", and none of the answers is the design");
+  if (design_among)
+    r.notes.push_back(text);
+  else
+    r.reasons.push_back(text);
+}
+
+// With three keys or more, each key's multiple correlation with the others (their estimates'
+// correlation matrix P, keys only, the offset marginalised: r_j^2 = 1 - 1 / (P^-1)_jj). A key over
+// the pairwise limit whose pairs all stay under it is inseparable from the others together.
+void report_group_correlations(const std::vector<DesignValue>& design, const LsqResult& fit,
+                               CompareResult& r, std::set<size_t>& inseparable) {
+  const size_t nk = r.fit.size(), n = nk + 1;
+  if (nk < 3 || fit.correlation.size() != n * n) return;
+  Eigen::MatrixXd P(nk, nk);
+  for (size_t i = 0; i < nk; ++i)
+    for (size_t j = 0; j < nk; ++j)
+      P(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = fit.correlation[i * n + j];
+  Eigen::FullPivLU<Eigen::MatrixXd> lu(P);
+  if (!lu.isInvertible()) return;  // rank deficient: the identifiability test has said so
+  const Eigen::MatrixXd Pi = lu.inverse();
+  for (size_t j = 0; j < nk; ++j) {
+    const double d = Pi(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(j));
+    if (!(d >= 1) || !std::isfinite(d)) continue;
+    FitKey& k = r.fit[j];
+    k.multiple_correlation = std::sqrt(1 - 1 / d);
+    if (k.multiple_correlation <= KeyCorrelation::kInseparable || !k.identifiable ||
+        inseparable.count(j))
+      continue;
+    inseparable.insert(j);
+    k.identifiable = false;
+    std::string others;
+    for (size_t i = 0; i < nk; ++i)
+      if (i != j) others += (others.empty() ? "" : " and ") + label_of(r.fit[i].key);
+    const std::string text = fmt::format(
+        "{} ({}) is correlated with {} together ({:.3f}, no pair alone over {:.2f}): this "
+        "capture fixes a combination of them, not {} alone, so its value is not a "
+        "measurement{}; fit fewer keys, or hold the others at known values",
+        label_of(k.key), si_of(k.key, k.value), others, k.multiple_correlation,
+        KeyCorrelation::kInseparable, label_of(k.key),
+        outside_band(k, design[j]) ? ", and it is not the design's" : "");
+    if (outside_band(k, design[j]))
+      r.reasons.push_back(text);
+    else
+      r.notes.push_back(text);
+  }
+}
+
 }  // namespace
 
 void report_fit(const CompareOptions& opt, const std::vector<DesignValue>& design,
                 const std::vector<std::pair<double, double>>& bounds, const FitSolution& best,
-                CompareResult& r) {
+                const std::vector<NearSolution>& near, CompareResult& r) {
   const size_t nk = opt.fit.size(), n = nk + 1;
   const LsqResult& fit = best.lsq;
   std::vector<std::string> unident;
@@ -117,14 +216,16 @@ void report_fit(const CompareOptions& opt, const std::vector<DesignValue>& desig
     k.identifiable = fit.identifiable[j];
     if (k.value <= k.low * 1.01) k.at_bound = "low";
     if (k.value >= k.high / 1.01) k.at_bound = "high";
-    if (!k.identifiable) unident.push_back(k.key);
+    if (!k.identifiable) unident.push_back(k.key);  // the Jacobian's rank; near answers below
     r.fit.push_back(k);
   }
   for (size_t i = 0; i < nk; ++i)
     for (size_t j = i + 1; j < nk; ++j)
       r.correlations.push_back({opt.fit[i], opt.fit[j], fit.correlation[i * n + j]});
   std::set<size_t> inseparable;
-  report_correlations(design, r, inseparable);
+  report_correlations(design, r, inseparable);  // on the Jacobian's identifiability alone
+  report_group_correlations(design, fit, r, inseparable);
+  report_near(design, best, near, r);
   for (size_t j = 0; j < nk; ++j) {
     const FitKey& k = r.fit[j];
     if (!k.at_bound.empty()) {

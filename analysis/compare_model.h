@@ -7,7 +7,9 @@
 // safe to call from several threads (the fit's parallel Jacobian).
 #pragma once
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <deque>
 #include <map>
 #include <memory>
@@ -103,11 +105,25 @@ struct FitSolution {
   double offset = 0;      // capture time - drive time (s)
   LsqResult lsq;
 };
+// Another local minimum (a refinement's solution, from the design or a scan or profile point) that
+// explains the capture within its noise of the kept solution: its sum of squares over the m
+// residual samples is at most m (noise^2 + q^2 / 12) above the kept one's, so the two simulations
+// differ by less than the capture's noise rms.
+// Two values of a key further apart than its tolerance band (log(1 + band)) are two different
+// answers; closer, the same one.
+inline double separation(const DesignValue& d) {
+  return std::log1p(std::max(d.tol_low, d.tol_high));
+}
+struct NearSolution {
+  std::vector<double> x;  // log(value / design) per key
+  double rms_v = 0;
+};
 // r.fit, r.findings, r.correlations, r.unidentifiable and the reasons on keys at their bounds or
-// inseparable, from the kept solution.
+// inseparable, from the kept solution; a key on which a near solution differs from it by more
+// than the key's tolerance band is not separable (FitKey::alternatives, no finding).
 void report_fit(const CompareOptions& opt, const std::vector<DesignValue>& design,
                 const std::vector<std::pair<double, double>>& bounds, const FitSolution& best,
-                CompareResult& r);
+                const std::vector<NearSolution>& near, CompareResult& r);
 
 // After a fit whose residual stays over the threshold: r.unexplained, where the residual
 // (capture minus `sim`, both at data.t) is largest, and the spec keys (not fitted) that move

@@ -13,6 +13,7 @@
 #include "analysis/compare.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -197,6 +198,84 @@ TEST(CompareFit, DefaultBoundsCoverAWrongMultiplierDigit) {
   b = fit_bounds(opt, "cable.length", 8);
   ASSERT_FALSE(b.ok());
   EXPECT_NE(b.status().message().find("cable.length=10:30"), std::string::npos);
+}
+
+// Issue 43's honest end: another point of the bounds that explains the capture within its noise
+// and differs from the kept solution beyond a key's band makes that key not separable (its
+// alternatives listed, no finding), while a key on which the two agree keeps its finding.
+TEST(CompareFit, NearSolutionElsewhereMakesTheKeysItMovesNotSeparable) {
+  CompareOptions opt;
+  opt.fit = {"cable.length", "rx.termination"};
+  const std::vector<DesignValue> design = {{3.0, 0.10, 0.10, "10 %"}, {1000, 0.10, 0.10, "1 %"}};
+  const std::vector<std::pair<double, double>> bounds = {{0.3, 30}, {100, 10000}};
+  compare_detail::FitSolution best;
+  best.x = {std::log(2.0 / 3.0), std::log(2.0)};  // 2 m, 2 kohm
+  best.lsq.stderr_x = {0.001, 0.001, 0.01};
+  best.lsq.identifiable = {true, true, true};
+  best.lsq.correlation = {1, 0.1, 0, 0.1, 1, 0, 0, 0, 1};
+  CompareResult r;
+  r.noise_rms_v = 0.010;
+  r.search.chosen_rms_v = 0.012;
+  // 2.6 m (a different answer) with 2.1 kohm (the same one: within its 10 % band).
+  const std::vector<compare_detail::NearSolution> near = {
+      {{std::log(2.6 / 3.0), std::log(2.1)}, 0.0125}};
+  compare_detail::report_fit(opt, design, bounds, best, near, r);
+  ASSERT_EQ(r.fit.size(), 2u);
+  EXPECT_FALSE(r.fit[0].identifiable);
+  ASSERT_EQ(r.fit[0].alternatives.size(), 1u);
+  EXPECT_NEAR(r.fit[0].alternatives[0], 2.6, 1e-9);
+  EXPECT_TRUE(r.fit[1].identifiable);
+  EXPECT_TRUE(r.fit[1].alternatives.empty());
+  ASSERT_EQ(r.findings.size(), 1u);  // the termination's, not the cable's
+  EXPECT_EQ(r.findings[0].key, "rx.termination");
+  bool said = false;
+  for (const std::string& s : r.reasons)
+    said = said || (s.find("cable length is not separable") != std::string::npos &&
+                    s.find("2.6 m") != std::string::npos &&
+                    s.find("none of the answers is the design") != std::string::npos);
+  EXPECT_TRUE(said) << fmt::format("{}", fmt::join(r.reasons, "\n"));
+  // With the design among the near answers it is a note, not a reason.
+  CompareResult r2;
+  r2.noise_rms_v = 0.010;
+  const std::vector<compare_detail::NearSolution> near_design = {{{0.0, 0.0}, 0.0125}};
+  compare_detail::report_fit(opt, design, bounds, best, near_design, r2);
+  EXPECT_FALSE(r2.fit[0].identifiable);
+  EXPECT_FALSE(r2.fit[1].identifiable);
+  EXPECT_TRUE(r2.findings.empty());
+  for (const std::string& s : r2.reasons) EXPECT_EQ(s.find("not separable"), std::string::npos);
+  bool noted = false;
+  for (const std::string& s : r2.notes)
+    noted = noted || s.find("are not separable") != std::string::npos;
+  EXPECT_TRUE(noted);
+}
+
+// Three keys whose pairs all stay under 0.95 except one, and a third key tied to the two together
+// (the corpus's seed 59: multiple correlation 0.953): inseparable from them, no finding.
+TEST(CompareFit, KeyTiedToTheOthersTogetherIsNotSeparable) {
+  CompareOptions opt;
+  opt.fit = {"tx.isolation.inductance", "rx.termination", "rx.isolation.cap"};
+  const std::vector<DesignValue> design = {
+      {260e-6, 0.10, 0.10, "10 %"}, {1000, 0.10, 0.10, "1 %"}, {2.2e-9, 0.10, 0.10, "10 %"}};
+  const std::vector<std::pair<double, double>> bounds = {
+      {26e-6, 520e-6}, {100, 10000}, {0.22e-9, 22e-9}};
+  compare_detail::FitSolution best;
+  best.x = {std::log(352.7 / 260), std::log(0.5904), std::log(3.724 / 2.2)};
+  best.lsq.stderr_x = {0.003, 0.001, 0.002, 0.01};
+  best.lsq.identifiable = {true, true, true, true};
+  const double a = 0.879, b = -0.946, c = -0.962;
+  best.lsq.correlation = {1, a, b, 0, a, 1, c, 0, b, c, 1, 0, 0, 0, 0, 1};
+  CompareResult r;
+  compare_detail::report_fit(opt, design, bounds, best, {}, r);
+  ASSERT_EQ(r.fit.size(), 3u);
+  EXPECT_NEAR(r.fit[0].multiple_correlation, 0.953, 0.001);
+  EXPECT_FALSE(r.fit[0].identifiable);
+  EXPECT_TRUE(r.findings.empty());  // the pair (termination, cap) by its own correlation
+  bool said = false;
+  for (const std::string& s : r.reasons)
+    said = said || s.find(
+                       "tx isolation inductance (352.7 uH) is correlated with rx termination "
+                       "and rx isolation cap together (0.953") != std::string::npos;
+  EXPECT_TRUE(said) << fmt::format("{}", fmt::join(r.reasons, "\n"));
 }
 
 TEST(CompareModel, SuperpositionAtAnyTimeEqualsTheGridSynthesis) {
