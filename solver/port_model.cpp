@@ -20,25 +20,6 @@ namespace {
 
 using Cplx = std::complex<double>;
 
-// A constant conductance between two nodes: the shunt across a port in the linear network.
-class PortShunt final : public Element {
- public:
-  PortShunt(std::string name, std::string p, std::string n, double g)
-      : Element(std::move(name), SourceLoc{}), g_(g) {
-    set_node_names({std::move(p), std::move(n)});
-  }
-  void stamp(MnaStamp& m) const override {
-    const int a = nodes_[0], b = nodes_[1];
-    m.g(a, a, g_), m.g(b, b, g_), m.g(a, b, -g_), m.g(b, a, -g_);
-  }
-  void dc_edges(std::vector<DcEdge>& out) const override {
-    out.push_back({nodes_[0], nodes_[1], DcLink::Conductive});
-  }
-
- private:
-  double g_;
-};
-
 // The name of unknown `u` among an element's nodes ("0" for ground).
 std::string node_name_of(const Element& e, int u) {
   if (u == 0) return "0";
@@ -75,9 +56,16 @@ StatusOr<std::unique_ptr<Circuit>> linear_network(const std::vector<Card>& cards
     std::string p = node_name_of(*pr.element, pr.p), n = node_name_of(*pr.element, pr.n);
     if ((pr.p != 0 && p.empty()) || (pr.n != 0 && n.empty()))
       return Status::Error("port model: a port's nodes are not the element's own");
-    auto shunt = std::make_unique<PortShunt>(fmt::format("port#{}#{}", pr.element->name(), m),
-                                             std::move(p), std::move(n), gs);
-    if (Status s = lin->add(std::move(shunt)); !s.ok()) return s;
+    // The shunt is an ordinary resistor card (solver/elements/resistor.cpp).
+    Card shunt;
+    shunt.letter = 'r';
+    shunt.name = fmt::format("port#{}#{}", pr.element->name(), m);
+    shunt.nodes = {std::move(p), std::move(n)};
+    shunt.node_locs.resize(2);
+    CardArg r;
+    r.number = 1.0 / gs;
+    shunt.args = {r};
+    if (Status s = lin->add(shunt); !s.ok()) return s;
   }
   if (Status s = lin->finalize(); !s.ok()) return s;
   if (lin->unknown_count() != circuit.unknown_count())
