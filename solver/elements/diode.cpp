@@ -97,10 +97,12 @@ double soft_exp(double x, double* slope) {
 }
 
 // SPICE's pnjlim: limits a junction voltage step beyond vcrit to a logarithmic one, and a
-// reverse step to twice the old voltage.
+// reverse step to twice the old voltage. A saturation current above vte/sqrt(2) makes vcrit
+// negative; SPICE's log(vnew/vt) from a reverse-biased start would then take the log of a
+// negative voltage (NaN), so a step that ends at or below 0 V is limited as a reverse one.
 double pnjlim(double vnew, double vold, double vt, double vcrit, bool* limited) {
   *limited = false;
-  if (vnew > vcrit && std::fabs(vnew - vold) > vt + vt) {
+  if (vnew > vcrit && vnew > 0 && std::fabs(vnew - vold) > vt + vt) {
     *limited = true;
     if (vold > 0) {
       const double arg = 1 + (vnew - vold) / vt;

@@ -208,6 +208,28 @@ TEST(Diode, BadModelValuesAreRefusedWithTheirName) {
             std::string::npos);
 }
 
+// A saturation current so large that vcrit = vte ln(vte / (sqrt(2) IS)) is negative (IS 0.11 A,
+// found by fuzz_model): SPICE's limiting would take log(vnew / vt) of a negative vnew. Every
+// limited voltage stays finite and keeps its side of 0 V, and the DC point still solves.
+TEST(Diode, NegativeCriticalVoltageLimitsToFiniteValues) {
+  Circuit c;
+  const auto m = model({{"is", 0.11}, {"n", 1.1}, {"bv", 27}});
+  ASSERT_EQ(build(c, {card("v1", {"a", "0"}, {num(0.3)}), diode("d1", {"a", "0"}, m)}), "");
+  const Element& d = *c.elements()[1];
+  for (double v_old : {-30.0, -5.0, -0.5, 0.0})
+    for (double v_new : {-0.04, -0.01, 0.0, 0.01, 0.5}) {
+      bool limited = false;
+      const double v = d.limit_port(0, v_new, v_old, &limited);
+      EXPECT_TRUE(std::isfinite(v)) << v_new << " from " << v_old;
+      if (v_new <= 0) {
+        EXPECT_LE(v, 0.0) << v_new << " from " << v_old;
+      }
+    }
+  // 0.3 V on IS 0.11 A, n 1.1: i = IS (e^(0.3 / (n Vt)) - 1), hundreds of amps, closed form.
+  const double expected = 0.11 * std::expm1(0.3 / (1.1 * kVt)) + kGmin * 0.3;
+  EXPECT_NEAR(dc_diode_current(m, 0.3) / expected, 1.0, 1e-6);
+}
+
 TEST(Diode, LtiEngineRefusesIt) {
   Circuit c;
   ASSERT_EQ(build(c, {card("v1", {"a", "0"}, {num(1)}), diode("d1", {"a", "0"}, model({}))}), "");
