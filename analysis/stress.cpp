@@ -312,6 +312,7 @@ double esd_current(double t, double level_v) {
 
 std::vector<double> esd_pwl(double level_v, double t0, double span) {
   std::vector<double> pts{0, 0};
+  if (t0 > 0) pts.insert(pts.end(), {t0, 0});  // no current before the discharge starts
   double t = 0;
   while (t < span) {
     const double step = t < 3e-9 ? 20e-12 : t < 20e-9 ? 0.25e-9 : 2e-9;

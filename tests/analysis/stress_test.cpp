@@ -42,6 +42,11 @@ TEST(EsdCurrent, MatchesTheStandardsTable) {
     worst = std::max(worst, std::abs(lin - esd_current(tm - 20e-9, 8e3)));
   }
   EXPECT_LT(worst, 0.005 * peak);
+  // Nothing flows before the discharge: the PWL is 0 up to t0 (a ramp from (0, 0) to the first
+  // point after t0 charged the line by 0.7 nC before the discharge, 3 V on the pins).
+  ASSERT_GE(pwl.size(), 4u);
+  EXPECT_EQ(pwl[2], 20e-9);
+  EXPECT_EQ(pwl[3], 0.0);
 }
 
 // The discharge's charge (1.169 uC at 8 kV) lands on a 1 uF Y cap at the zapped connector: the
