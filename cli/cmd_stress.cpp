@@ -1,6 +1,7 @@
 // isolink stress: what breaks a daisy chain in the field (analysis/stress.h): module-ground
 // steps during traffic and IEC 61000-4-2 contact discharges, simulated with the pins' clamps and
-// the spec's TVS parts; report.md and report.json, --export-spice each scenario's netlist.
+// the spec's TVS parts; report.md, report.json, report.html and stress.png, --export-spice each
+// scenario's netlist.
 #include <fmt/format.h>
 
 #include <cstdio>
@@ -18,6 +19,8 @@
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
 #include "netlists/spice_writer.h"
+#include "reports/html_report.h"
+#include "reports/stress_png.h"
 #include "reports/stress_report.h"
 
 namespace isolink::cli {
@@ -67,7 +70,8 @@ int run_stress(const StressArgs& a) {
       a.out_dir.empty() ? "reports/out/" + safe_path_component(spec->name) + "-stress" : a.out_dir;
   // The report folder appears whole or not at all; opened before the (long) runs so a bad -o
   // is reported at once.
-  StatusOr<OutputBundle> bundle = OutputBundle::open(dir, {"report.md", "report.json"});
+  StatusOr<OutputBundle> bundle =
+      OutputBundle::open(dir, {"report.md", "report.json", "stress.png", "report.html"});
   if (!bundle) return fail(bundle.status());
   analysis::StressOptions so;
   so.only = *only;
@@ -101,6 +105,14 @@ int run_stress(const StressArgs& a) {
                                    reports::stress_markdown(spec->name, *r, netlists));
       !s.ok())
     return fail(s);
+  if (Status s = reports::write_stress_png(*r, spec->name, bundle->path("stress.png")); !s.ok())
+    return fail(s);
+  StatusOr<std::string> png = read_input_file(bundle->path("stress.png"));
+  if (!png) return fail(png.status());
+  if (Status s =
+          write_file_atomic(bundle->path("report.html"), reports::stress_report_html(j, *png, *r));
+      !s.ok())
+    return fail(s);
   if (Status s = bundle->commit(); !s.ok()) return fail(s);
   if (a.json) {
     std::puts(j.dump(2).c_str());
@@ -120,8 +132,8 @@ void add_stress_command(CLI::App& app, int* exit_code) {
   CLI::App* cmd = app.add_subcommand(
       "stress",
       "What breaks a link in the field: module-ground steps during traffic and IEC 61000-4-2 ESD, "
-      "with the pins' clamps and the TVS parts; report.md, report.json; exit 1 when a limit or "
-      "rule breaks");
+      "with the pins' clamps and the TVS parts; report.md, report.json, report.html, stress.png; "
+      "exit 1 when a limit or rule breaks");
   cmd->add_option("spec", args->spec, "Link spec (YAML) with an optional stress: block")
       ->required();
   cmd->add_option("-o,--output", args->out_dir,

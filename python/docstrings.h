@@ -128,6 +128,25 @@ Returns:
     the pack's report.json: {"verdict", "weakest_hop", "hops": [{"index", "verdict",
     "directions": [...] as run()'s}], "ring_breaks": [...], "timing": {...}, ...}.)doc";
 
+inline constexpr const char* kStress =
+    R"doc(What breaks a link in the field, as `isolink stress SPEC --json` (nothing written).
+
+Each scenario (module-ground steps during traffic, IEC 61000-4-2 contact ESD, and the kinds
+docs/stress.md lists) runs the link's circuit with the pins' clamp diodes and the spec's TVS
+parts; its peaks are checked against the limits of the spec's stress: block.
+
+Args:
+    spec: a link spec, a path or a dict.
+    only: the scenario kinds to run (["esd"], ["cm_step"], ...; empty: the spec's stress.only,
+        else all).
+    parts: extra part-library folders.
+
+Returns:
+    `isolink stress --json`'s object: {"verdict", "survives", "communicates", "limits": {KEY:
+    {"value", "source"}}, "scenarios": [{"id", "kind", "end", "line", "level", "peak_pin_v":
+    {NODE: {"max", "min"}}, "diodes", "isolation_caps", "traffic", "survives", "communicates",
+    "first_broken", ...}]}, in SI units.)doc";
+
 inline constexpr const char* kCheck = R"doc(Score a differential waveform against receiver rules.
 
 As `isolink check --json` (less its "input").

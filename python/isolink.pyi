@@ -65,6 +65,14 @@ def sweep(
 ) -> list[dict[str, Any]]:
     """`isolink sweep --no-plots`: results.csv's rows as dicts, in point order."""
 
+def stress(
+    spec: Spec,
+    *,
+    only: Sequence[str] = [],
+    parts: Sequence[str] = [],
+) -> dict[str, Any]:
+    """`isolink stress SPEC --json`: the scenarios' peaks, parts, traffic and verdicts."""
+
 def pack(
     pack_spec: Spec,
     *,

@@ -33,6 +33,7 @@
 #include "analysis/pack.h"
 #include "analysis/pack_spec.h"
 #include "analysis/simulate.h"
+#include "analysis/stress.h"
 #include "analysis/sweep_run.h"
 #include "analysis/sweep_spec.h"
 #include "analysis/worst.h"
@@ -50,6 +51,7 @@
 #include "reports/noise_report.h"
 #include "reports/pack_report.h"
 #include "reports/run_report.h"
+#include "reports/stress_report.h"
 #include "reports/sweep_report.h"
 #include "reports/worst_report.h"
 
@@ -177,6 +179,26 @@ py::object noise(const py::object& spec_obj, const Strings& parts_dirs) {
   py::object out = to_python(reports::noise_json(nr->noise));
   warn_once(sim_warnings(nr->run));
   return out;
+}
+
+// isolink.stress: `isolink stress SPEC --json`.
+py::object stress(const py::object& spec_obj, const Strings& only, const Strings& parts_dirs) {
+  const SpecArg arg = spec_arg(spec_obj, "spec");
+  StatusOr<link::LinkSpec> spec = Status::Error("not read");
+  StatusOr<link::PartLibrary> parts = Status::Error("not read");
+  StatusOr<analysis::StressResult> r = Status::Error("not run");
+  {
+    py::gil_scoped_release nogil;
+    spec = read_link(arg);
+    if (spec) parts = link::PartLibrary::load(parts_dirs);
+    analysis::StressOptions so;
+    so.only = only;
+    if (spec && parts) r = analysis::run_stress(*spec, *parts, so);
+  }
+  if (!spec) raise(spec.status());
+  if (!parts) raise(parts.status());
+  if (!r) raise(r.status().with_context(arg.where()));
+  return to_python(reports::stress_json(spec->name, *r));
 }
 
 // isolink.sim: `isolink sim NETLIST --probe ...`'s columns as numpy arrays.
@@ -416,6 +438,8 @@ PYBIND11_MODULE(isolink, m) {
   m.def("worst", &worst, py::arg("spec"), py::kw_only(), py::arg("direction") = py::none(),
         py::arg("edge_engine") = "auto", py::arg("parts") = no_parts, doc::kWorst);
   m.def("noise", &noise, py::arg("spec"), py::kw_only(), py::arg("parts") = no_parts, doc::kNoise);
+  m.def("stress", &stress, py::arg("spec"), py::kw_only(), py::arg("only") = no_parts,
+        py::arg("parts") = no_parts, doc::kStress);
   m.def("sim", &sim, py::arg("netlist"), py::arg("probes"), py::kw_only(),
         py::arg("engine") = "auto", py::arg("step") = py::none(), py::arg("tstop") = py::none(),
         py::arg("tmax") = py::none(), py::arg("method") = py::none(),

@@ -289,4 +289,46 @@ std::string pack_report_html(const ordered_json& report, const std::string& pack
   return html_page("pack", "isolink pack: " + name, data);
 }
 
+ordered_json stress_pins_json(const analysis::StressScenario& s, size_t max_samples) {
+  const Waveform& w = s.pins;
+  const size_t n = w.samples();
+  std::vector<size_t> keep;
+  if (n <= max_samples || w.columns.empty()) {
+    keep.resize(n);
+    for (size_t i = 0; i < n; ++i) keep[i] = i;
+  } else {
+    const size_t per_pin = std::max<size_t>(4, max_samples / w.columns.size());
+    for (const std::vector<double>& col : w.columns) {
+      const std::vector<size_t> k = minmax_keep(col, per_pin);
+      keep.insert(keep.end(), k.begin(), k.end());
+    }
+    keep.push_back(0);
+    keep.push_back(n - 1);
+    std::sort(keep.begin(), keep.end());
+    keep.erase(std::unique(keep.begin(), keep.end()), keep.end());
+  }
+  std::vector<double> t(keep.size());
+  for (size_t i = 0; i < keep.size(); ++i) t[i] = w.time[keep[i]];
+  ordered_json pins = ordered_json::object();
+  for (size_t k = 0; k < w.columns.size() && k < w.names.size(); ++k) {
+    std::vector<float> v(keep.size());
+    for (size_t i = 0; i < keep.size(); ++i) {
+      const double x = w.columns[k][keep[i]];
+      v[i] = std::isfinite(x) ? static_cast<float>(x) : std::numeric_limits<float>::quiet_NaN();
+    }
+    pins[w.names[k]] = base64_of(v);
+  }
+  return {{"t", base64_of(t)}, {"pins", pins}, {"samples", n}, {"kept", keep.size()}};
+}
+
+std::string stress_report_html(const ordered_json& report, const std::string& stress_png,
+                               const analysis::StressResult& r) {
+  ordered_json pins = ordered_json::object();
+  for (const analysis::StressScenario& s : r.scenarios)
+    pins[s.id] = stress_pins_json(s, kStressPinSamples);
+  const ordered_json data{{"report", report}, {"image", png_data_uri(stress_png)}, {"pins", pins}};
+  const std::string name = report.contains("spec") ? report["spec"].get<std::string>() : "";
+  return html_page("stress", "isolink stress: " + name, data);
+}
+
 }  // namespace isolink::reports

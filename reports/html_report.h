@@ -21,6 +21,7 @@
 #include <string_view>
 #include <vector>
 
+#include "analysis/stress.h"
 #include "analysis/sweep_run.h"
 #include "base/status.h"
 
@@ -90,6 +91,17 @@ std::string sweep_report_html(const analysis::sweep::SweepSpec& s,
                               const std::vector<analysis::sweep::PointResult>& results);
 // A pack: report is report.json's object (pack_report_json); pack_png the diagram's bytes.
 std::string pack_report_html(const nlohmann::ordered_json& report, const std::string& pack_png);
+// The samples each stress scenario's pin plot keeps at most (per scenario, all pins together).
+inline constexpr size_t kStressPinSamples = 8000;
+// A scenario's pins for the stress page: {"t" (base64 Float64 times), "pins": {NODE: base64
+// Float32}, "samples", "kept"}. A record longer than max_samples keeps, per pin, the lowest and
+// highest sample of each of max_samples / (2 x pins) buckets (minmax_keep), the union in time
+// order: every peak the report names is on the plot.
+nlohmann::ordered_json stress_pins_json(const analysis::StressScenario& s, size_t max_samples);
+// A stress run: report is report.json's object (stress_json); stress_png the image's bytes ("" when
+// not drawn); each scenario's pins (stress_pins_json) are drawn under its row.
+std::string stress_report_html(const nlohmann::ordered_json& report, const std::string& stress_png,
+                               const analysis::StressResult& r);
 
 namespace detail {
 std::string_view dygraph_js();   // Debian's dygraph.min.js (licence and source-map comments cut)

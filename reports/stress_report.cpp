@@ -27,6 +27,7 @@ ordered_json scenario_json(const analysis::StressScenario& s, const std::string&
   for (const auto& [k, v] : s.level) level[k] = num(v);
   j["level"] = level;
   j["description"] = s.description;
+  j["window_s"] = {num(s.t_start), num(s.t_end)};  // the disturbance's start and end
   ordered_json pins = ordered_json::object(), grounds = ordered_json::object();
   for (const auto& [node, p] : s.peak_pin_v)
     pins[node] = {{"max", num(p.max)}, {"min", num(p.min)}};

@@ -6,10 +6,10 @@
 // are SI, named in the JSON keys (`_V`, `_A`, `_J`, `_s`, `_kV`) and the Markdown text.
 // JSON shape (issue 42): {"spec", "verdict", "survives", "communicates", "limits": {KEY:
 // {"value", "source"}}, "scenarios": [{"id", "kind", "end", "line", "level": {KEY_UNIT: v},
-// "description", "peak_pin_v": {NODE: {"max", "min"}}, "pin_ground": {NODE: GROUND},
-// "peak_cm_V", "diodes": [...], "isolation_caps": [...], "receiver": {"p", "n", "rules"},
-// "traffic": {...}, "survives", "communicates", "first_broken", "broken", "engine", "seconds",
-// "netlist"}]}.
+// "description", "window_s": [start, end], "peak_pin_v": {NODE: {"max", "min"}}, "pin_ground":
+// {NODE: GROUND}, "peak_cm_V", "diodes": [...], "isolation_caps": [...], "receiver": {"p", "n",
+// "rules"}, "traffic": {...}, "survives", "communicates", "first_broken", "broken", "engine",
+// "seconds", "netlist"}]}.
 
 #include <map>
 #include <nlohmann/json.hpp>

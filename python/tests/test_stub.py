@@ -44,7 +44,8 @@ def test_stub_matches_the_module():
     assert sorted(mod) == sorted(stub)
     for name in mod:
         assert mod[name] == stub[name], name
-    assert sorted(mod) == ["check", "compare", "load_spec", "noise", "pack", "run", "sim", "sweep", "worst"]
+    assert sorted(mod) == ["check", "compare", "load_spec", "noise", "pack", "run", "sim", "stress", "sweep",
+                           "worst"]
 
 
 def test_docstrings_give_arguments_and_returns():

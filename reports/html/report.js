@@ -1,4 +1,4 @@
-// isolink report.html: draws a run, a sweep or a pack from the JSON block #isolink-data with
+// isolink report.html: draws a run, a sweep, a pack or a stress run from the JSON block #isolink-data with
 // dygraphs (inlined beside this script). Nothing is fetched: the page opens offline. When every
 // plot has drawn, the body gets data-ready="1".
 (function () {
@@ -42,7 +42,8 @@
   }
   function fmt(x, digits) {
     if (x == null || !isFinite(x)) return '-';
-    return Number(x).toPrecision(digits || 4).replace(/\.?0+(e|$)/, '$1');
+    // Trailing zeros after a decimal point only: 2000 stays 2000, 2.500 is 2.5, 1.000e+3 1e+3.
+    return Number(x).toPrecision(digits || 4).replace(/(\.\d*?)0+(e|$)/, '$1$2').replace(/\.(e|$)/, '$1');
   }
   function signed(x, digits) { return x == null || !isFinite(x) ? '-' : (x >= 0 ? '+' : '') + fmt(x, digits); }
   // Seconds with an SI prefix ("12.5 us").
@@ -469,10 +470,80 @@
     }
   }
 
+  // --- a stress run ---
+  const kPinColors = {txp: '#1f77b4', txn: '#ff7f0e', rxp: '#2ca02c', rxn: '#9467bd'};
+  // A scenario's pin voltages (each to its own device ground) with the pin limit dashed and the
+  // disturbance shaded.
+  function pinPlot(host, sc, pins, limit) {
+    const t = decode(pins.t, Float64Array);
+    const names = Object.keys(pins.pins);
+    const cols = names.map(k => decode(pins.pins[k], Float32Array));
+    const rows = [];
+    for (let i = 0; i < t.length; ++i) rows.push([t[i]].concat(cols.map(c => c[i])));
+    const div = el('div', {cls: 'plot wave'});
+    host.append(div);
+    const done = waitFor();
+    const g = new Dygraph(div, rows, {
+      labels: ['time'].concat(names.map(k => k + ' to ' + (sc.pin_ground[k] || '?'))),
+      colors: names.map(k => kPinColors[k] || '#7f7f7f'),
+      xlabel: 'time', ylabel: 'pin to its ground [V]', legend: 'always', labelsSeparateLines: false,
+      axes: {x: {axisLabelFormatter: x => si(x, 's'), valueFormatter: x => si(x, 's')}},
+      valueRange: [Math.min(-limit, ...names.map(k => sc.peak_pin_v[k].min)) * 1.1,
+                   Math.max(limit, ...names.map(k => sc.peak_pin_v[k].max)) * 1.1],
+      underlayCallback: (ctx, area, gr) => {
+        const win = sc.window_s;
+        if (win) {
+          const a = Math.max(area.x, gr.toDomXCoord(win[0])), b = Math.min(area.x + area.w, gr.toDomXCoord(win[1]));
+          ctx.fillStyle = 'rgba(242,142,0,0.15)'; ctx.fillRect(a, area.y, Math.max(1, b - a), area.h);
+        }
+        ctx.strokeStyle = '#e00000'; ctx.lineWidth = 1.5; ctx.setLineDash([8, 5]);
+        for (const s of [1, -1]) { const y = gr.toDomYCoord(s * limit);
+          ctx.beginPath(); ctx.moveTo(area.x, y); ctx.lineTo(area.x + area.w, y); ctx.stroke(); }
+        ctx.setLineDash([]);
+      },
+      drawCallback: (gr, initial) => { if (initial) done(); },
+    });
+    plots.push({kind: 'pins', graph: g, id: sc.id});
+    if (pins.kept < pins.samples)
+      host.append(el('p', {cls: 'note', text: 'Drawn from ' + pins.kept + ' of ' + pins.samples +
+        ' samples: each pin\'s lowest and highest per bucket, so every peak is on the plot.'}));
+  }
+  function stressPage() {
+    const r = data.report;
+    const ok = r.survives && r.communicates;
+    app.append(el('header', {}, [el('h1', {}, ['isolink stress: ' + r.spec + ' ', verdictBadge(ok ? 'pass' : 'fail', 'verdict')]),
+      el('p', {cls: 'sub', text: r.verdict + ' (' + r.scenarios.length + ' scenarios in ' + fmt(r.seconds, 3) + ' s)'})]));
+    const lim = section('Limits', 'limits');
+    lim.append(table(['limit', 'value', 'source'], Object.keys(r.limits).map(k => ({cells: [k, fmt(r.limits[k].value, 4), r.limits[k].source]}))));
+    if (data.image) section('Pins over time', 'figure').append(image(data.image, 'stress.png'));
+    const pinLimit = r.limits.pin_abs_max_V ? r.limits.pin_abs_max_V.value : 20;
+    const sc = section('Scenarios', 'scenarios');
+    function peaks(s) { return Object.keys(s.peak_pin_v).map(k => k + ' ' + fmt(s.peak_pin_v[k].min, 3) + '..' + fmt(s.peak_pin_v[k].max, 3)).join(', '); }
+    function level(s) { return Object.keys(s.level).map(k => k + ' ' + fmt(s.level[k], 4)).join(', '); }
+    function yesNo(x) { return x == null ? '-' : x ? 'yes' : 'NO'; }
+    sc.append(table(['scenario', 'kind', 'level', 'pins: min..max [V]', 'peak CM [V]', 'survives', 'communicates', 'first broken'],
+      r.scenarios.map(s => ({attrs: {cls: s.first_broken ? 'broken' : ''}, cells: [el('a', {href: '#sc-' + s.id, text: s.id}), s.kind, level(s), peaks(s),
+        fmt(s.peak_cm_V, 3), yesNo(s.survives), yesNo(s.communicates), s.first_broken || '-']}))));
+    for (const s of r.scenarios) {
+      const d = section(s.id + (s.first_broken ? ': breaks' : ''), 'sc-' + s.id);
+      d.append(el('p', {text: s.description}));
+      if (s.first_broken) d.append(el('p', {cls: 'error', text: (s.broken || [s.first_broken]).join('; ')}));
+      if (data.pins && data.pins[s.id]) pinPlot(d, s, data.pins[s.id], pinLimit);
+      if (s.diodes && s.diodes.length)
+        d.append(table(['part', 'probe', 'peak current', 'energy', 'rating'], s.diodes.map(x => ({cells: [x.what, x.probe, si(x.peak_A, 'A'),
+          x.energy_J == null ? '-' : si(x.energy_J, 'J'), x.rating_A ? si(x.rating_A.value, 'A') : '-']}))));
+      if (s.traffic) { const t = s.traffic;
+        d.append(el('p', {text: 'Traffic at ' + s.receiver.p + '/' + s.receiver.n + ' (' + s.receiver.rules + '): ' + t.bytes_decoded + ' of ' + t.bytes_sent +
+          ' bytes decoded, ' + t.decoded_during + ' of ' + t.bytes_during + ' during the disturbance; recovery ' + (t.recovery_s == null ? 'not within the record' : si(t.recovery_s, 's')) +
+          (t.first_failure ? '; first failure: ' + t.first_failure : '')})); }
+      if (s.netlist) d.append(el('p', {cls: 'note', text: 'netlist: ' + s.netlist}));
+    }
+  }
+
   // The page itself counts as one pending plot until it is built; an error leaves data-ready 0.
   const built = waitFor();
   try {
-    if (kind === 'run') runPage(); else if (kind === 'sweep') sweepPage(); else if (kind === 'pack') packPage();
+    if (kind === 'run') runPage(); else if (kind === 'sweep') sweepPage(); else if (kind === 'pack') packPage(); else if (kind === 'stress') stressPage();
     built();
   } catch (e) {
     app.prepend(el('p', {cls: 'error', text: 'report.html could not draw: ' + e}));

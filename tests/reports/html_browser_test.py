@@ -3,12 +3,13 @@
 
   html_browser_test.py CHROMIUM OIIOTOOL OUT_DIR [--max-mb 8] [--screenshot FILE] -- ISOLINK ARGS...
 
-Runs `ISOLINK ARGS... -o OUT_DIR` (run, sweep or pack; OUT_DIR is removed first), then checks
+Runs `ISOLINK ARGS... -o OUT_DIR` (run, sweep, pack or stress; OUT_DIR is removed first), then checks
 OUT_DIR/report.html (the screenshot goes to OUT_DIR_screenshot.png unless --screenshot says):
 - the file names no network address of any kind and is under --max-mb megabytes;
 - chromium (no network: --disable-background-networking and friends, and the page has nothing to
   fetch) loads it, and within the virtual-time budget the script sets data-ready="1" on <body>;
-- the verdict the page shows (#verdict) is the verdict of report.json (run, pack) or of the
+- the verdict the page shows (#verdict) is the verdict of report.json (run, pack; stress: PASS
+  when it survives and communicates, as its exit status) or of the
   points in results.csv (sweep: PASS only when every point passes);
 - every plot drew: one dygraph canvas per waveform / margin plot;
 - a screenshot is not blank: enough non-white pixels, many colours, and the waveform trace's own
@@ -213,6 +214,10 @@ def main():
             verdicts = [r["verdict"] for r in csv.DictReader(f)]
         expected = "PASS" if all(v == "pass" for v in verdicts) else "FAIL"
         plots = 1
+    elif kind == "stress":  # the badge is the exit status's verdict: pass when nothing broke
+        report = json.load(open(os.path.join(out, "report.json")))
+        expected = "PASS" if report["survives"] and report["communicates"] else "FAIL"
+        plots = len(report["scenarios"])  # one pin plot per scenario
     else:
         report = json.load(open(os.path.join(out, "report.json")))
         expected = report["verdict"].upper()

@@ -205,5 +205,43 @@ TEST(HtmlReport, PageIsSelfContained) {
   EXPECT_EQ(page_data(page)["report"]["name"], "t</b>");
 }
 
+// A stress scenario's pins on the page: a 200,000-sample record is cut to at most
+// kStressPinSamples, and every pin's highest and lowest sample (a one-sample spike among them)
+// survives with its time; a short record is kept whole.
+TEST(HtmlReport, StressPinsKeepEveryPeak) {
+  analysis::StressScenario s;
+  s.id = "esd_tx_p_pos";
+  const size_t n = 200'000;
+  for (size_t i = 0; i < n; ++i) s.pins.time.push_back(1e-9 * static_cast<double>(i));
+  s.pins.names = {"txp", "rxp"};
+  s.pins.columns.assign(2, std::vector<double>(n));
+  for (size_t i = 0; i < n; ++i) {
+    s.pins.columns[0][i] = 2.5 + std::sin(1e-3 * static_cast<double>(i));
+    s.pins.columns[1][i] = 2.5;
+  }
+  s.pins.columns[1][123'457] = 17.25;  // one sample
+  s.pins.columns[0][77] = -6.5;
+  const ordered_json j = stress_pins_json(s, kStressPinSamples);
+  EXPECT_EQ(j["samples"], n);
+  const std::vector<double> t = decode<double>(j["t"].get<std::string>());
+  const std::vector<float> txp = decode<float>(j["pins"]["txp"].get<std::string>());
+  const std::vector<float> rxp = decode<float>(j["pins"]["rxp"].get<std::string>());
+  ASSERT_EQ(t.size(), j["kept"].get<size_t>());
+  ASSERT_LE(t.size(), kStressPinSamples + 2);
+  ASSERT_EQ(txp.size(), t.size());
+  ASSERT_EQ(rxp.size(), t.size());
+  EXPECT_TRUE(std::is_sorted(t.begin(), t.end()));
+  const auto spike = std::max_element(rxp.begin(), rxp.end());
+  EXPECT_EQ(*spike, 17.25f);
+  EXPECT_DOUBLE_EQ(t[static_cast<size_t>(spike - rxp.begin())], 123'457e-9);
+  EXPECT_EQ(*std::min_element(txp.begin(), txp.end()), -6.5f);
+  EXPECT_NEAR(*std::max_element(txp.begin(), txp.end()), 3.5, 1e-6);  // the sine's top
+  EXPECT_EQ(t.front(), 0.0);
+  EXPECT_DOUBLE_EQ(t.back(), 1e-9 * static_cast<double>(n - 1));
+  s.pins.time.resize(100);
+  for (auto& c : s.pins.columns) c.resize(100);
+  EXPECT_EQ(stress_pins_json(s, kStressPinSamples)["kept"], 100u);
+}
+
 }  // namespace
 }  // namespace isolink::reports
