@@ -86,7 +86,9 @@ nlohmann::ordered_json compare_json(const CompareResult& r) {
   j["offset_s"] = num(r.offset_s);
   j["residual"] = residual_json(r.residual);
   json fit = json::object();
-  for (const FitKey& k : r.fit)
+  for (const FitKey& k : r.fit) {
+    json alternatives = json::array();
+    for (double a : k.alternatives) alternatives.push_back(num(a));
     fit[k.key] = {{"value", num(k.value)},
                   {"initial", num(k.initial)},
                   {"low", num(k.low)},
@@ -95,7 +97,10 @@ nlohmann::ordered_json compare_json(const CompareResult& r) {
                   {"tolerance_rel", num(k.tolerance)},
                   {"tolerance_from", k.tolerance_from},
                   {"identifiable", k.identifiable},
-                  {"at_bound", k.at_bound.empty() ? json(nullptr) : json(k.at_bound)}};
+                  {"at_bound", k.at_bound.empty() ? json(nullptr) : json(k.at_bound)},
+                  {"alternatives", alternatives},
+                  {"multiple_correlation", num(k.multiple_correlation)}};
+  }
   j["fit"] = fit;
   json corr = json::array();
   for (const analysis::KeyCorrelation& c : r.correlations)
@@ -108,6 +113,7 @@ nlohmann::ordered_json compare_json(const CompareResult& r) {
                    {"failed", r.search.failed},
                    {"starts", r.search.starts},
                    {"from_scan", r.search.from_scan},
+                   {"near", r.search.near},
                    {"local_rms_v", num(r.search.local_rms_v)},
                    {"chosen_rms_v", num(r.search.chosen_rms_v)}};
   if (r.unexplained) {

@@ -234,6 +234,14 @@ TEST(CompareFit, NearSolutionElsewhereMakesTheKeysItMovesNotSeparable) {
                     s.find("2.6 m") != std::string::npos &&
                     s.find("none of the answers is the design") != std::string::npos);
   EXPECT_TRUE(said) << fmt::format("{}", fmt::join(r.reasons, "\n"));
+  // The JSON carries the other answer and the multiple correlation (0 with two keys).
+  r.search.near = 1;
+  const nlohmann::ordered_json j = reports::compare_json(r);
+  ASSERT_EQ(j["fit"]["cable.length"]["alternatives"].size(), 1u);
+  EXPECT_NEAR(j["fit"]["cable.length"]["alternatives"][0].get<double>(), 2.6, 1e-9);
+  EXPECT_TRUE(j["fit"]["rx.termination"]["alternatives"].empty());
+  EXPECT_EQ(j["fit"]["rx.termination"]["multiple_correlation"], 0.0);
+  EXPECT_EQ(j["search"]["near"], 1);
   // With the design among the near answers it is a note, not a reason.
   CompareResult r2;
   r2.noise_rms_v = 0.010;
