@@ -15,6 +15,7 @@
 #include "cli/commands.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/touchstone_cable.h"
+#include "reports/touchstone_png.h"
 
 namespace isolink::cli {
 namespace {
@@ -24,6 +25,7 @@ struct TouchstoneArgs {
   std::vector<int> ports;
   double tolerance = 1e-3;
   bool json = false;
+  std::string plot;  // PNG path, "" for none
 };
 
 nlohmann::json matrix_json(const Eigen::MatrixXd& m) {
@@ -64,6 +66,10 @@ nlohmann::json fit_json(const link::TouchstoneCable& c) {
   j["dc_extrapolated"] = c.dc_extrapolated;
   if (c.dc_extrapolated) j["dc_resistance_ohm"] = matrix_json(c.dc_resistance);
   j["dc_conductance_s"] = matrix_json(c.dc_conductance);
+  const reports::TouchstoneCurves k = reports::touchstone_curves(c);  // the model as simulated
+  j["simulated_rms_error"] = k.rms_error;
+  j["simulated_max_error"] = k.max_error;
+  j["simulated_max_error_hz"] = k.max_error_hz;
   j["delay_extracted"] = false;
   return j;
 }
@@ -80,6 +86,11 @@ int run_touchstone(const TouchstoneArgs& a) {
     return 2;
   }
   const link::TouchstoneCable& cable = **c;
+  if (!a.plot.empty())
+    if (Status s = reports::write_touchstone_png(cable, a.plot); !s.ok()) {
+      std::fprintf(stderr, "%s\n", s.message().c_str());
+      return 2;
+    }
   if (a.json) {
     std::printf("%s\n", fit_json(cable).dump(2).c_str());
     return 0;
@@ -96,6 +107,13 @@ int run_touchstone(const TouchstoneArgs& a) {
       cable.passivity.passive ? "passive as fitted" : "enforced", cable.passivity.min_eigenvalue,
       cable.passivity.at_frequency, cable.passivity.perturbation_iterations,
       cable.passivity.enforced_min_eigenvalue);
+  if (!cable.passivity.passive) {
+    const reports::TouchstoneCurves k = reports::touchstone_curves(cable);
+    std::printf(
+        "the model simulated (after enforcement): RMS |S_fit - S| %.3g, largest %.3g at "
+        "%.4g Hz\n",
+        k.rms_error, k.max_error, k.max_error_hz);
+  }
   if (cable.dc_extrapolated)
     std::printf(
         "below %.4g Hz: extrapolated as a lumped pi section, DC series R %.4g ohm (P), "
@@ -103,6 +121,7 @@ int run_touchstone(const TouchstoneArgs& a) {
         t->freqs.front(), cable.dc_resistance(0, 0),
         cable.dc_resistance(cable.dc_resistance.rows() - 1, cable.dc_resistance.cols() - 1));
   std::printf("delay: not extracted (the fit is rational)\n");
+  if (!a.plot.empty()) std::printf("plot: %s\n", a.plot.c_str());
   return 0;
 }
 
@@ -151,6 +170,9 @@ void add_touchstone_command(CLI::App& app, int* exit_code) {
   cmd->add_option("--tolerance", args->tolerance, "Largest RMS |S_fit - S| accepted")
       ->check(CLI::Range(1e-9, 0.5));
   cmd->add_flag("--json", args->json, "JSON on standard output");
+  cmd->add_option("--plot", args->plot,
+                  "Draw the file against the fit (differential magnitude and phase, the error "
+                  "per frequency) into this PNG");
   cmd->callback([args, exit_code] { *exit_code = run_touchstone(*args); });
 
   auto ex = std::make_shared<ExportArgs>();

@@ -18,18 +18,6 @@ constexpr int kW = 1800, kH = 1650, kFont = 20;
 constexpr Color kDirColor[2] = {kSeriesP, kSeriesN};
 constexpr Color kLimit = kFail;
 
-// Decade ticks over [lo, hi] (log10 values), labelled by fmt_label(10^k).
-template <typename F>
-AxisTicks decade_ticks(double lo, double hi, const std::string& unit, F fmt_label) {
-  AxisTicks t;
-  t.unit = UnitScale{1, unit};
-  t.step = 1;
-  for (int k = static_cast<int>(std::ceil(lo - 1e-9)); k <= static_cast<int>(std::floor(hi + 1e-9));
-       ++k)
-    t.ticks.push_back({static_cast<double>(k), fmt_label(std::pow(10.0, k))});
-  return t;
-}
-
 std::string si_label(double v) {
   std::string s = link::format_si(v, "");
   while (!s.empty() && s.back() == ' ') s.pop_back();

@@ -650,6 +650,17 @@ AxisTicks make_ticks(const Axis& a, const UnitScale& u, int target) {
   return ticks_at(tick_values(lo, hi, step), step, u);
 }
 
+AxisTicks decade_ticks(double lo, double hi, const std::string& unit,
+                       const std::function<std::string(double)>& label) {
+  AxisTicks t;
+  t.unit = UnitScale{1, unit};
+  t.step = 1;
+  for (int k = static_cast<int>(std::ceil(lo - 1e-9)); k <= static_cast<int>(std::floor(hi + 1e-9));
+       ++k)
+    t.ticks.push_back({static_cast<double>(k), label(std::pow(10.0, k))});
+  return t;
+}
+
 AxisTicks ticks_at(std::vector<double> values, double step, const UnitScale& u) {
   AxisTicks t;
   t.unit = u;

@@ -237,6 +237,10 @@ struct AxisTicks {
 AxisTicks make_ticks(const Axis& a, const UnitScale& u, int target = 8);
 // Ticks at the given values.
 AxisTicks ticks_at(std::vector<double> values, double step, const UnitScale& u);
+// Ticks at the decades 10^k inside [lo, hi], for an axis of log10 values, each labelled
+// label(10^k) (e.g. "1M" on an axis titled in Hz).
+AxisTicks decade_ticks(double lo, double hi, const std::string& unit,
+                       const std::function<std::string(double)>& label);
 
 // Gridlines at the ticks (inside a.rect).
 void draw_grid(Canvas& c, const PlotArea& a, const AxisTicks& xt, const AxisTicks& yt,
