@@ -47,6 +47,9 @@ std::string format_diagnostic(const SourceLoc& loc, const std::string& severity,
 }
 
 Status error_at(const SourceLoc& loc, const std::string& message) {
+  // No place (a value built in code or given from Python): the message alone, which the caller's
+  // context leads, rather than "<unknown>: error: ...".
+  if (!loc.valid()) return Status::Error(message);
   return Status::Error(format_diagnostic(loc, "error", message));
 }
 

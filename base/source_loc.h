@@ -45,7 +45,8 @@ struct SourceLoc {
 std::string format_diagnostic(const SourceLoc& loc, const std::string& severity,
                               const std::string& message);
 
-// Status::Error carrying a formatted "error" diagnostic at loc.
+// Status::Error carrying a formatted "error" diagnostic at loc; the message alone when loc is not
+// valid (no file).
 Status error_at(const SourceLoc& loc, const std::string& message);
 
 }  // namespace isolink
