@@ -11,11 +11,14 @@
 #include <string>
 #include <vector>
 
+#include "analysis/pack_spec.h"
+#include "analysis/pack_stress.h"
 #include "analysis/stress.h"
 #include "base/file_io.h"
 #include "base/progress.h"
 #include "cli/commands.h"
 #include "cli/common_options.h"
+#include "config/yaml_reader.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
 #include "netlists/spice_writer.h"
@@ -59,9 +62,55 @@ StatusOr<std::vector<std::string>> parse_only(const std::string& text) {
   return out;
 }
 
+// A pack file: every hop's wire faults and what the ring still reaches (analysis/pack_stress.h).
+int run_pack_stress(const StressArgs& a, const std::vector<std::string>& only) {
+  if (!a.spice_dir.empty())
+    return fail(Status::Error(fmt::format(
+        "{}: error: --export-spice is for link specs; run stress on a hop's link spec to export "
+        "its scenarios",
+        a.spec)));
+  StatusOr<analysis::PackSpec> pack = analysis::read_pack_spec_file(a.spec);
+  if (!pack) return fail(pack.status());
+  StatusOr<link::PartLibrary> parts = link::PartLibrary::load(a.part_dirs);
+  if (!parts) return fail(parts.status());
+  const std::string dir =
+      a.out_dir.empty() ? "reports/out/" + safe_path_component(pack->name) + "-stress" : a.out_dir;
+  StatusOr<OutputBundle> bundle = OutputBundle::open(dir, {"report.md", "report.json"});
+  if (!bundle) return fail(bundle.status());
+  analysis::StressOptions so;
+  so.only = only;
+  ProgressLine line({.label = "isolink stress", .enabled = !a.quiet && !a.json});
+  so.progress = [&line](const std::string& what, double f) { line.show_fraction(what, f); };
+  StatusOr<analysis::PackStressResult> r = analysis::run_pack_stress(*pack, *parts, so);
+  line.finish();
+  if (!r) return fail(r.status().with_context(a.spec));
+  const nlohmann::ordered_json j = reports::pack_stress_json(pack->name, *r);
+  if (Status s = write_file_atomic(bundle->path("report.json"), j.dump(2) + "\n"); !s.ok())
+    return fail(s);
+  if (Status s = write_file_atomic(bundle->path("report.md"),
+                                   reports::pack_stress_markdown(pack->name, *r));
+      !s.ok())
+    return fail(s);
+  if (Status s = bundle->commit(); !s.ok()) return fail(s);
+  if (a.json) {
+    std::puts(j.dump(2).c_str());
+  } else {
+    for (const analysis::HopFault& f : r->faults)
+      if (f.breaks_hop || !f.scenario.survives)
+        std::printf("hop %-3d %-20s %s\n", f.hop, f.scenario.id.c_str(),
+                    f.unreached.empty() ? "stops the hop; the ring reaches every device"
+                                        : "stops the hop; devices unreached");
+    std::printf("%s\nreport: %s/report.md\n", r->verdict.c_str(), dir.c_str());
+  }
+  return r->survives && r->all_reached ? 0 : 1;
+}
+
 int run_stress(const StressArgs& a) {
   StatusOr<std::vector<std::string>> only = parse_only(a.only);
   if (!only) return fail(only.status());
+  if (StatusOr<config::YamlDoc> doc = config::YamlDoc::load_file(a.spec);
+      doc && analysis::is_pack_spec(*doc))
+    return run_pack_stress(a, *only);
   StatusOr<link::LinkSpec> spec = link::read_link_spec_file(a.spec);
   if (!spec) return fail(spec.status());
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load(a.part_dirs);
@@ -134,7 +183,9 @@ void add_stress_command(CLI::App& app, int* exit_code) {
       "What breaks a link in the field: module-ground steps during traffic and IEC 61000-4-2 ESD, "
       "with the pins' clamps and the TVS parts; report.md, report.json, report.html, stress.png; "
       "exit 1 when a limit or rule breaks");
-  cmd->add_option("spec", args->spec, "Link spec (YAML) with an optional stress: block")
+  cmd->add_option("spec", args->spec,
+                  "Link spec (YAML) with an optional stress: block, or a pack spec (each hop's "
+                  "wire faults and what the ring still reaches)")
       ->required();
   cmd->add_option("-o,--output", args->out_dir,
                   "Report folder (default reports/out/<name>-stress)");

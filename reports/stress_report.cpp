@@ -158,4 +158,65 @@ std::string stress_markdown(const std::string& spec_name, const analysis::Stress
   return md;
 }
 
+namespace {
+
+std::string devices_text(const std::vector<int>& d) {
+  if (d.empty()) return "-";
+  std::string s;
+  for (int k : d) s += (s.empty() ? "" : " ") + std::to_string(k);
+  return s;
+}
+
+}  // namespace
+
+ordered_json pack_stress_json(const std::string& pack_name, const analysis::PackStressResult& r) {
+  ordered_json j;
+  j["pack"] = pack_name;
+  j["devices"] = r.devices;
+  j["ring"] = r.ring;
+  j["verdict"] = r.verdict;
+  j["survives"] = r.survives;
+  j["all_reached"] = r.all_reached;
+  j["simulations"] = r.simulations;
+  j["seconds"] = num(r.seconds);
+  ordered_json faults = ordered_json::array();
+  for (const analysis::HopFault& f : r.faults)
+    faults.push_back({{"hop", f.hop},
+                      {"breaks_hop", f.breaks_hop},
+                      {"normal_side",
+                       f.breaks_hop ? ordered_json(f.reroute.normal_side) : ordered_json(nullptr)},
+                      {"reverse_side",
+                       f.breaks_hop ? ordered_json(f.reroute.reverse_side) : ordered_json(nullptr)},
+                      {"unreached", f.unreached},
+                      {"reroute_delay_s", num(f.reroute_delay_s)},
+                      {"scenario", scenario_json(f.scenario, "")}});
+  j["faults"] = faults;
+  return j;
+}
+
+std::string pack_stress_markdown(const std::string& pack_name,
+                                 const analysis::PackStressResult& r) {
+  std::string md = fmt::format(
+      "# isolink stress: {} (pack)\n\n**Verdict:** {}\n\n{} devices{}; each hop's wire faults "
+      "on its own link spec ({} distinct circuits simulated in {:.1f} s). A fault that stops a "
+      "hop (it no longer communicates in either direction) is taken as that hop's cable "
+      "broken: the devices the ring still reaches the other way round, those none reaches, and "
+      "the most a command's arrival is delayed by the re-route.\n\n",
+      pack_name, r.verdict, r.devices, r.ring ? ", ring" : ", no ring", r.simulations, r.seconds);
+  md +=
+      "| hop | fault | survives | communicates | re-routed (other way round) | unreached | "
+      "added delay | first broken |\n|---|---|---|---|---|---|---|---|\n";
+  for (const analysis::HopFault& f : r.faults) {
+    const analysis::StressScenario& s = f.scenario;
+    md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", f.hop, s.id,
+                      s.survives ? "yes" : "**no**",
+                      s.communicates ? (*s.communicates ? "yes" : "**no**") : "-",
+                      f.breaks_hop ? devices_text(f.reroute.reverse_side) : "-",
+                      f.breaks_hop ? devices_text(f.unreached) : "-",
+                      f.breaks_hop ? link::format_si(f.reroute_delay_s, "s") : "-",
+                      s.first_broken.empty() ? "-" : s.first_broken);
+  }
+  return md;
+}
+
 }  // namespace isolink::reports

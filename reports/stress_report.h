@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "analysis/pack_stress.h"
 #include "analysis/stress.h"
 
 namespace isolink::reports {
@@ -24,5 +25,12 @@ nlohmann::ordered_json stress_json(const std::string& spec_name, const analysis:
                                    const std::map<std::string, std::string>& netlists = {});
 std::string stress_markdown(const std::string& spec_name, const analysis::StressResult& r,
                             const std::map<std::string, std::string>& netlists = {});
+
+// A pack's stress (analysis/pack_stress.h): {"pack", "devices", "ring", "verdict", "survives",
+// "all_reached", "simulations", "seconds", "faults": [{"hop", "breaks_hop", "normal_side",
+// "reverse_side", "unreached", "reroute_delay_s", "scenario": a scenario object as above}]}.
+nlohmann::ordered_json pack_stress_json(const std::string& pack_name,
+                                        const analysis::PackStressResult& r);
+std::string pack_stress_markdown(const std::string& pack_name, const analysis::PackStressResult& r);
 
 }  // namespace isolink::reports
