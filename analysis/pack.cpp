@@ -14,6 +14,7 @@
 #include "netlists/link/cable.h"
 #include "netlists/link/expand.h"
 #include "netlists/traffic/command.h"
+#include "netlists/traffic/sequences.h"
 
 namespace isolink::analysis {
 
@@ -72,6 +73,36 @@ std::vector<BreakCase> ring_breaks(int n, bool ring) {
   return out;
 }
 
+namespace {
+
+// The commands the host sends, in order: each frame text, an `auto-address` item as its commands
+// (netlists/traffic/sequences.h, the stimulus expands it the same way); a `responses` item is
+// what devices send back, not a command of the host's: left out.
+StatusOr<std::vector<std::string>> host_commands(const std::vector<std::string>& frames) {
+  std::vector<std::string> out;
+  for (const std::string& text : frames) {
+    std::vector<std::string_view> tok;
+    for (size_t i = 0; i < text.size();) {
+      const size_t j = text.find_first_of(" \t", i);
+      const size_t e = j == std::string::npos ? text.size() : j;
+      if (e > i) tok.emplace_back(text.data() + i, e - i);
+      i = e + 1;
+    }
+    if (!tok.empty() && tok[0] == "responses") continue;
+    if (!tok.empty() && tok[0] == "auto-address") {
+      StatusOr<std::vector<std::string>> cmds =
+          traffic::auto_address_item({tok.begin() + 1, tok.end()});
+      if (!cmds) return cmds.status();
+      out.insert(out.end(), cmds->begin(), cmds->end());
+      continue;
+    }
+    out.push_back(text);
+  }
+  return out;
+}
+
+}  // namespace
+
 StatusOr<PackTiming> pack_timing(const PackSpec& pack) {
   PackTiming t;
   const TimingSpec& ts = pack.timing;
@@ -90,13 +121,16 @@ StatusOr<PackTiming> pack_timing(const PackSpec& pack) {
     down[n] = t.cable_delay[n];  // the return hop
     for (int k = n - 1; k >= 1; --k) down[k] = down[k + 1] + t.cable_delay[k];
   }
+  StatusOr<std::vector<std::string>> commands =
+      host_commands(pack.hops.front().spec.stimulus.frames);
+  if (!commands) return commands.status().with_context("stimulus");
   for (bool reversed : {false, true}) {
     if (reversed && !ring) break;
     // Device k has the whole command after the bridge's byte delay, the re-clock of every stack
     // device before it and the cables on the way.
     auto cable = [&](int k) { return reversed ? down[k] : up[k]; };
     auto before = [&](int k) { return reversed ? n - k : k - 1; };
-    for (const std::string& text : pack.hops.front().spec.stimulus.frames) {
+    for (const std::string& text : *commands) {
       CommandTiming c;
       c.command = text;
       c.reversed = reversed;

@@ -66,6 +66,17 @@ StatusOr<std::vector<uint8_t>> response_frame(int device, uint16_t reg,
   return out;
 }
 
+StatusOr<std::vector<std::string>> auto_address_item(const std::vector<std::string_view>& fields) {
+  const std::string_view f = fields.size() == 1 ? fields[0] : std::string_view();
+  if (f.substr(0, 8) != "devices=")
+    return Status::Error("auto-address: expected devices=N, e.g. 'auto-address devices=16'");
+  const std::optional<long> n = parse_int(f.substr(8));
+  if (!n || *n < 0 || *n > kMaxStackDevices)
+    return Status::Error(
+        fmt::format("auto-address: devices={} is not an integer of 2-64", f.substr(8)));
+  return auto_address_commands(static_cast<int>(*n));
+}
+
 StatusOr<std::vector<std::vector<uint8_t>>> response_frames(
     const std::vector<std::string_view>& fields) {
   std::optional<long> reg, n, devices;

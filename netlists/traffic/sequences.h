@@ -44,6 +44,8 @@ inline constexpr int kMaxStackDevices = 64;            // addresses 0-63
 
 // The command texts (command.h syntax) of auto-addressing N devices (2-64), in order.
 StatusOr<std::vector<std::string>> auto_address_commands(int devices);
+// The same from the item's fields after `auto-address` (["devices=16"]); errors name the field.
+StatusOr<std::vector<std::string>> auto_address_item(const std::vector<std::string_view>& fields);
 // One response frame: device 0-63, 1-128 data bytes, CRC appended.
 StatusOr<std::vector<uint8_t>> response_frame(int device, uint16_t reg,
                                               const std::vector<uint8_t>& data);

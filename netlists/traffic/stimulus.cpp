@@ -137,13 +137,7 @@ Status add_item(DriveBuilder& b, std::string_view item, const StimulusOptions& o
     return b.add_frame(pattern_bytes(*p, n), std::string(pattern_name(*p)));
   }
   if (kw == "auto-address") {  // sequences.h: TI's auto-addressing of a stack
-    if (rest.size() != 1 || lower(rest[0]).rfind("devices=", 0) != 0)
-      return Status::Error("auto-address: expected devices=N, e.g. 'auto-address devices=16'");
-    const std::string n(rest[0].substr(8));
-    const std::optional<SiNumber> v = scan_si_number(n, {.scale = false, .unit_letters = false});
-    if (!v || v->length != n.size() || v->value != static_cast<int>(v->value))
-      return Status::Error(fmt::format("auto-address: devices={} is not an integer", n));
-    StatusOr<std::vector<std::string>> cmds = auto_address_commands(static_cast<int>(v->value));
+    StatusOr<std::vector<std::string>> cmds = auto_address_item(rest);
     if (!cmds) return cmds.status();
     for (const std::string& c : *cmds)
       if (Status s = b.add_frame(*command_bytes(c), c); !s.ok()) return s;

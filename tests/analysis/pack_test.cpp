@@ -15,6 +15,7 @@
 #include <sstream>
 #include <string>
 
+#include "netlists/traffic/sequences.h"
 #include "reports/pack_report.h"
 #include "reports/run_report.h"
 #include "reports/worst_report.h"
@@ -198,6 +199,27 @@ TEST(PackTiming, ReadOfAMissingDeviceIsFlagged) {
   EXPECT_TRUE(t->commands[0].late);
   EXPECT_TRUE(std::isnan(t->commands[0].response_done));
   EXPECT_NE(t->commands[0].note.find("device 5 is not in the stack"), std::string::npos);
+}
+
+// TI's start-up in a pack's stimulus (issue 45): `auto-address devices=2` is timed as the 21
+// commands it stands for (8 + 1 + 2 + 1 + 1 + 8, netlists/traffic/sequences.h), the last eight
+// stack reads answered by both devices; `responses` is what the devices send, not a command.
+TEST(PackTiming, AutoAddressIsTimedAsItsCommands) {
+  StatusOr<PackSpec> p =
+      timing_pack({1.0, 1.0}, "\"auto-address devices=2\", \"responses reg=0x0343 n=1 devices=2\"");
+  ASSERT_TRUE(p.ok()) << p.status().message();
+  StatusOr<PackTiming> t = pack_timing(*p);
+  ASSERT_TRUE(t.ok()) << t.status().message();
+  StatusOr<std::vector<std::string>> cmds = traffic::auto_address_commands(2);
+  ASSERT_TRUE(cmds.ok());
+  ASSERT_EQ(cmds->size(), 21u);
+  ASSERT_EQ(t->commands.size(), 21u);
+  for (size_t k = 0; k < 21; ++k) EXPECT_EQ(t->commands[k].command, (*cmds)[k]);
+  // Device 2 has each command after 12 us, one re-clock (3 us) and two 1 m hops (5 ns each).
+  EXPECT_NEAR(t->commands[0].arrival[1], 15.010e-6, 1e-12);
+  EXPECT_FALSE(t->commands[0].read);
+  EXPECT_TRUE(t->commands[20].read);
+  EXPECT_EQ(t->commands[20].responders, (V{1, 2}));
 }
 
 // Five hops: the bridge hop, then a module hop, the same module renamed, the same module with
