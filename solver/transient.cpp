@@ -279,7 +279,9 @@ void TransientMarch::initial_charges() {
   for (const auto& e : circuit_.elements())
     for (int j = 0; j < e->nonlinear_port_count(); ++j, ++k) {
       const NonlinearPort p = e->nonlinear_port(j);
-      x_[n_ + 1 + k] = e->eval_port(j, x_[p.p] - x_[p.n]).q;
+      const double v = x_[p.p] - x_[p.n];
+      x_[n_ + 1 + k] = p.controlled ? e->eval_controlled_port(j, v, x_[p.cp] - x_[p.cn]).q
+                                    : e->eval_port(j, v).q;
     }
 }
 
