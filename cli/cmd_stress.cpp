@@ -1,6 +1,7 @@
 // isolink stress: what breaks a daisy chain in the field (analysis/stress.h): module-ground
-// steps during traffic and IEC 61000-4-2 contact discharges, simulated with the pins' clamps and
-// the spec's TVS parts; report.md and report.json, --export-spice each scenario's netlist.
+// steps and an inverter's wave during traffic, IEC 61000-4-2 contact discharges, hot-plugging a
+// module and wire faults, simulated with the pins' clamps and the spec's TVS parts; report.md and
+// report.json, --export-spice each scenario's netlist.
 #include <fmt/format.h>
 
 #include <cstdio>
@@ -31,6 +32,8 @@ struct StressArgs {
   bool quiet = false;
   std::string only;  // comma-separated kinds
   std::string spice_dir;
+  std::string direction = "both";
+  int jobs = 1;
 };
 
 int fail(const Status& s) {
@@ -49,7 +52,7 @@ StatusOr<std::vector<std::string>> parse_only(const std::string& text) {
     if (std::find(kinds.begin(), kinds.end(), item) == kinds.end())
       return Status::Error(fmt::format(
           "isolink stress: error: --only = '{}': '{}' is not a scenario kind (one of cm_step, "
-          "esd, comma-separated)",
+          "cm_wave, esd, hot_plug, wire, comma-separated)",
           text, item));
     out.push_back(item);
   }
@@ -59,6 +62,12 @@ StatusOr<std::vector<std::string>> parse_only(const std::string& text) {
 int run_stress(const StressArgs& a) {
   StatusOr<std::vector<std::string>> only = parse_only(a.only);
   if (!only) return fail(only.status());
+  if (a.direction != "down" && a.direction != "up" && a.direction != "both")
+    return fail(Status::Error(fmt::format(
+        "isolink stress: error: --direction = '{}': must be down, up or both", a.direction)));
+  if (a.jobs < 0)
+    return fail(Status::Error(
+        fmt::format("isolink stress: error: -j = {}: must be >= 0 (0: all cores)", a.jobs)));
   StatusOr<link::LinkSpec> spec = link::read_link_spec_file(a.spec);
   if (!spec) return fail(spec.status());
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load(a.part_dirs);
@@ -71,6 +80,9 @@ int run_stress(const StressArgs& a) {
   if (!bundle) return fail(bundle.status());
   analysis::StressOptions so;
   so.only = *only;
+  so.jobs = a.jobs;
+  if (a.direction != "both")
+    so.directions = {a.direction == "down" ? link::Direction::kDown : link::Direction::kUp};
   ProgressLine line({.label = "isolink stress", .enabled = !a.quiet && !a.json});
   so.progress = [&line](const std::string& what, double f) { line.show_fraction(what, f); };
 
@@ -106,7 +118,7 @@ int run_stress(const StressArgs& a) {
     std::puts(j.dump(2).c_str());
   } else {
     for (const analysis::StressScenario& s : r->scenarios)
-      std::printf("%-4s %-16s %s\n", s.first_broken.empty() ? "ok" : "FAIL", s.id.c_str(),
+      std::printf("%-4s %-22s %s\n", s.first_broken.empty() ? "ok" : "FAIL", s.id.c_str(),
                   s.first_broken.empty() ? s.description.c_str() : s.first_broken.c_str());
     std::printf("%s\nreport: %s/report.md\n", r->verdict.c_str(), dir.c_str());
   }
@@ -119,9 +131,11 @@ void add_stress_command(CLI::App& app, int* exit_code) {
   auto args = std::make_shared<StressArgs>();
   CLI::App* cmd = app.add_subcommand(
       "stress",
-      "What breaks a link in the field: module-ground steps during traffic and IEC 61000-4-2 ESD, "
-      "with the pins' clamps and the TVS parts; report.md, report.json; exit 1 when a limit or "
-      "rule breaks");
+      "What breaks a link in the field: module-ground steps and an inverter's square or sine "
+      "during traffic, IEC 61000-4-2 ESD, hot-plugging a module (its contacts as switches, P or "
+      "N first) and wire faults (open, short, to ground or chassis, a leaking pin) during "
+      "traffic, with the pins' clamps and the TVS parts; report.md, report.json; exit 1 when a "
+      "limit or rule breaks");
   cmd->add_option("spec", args->spec, "Link spec (YAML) with an optional stress: block")
       ->required();
   cmd->add_option("-o,--output", args->out_dir,
@@ -129,7 +143,12 @@ void add_stress_command(CLI::App& app, int* exit_code) {
   add_parts_option(*cmd, &args->part_dirs);
   cmd->add_flag("--json", args->json, "Print the stress result as JSON on stdout");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress line");
-  cmd->add_option("--only", args->only, "Scenario kinds to run, comma-separated: cm_step, esd");
+  cmd->add_option("--only", args->only,
+                  "Scenario kinds to run, comma-separated: cm_step, cm_wave, esd, hot_plug, wire");
+  cmd->add_option("--direction", args->direction,
+                  "Which end transmits in the traffic scenarios (cm_step, cm_wave, wire): down "
+                  "(the tx end), up (the rx end) or both (default)");
+  cmd->add_option("-j,--jobs", args->jobs, "Scenarios run at once (default 1; 0: all cores)");
   cmd->add_option("--export-spice", args->spice_dir,
                   "Write each scenario's netlist (ngspice dialect) into this folder");
   cmd->callback([args, exit_code] { *exit_code = run_stress(*args); });

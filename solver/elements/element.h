@@ -104,6 +104,10 @@ class Element {
   virtual PortEval eval_controlled_port(int k, double v, double vc) const {
     return eval_port(k, v);
   }
+  // A controlled port's discrete state at control voltage vc (the switch: on). The transient
+  // takes a step where one changes as ending at a breakpoint: the change is a corner of the
+  // solution, not an error of the formula.
+  virtual bool control_state(int k, double vc) const { return false; }
   // Newton's voltage step limit (SPICE's pnjlim): the voltage to evaluate at, given the new
   // iterate v_new and the last evaluated v_old; *limited = true when it changed v_new.
   virtual double limit_port(int k, double v_new, double v_old, bool* limited) const {

@@ -55,6 +55,7 @@ class Switch final : public Element {
   PortEval eval_port(int k, double v) const override {
     return eval_controlled_port(k, v, -std::numeric_limits<double>::infinity());
   }
+  bool control_state(int, double vc) const override { return vc > vt_; }
   PortEval eval_controlled_port(int, double v, double vc) const override {
     PortEval e;
     e.g = vc > vt_ ? gon_ : goff_;
@@ -109,8 +110,8 @@ StatusOr<std::unique_ptr<Element>> parse(const Card& card) {
 }  // namespace
 
 const ElementKind& switch_kind() {
-  static const ElementKind kind{
-      's', "switch", "Sname n+ n- nc+ nc- model", 4, 0, {}, parse, "sw", kModelParams};
+  static const ElementKind kind{'s',  "switch",    "Sname n+ n- nc+ nc- model", 4, 0, {}, parse,
+                                "sw", kModelParams};
   return kind;
 }
 

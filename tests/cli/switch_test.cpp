@@ -70,9 +70,10 @@ TEST(Switch, ClosesAnRcAgainstTheClosedFormAndNgspice) {
   for (double x : ng->columns[1]) ng_peak = std::max(ng_peak, x);
   EXPECT_LT(dv, 5e-3);
   EXPECT_NEAR(ng_peak, peak, 1e-3);
-  std::printf("switch_rc: closed form within %.3f mV; ngspice v(c) within %.3f mV, i(vam) %.3f mA "
-              "after 1.01 us, peak %.5f A (ngspice %.5f A)\n",
-              worst * 1e3, dv * 1e3, di * 1e3, peak, ng_peak);
+  std::printf(
+      "switch_rc: closed form within %.3f mV; ngspice v(c) within %.3f mV, i(vam) %.3f mA "
+      "after 1.01 us, peak %.5f A (ngspice %.5f A)\n",
+      worst * 1e3, dv * 1e3, di * 1e3, peak, ng_peak);
 }
 
 TEST(Switch, RefusesHysteresisAndBadResistances) {
