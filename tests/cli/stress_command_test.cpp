@@ -1,6 +1,7 @@
-// isolink stress: an exported ESD scenario replayed in ngspice (the pins' peaks and the TVS's
-// current within 5 % or 0.2 V, issue 42), the slow module-ground step likewise, and the command's
-// input errors (a bad stress: key at file:line:col, a bad --only) with exit 2 before any run.
+// isolink stress: an exported scenario of each kind replayed in ngspice (the pins' peaks and the
+// diodes' currents within 5 % or 0.2 V, issue 42; with traffic, the checker's verdict on ngspice's
+// waveform against the scenario's `communicates`), and the command's input errors (a bad stress:
+// key at file:line:col, a bad --only or --direction) with exit 2 before any run.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include <string>
 
 #include "analysis/stress.h"
+#include "eye/check.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
 #include "netlists/spice_writer.h"
@@ -33,7 +35,8 @@ void compare_with_ngspice(const std::string& spec_path, const std::string& id) {
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
   ASSERT_TRUE(parts.ok());
   analysis::StressOptions opt;
-  opt.only = {id.starts_with("cm_step") ? "cm_step" : "esd"};
+  for (const std::string& k : link::stress_kinds())
+    if (id.starts_with(k)) opt.only = {k};
   StatusOr<std::vector<analysis::StressScenario>> sc =
       analysis::build_stress_scenarios(*spec, *parts, opt);
   ASSERT_TRUE(sc.ok()) << sc.status().message();
@@ -49,6 +52,7 @@ void compare_with_ngspice(const std::string& spec_path, const std::string& id) {
   for (const auto& [node, ground] : s.pin_ground)
     probes.push_back(ground == "0" ? "v(" + node + ")" : "v(" + node + "," + ground + ")");
   for (const analysis::DiodePeak& d : s.diodes) probes.push_back("i(" + d.ammeter + ")");
+  if (s.traffic) probes.push_back("v(" + s.receiver_p + "," + s.receiver_n + ")");
   StatusOr<Waveform> ng = testing::run_ngspice(path, probes, work, ".options reltol=1e-4");
   ASSERT_TRUE(ng.ok()) << ng.status().message();
   size_t k = 0;
@@ -68,6 +72,18 @@ void compare_with_ngspice(const std::string& spec_path, const std::string& id) {
     EXPECT_NEAR(d.peak_a, mx, std::max(0.05, 0.05 * mx)) << id << " " << d.diode;
     std::printf("%s %s: peak %.4g A (ngspice %.4g)\n", id.c_str(), d.diode.c_str(), d.peak_a, mx);
   }
+  if (!s.traffic) return;
+  // The checker on ngspice's receiver waveform gives the scenario's verdict.
+  StatusOr<eye::Rules> rules = eye::load_rules(s.rules);
+  ASSERT_TRUE(rules.ok());
+  eye::CheckOptions co;
+  co.expect = s.link.expected;
+  StatusOr<eye::CheckResult> check = eye::check_samples(ng->time, ng->columns[k], *rules, co);
+  ASSERT_TRUE(check.ok()) << check.status().message();
+  ASSERT_TRUE(s.communicates.has_value());
+  EXPECT_EQ(check->pass, *s.communicates) << id;
+  std::printf("%s: communicates %d (the checker on ngspice's waveform: %d)\n", id.c_str(),
+              *s.communicates, check->pass);
 }
 
 TEST(StressVsNgspice, EsdIntoTheTvsLink) {
@@ -76,6 +92,18 @@ TEST(StressVsNgspice, EsdIntoTheTvsLink) {
 
 TEST(StressVsNgspice, GroundStepDuringTraffic) {
   compare_with_ngspice(kExamples + "/bq79606a_tvs_2m.yaml", "cm_step_tx");
+}
+
+TEST(StressVsNgspice, HotPlugPFirst) {
+  compare_with_ngspice(kExamples + "/bq79606a_tvs_2m.yaml", "hot_plug_rx_p_first");
+}
+
+TEST(StressVsNgspice, InverterSquareDuringTraffic) {
+  compare_with_ngspice(kExamples + "/bq79606a_tvs_2m.yaml", "cm_wave_tx");
+}
+
+TEST(StressVsNgspice, WireShortToChassisDuringTraffic) {
+  compare_with_ngspice(kExamples + "/bq79606a_tvs_2m.yaml", "wire_p_to_chassis_down");
 }
 
 TEST(StressCommand, BadInputExitsTwoBeforeAnyRun) {
@@ -88,11 +116,23 @@ TEST(StressCommand, BadInputExitsTwoBeforeAnyRun) {
   EXPECT_NE(r.err.find("ground_stepp"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir + "/out"));
   r = isolink::testing::run_isolink(
-      kBinary, "stress " + kExamples + "/cap_2m.yaml --only esd,wire -o " + dir + "/out2", "only");
+      kBinary, "stress " + kExamples + "/cap_2m.yaml --only esd,wires -o " + dir + "/out2", "only");
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("--only = 'esd,wire': 'wire' is not a scenario kind"), std::string::npos)
+  EXPECT_NE(r.err.find("--only = 'esd,wires': 'wires' is not a scenario kind"), std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(dir + "/out2"));
+  r = isolink::testing::run_isolink(
+      kBinary, "stress " + kExamples + "/cap_2m.yaml --direction sideways -o " + dir + "/out3",
+      "direction");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--direction = 'sideways': must be down, up or both"), std::string::npos)
+      << r.err;
+  r = isolink::testing::run_isolink(
+      kBinary, "stress " + kExamples + "/cap_2m.yaml -j -1 -o " + dir + "/out4", "jobs");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("-j = -1: must be >= 0"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/out3"));
+  EXPECT_FALSE(fs::exists(dir + "/out4"));
 }
 
 }  // namespace
