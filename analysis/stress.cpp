@@ -1,11 +1,16 @@
 #include "analysis/stress.h"
 
 #include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <utility>
 
 #include "netlists/link/cards.h"
@@ -27,9 +32,11 @@ double heidler(double t, double i, double t_rise, double t_fall) {
 }
 
 // Where the disturbed scenarios start: the cm_step inside the first data frame, the ESD here.
-constexpr double kEsdStart = 20e-9;    // s, idle before the discharge
-constexpr double kEsdSpan = 280e-9;    // s, after it (the tail is 0.5 % of the peak at 200 ns)
-constexpr double kDuringLead = 10e-6;  // s, bytes starting this much before the step count
+constexpr double kEsdStart = 20e-9;       // s, idle before the discharge
+constexpr double kEsdSpan = 280e-9;       // s, after it (the tail is 0.5 % of the peak at 200 ns)
+constexpr double kDuringLead = 10e-6;     // s, bytes starting this much before the step count
+constexpr double kHotPlugStart = 1e-6;    // s, idle before the first contact
+constexpr double kHotPlugSettle = 20e-6;  // s, simulated after the second
 
 CardArg pwl_arg(std::vector<double> points) {
   CardArg a;
@@ -150,6 +157,58 @@ std::string level_text(double v) {
   return link::format_si(v, "V");
 }
 
+// The spec's traffic sent `copies` times at least, and again until the record runs past
+// `until(first data frame)`; the first data frame (an error without one, naming `kind`).
+StatusOr<traffic::Drive> repeated_traffic(const link::LinkSpec& spec,
+                                          const traffic::StimulusOptions& so,
+                                          const std::string& kind, int copies,
+                                          const std::function<double(double)>& until,
+                                          traffic::DriveFrame* first_data) {
+  const std::string once = spec.stimulus.to_script();
+  StatusOr<traffic::Drive> drive = traffic::build_drive(once, so);
+  if (!drive) return at(spec.stimulus.loc, "stimulus: " + drive.status().message());
+  const traffic::DriveFrame* first = nullptr;
+  for (const traffic::DriveFrame& f : drive->frames)
+    if (f.kind == traffic::FrameKind::kData && first == nullptr) first = &f;
+  if (first == nullptr)
+    return at(spec.stimulus.loc,
+              fmt::format("stress: the {} scenario needs data frames in the stimulus (it scores "
+                          "the traffic through the disturbance); give stimulus.frames or "
+                          "patterns, or narrow with --only",
+                          kind));
+  *first_data = *first;
+  const double need = until(first->start + (first->end - first->start) / 3);
+  for (int k = 2; k <= 64 && (k <= copies || drive->duration() <= need); ++k) {
+    std::string script = once;
+    for (int i = 1; i < k; ++i) script += "; " + once;
+    drive = traffic::build_drive(script, so);
+    if (!drive) return at(spec.stimulus.loc, "stimulus: " + drive.status().message());
+  }
+  return drive;
+}
+
+// The link transmitting from `end` (tx: down, rx: up) with its board ground `tx_ground` (the
+// receiving board on `rx_ground`), the clamps on, driven by `drive`; fills the scenario's link,
+// receiver, pin grounds and ammeters.
+Status expand_traffic(StressScenario& s, const link::LinkSpec& spec, const link::PartLibrary& parts,
+                      link::Direction d, traffic::Drive drive, const std::string& tx_ground,
+                      const std::string& rx_ground) {
+  link::ExpandOptions eo = stress_expand_options();
+  eo.tx_ground = tx_ground;
+  eo.rx_ground = rx_ground;
+  eo.drive = std::move(drive);
+  StatusOr<link::ExpandedLink> x = link::expand_link(spec, parts, d, eo);
+  if (!x) return x.status();
+  s.link = std::move(*x);
+  s.direction = link::direction_name(d);
+  s.tx_end = d == link::Direction::kDown ? "tx" : "rx";
+  s.pin_ground = {{"txp", tx_ground}, {"txn", tx_ground}, {"rxp", rx_ground}, {"rxn", rx_ground}};
+  s.receiver_p = "rxp", s.receiver_n = "rxn", s.rules = s.link.rules;
+  const std::string other = s.tx_end == "tx" ? "rx" : "tx";
+  add_ammeters(s, {{"tx", s.tx_end}, {"rx", other}}, tvs_parts(spec, parts, d));
+  return Status::Ok();
+}
+
 StatusOr<StressScenario> build_cm_step(const link::LinkSpec& spec, const link::PartLibrary& parts,
                                        const std::string& end) {
   StressScenario s;
@@ -158,35 +217,15 @@ StatusOr<StressScenario> build_cm_step(const link::LinkSpec& spec, const link::P
   s.id = "cm_step_" + end;
   const link::Direction d = end == "tx" ? link::Direction::kDown : link::Direction::kUp;
   const link::StressSpec& st = spec.stress;
-  link::ExpandOptions eo = stress_expand_options();
-  eo.tx_ground = "gtx";
-  eo.rx_ground = "0";
   // The spec's traffic, sent again until the record runs 30 us past the step (at least twice).
-  const std::string once = spec.stimulus.to_script();
-  std::string script = once;
-  StatusOr<traffic::Drive> drive = traffic::build_drive(script, eo.stimulus);
-  if (!drive) return at(spec.stimulus.loc, "stimulus: " + drive.status().message());
-  const traffic::DriveFrame* first = nullptr;
-  for (const traffic::DriveFrame& f : drive->frames)
-    if (f.kind == traffic::FrameKind::kData && first == nullptr) first = &f;
-  if (first == nullptr)
-    return at(spec.stimulus.loc,
-              "stress: the cm_step scenario needs data frames in the stimulus (it scores "
-              "the traffic through the step); give stimulus.frames or patterns, or narrow "
-              "with --only esd");
-  s.t_start = first->start + (first->end - first->start) / 3;
+  traffic::DriveFrame first;
+  StatusOr<traffic::Drive> drive = repeated_traffic(
+      spec, {}, "cm_step", 2, [&](double t0) { return t0 + st.step_rise + 30e-6; }, &first);
+  if (!drive) return drive.status();
+  s.t_start = first.start + (first.end - first.start) / 3;
   s.t_end = s.t_start + st.step_rise;
-  for (int k = 2; k <= 64; ++k) {
-    script = once;
-    for (int i = 1; i < k; ++i) script += "; " + once;
-    drive = traffic::build_drive(script, eo.stimulus);
-    if (!drive) return at(spec.stimulus.loc, "stimulus: " + drive.status().message());
-    if (drive->duration() > s.t_end + 30e-6) break;
-  }
-  eo.drive = *drive;
-  StatusOr<link::ExpandedLink> x = link::expand_link(spec, parts, d, eo);
-  if (!x) return x.status();
-  s.link = std::move(*x);
+  if (Status e = expand_traffic(s, spec, parts, d, std::move(*drive), "gtx", "0"); !e.ok())
+    return e;
   s.link.netlist.cards.push_back(link::make_card(
       'v', "vstep", {"gtx", "0"}, {pwl_arg({0, 0, s.t_start, 0, s.t_end, st.step_v})}));
   s.link.netlist.title =
@@ -196,10 +235,205 @@ StatusOr<StressScenario> build_cm_step(const link::LinkSpec& spec, const link::P
   s.description =
       fmt::format("the {} module's ground steps {} in {} while it transmits ({})", end,
                   level_text(st.step_v), link::format_si(st.step_rise, "s"), s.link.description);
-  s.pin_ground = {{"txp", "gtx"}, {"txn", "gtx"}, {"rxp", "0"}, {"rxn", "0"}};
-  s.receiver_p = "rxp", s.receiver_n = "rxn", s.rules = s.link.rules;
-  const std::string other = end == "tx" ? "rx" : "tx";
-  add_ammeters(s, {{"tx", end}, {"rx", other}}, tvs_parts(spec, parts, d));
+  return s;
+}
+
+CardArg call_arg(const char* name, std::vector<double> values) {
+  CardArg a = pwl_arg(std::move(values));
+  a.word = name;
+  return a;
+}
+
+// The inverter's disturbance on the transmitting module's ground during traffic: a square
+// (PULSE, edges wave_v / wave_dvdt) or a sine (SIN from 0 to wave_v), two periods at least.
+StatusOr<StressScenario> build_cm_wave(const link::LinkSpec& spec, const link::PartLibrary& parts,
+                                       const std::string& end) {
+  StressScenario s;
+  s.kind = "cm_wave";
+  s.end = end;
+  s.id = "cm_wave_" + end;
+  const link::Direction d = end == "tx" ? link::Direction::kDown : link::Direction::kUp;
+  const link::StressSpec& st = spec.stress;
+  const double period = 1 / st.wave_f;
+  traffic::DriveFrame first;
+  StatusOr<traffic::Drive> drive = repeated_traffic(
+      spec, {}, "cm_wave", 1, [&](double t0) { return t0 + 2 * period + 5e-6; }, &first);
+  if (!drive) return drive.status();
+  s.t_start = first.start + (first.end - first.start) / 3;
+  s.t_end = drive->duration();
+  if (Status e = expand_traffic(s, spec, parts, d, std::move(*drive), "gtx", "0"); !e.ok())
+    return e;
+  const bool square = st.wave_shape == "square";
+  const double edge = st.wave_v / (st.wave_dvdt * 1e9);
+  CardArg wave =
+      square ? call_arg("pulse", {0, st.wave_v, s.t_start, edge, edge, period / 2 - edge, period})
+             : call_arg("sin", {st.wave_v / 2, st.wave_v / 2, st.wave_f, s.t_start, 0, -90});
+  s.link.netlist.cards.push_back(link::make_card('v', "vwave", {"gtx", "0"}, {wave}));
+  const std::string what =
+      square ? fmt::format("a {} square of {} ({:g} V/ns edges)", link::format_si(st.wave_f, "Hz"),
+                           level_text(st.wave_v), st.wave_dvdt)
+             : fmt::format("a {} sine of {} peak to peak", link::format_si(st.wave_f, "Hz"),
+                           level_text(st.wave_v));
+  s.link.netlist.title = fmt::format("isolink stress '{}', {}: {} on the {} module's ground",
+                                     spec.name, s.id, what, end);
+  s.level = {{"wave_V", st.wave_v}, {"frequency_Hz", st.wave_f}};
+  if (square) s.level.push_back({"dvdt_V_per_ns", st.wave_dvdt});
+  s.description = fmt::format("{} on the {} module's ground while it transmits ({})", what, end,
+                              s.link.description);
+  return s;
+}
+
+// Moves the cable's end at netlist side `side` off its connector nodes onto (p, n): the cable's
+// cards are named "<letter>cab...".
+void detach_cable(StressScenario& s, const std::string& side, const std::string& p,
+                  const std::string& n, bool move_p = true, bool move_n = true) {
+  auto [cp, cn] = connector(s.link, side);
+  for (Card& c : s.link.netlist.cards) {
+    if (c.name.rfind("cab", 1) != 1) continue;
+    for (std::string& node : c.nodes) {
+      if (move_p && node == cp) node = p;
+      if (move_n && node == cn) node = n;
+    }
+  }
+}
+
+// A connector contact: ron 20 mohm (assumed: a crimped automotive contact, 5-20 mohm), closing
+// when its control source crosses 0.5 V on its 1 ns ramp from t_close, with an ammeter
+// ("vcontact<tag>am", positive from the cable into the module) in series.
+void add_contact(std::vector<Card>& cards, const std::string& tag, const std::string& cable,
+                 const std::string& module, double t_close, double t_stop) {
+  static const std::shared_ptr<CardModel> model = [] {
+    auto m = std::make_shared<CardModel>();
+    m->name = "contact";
+    m->type = "sw";
+    m->params = {{"vt", link::number_arg(0.5)},
+                 {"ron", link::number_arg(20e-3)},
+                 {"roff", link::number_arg(1e12)}};
+    return m;
+  }();
+  const std::string ctl = "ctl_" + tag, mid = "contact_" + tag;
+  Card sw = link::make_card('s', "scontact" + tag, {cable, mid, ctl, "0"}, {});
+  sw.model = model;
+  cards.push_back(std::move(sw));
+  cards.push_back(
+      link::make_card('v', "vcontact" + tag + "am", {mid, module}, {link::number_arg(0)}));
+  cards.push_back(link::make_card('v', "vcontact" + tag, {ctl, "0"},
+                                  {pwl_arg({0, 0, t_close, 0, t_close + 1e-9, 1, t_stop, 1})}));
+}
+
+StatusOr<StressScenario> build_hot_plug(const link::LinkSpec& spec, const link::PartLibrary& parts,
+                                        const std::string& end, const std::string& first) {
+  StressScenario s;
+  s.kind = "hot_plug";
+  s.end = end;
+  s.line = first;
+  s.id = fmt::format("hot_plug_{}_{}_first", end, first);
+  const link::StressSpec& st = spec.stress;
+  const double t1 = kHotPlugStart, t2 = t1 + st.hot_plug_gap, stop = t2 + kHotPlugSettle;
+  link::ExpandOptions eo = stress_expand_options();
+  traffic::Drive idle;
+  idle.segments.push_back({0, stop, 0});
+  eo.drive = idle;
+  // The plugged module on its own ground, hot_plug_v above the chassis; the other on it.
+  const std::string plug = "gplug";
+  (end == "tx" ? eo.tx_ground : eo.rx_ground) = plug;
+  StatusOr<link::ExpandedLink> x = link::expand_link(spec, parts, link::Direction::kDown, eo);
+  if (!x) return x.status();
+  s.link = std::move(*x);
+  std::vector<Card>& cards = s.link.netlist.cards;
+  cards.push_back(link::make_card('v', "vplug", {plug, "0"}, {link::number_arg(st.hot_plug_v)}));
+  auto [cp, cn] = connector(s.link, end);
+  detach_cable(s, end, "plug_p", "plug_n");
+  const std::string second = first == "p" ? "n" : "p";
+  add_contact(cards, first, "plug_" + first, first == "p" ? cp : cn, t1, stop);
+  add_contact(cards, second, "plug_" + second, second == "p" ? cp : cn, t2, stop);
+  s.t_start = t1;
+  s.t_end = stop;
+  if (s.link.netlist.tran) {
+    s.link.netlist.tran->tstep = 1e-9;
+    s.link.netlist.tran->tmax = 50e-9;
+  }
+  const std::string order = first == "p" ? "P, then N" : "N, then P";
+  s.link.netlist.title = fmt::format(
+      "isolink stress '{}', {}: the {} module, {} above the chassis, plugged onto the "
+      "cable: {} {} later",
+      spec.name, s.id, end, level_text(st.hot_plug_v), order,
+      link::format_si(st.hot_plug_gap, "s"));
+  s.level = {{"module_V", st.hot_plug_v}, {"gap_s", st.hot_plug_gap}};
+  s.description = fmt::format(
+      "the {} module, {} above the chassis with its lines floating, plugged onto the cable: "
+      "line {} contacts first, the other {} later",
+      end, level_text(st.hot_plug_v), first == "p" ? "P" : "N",
+      link::format_si(st.hot_plug_gap, "s"));
+  const std::string tg = end == "tx" ? plug : "0", rg = end == "rx" ? plug : "0";
+  s.pin_ground = {{"txp", tg}, {"txn", tg}, {"rxp", rg}, {"rxn", rg}};
+  add_ammeters(s, {{"tx", "tx"}, {"rx", "rx"}}, tvs_parts(spec, parts, link::Direction::kDown));
+  return s;
+}
+
+// The wire faults, in their ids' words.
+struct WireFault {
+  const char* id;
+  const char* line;  // "p", "n" or ""
+  const char* what;
+};
+constexpr WireFault kWireFaults[] = {
+    {"open_p", "p", "line P open at the rx end's connector"},
+    {"open_n", "n", "line N open at the rx end's connector"},
+    {"short_pn", "", "lines P and N shorted at the rx end's connector"},
+    {"p_to_ground", "p", "line P shorted to the rx module's ground at its connector"},
+    {"n_to_ground", "n", "line N shorted to the rx module's ground at its connector"},
+    {"p_to_chassis", "p", "line P shorted to the chassis at the rx end's connector"},
+    {"n_to_chassis", "n", "line N shorted to the chassis at the rx end's connector"},
+    {"leak_p", "p", "the rx device's pin P leaking to its ground"},
+    {"leak_n", "n", "the rx device's pin N leaking to its ground"},
+};
+
+// Resistance of a short (a wire or a crushed cable's contact).
+constexpr double kShortOhms = 10e-3;
+
+StatusOr<StressScenario> build_wire(const link::LinkSpec& spec, const link::PartLibrary& parts,
+                                    const WireFault& f, link::Direction d) {
+  StressScenario s;
+  s.kind = "wire";
+  s.end = "rx";
+  s.line = f.line;
+  s.id = fmt::format("wire_{}_{}", f.id, link::direction_name(d));
+  const link::StressSpec& st = spec.stress;
+  traffic::DriveFrame first;
+  StatusOr<traffic::Drive> drive = repeated_traffic(
+      spec, {}, "wire", 1, [](double) { return 0.0; }, &first);
+  if (!drive) return drive.status();
+  s.t_start = 0;
+  s.t_end = drive->duration();
+  // The spec's rx end is the netlist's rx side going down, its tx side going up.
+  const std::string side = d == link::Direction::kDown ? "rx" : "tx";
+  const std::string gfault = "gfault";
+  if (Status e = expand_traffic(s, spec, parts, d, std::move(*drive), side == "tx" ? gfault : "0",
+                                side == "rx" ? gfault : "0");
+      !e.ok())
+    return e;
+  std::vector<Card>& cards = s.link.netlist.cards;
+  cards.push_back(link::make_card('v', "vfault", {gfault, "0"}, {link::number_arg(st.hot_plug_v)}));
+  auto [cp, cn] = connector(s.link, side);
+  const std::string id = f.id, line = f.line == std::string("p") ? cp : cn;
+  if (id == "open_p" || id == "open_n")
+    detach_cable(s, side, "open_p", "open_n", id == "open_p", id == "open_n");
+  if (id == "short_pn")
+    cards.push_back(link::make_card('r', "rfault", {cp, cn}, {link::number_arg(kShortOhms)}));
+  if (id == "p_to_ground" || id == "n_to_ground")
+    cards.push_back(link::make_card('r', "rfault", {line, gfault}, {link::number_arg(kShortOhms)}));
+  if (id == "p_to_chassis" || id == "n_to_chassis")
+    cards.push_back(link::make_card('r', "rfault", {line, "0"}, {link::number_arg(kShortOhms)}));
+  if (id == "leak_p" || id == "leak_n")
+    cards.push_back(
+        link::make_card('r', "rfault", {side + f.line, gfault}, {link::number_arg(st.leak_ohms)}));
+  s.link.netlist.title = fmt::format("isolink stress '{}', {}: {} for the whole record ({})",
+                                     spec.name, s.id, f.what, s.link.description);
+  s.level = {{"module_V", st.hot_plug_v}};
+  if (id.starts_with("leak")) s.level.push_back({"leak_ohm", st.leak_ohms});
+  s.description = fmt::format("{} for the whole record, the rx module {} above the chassis ({})",
+                              f.what, level_text(st.hot_plug_v), s.link.description);
   return s;
 }
 
@@ -244,8 +478,7 @@ StatusOr<StressScenario> build_esd(const link::LinkSpec& spec, const link::PartL
 // Which spec end a pin node ("txp") of a scenario's netlist belongs to.
 std::string end_of_pin(const StressScenario& s, const std::string& node) {
   const bool tx_node = starts_with(node, "tx");
-  if (s.kind == "cm_step") return tx_node ? s.end : (s.end == "tx" ? "rx" : "tx");
-  return tx_node ? "tx" : "rx";
+  return tx_node ? s.tx_end : (s.tx_end == "tx" ? "rx" : "tx");
 }
 
 double column_max_abs(const Waveform& w, size_t k) {
@@ -354,26 +587,43 @@ StatusOr<std::vector<StressScenario>> build_stress_scenarios(const link::LinkSpe
   const std::vector<std::string>& kinds = link::stress_kinds();
   for (const std::string& k : only)
     if (std::find(kinds.begin(), kinds.end(), k) == kinds.end())
-      return Status::Error(
-          fmt::format("--only: '{}' is not a stress scenario (one of cm_step, esd)", k));
+      return Status::Error(fmt::format(
+          "--only: '{}' is not a stress scenario (one of cm_step, cm_wave, esd, hot_plug, wire)",
+          k));
   auto wanted = [&](const std::string& k) {
     return only.empty() || std::find(only.begin(), only.end(), k) != only.end();
   };
+  std::vector<link::Direction> dirs = opt.directions;
+  if (dirs.empty()) dirs = {link::Direction::kDown, link::Direction::kUp};
   std::vector<StressScenario> out;
-  if (wanted("cm_step"))
-    for (const std::string end : {"tx", "rx"}) {
-      StatusOr<StressScenario> s = build_cm_step(spec, parts, end);
-      if (!s) return s.status();
-      out.push_back(std::move(*s));
-    }
+  auto add = [&](StatusOr<StressScenario> sc) -> Status {
+    if (!sc) return sc.status();
+    out.push_back(std::move(*sc));
+    return Status::Ok();
+  };
+  for (link::Direction d : dirs) {
+    const std::string end = d == link::Direction::kDown ? "tx" : "rx";
+    if (wanted("cm_step"))
+      if (Status e = add(build_cm_step(spec, parts, end)); !e.ok()) return e;
+  }
+  for (link::Direction d : dirs) {
+    const std::string end = d == link::Direction::kDown ? "tx" : "rx";
+    if (wanted("cm_wave"))
+      if (Status e = add(build_cm_wave(spec, parts, end)); !e.ok()) return e;
+  }
   if (wanted("esd"))
     for (const std::string end : {"tx", "rx"})
       for (const std::string line : {"p", "n"})
-        for (int sign : {+1, -1}) {
-          StatusOr<StressScenario> s = build_esd(spec, parts, end, line, sign);
-          if (!s) return s.status();
-          out.push_back(std::move(*s));
-        }
+        for (int sign : {+1, -1})
+          if (Status e = add(build_esd(spec, parts, end, line, sign)); !e.ok()) return e;
+  if (wanted("hot_plug"))
+    for (const std::string end : {"tx", "rx"})
+      for (const std::string first : {"p", "n"})
+        if (Status e = add(build_hot_plug(spec, parts, end, first)); !e.ok()) return e;
+  if (wanted("wire"))
+    for (const WireFault& f : kWireFaults)
+      for (link::Direction d : dirs)
+        if (Status e = add(build_wire(spec, parts, f, d)); !e.ok()) return e;
   return out;
 }
 
@@ -486,7 +736,7 @@ Status run_stress_scenario(StressScenario& s, const link::LinkSpec& spec,
           part->figure("rating.esd") ? part->figure("rating.esd")->source : "its data sheet"));
   }
   s.survives = s.broken.empty();
-  if (s.kind == "cm_step") {
+  if (!s.receiver_p.empty()) {
     score_traffic(s, w);
     s.communicates = s.traffic->pass;
     if (!s.traffic->pass)
@@ -507,10 +757,32 @@ StatusOr<StressResult> run_stress(const link::LinkSpec& spec, const link::PartLi
   StatusOr<std::vector<StressScenario>> built = build_stress_scenarios(spec, parts, opt);
   if (!built) return built.status();
   out.scenarios = std::move(*built);
-  for (size_t i = 0; i < out.scenarios.size(); ++i) {
-    StressScenario& s = out.scenarios[i];
-    if (opt.progress) opt.progress(s.id, static_cast<double>(i) / out.scenarios.size());
-    if (Status st = run_stress_scenario(s, spec, parts); !st.ok()) return st;
+  // Each scenario is its own circuit and run: oneTBB runs them side by side, each writing only
+  // its own scenario and status; the first failure in scenario order is the error.
+  std::vector<Status> status(out.scenarios.size());
+  std::mutex progress_mu;
+  size_t done = 0;
+  tbb::task_arena arena(opt.jobs > 0 ? opt.jobs : tbb::task_arena::automatic);
+  arena.execute([&] {
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, out.scenarios.size(), 1),
+        [&](const tbb::blocked_range<size_t>& range) {
+          for (size_t i = range.begin(); i != range.end(); ++i) {
+            StressScenario& s = out.scenarios[i];
+            if (opt.progress) {
+              std::lock_guard<std::mutex> lock(progress_mu);
+              opt.progress(s.id, static_cast<double>(done) / out.scenarios.size());
+            }
+            status[i] = run_stress_scenario(s, spec, parts);
+            std::lock_guard<std::mutex> lock(progress_mu);
+            ++done;
+          }
+        },
+        tbb::simple_partitioner());
+  });
+  for (const Status& st : status)
+    if (!st.ok()) return st;
+  for (const StressScenario& s : out.scenarios) {
     out.survives = out.survives && s.survives;
     if (s.communicates) out.communicates = out.communicates && *s.communicates;
   }

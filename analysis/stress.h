@@ -17,8 +17,22 @@
 //   esd      IEC 61000-4-2 contact discharge (esd_current, scaled by stress.esd kV) as a PWL
 //            current source from the chassis into one connector line of one end, both boards on
 //            the chassis, the link idle: per end, line and polarity (8 scenarios).
+//   cm_wave  the inverter's square (edges at stress.wave_dvdt) or sine, 0 to stress.wave_v at
+//            stress.wave_f, on the transmitting module's ground during traffic (a PULSE / SIN
+//            source where cm_step has its PWL): one per direction.
+//   hot_plug the module at one end, stress.hot_plug_v above the chassis, plugged onto the cable
+//            (whose other end is on its module, on the chassis): its connector's two contacts
+//            are switches (S, solver/elements/switch.cpp) closing stress.hot_plug_gap apart,
+//            P first or N first; the link idle. Per end and order (4 scenarios).
+//   wire     a fault at the spec's rx end's connector for the whole record (in the DC point
+//            too), its module stress.hot_plug_v above the chassis, during the spec's traffic
+//            sent once: open P / N, P-N short, P / N to the module's ground, P / N to the
+//            chassis, the rx device's pin P / N leaking to its ground through stress.leak_ohms.
+//            Per fault and direction (18 scenarios).
 // Pins are measured against their own device's ground (the node the end's board is on), named
 // as in the scenario's netlist: txp, txn (the transmitting device of that netlist), rxp, rxn.
+// Scenarios with traffic (cm_step, cm_wave, wire) score the receiver's v(rxp, rxn) with the
+// checker.
 //
 // Contract:
 // - Units: SI (V, A, s, J); ESD levels in V (8e3 = 8 kV).
@@ -98,10 +112,12 @@ struct StressTraffic {
 };
 
 struct StressScenario {
-  std::string id;                                     // "cm_step_tx", "esd_rx_n_neg"
-  std::string kind;                                   // "cm_step" | "esd"
-  std::string end;                                    // the spec end disturbed: "tx" | "rx"
-  std::string line;                                   // "p" | "n" (esd), "" (cm_step)
+  std::string id;    // "cm_step_tx", "esd_rx_n_neg", "hot_plug_rx_p_first", "wire_open_p_down"
+  std::string kind;  // "cm_step" | "cm_wave" | "esd" | "hot_plug" | "wire"
+  std::string end;   // the spec end disturbed (plugged, faulted): "tx" | "rx"
+  std::string line;  // "p" | "n" (esd; hot_plug: the first contact; wire: the line faulted), ""
+  std::string direction;      // traffic scenarios: "down" | "up" (which end transmits), else ""
+  std::string tx_end = "tx";  // the spec end the netlist's tx side is
   std::vector<std::pair<std::string, double>> level;  // {"step_V", 60}, {"rise_s", 1e-6}
   std::string description;                            // in words
   link::ExpandedLink link;        // its circuit (netlist with the disturbance and the ammeters)
@@ -112,8 +128,8 @@ struct StressScenario {
   std::string peak_cm_device;                     // "rx" / "tx" (nodes' prefix)
   std::vector<DiodePeak> diodes;
   std::vector<CapPeak> caps;
-  std::optional<StressTraffic> traffic;       // cm_step
-  std::string receiver_p, receiver_n, rules;  // cm_step: the receiving pins and rule set
+  std::optional<StressTraffic> traffic;       // scenarios with traffic
+  std::string receiver_p, receiver_n, rules;  // with traffic: the receiving pins and rule set
   bool survives = true;
   std::optional<bool> communicates;
   std::string first_broken;         // "" when nothing broke
@@ -134,6 +150,10 @@ struct StressResult {
 struct StressOptions {
   // Scenario kinds to run (empty: the spec's stress.only, else all).
   std::vector<std::string> only;
+  // Which end transmits in the traffic scenarios (cm_step, cm_wave, wire): empty: both.
+  std::vector<link::Direction> directions;
+  // Scenarios run at once (oneTBB; 0: all cores).
+  int jobs = 1;
   // Progress for a display: the scenario's id and the fraction done (0-1).
   std::function<void(const std::string& what, double fraction)> progress;
 };

@@ -1,7 +1,8 @@
 // isolink stress: what breaks a daisy chain in the field (analysis/stress.h): module-ground
-// steps during traffic and IEC 61000-4-2 contact discharges, simulated with the pins' clamps and
-// the spec's TVS parts; report.md, report.json, report.html and stress.png, --export-spice each
-// scenario's netlist.
+// steps and an inverter's wave during traffic, IEC 61000-4-2 contact discharges, hot-plugging a
+// module and wire faults, simulated with the pins' clamps and the spec's TVS parts; report.md,
+// report.json, report.html and stress.png, --export-spice each scenario's netlist. A pack file:
+// each hop's wire faults and what the ring still reaches (analysis/pack_stress.h).
 #include <fmt/format.h>
 
 #include <cstdio>
@@ -37,6 +38,8 @@ struct StressArgs {
   bool quiet = false;
   std::string only;  // comma-separated kinds
   std::string spice_dir;
+  std::string direction = "both";
+  int jobs = 1;
 };
 
 int fail(const Status& s) {
@@ -55,7 +58,7 @@ StatusOr<std::vector<std::string>> parse_only(const std::string& text) {
     if (std::find(kinds.begin(), kinds.end(), item) == kinds.end())
       return Status::Error(fmt::format(
           "isolink stress: error: --only = '{}': '{}' is not a scenario kind (one of cm_step, "
-          "esd, comma-separated)",
+          "cm_wave, esd, hot_plug, wire, comma-separated)",
           text, item));
     out.push_back(item);
   }
@@ -108,6 +111,12 @@ int run_pack_stress(const StressArgs& a, const std::vector<std::string>& only) {
 int run_stress(const StressArgs& a) {
   StatusOr<std::vector<std::string>> only = parse_only(a.only);
   if (!only) return fail(only.status());
+  if (a.direction != "down" && a.direction != "up" && a.direction != "both")
+    return fail(Status::Error(fmt::format(
+        "isolink stress: error: --direction = '{}': must be down, up or both", a.direction)));
+  if (a.jobs < 0)
+    return fail(Status::Error(
+        fmt::format("isolink stress: error: -j = {}: must be >= 0 (0: all cores)", a.jobs)));
   if (StatusOr<config::YamlDoc> doc = config::YamlDoc::load_file(a.spec);
       doc && analysis::is_pack_spec(*doc))
     return run_pack_stress(a, *only);
@@ -124,6 +133,9 @@ int run_stress(const StressArgs& a) {
   if (!bundle) return fail(bundle.status());
   analysis::StressOptions so;
   so.only = *only;
+  so.jobs = a.jobs;
+  if (a.direction != "both")
+    so.directions = {a.direction == "down" ? link::Direction::kDown : link::Direction::kUp};
   ProgressLine line({.label = "isolink stress", .enabled = !a.quiet && !a.json});
   so.progress = [&line](const std::string& what, double f) { line.show_fraction(what, f); };
 
@@ -167,7 +179,7 @@ int run_stress(const StressArgs& a) {
     std::puts(j.dump(2).c_str());
   } else {
     for (const analysis::StressScenario& s : r->scenarios)
-      std::printf("%-4s %-16s %s\n", s.first_broken.empty() ? "ok" : "FAIL", s.id.c_str(),
+      std::printf("%-4s %-22s %s\n", s.first_broken.empty() ? "ok" : "FAIL", s.id.c_str(),
                   s.first_broken.empty() ? s.description.c_str() : s.first_broken.c_str());
     std::printf("%s\nreport: %s/report.md\n", r->verdict.c_str(), dir.c_str());
   }
@@ -180,9 +192,12 @@ void add_stress_command(CLI::App& app, int* exit_code) {
   auto args = std::make_shared<StressArgs>();
   CLI::App* cmd = app.add_subcommand(
       "stress",
-      "What breaks a link in the field: module-ground steps during traffic and IEC 61000-4-2 ESD, "
-      "with the pins' clamps and the TVS parts; report.md, report.json, report.html, stress.png; "
-      "exit 1 when a limit or rule breaks");
+      "What breaks a link in the field: module-ground steps and an inverter's square or sine "
+      "during traffic, IEC 61000-4-2 ESD, hot-plugging a module (its contacts as switches, P or "
+      "N first) and wire faults (open, short, to ground or chassis, a leaking pin) during "
+      "traffic, with the pins' clamps and the TVS parts; report.md, report.json, report.html, "
+      "stress.png; a pack spec: each hop's wire faults and what the ring still reaches; exit 1 "
+      "when a limit or rule breaks");
   cmd->add_option("spec", args->spec,
                   "Link spec (YAML) with an optional stress: block, or a pack spec (each hop's "
                   "wire faults and what the ring still reaches)")
@@ -192,7 +207,12 @@ void add_stress_command(CLI::App& app, int* exit_code) {
   add_parts_option(*cmd, &args->part_dirs);
   cmd->add_flag("--json", args->json, "Print the stress result as JSON on stdout");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress line");
-  cmd->add_option("--only", args->only, "Scenario kinds to run, comma-separated: cm_step, esd");
+  cmd->add_option("--only", args->only,
+                  "Scenario kinds to run, comma-separated: cm_step, cm_wave, esd, hot_plug, wire");
+  cmd->add_option("--direction", args->direction,
+                  "Which end transmits in the traffic scenarios (cm_step, cm_wave, wire): down "
+                  "(the tx end), up (the rx end) or both (default)");
+  cmd->add_option("-j,--jobs", args->jobs, "Scenarios run at once (default 1; 0: all cores)");
   cmd->add_option("--export-spice", args->spice_dir,
                   "Write each scenario's netlist (ngspice dialect) into this folder");
   cmd->callback([args, exit_code] { *exit_code = run_stress(*args); });

@@ -149,10 +149,9 @@ constexpr RefusedLetter kRefusedLetters[] = {
     {'o', "lossy transmission line (O)", kLine},
     {'p', "coupled multiconductor line (P)", kLine},
     {'q', "bipolar transistor (Q)", kSemiconductor},
-    {'s', "voltage-controlled switch (S)", "switches are out of scope"},
     {'t', "transmission line (T)", kLine},
     {'u', "uniform RC line (U)", kLine},
-    {'w', "current-controlled switch (W)", "switches are out of scope"},
+    {'w', "current-controlled switch (W)", "use a voltage-controlled switch (S)"},
     {'y', "transmission line (Y, TXL)", kLine},
     {'z', "MESFET (Z)", kSemiconductor},
 };

@@ -19,6 +19,7 @@ void NewtonSolver::bind(const Circuit& circuit, const MnaPattern& pattern) {
       port.element = e.get();
       port.index = k;
       port.p = np.p, port.n = np.n;
+      port.controlled = np.controlled, port.cp = np.cp, port.cn = np.cn;
       port.pp = pattern.slot(np.p, np.p), port.nn = pattern.slot(np.n, np.n);
       port.pn = pattern.slot(np.p, np.n), port.np = pattern.slot(np.n, np.p);
       ports_.push_back(port);
@@ -51,7 +52,9 @@ bool NewtonSolver::load(const std::vector<double>& x, const NewtonInput& in) {
       v = port.element->port_start_voltage(port.index);
     else if (port.evaluated)
       v = port.element->limit_port(port.index, v_raw, port.v, &limited);
-    const PortEval e = port.element->eval_port(port.index, v);
+    const PortEval e =
+        port.controlled ? port.element->eval_controlled_port(port.index, v, x[port.cp] - x[port.cn])
+                        : port.element->eval_port(port.index, v);
     if (port.evaluated && !at_start_) {
       // The residual: the port's current at the new voltage against the linearisation's.
       const PortEval& o = port.eval;

@@ -79,6 +79,8 @@ class NewtonSolver {
     const Element* element = nullptr;
     int index = 0;  // the element's port number
     int p = 0, n = 0;
+    bool controlled = false;
+    int cp = 0, cn = 0;  // a controlled port's control nodes
     Slot pp = 0, nn = 0, pn = 0, np = 0;
     double v = 0;   // the voltage of the last evaluation (limited)
     PortEval eval;  // at v

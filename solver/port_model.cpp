@@ -81,6 +81,13 @@ StatusOr<PortModel> build_port_model(const std::vector<Card>& cards, const Circu
   const auto started = std::chrono::steady_clock::now();
   const std::vector<PortRef> ports = collect_ports(circuit);
   if (ports.empty()) return Status::Error("the circuit has no nonlinear element: no ports");
+  for (const auto& e : circuit.elements())
+    for (int k = 0; k < e->nonlinear_port_count(); ++k)
+      if (e->nonlinear_port(k).controlled)
+        return Status::Error(fmt::format(
+            "{} is a voltage-controlled switch: its port depends on a control voltage, which "
+            "the port model's network does not carry (the full transient runs it)",
+            e->name()));
   if (!circuit.dc_open_branches().empty())
     return Status::Error(
         "an inductor closes a loop of voltage sources and inductors and is opened for the DC "

@@ -191,6 +191,9 @@ class TransientMarch {
         xdot_(m_ + 1, 0.0),
         hist_part_(m_ + 1, 0.0),
         xnew_(m_ + 1) {
+    for (const auto& e : circuit.elements())
+      for (int k = 0; k < e->nonlinear_port_count(); ++k)
+        has_controlled_ = has_controlled_ || e->nonlinear_port(k).controlled;
     if (ports_ > 0) {
       newton_.bind(circuit, sys.pattern);
       newton_.tolerances() = opt.newton;
@@ -217,6 +220,8 @@ class TransientMarch {
   // Truncation error / tolerance of the step (0 until there are four points); the worst unknown
   // into worst_unknown_.
   double truncation_ratio(double step, bool gear, const History& hist);
+  // True when a controlled port (a switch) changed state between x_ and xnew_.
+  bool control_changed() const;
   // The backward-Euler first step after a breakpoint, judged one step late (see run()).
   double euler_start_ratio(double step, const History& hist);
   Status too_small(double t, double h) const;
@@ -229,6 +234,7 @@ class TransientMarch {
   }
 
   const Circuit& circuit_;
+  bool has_controlled_ = false;  // a switch: control_changed() is checked on every step
   const TransientOptions& opt_;
   const std::vector<Probe>& probes_;
   MnaSystem& sys_;
@@ -279,7 +285,9 @@ void TransientMarch::initial_charges() {
   for (const auto& e : circuit_.elements())
     for (int j = 0; j < e->nonlinear_port_count(); ++j, ++k) {
       const NonlinearPort p = e->nonlinear_port(j);
-      x_[n_ + 1 + k] = e->eval_port(j, x_[p.p] - x_[p.n]).q;
+      const double v = x_[p.p] - x_[p.n];
+      x_[n_ + 1 + k] = p.controlled ? e->eval_controlled_port(j, v, x_[p.cp] - x_[p.cn]).q
+                                    : e->eval_port(j, v).q;
     }
 }
 
@@ -421,6 +429,17 @@ Status TransientMarch::too_small(double t, double h) const {
                   t, h, circuit_.unknown_name(worst_unknown_)));
 }
 
+bool TransientMarch::control_changed() const {
+  for (const auto& e : circuit_.elements())
+    for (int k = 0; k < e->nonlinear_port_count(); ++k) {
+      const NonlinearPort p = e->nonlinear_port(k);
+      if (p.controlled && e->control_state(k, x_[p.cp] - x_[p.cn]) !=
+                              e->control_state(k, xnew_[p.cp] - xnew_[p.cn]))
+        return true;
+    }
+  return false;
+}
+
 StatusOr<Waveform> TransientMarch::run(TransientStats& stats_out) {
   const double tstop = opt_.tstop, tiny = tiny_, hmax = control_.hmax, hmin = control_.hmin;
   const std::vector<double> bps = merged_breakpoints(circuit_, tstop, tiny);
@@ -466,13 +485,17 @@ StatusOr<Waveform> TransientMarch::run(TransientStats& stats_out) {
       h = control_.ladder(h);
       continue;
     }
-    const double ratio = truncation_ratio(step, gear, hist);
+    // A switch that changed state in this step: its end is a corner of the solution, taken as a
+    // breakpoint (no error check across it, the formula restarted after it).
+    const bool event = has_controlled_ && control_changed();
+    if (event) ++stats_.breakpoints;
+    const double ratio = event ? 0.0 : truncation_ratio(step, gear, hist);
 
     // The first step after a breakpoint (backward Euler, from a history of one point) is checked
     // one step late, with the second step's point. When its error is too large both steps are
     // undone and the first one is retried smaller (the second step, at most twice the first, is
     // then accurate too: its trapezoidal error is third order).
-    if (hist.count == 2 && !watched_->unknowns.empty()) {
+    if (!event && hist.count == 2 && !watched_->unknowns.empty()) {
       const double ratio1 = euler_start_ratio(step, hist);
       if (ratio1 > 1.0) {
         stats_.rejected += 2;
@@ -520,6 +543,11 @@ StatusOr<Waveform> TransientMarch::run(TransientStats& stats_out) {
       // as at a breakpoint (x is consistent from now on).
       uic_dq_.clear();
       after_bp = true;
+      hist.reset(t_, x_);
+    }
+    if (event && !lands) {
+      after_bp = true;
+      h = control_.ladder(0.1 * std::min(last_regular_h, bp - t_));
       hist.reset(t_, x_);
     }
     if (lands) {

@@ -390,8 +390,41 @@ Status read_noise(const YamlDoc& doc, const YAML::Node& node, NoiseSpec* ns) {
 
 // Scenario kinds isolink stress runs (analysis/stress.h).
 const std::vector<std::string>& stress_kinds_list() {
-  static const std::vector<std::string> kinds{"cm_step", "esd"};
+  static const std::vector<std::string> kinds{"cm_step", "cm_wave", "esd", "hot_plug", "wire"};
   return kinds;
+}
+
+// The bounds of the hot_plug, cm_wave and wire levels, each at its value.
+Status check_stress_levels(const YamlDoc& doc, const YAML::Node& node, const StressSpec& st) {
+  struct Bound {
+    const char* key;
+    double value, lo, hi;
+    const char* rule;
+  };
+  const Bound bounds[] = {
+      {"hot_plug_v", st.hot_plug_v, 0, 2e3, "must be at most 2 kV (a module's stack voltage)"},
+      {"hot_plug_gap", st.hot_plug_gap, 1e-9, 1e-3,
+       "must be from 1 ns to 1 ms (the scenario simulates the gap and 5 us after it)"},
+      {"wave_v", st.wave_v, 0, 2e3, "must be at most 2 kV (an inverter's DC link)"},
+      {"wave_f", st.wave_f, 1e3, 1e6,
+       "must be from 1 kHz to 1 MHz (the record holds two periods of it)"},
+      {"wave_dvdt", st.wave_dvdt, 1e-3, 100,
+       "must be from 0.001 to 100 V/ns (SiC switch nodes reach 10-50 V/ns)"},
+      {"leak_ohms", st.leak_ohms, 1, 1e9, "must be from 1 ohm to 1 Gohm"},
+  };
+  for (const Bound& b : bounds)
+    if (b.value < b.lo || b.value > b.hi)
+      return doc.error(node[b.key],
+                       fmt::format("key 'stress.{}' = {:g}: {}", b.key, b.value, b.rule));
+  // The square's edges (wave_v / wave_dvdt) must fit in its half period.
+  const double edge = st.wave_v / (st.wave_dvdt * 1e9);
+  if (st.wave_shape == "square" && edge >= 0.25 / st.wave_f)
+    return doc.error(node["wave_dvdt"] ? node["wave_dvdt"] : node["wave_v"],
+                     fmt::format("key 'stress.wave_dvdt' = {:g} V/ns: the square's edge, "
+                                 "wave_v / wave_dvdt = {:g} s, must be shorter than a quarter "
+                                 "period of wave_f ({:g} s)",
+                                 st.wave_dvdt, edge, 0.25 / st.wave_f));
+  return Status::Ok();
 }
 
 Status read_stress(const YamlDoc& doc, const YAML::Node& node, StressSpec* st) {
@@ -406,6 +439,13 @@ Status read_stress(const YamlDoc& doc, const YAML::Node& node, StressSpec* st) {
           {"pin_abs_max", read_quantity(doc, Unit::kVolt, Rule::kPositive, &st->pin_abs_max)},
           {"pin_cm_limit", read_quantity(doc, Unit::kVolt, Rule::kPositive, &st->pin_cm_limit)},
           {"cap_rating", read_quantity(doc, Unit::kVolt, Rule::kPositive, &st->cap_rating)},
+          {"hot_plug_v", read_quantity(doc, Unit::kVolt, Rule::kPositive, &st->hot_plug_v)},
+          {"hot_plug_gap", read_quantity(doc, Unit::kSecond, Rule::kPositive, &st->hot_plug_gap)},
+          {"wave_v", read_quantity(doc, Unit::kVolt, Rule::kPositive, &st->wave_v)},
+          {"wave_f", read_quantity(doc, Unit::kHertz, Rule::kPositive, &st->wave_f)},
+          {"wave_shape", read_choice(doc, {"square", "sine"}, &st->wave_shape)},
+          {"wave_dvdt", read_quantity(doc, Unit::kNone, Rule::kPositive, &st->wave_dvdt)},
+          {"leak_ohms", read_quantity(doc, Unit::kOhm, Rule::kPositive, &st->leak_ohms)},
           {"only",
            [&](const YAML::Node& n, const std::string& p) -> Status {
              if (Status r = read_text_list(doc, &st->only)(n, p); !r.ok()) return r;
@@ -414,7 +454,7 @@ Status read_stress(const YamlDoc& doc, const YAML::Node& node, StressSpec* st) {
                if (std::find(kinds.begin(), kinds.end(), st->only[i]) == kinds.end())
                  return doc.error(n.IsSequence() ? n[i] : n,
                                   fmt::format("key '{}' = '{}': not a stress scenario (one of "
-                                              "cm_step, esd)",
+                                              "cm_step, cm_wave, esd, hot_plug, wire)",
                                               p, st->only[i]));
              }
              return Status::Ok();
@@ -437,7 +477,7 @@ Status read_stress(const YamlDoc& doc, const YAML::Node& node, StressSpec* st) {
                      fmt::format("key 'stress.ground_step' = {:g} V: must be at most 2 kV (a "
                                  "module's stack voltage)",
                                  st->step_v));
-  return Status::Ok();
+  return check_stress_levels(doc, node, *st);
 }
 
 }  // namespace

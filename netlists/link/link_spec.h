@@ -11,7 +11,8 @@
 //   stimulus: {frames, gaps, tones, patterns, script, direction}, sim: {tstep, tmax, method,
 //   reltol}, noise: {injection, level, position, modulation, band, points_per_decade,
 //   pin_limit, time_domain, samples, seed, verdict_on, tolerance: {...}} (isolink noise),
-//   stress: {esd, ground_step, ground_rise, pin_abs_max, pin_cm_limit, cap_rating, only}
+//   stress: {esd, ground_step, ground_rise, hot_plug_v, hot_plug_gap, wave_v, wave_f, wave_shape,
+//   wave_dvdt, leak_ohms, pin_abs_max, pin_cm_limit, cap_rating, only}
 //   (isolink stress; tx / rx
 //   also take x_cap, y_cap, chassis_c, chassis_r, chassis_l, isolation.cable_side_return,
 //   isolation.choke_loss, and cable chassis_c).
@@ -137,13 +138,26 @@ struct NoiseSpec {
 // The `stress:` block: the levels of isolink stress's scenarios and the limits it checks against
 // (analysis/stress.h; netlists/link/README.md "stress" has the table with the sources).
 struct StressSpec {
-  double esd_v = 8e3;             // V, IEC 61000-4-2 contact discharge (level 4: +-8 kV)
-  double step_v = 60;             // V, module ground step (issue 41's contactor experiment)
-  double step_rise = 1e-6;        // s, its 0-100 % rise
-  double pin_abs_max = 20;        // V, |COM pin to its device ground| (assumed: see README)
-  double pin_cm_limit = 20;       // V, |pin common mode to its device ground| (docs/physics.md 2)
-  double cap_rating = 2e3;        // V, isolation caps (1206J2K00222KXR: 2 kV)
-  std::vector<std::string> only;  // scenario kinds to run (empty: all): esd, cm_step
+  double esd_v = 8e3;        // V, IEC 61000-4-2 contact discharge (level 4: +-8 kV)
+  double step_v = 60;        // V, module ground step (issue 41's contactor experiment)
+  double step_rise = 1e-6;   // s, its 0-100 % rise
+  double pin_abs_max = 20;   // V, |COM pin to its device ground| (assumed: see README)
+  double pin_cm_limit = 20;  // V, |pin common mode to its device ground| (docs/physics.md 2)
+  double cap_rating = 2e3;   // V, isolation caps (1206J2K00222KXR: 2 kV)
+  // hot_plug: the plugged module's potential to the chassis (a link spec has no module voltage:
+  // 60 V, issue 41's module) and the time between its two lines' contacts (any gap longer than
+  // the first contact's settling gives the same peaks; real ones are 0.1-1 ms).
+  double hot_plug_v = 60;      // V
+  double hot_plug_gap = 5e-6;  // s
+  // cm_wave: the inverter's disturbance on the transmitting module's ground (assumed: see
+  // docs/stress.md): peak-to-peak V, frequency, shape, the square's edge rate.
+  double wave_v = 50;                 // V, 0 to wave_v
+  double wave_f = 20e3;               // Hz
+  std::string wave_shape = "square";  // square | sine
+  double wave_dvdt = 2;               // V/ns, the square's edges
+  // wire: a damaged port's pin leaking to its device ground (assumed: 1 kohm).
+  double leak_ohms = 1e3;
+  std::vector<std::string> only;  // scenario kinds to run (empty: all): stress_kinds()
   SourceLoc loc;
   bool given = false;  // the spec has a stress: block
 };
@@ -174,7 +188,8 @@ std::vector<std::string> nonlinear_parts(const LinkSpec& spec);
 // and the way out.
 std::string linear_only(const LinkSpec& spec, const std::string& what);
 
-// The scenario kinds of `stress.only` and `isolink stress --only`: "cm_step", "esd".
+// The scenario kinds of `stress.only` and `isolink stress --only`: "cm_step", "cm_wave", "esd",
+// "hot_plug", "wire".
 const std::vector<std::string>& stress_kinds();
 
 // Devices and their receiver rule sets: bq79600 -> bq79600 (bridge), bq7961x and bq79606a ->

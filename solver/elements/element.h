@@ -46,9 +46,13 @@ struct DcEdge {
   DcLink link;
 };
 
-// One nonlinear port: a two-terminal branch from unknown p to unknown n (0 = ground).
+// One nonlinear port: a two-terminal branch from unknown p to unknown n (0 = ground). A
+// controlled port (the switch) also depends on the control voltage x[cp] - x[cn], which draws no
+// current and enters no stamp: its current's derivative with respect to it is 0.
 struct NonlinearPort {
   int p = 0, n = 0;
+  bool controlled = false;
+  int cp = 0, cn = 0;
 };
 // A port evaluated at branch voltage v: the current from p through the element to n (A), its
 // derivative (S), the charge stored between p and n (C) and its derivative (F).
@@ -96,6 +100,14 @@ class Element {
   virtual NonlinearPort nonlinear_port(int k) const { return {}; }
   // Current and charge of port k at branch voltage v. Must be finite for any finite v.
   virtual PortEval eval_port(int k, double v) const { return {}; }
+  // A controlled port's current and charge at branch voltage v and control voltage vc.
+  virtual PortEval eval_controlled_port(int k, double v, double vc) const {
+    return eval_port(k, v);
+  }
+  // A controlled port's discrete state at control voltage vc (the switch: on). The transient
+  // takes a step where one changes as ending at a breakpoint: the change is a corner of the
+  // solution, not an error of the formula.
+  virtual bool control_state(int k, double vc) const { return false; }
   // Newton's voltage step limit (SPICE's pnjlim): the voltage to evaluate at, given the new
   // iterate v_new and the last evaluated v_old; *limited = true when it changed v_new.
   virtual double limit_port(int k, double v_new, double v_old, bool* limited) const {

@@ -13,5 +13,6 @@ const ElementKind& voltage_source_kind();
 const ElementKind& current_source_kind();
 const ElementKind& diode_kind();
 const ElementKind& vccs_kind();
+const ElementKind& switch_kind();
 
 }  // namespace isolink

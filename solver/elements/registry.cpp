@@ -10,9 +10,10 @@
 namespace isolink {
 
 std::span<const ElementKind> element_kinds() {
-  static const std::array<ElementKind, 8> kKinds = {
+  static const std::array<ElementKind, 9> kKinds = {
       capacitor_kind(),         diode_kind(),    vccs_kind(),     current_source_kind(),
-      mutual_inductance_kind(), inductor_kind(), resistor_kind(), voltage_source_kind(),
+      mutual_inductance_kind(), inductor_kind(), resistor_kind(), switch_kind(),
+      voltage_source_kind(),
   };
   return kKinds;
 }

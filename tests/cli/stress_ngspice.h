@@ -1,8 +1,9 @@
 // A stress scenario replayed in ngspice (issue 42): the scenario built from a spec, run by
 // isolink, exported, simulated by ngspice at reltol 1e-4 (its other options at their defaults:
 // tighter ones abort on clamp circuits, issue 41), and every pin's max and min and every diode's
-// peak current held to ngspice's within 5 % or 0.2 V (0.05 A). Shared by the command's tests and
-// the seeded corpus (stress_command_test.cpp, stress_corpus_test.cpp).
+// peak current held to ngspice's within 5 % or 0.2 V (0.05 A); a scenario with traffic has its
+// `communicates` held to the checker's verdict on ngspice's receiver waveform. Shared by the
+// command's tests and the seeded corpus (stress_command_test.cpp, stress_corpus_test.cpp).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "analysis/stress.h"
+#include "eye/check.h"
 #include "netlists/link/link_spec.h"
 #include "netlists/link/parts.h"
 #include "netlists/spice_writer.h"
@@ -57,6 +59,7 @@ inline StressAgreement stress_vs_ngspice(const link::LinkSpec& spec, const std::
   for (const auto& [node, ground] : s.pin_ground)
     probes.push_back(ground == "0" ? "v(" + node + ")" : "v(" + node + "," + ground + ")");
   for (const analysis::DiodePeak& d : s.diodes) probes.push_back("i(" + d.ammeter + ")");
+  if (s.traffic) probes.push_back("v(" + s.receiver_p + "," + s.receiver_n + ")");
   StatusOr<Waveform> ng = run_ngspice(path, probes, work, ".options reltol=1e-4");
   EXPECT_TRUE(ng.ok()) << ng.status().message();
   if (!ng) return out;
@@ -82,6 +85,20 @@ inline StressAgreement stress_vs_ngspice(const link::LinkSpec& spec, const std::
     out.worst_diode_a = std::max(out.worst_diode_a, std::abs(d.peak_a - mx));
     std::printf("%s %s: peak %.4g A (ngspice %.4g)\n", id.c_str(), d.diode.c_str(), d.peak_a, mx);
   }
+  if (!s.traffic) return out;
+  // The checker on ngspice's receiver waveform gives the scenario's verdict.
+  StatusOr<eye::Rules> rules = eye::load_rules(s.rules);
+  EXPECT_TRUE(rules.ok());
+  if (!rules) return out;
+  eye::CheckOptions co;
+  co.expect = s.link.expected;
+  StatusOr<eye::CheckResult> check = eye::check_samples(ng->time, ng->columns[k], *rules, co);
+  EXPECT_TRUE(check.ok()) << check.status().message();
+  EXPECT_TRUE(s.communicates.has_value());
+  if (!check || !s.communicates) return out;
+  EXPECT_EQ(check->pass, *s.communicates) << id;
+  std::printf("%s: communicates %d (the checker on ngspice's waveform: %d)\n", id.c_str(),
+              *s.communicates, check->pass);
   return out;
 }
 

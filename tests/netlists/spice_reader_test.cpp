@@ -469,7 +469,7 @@ TEST(SpiceReaderErrors, RefusedElementLetters) {
   EXPECT_EQ(d.head.substr(0, 56), "t.cir:2:1: error: transmission line (T) is not supported");
   EXPECT_NE(d.head.find("'cable:' key"), std::string::npos) << d.head;
   for (const char* card : {"B1 a 0 v=1", "E1 a 0 b 0 2", "A1 a b amp", "O1 a 0 b 0 m", "U1 a b 0 m",
-                           "P1 a b 0 c d 0 m", "M1 d g s b n", "J1 d g s j", "S1 a b c d sw"}) {
+                           "P1 a b 0 c d 0 m", "M1 d g s b n", "J1 d g s j", "W1 a b vc sw"}) {
     d = read_error(std::string("t\n") + card + "\n");
     EXPECT_NE(d.head.find("t.cir:2:1: error: "), std::string::npos) << d.head;
     EXPECT_NE(d.head.find(" is not supported ("), std::string::npos) << d.head;
