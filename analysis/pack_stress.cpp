@@ -62,25 +62,31 @@ StatusOr<PackStressResult> run_pack_stress(const PackSpec& pack, const link::Par
   so.only = {"wire"};
   StatusOr<PackTiming> timing = pack_timing(pack);
   if (!timing) return timing.status();
-  std::map<std::string, size_t> done;  // circuit -> its first run (index in runs)
-  std::vector<std::pair<int, StressScenario>> runs;
+  // Every hop's scenarios built; identical circuits (the same spec on several hops) run once.
+  std::map<std::string, size_t> first;  // circuit -> its index in `distinct`
+  std::vector<StressScenario> distinct;
+  std::vector<const link::LinkSpec*> specs;
+  std::vector<std::pair<int, size_t>> uses;  // (hop, index in distinct), in hop order
   for (const HopSpec& h : pack.hops) {
     StatusOr<std::vector<StressScenario>> built = build_stress_scenarios(h.spec, parts, so);
     if (!built) return built.status().with_context(fmt::format("hop {}", h.index));
     for (StressScenario& s : *built) {
-      const std::string key = circuit_key(s);
-      if (auto it = done.find(key); it != done.end()) {
-        StressScenario copy = runs[it->second].second;
-        runs.emplace_back(h.index, std::move(copy));
-        continue;
+      auto [it, fresh] = first.emplace(circuit_key(s), distinct.size());
+      if (fresh) {
+        s.id = fmt::format("hop{}_{}", h.index, s.id);  // the progress line says whose it is
+        distinct.push_back(std::move(s));
+        specs.push_back(&h.spec);
       }
-      if (opt.progress) opt.progress(fmt::format("hop {} {}", h.index, s.id), 0);
-      if (Status st = run_stress_scenario(s, h.spec, parts); !st.ok())
-        return st.with_context(fmt::format("hop {}", h.index));
-      ++out.simulations;
-      done[key] = runs.size();
-      runs.emplace_back(h.index, std::move(s));
+      uses.emplace_back(h.index, it->second);
     }
+  }
+  if (Status st = run_stress_scenarios(distinct, specs, parts, so); !st.ok()) return st;
+  out.simulations = static_cast<int>(distinct.size());
+  std::vector<std::pair<int, StressScenario>> runs;
+  for (auto [hop, k] : uses) {
+    StressScenario s = distinct[k];
+    s.id = s.id.substr(s.id.find('_') + 1);  // its own id, as on a link
+    runs.emplace_back(hop, std::move(s));
   }
   for (auto& [hop, s] : runs) {
     HopFault f;

@@ -749,31 +749,26 @@ Status run_stress_scenario(StressScenario& s, const link::LinkSpec& spec,
   return Status::Ok();
 }
 
-StatusOr<StressResult> run_stress(const link::LinkSpec& spec, const link::PartLibrary& parts,
-                                  const StressOptions& opt) {
-  const auto start = std::chrono::steady_clock::now();
-  StressResult out;
-  out.limits = stress_limits(spec);
-  StatusOr<std::vector<StressScenario>> built = build_stress_scenarios(spec, parts, opt);
-  if (!built) return built.status();
-  out.scenarios = std::move(*built);
+Status run_stress_scenarios(std::vector<StressScenario>& scenarios,
+                            const std::vector<const link::LinkSpec*>& specs,
+                            const link::PartLibrary& parts, const StressOptions& opt) {
   // Each scenario is its own circuit and run: oneTBB runs them side by side, each writing only
   // its own scenario and status; the first failure in scenario order is the error.
-  std::vector<Status> status(out.scenarios.size());
+  std::vector<Status> status(scenarios.size());
   std::mutex progress_mu;
   size_t done = 0;
   tbb::task_arena arena(opt.jobs > 0 ? opt.jobs : tbb::task_arena::automatic);
   arena.execute([&] {
     tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, out.scenarios.size(), 1),
+        tbb::blocked_range<size_t>(0, scenarios.size(), 1),
         [&](const tbb::blocked_range<size_t>& range) {
           for (size_t i = range.begin(); i != range.end(); ++i) {
-            StressScenario& s = out.scenarios[i];
+            StressScenario& s = scenarios[i];
             if (opt.progress) {
               std::lock_guard<std::mutex> lock(progress_mu);
-              opt.progress(s.id, static_cast<double>(done) / out.scenarios.size());
+              opt.progress(s.id, static_cast<double>(done) / scenarios.size());
             }
-            status[i] = run_stress_scenario(s, spec, parts);
+            status[i] = run_stress_scenario(s, *specs[i], parts);
             std::lock_guard<std::mutex> lock(progress_mu);
             ++done;
           }
@@ -782,6 +777,19 @@ StatusOr<StressResult> run_stress(const link::LinkSpec& spec, const link::PartLi
   });
   for (const Status& st : status)
     if (!st.ok()) return st;
+  return Status::Ok();
+}
+
+StatusOr<StressResult> run_stress(const link::LinkSpec& spec, const link::PartLibrary& parts,
+                                  const StressOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  StressResult out;
+  out.limits = stress_limits(spec);
+  StatusOr<std::vector<StressScenario>> built = build_stress_scenarios(spec, parts, opt);
+  if (!built) return built.status();
+  out.scenarios = std::move(*built);
+  const std::vector<const link::LinkSpec*> specs(out.scenarios.size(), &spec);
+  if (Status st = run_stress_scenarios(out.scenarios, specs, parts, opt); !st.ok()) return st;
   for (const StressScenario& s : out.scenarios) {
     out.survives = out.survives && s.survives;
     if (s.communicates) out.communicates = out.communicates && *s.communicates;

@@ -167,6 +167,11 @@ StatusOr<std::vector<StressScenario>> build_stress_scenarios(const link::LinkSpe
 // Simulates one built scenario and judges it against the limits.
 Status run_stress_scenario(StressScenario& s, const link::LinkSpec& spec,
                            const link::PartLibrary& parts);
+// Simulates and judges built scenarios side by side (opt.jobs threads; opt.progress under a
+// lock), scenario i against specs[i]; the first failure in scenario order is the error.
+Status run_stress_scenarios(std::vector<StressScenario>& scenarios,
+                            const std::vector<const link::LinkSpec*>& specs,
+                            const link::PartLibrary& parts, const StressOptions& opt);
 StatusOr<StressResult> run_stress(const link::LinkSpec& spec, const link::PartLibrary& parts,
                                   const StressOptions& opt = {});
 
