@@ -82,6 +82,9 @@ int run_pack_stress(const StressArgs& a, const std::vector<std::string>& only) {
   if (!bundle) return fail(bundle.status());
   analysis::StressOptions so;
   so.only = only;
+  so.jobs = a.jobs;
+  if (a.direction != "both")
+    so.directions = {a.direction == "down" ? link::Direction::kDown : link::Direction::kUp};
   ProgressLine line({.label = "isolink stress", .enabled = !a.quiet && !a.json});
   so.progress = [&line](const std::string& what, double f) { line.show_fraction(what, f); };
   StatusOr<analysis::PackStressResult> r = analysis::run_pack_stress(*pack, *parts, so);
