@@ -29,6 +29,13 @@ StatusOr<WaveRows> parse_wave_rows(const std::string& text) {
 std::vector<size_t> thin_rows(std::span<const double> time,
                               const std::vector<std::span<const double>>& columns,
                               double tolerance) {
+  const std::vector<double> tolerances(columns.size(), tolerance);
+  return thin_rows(time, columns, tolerances);
+}
+
+std::vector<size_t> thin_rows(std::span<const double> time,
+                              const std::vector<std::span<const double>>& columns,
+                              std::span<const double> tolerances) {
   const size_t n = time.size();
   std::vector<size_t> keep;
   if (n == 0) return keep;
@@ -72,8 +79,8 @@ std::vector<size_t> thin_rows(std::span<const double> time,
     const double dtj = time[j] - time[a];
     for (size_t c = 0; c < nc; ++c) {
       const double d = columns[c][j] - columns[c][a];
-      lo[c] = std::max(lo[c], (d - tolerance) / dtj);
-      hi[c] = std::min(hi[c], (d + tolerance) / dtj);
+      lo[c] = std::max(lo[c], (d - tolerances[c]) / dtj);
+      hi[c] = std::min(hi[c], (d + tolerances[c]) / dtj);
     }
   }
   if (keep.back() != n - 1) keep.push_back(n - 1);
@@ -154,12 +161,16 @@ WaveFile run_wave_file(const LinkRun& run, const WaveFileOptions& opt) {
   f.rows = opt.rows;
   double t_end = std::numeric_limits<double>::infinity();
   size_t columns = 0;
+  double record_tol = 0;  // the runs' own thinning (SimulationResult::record_tol)
   for (const DirectionRun& d : run.directions) {
     const Waveform& w = d.sim.wave;
     t_end = std::min(t_end, w.time.empty() ? 0.0 : w.time.back());
-    f.engine_rows += w.time.size();
+    // A thinned record holds fewer rows than the engine made: count the engine's.
+    f.engine_rows += d.sim.record_tol > 0 ? static_cast<size_t>(d.sim.grid.rows) : w.time.size();
+    record_tol = std::max(record_tol, d.sim.record_tol);
     columns += w.columns.size();
   }
+  f.record_tol = record_tol;
   if (run.directions.empty()) return f;
   if (opt.rows == WaveRows::Grid) {
     f.wave = run_waveforms(run, opt.grid_step);
@@ -178,7 +189,10 @@ WaveFile run_wave_file(const LinkRun& run, const WaveFileOptions& opt) {
     for (double tol : ladder) {
       size_t rows = 0;
       kept = thin_each(run, tol, &rows);
-      f.tolerance = tol;
+      // Within tol of the record's rows, which are within record_tol of the engine's: the kept
+      // line and the record's differ by at most tol at the record's rows and are straight between
+      // them.
+      f.tolerance = tol + record_tol;
       f.over_budget = wave_file_bytes(rows, columns) > kWaveFileBytes;
       if (!f.over_budget) break;
     }
@@ -190,6 +204,11 @@ WaveFile run_wave_file(const LinkRun& run, const WaveFileOptions& opt) {
 std::string wave_file_note(const WaveFile& f) {
   switch (f.rows) {
     case WaveRows::Rows:
+      if (f.record_tol > 0)
+        return fmt::format(
+            "wave.csv: every row of the run's record ({} of the engine's {} rows, within {:g} mV "
+            "of every engine row)",
+            f.wave.time.size(), f.engine_rows, f.record_tol * 1e3);
       return fmt::format("wave.csv: every engine row ({} rows)", f.wave.time.size());
     case WaveRows::Grid:
       return fmt::format("wave.csv: every probe resampled linearly onto a uniform grid ({} rows)",
