@@ -71,6 +71,8 @@ struct RunOptions {
   // one engine window, not every row. 0: every engine row (`isolink run --wave rows`).
   double record_tol = kRecordTolerance;
   int threads = 1;  // SimulationRequest::lti_threads
+  // SimulationRequest::record_full_rows: rows kept in full before record_tol applies.
+  size_t record_full_rows = SimulationRequest{}.record_full_rows;
   // Progress for a display: what runs ("down transient") and the fraction done (0-1).
   std::function<void(const std::string& what, double fraction)> progress;
 };
