@@ -75,6 +75,9 @@ struct WaveFile {
 std::vector<size_t> thin_rows(std::span<const double> time,
                               const std::vector<std::span<const double>>& columns,
                               double tolerance);
+// How many rows thin_rows keeps (nothing kept in memory).
+size_t thin_rows_count(std::span<const double> time,
+                       const std::vector<std::span<const double>>& columns, double tolerance);
 // The same with a tolerance per column.
 std::vector<size_t> thin_rows(std::span<const double> time,
                               const std::vector<std::span<const double>>& columns,
