@@ -50,6 +50,9 @@ StatusOr<DirectionRun> run_direction(link::ExpandedLink link, const RunOptions& 
   req.probes = run_probes();
   req.reltol = opt.reltol;
   req.engine = opt.engine;
+  req.record_tol = opt.record_tol;
+  req.lti_threads = opt.threads;
+  req.record_full_rows = opt.record_full_rows;
   // The LTI grid follows the receiver probes; v(txp,txn) is the ideal PWL drive, whose corners
   // a uniform grid could only meet within 1 mV at a few ps (it is only plotted).
   req.grid_probes = {true, true, true, false};

@@ -57,10 +57,22 @@ struct LinkRun {
   double seconds = 0;  // wall time, all directions
 };
 
+// The default of RunOptions::record_tol (V).
+inline constexpr double kRecordTolerance = 1e-3;
+
 struct RunOptions {
   link::ExpandOptions expand;
   std::optional<double> reltol;  // overrides the spec's sim.reltol
   Engine engine = Engine::Auto;  // LTI when the link allows it (every link today)
+  // V: the record each direction keeps (SimulationRequest::record_tol): the LTI engine's rows
+  // that linear interpolation needs to stay within this of every engine row (the engine's own
+  // rule puts its rows within 1 mV of the exact response, so the kept rows are within
+  // 1 mV + record_tol), thinned as the engine makes them: a long record holds the kept rows and
+  // one engine window, not every row. 0: every engine row (`isolink run --wave rows`).
+  double record_tol = kRecordTolerance;
+  int threads = 1;  // SimulationRequest::lti_threads
+  // SimulationRequest::record_full_rows: rows kept in full before record_tol applies.
+  size_t record_full_rows = SimulationRequest{}.record_full_rows;
   // Progress for a display: what runs ("down transient") and the fraction done (0-1).
   std::function<void(const std::string& what, double fraction)> progress;
 };

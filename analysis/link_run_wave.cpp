@@ -29,9 +29,18 @@ StatusOr<WaveRows> parse_wave_rows(const std::string& text) {
 std::vector<size_t> thin_rows(std::span<const double> time,
                               const std::vector<std::span<const double>>& columns,
                               double tolerance) {
+  const std::vector<double> tolerances(columns.size(), tolerance);
+  return thin_rows(time, columns, tolerances);
+}
+
+namespace {
+
+// thin_rows's pass: keep(i) for each row kept, in order.
+template <typename Keep>
+void thin_pass(std::span<const double> time, const std::vector<std::span<const double>>& columns,
+               std::span<const double> tolerances, Keep&& keep) {
   const size_t n = time.size();
-  std::vector<size_t> keep;
-  if (n == 0) return keep;
+  if (n == 0) return;
   const size_t nc = columns.size();
   auto finite_row = [&](size_t i) {
     for (const auto& c : columns)
@@ -41,7 +50,7 @@ std::vector<size_t> thin_rows(std::span<const double> time,
   constexpr double kInf = std::numeric_limits<double>::infinity();
   std::vector<double> lo(nc), hi(nc);
   size_t a = 0;  // the last row kept
-  keep.push_back(0);
+  keep(0);
   bool anchor_finite = finite_row(0);
   std::fill(lo.begin(), lo.end(), -kInf);
   std::fill(hi.begin(), hi.end(), kInf);
@@ -56,7 +65,7 @@ std::vector<size_t> thin_rows(std::span<const double> time,
       // Row j cannot be reached from a in one straight line: j - 1 (which could) is kept and
       // becomes the anchor, and j is tried again from there.
       a = j - 1;
-      keep.push_back(a);
+      keep(a);
       std::fill(lo.begin(), lo.end(), -kInf);
       std::fill(hi.begin(), hi.end(), kInf);
       anchor_finite = finite_row(a);
@@ -65,19 +74,36 @@ std::vector<size_t> thin_rows(std::span<const double> time,
     }
     if (!reach) {  // j = a + 1 with a non-finite value on either side: both rows kept
       a = j;
-      keep.push_back(a);
+      keep(a);
       anchor_finite = finite_row(a);
       continue;
     }
     const double dtj = time[j] - time[a];
     for (size_t c = 0; c < nc; ++c) {
       const double d = columns[c][j] - columns[c][a];
-      lo[c] = std::max(lo[c], (d - tolerance) / dtj);
-      hi[c] = std::min(hi[c], (d + tolerance) / dtj);
+      lo[c] = std::max(lo[c], (d - tolerances[c]) / dtj);
+      hi[c] = std::min(hi[c], (d + tolerances[c]) / dtj);
     }
   }
-  if (keep.back() != n - 1) keep.push_back(n - 1);
-  return keep;
+  if (a != n - 1) keep(n - 1);
+}
+
+}  // namespace
+
+std::vector<size_t> thin_rows(std::span<const double> time,
+                              const std::vector<std::span<const double>>& columns,
+                              std::span<const double> tolerances) {
+  std::vector<size_t> kept;
+  thin_pass(time, columns, tolerances, [&](size_t i) { kept.push_back(i); });
+  return kept;
+}
+
+size_t thin_rows_count(std::span<const double> time,
+                       const std::vector<std::span<const double>>& columns, double tolerance) {
+  const std::vector<double> tolerances(columns.size(), tolerance);
+  size_t count = 0;
+  thin_pass(time, columns, tolerances, [&](size_t) { ++count; });
+  return count;
 }
 
 namespace {
@@ -154,12 +180,16 @@ WaveFile run_wave_file(const LinkRun& run, const WaveFileOptions& opt) {
   f.rows = opt.rows;
   double t_end = std::numeric_limits<double>::infinity();
   size_t columns = 0;
+  double record_tol = 0;  // the runs' own thinning (SimulationResult::record_tol)
   for (const DirectionRun& d : run.directions) {
     const Waveform& w = d.sim.wave;
     t_end = std::min(t_end, w.time.empty() ? 0.0 : w.time.back());
-    f.engine_rows += w.time.size();
+    // A thinned record holds fewer rows than the engine made: count the engine's.
+    f.engine_rows += d.sim.record_tol > 0 ? static_cast<size_t>(d.sim.grid.rows) : w.time.size();
+    record_tol = std::max(record_tol, d.sim.record_tol);
     columns += w.columns.size();
   }
+  f.record_tol = record_tol;
   if (run.directions.empty()) return f;
   if (opt.rows == WaveRows::Grid) {
     f.wave = run_waveforms(run, opt.grid_step);
@@ -175,13 +205,26 @@ WaveFile run_wave_file(const LinkRun& run, const WaveFileOptions& opt) {
   } else {
     std::vector<double> ladder(std::begin(kWaveTolerances), std::end(kWaveTolerances));
     if (opt.tolerance > 0) ladder = {opt.tolerance};
+    // Each tolerance's rows counted without keeping their indices (a long record's would take
+    // hundreds of MB beside it), then the chosen one's kept.
+    double chosen = ladder.back();
     for (double tol : ladder) {
       size_t rows = 0;
-      kept = thin_each(run, tol, &rows);
-      f.tolerance = tol;
+      for (const DirectionRun& d : run.directions) {
+        const Waveform& w = d.sim.wave;
+        std::vector<std::span<const double>> cols(w.columns.begin(), w.columns.end());
+        rows += thin_rows_count(w.time, cols, tol);
+      }
+      chosen = tol;
+      // Within tol of the record's rows, which are within record_tol of the engine's: the kept
+      // line and the record's differ by at most tol at the record's rows and are straight between
+      // them.
+      f.tolerance = tol + record_tol;
       f.over_budget = wave_file_bytes(rows, columns) > kWaveFileBytes;
       if (!f.over_budget) break;
     }
+    size_t rows = 0;
+    kept = thin_each(run, chosen, &rows);
   }
   f.wave = merged(run, kept, t_end);
   return f;
@@ -190,6 +233,11 @@ WaveFile run_wave_file(const LinkRun& run, const WaveFileOptions& opt) {
 std::string wave_file_note(const WaveFile& f) {
   switch (f.rows) {
     case WaveRows::Rows:
+      if (f.record_tol > 0)
+        return fmt::format(
+            "wave.csv: every row of the run's record ({} of the engine's {} rows, within {:g} mV "
+            "of every engine row)",
+            f.wave.time.size(), f.engine_rows, f.record_tol * 1e3);
       return fmt::format("wave.csv: every engine row ({} rows)", f.wave.time.size());
     case WaveRows::Grid:
       return fmt::format("wave.csv: every probe resampled linearly onto a uniform grid ({} rows)",

@@ -59,7 +59,10 @@ struct WaveFileOptions {
 struct WaveFile {
   Waveform wave;
   WaveRows rows = WaveRows::Thinned;
-  double tolerance = 0;      // Thinned: the tolerance used (V); 0 otherwise
+  // Thinned: the tolerance used (V), against the engine's rows (the run's own record thinning,
+  // record_tol, included); 0 otherwise
+  double tolerance = 0;
+  double record_tol = 0;     // V: the runs' records were thinned within this (0: every row)
   size_t engine_rows = 0;    // rows of the engines, all directions together
   bool over_budget = false;  // Thinned: even the coarsest tolerance leaves it over kWaveFileBytes
 };
@@ -72,6 +75,13 @@ struct WaveFile {
 std::vector<size_t> thin_rows(std::span<const double> time,
                               const std::vector<std::span<const double>>& columns,
                               double tolerance);
+// How many rows thin_rows keeps (nothing kept in memory).
+size_t thin_rows_count(std::span<const double> time,
+                       const std::vector<std::span<const double>>& columns, double tolerance);
+// The same with a tolerance per column.
+std::vector<size_t> thin_rows(std::span<const double> time,
+                              const std::vector<std::span<const double>>& columns,
+                              std::span<const double> tolerances);
 
 // Every direction's probes (columns "down v(rxp,rxn)", ...) on one axis, by the rule above. A
 // direction that is a copy of another (same_as) is still written (the file's columns do not

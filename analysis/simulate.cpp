@@ -4,7 +4,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
+#include <span>
 
+#include "analysis/link_run_wave.h"
 #include "solver/circuit.h"
 
 namespace isolink::analysis {
@@ -270,6 +273,80 @@ struct EngineRun {
   std::chrono::steady_clock::time_point start;
 };
 
+// SimulationRequest::record_tol: the engine's windows of rows join `wave`, every row while it
+// holds up to full_rows, thinned after that, each window with the last one's end (held back
+// until then) as its first row and anchor.
+class RecordThinner {
+ public:
+  // [t0, t1]: the record's span (its rate so far sizes the vectors: see grow).
+  RecordThinner(const std::vector<Probe>& probes, double tol, size_t full_rows, double t0,
+                double t1, Waveform& wave)
+      : wave_(wave), full_rows_(full_rows), t0_(t0), t1_(t1) {
+    for (const Probe& p : probes) tols_.push_back(p.label.rfind("i(", 0) == 0 ? 1e-3 * tol : tol);
+  }
+  // The time from which rows were thinned (infinity: none were).
+  double thinned_from() const { return thinned_from_; }
+  void add(const std::vector<double>& t, const std::vector<std::vector<double>>& v) {
+    const size_t np = tols_.size();
+    grow(t.size(), t.back());
+    if (thinned_from_ == kNever && wave_.time.size() + time_.size() + t.size() <= full_rows_) {
+      for (size_t i = 0; i < time_.size(); ++i) push(i);
+      time_.clear();
+      for (auto& c : cols_) c.clear();
+      wave_.time.insert(wave_.time.end(), t.begin(), t.end() - 1);
+      for (size_t p = 0; p < np; ++p)
+        wave_.columns[p].insert(wave_.columns[p].end(), v[p].begin(), v[p].end() - 1);
+      time_ = {t.back()};
+      cols_.resize(np);
+      for (size_t p = 0; p < np; ++p) cols_[p] = {v[p].back()};
+      return;
+    }
+    if (thinned_from_ == kNever) thinned_from_ = time_.empty() ? t.front() : time_.front();
+    time_.insert(time_.end(), t.begin(), t.end());
+    cols_.resize(np);
+    std::vector<std::span<const double>> spans;
+    for (size_t p = 0; p < np; ++p) {
+      cols_[p].insert(cols_[p].end(), v[p].begin(), v[p].end());
+      spans.emplace_back(cols_[p]);
+    }
+    const std::vector<size_t> keep = thin_rows(time_, spans, tols_);
+    for (size_t k = 0; k + 1 < keep.size(); ++k) push(keep[k]);  // the last: the window's end
+    const size_t last = time_.size() - 1;
+    time_ = {time_[last]};
+    for (auto& c : cols_) c = {c[last]};
+  }
+  void finish() {
+    if (!time_.empty()) push(0);
+  }
+
+ private:
+  static constexpr double kNever = std::numeric_limits<double>::infinity();
+  // Room for `more` rows: when the vectors must grow, to the rows the record will hold at its
+  // rate so far (5 % over) rather than twice what they hold, so that a long record's vectors
+  // are about its size (doubling leaves up to half of them unused).
+  void grow(size_t more, double t_now) {
+    const size_t need = wave_.time.size() + more + 1;
+    if (need <= wave_.time.capacity()) return;
+    const double done = std::max(1e-30, (t_now - t0_) / (t1_ - t0_));
+    const size_t at_rate =
+        static_cast<size_t>(1.05 * static_cast<double>(need) / std::min(1.0, done));
+    const size_t room = std::max(need + need / 8, std::min(at_rate, 2 * need));
+    wave_.time.reserve(room);
+    for (auto& c : wave_.columns) c.reserve(room);
+  }
+  void push(size_t i) {
+    wave_.time.push_back(time_[i]);
+    for (size_t p = 0; p < tols_.size(); ++p) wave_.columns[p].push_back(cols_[p][i]);
+  }
+  Waveform& wave_;
+  const size_t full_rows_;
+  const double t0_, t1_;
+  double thinned_from_ = kNever;
+  std::vector<double> tols_;
+  std::vector<double> time_;               // the window's rows, after the held-back one
+  std::vector<std::vector<double>> cols_;  // [probe][row]
+};
+
 // The LTI engine: *done when result holds its waveform; otherwise result.engine_note says why
 // not (auto falls back to the transient). Errors: a forced `lti` that cannot run.
 Status run_lti(const EngineRun& run, SimulationResult& result, bool* done) {
@@ -305,6 +382,7 @@ Status run_lti(const EngineRun& run, SimulationResult& result, bool* done) {
       grid.tstop = opt.tstop;
       grid.step = req.grid_step;
       grid.grid_probes = req.grid_probes;
+      grid.threads = req.lti_threads;
       grid.max_rows =
           std::min<long>(grid.max_rows, static_cast<long>(kMemoryLimitBytes / (4 * run.row_bytes)));
       // auto: the LTI output only when it costs about what the transient would (a transient
@@ -312,7 +390,31 @@ Status run_lti(const EngineRun& run, SimulationResult& result, bool* done) {
       if (req.engine == Engine::Auto && !responses->reduced())
         grid.max_evaluations =
             kAutoLtiBudget * static_cast<double>(responses->stats().steps) * result.unknowns;
+      const bool thin = req.record_tol > 0 && responses->reduced() && grid.step == 0;
+      Waveform kept;
+      RecordThinner thinner(run.probes, req.record_tol, req.record_full_rows, grid.tstart,
+                            grid.tstop, kept);
+      if (thin) {
+        grid.max_rows = LtiResponses::GridOptions{}.max_rows;  // per window: one at a time
+        kept.names = responses->probe_labels();
+        kept.columns.resize(kept.names.size());
+        grid.on_rows = [&](const std::vector<double>& t,
+                           const std::vector<std::vector<double>>& v) { thinner.add(t, v); };
+      }
       result.wave = responses->waveform(responses->netlist_inputs(opt.tstop), grid, &result.grid);
+      if (thin) {
+        thinner.finish();
+        result.wave = std::move(kept);
+        if (thinner.thinned_from() < opt.tstop) {
+          result.record_tol = req.record_tol;
+          result.warnings.push_back(fmt::format(
+              "note: the record keeps {} of the LTI engine's {} rows: from {:.6g} ms on, those "
+              "that linear interpolation needs to stay within {:g} mV of every engine row "
+              "(every row would take {:.0f} MB)",
+              result.wave.time.size(), result.grid.rows, 1e3 * thinner.thinned_from(),
+              1e3 * req.record_tol, static_cast<double>(result.grid.rows) * run.row_bytes / 1e6));
+        }
+      }
     }
     if (responses && result.grid.over_budget) {
       lti_ok = Status::Error(fmt::format(
@@ -435,6 +537,7 @@ Status run_port(const Netlist& netlist, const EngineRun& run, SimulationResult& 
   return Status::Ok();
 }
 
+// Fills `result` and moves it out (a copy would hold the record twice: 600 MB for 25 ms).
 StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequest& req,
                                     SimulationResult& result) {
   TransientOptions opt;
@@ -462,15 +565,15 @@ StatusOr<SimulationResult> simulate(const Netlist& netlist, const SimulationRequ
   if (nonlinear && (req.engine == Engine::Auto || req.engine == Engine::PortModel)) {
     bool done = false;
     if (Status s = run_port(netlist, run, result, &done); !s.ok()) return s;
-    if (done) return result;
+    if (done) return std::move(result);
   }
   if (req.engine != Engine::Transient && (!nonlinear || req.engine == Engine::Lti)) {
     bool done = false;
     if (Status s = run_lti(run, result, &done); !s.ok()) return s;
-    if (done) return result;
+    if (done) return std::move(result);
   }
   if (Status s = run_transient_engine(netlist, run, result); !s.ok()) return s;
-  return result;
+  return std::move(result);
 }
 
 }  // namespace

@@ -93,6 +93,19 @@ struct SimulationRequest {
   // looks at (empty = all). The transient ignores both (its rows are its steps).
   double grid_step = 0.0;
   std::vector<bool> grid_probes;
+  // LTI engine, reduced model, on the 1 mV rule (grid_step 0): keep only the engine's rows that
+  // linear interpolation between kept rows needs to stay within record_tol (V; A/1000 for
+  // current probes) of every engine row on every probe, thinned window by window as the engine
+  // makes them (analysis/link_run_wave.h thin_rows; each window's ends kept), so the run holds
+  // the kept rows and one window. Rows are thinned only once the record holds record_full_rows
+  // (a short record keeps every row, as with 0). 0: every engine row. SimulationResult::record_tol
+  // and a note in warnings say when it applied; grid.rows counts the engine's rows, wave the
+  // kept ones.
+  double record_tol = 0.0;
+  size_t record_full_rows = 2'000'000;
+  // Threads the LTI engine's output grid may use (solver/lti.h GridOptions::threads; the rows do
+  // not depend on it). A sweep running points side by side leaves it at 1.
+  int lti_threads = 1;
   // Progress of the engine for a display: its phase ("transient", "LTI responses") and the
   // fraction of it done (0-1), every 1024 engine steps. Empty: none.
   std::function<void(const char* phase, double fraction)> progress;
@@ -106,6 +119,9 @@ struct SimulationResult {
   LtiStats lti;                       // LTI engine
   PortModelStats port;                // port model engine
   LtiResponses::GridInfo grid;        // LTI engine: the output grid
+  // The rows of `wave` are the engine's rows thinned within this (SimulationRequest::record_tol)
+  // from some time on (the note in warnings says when), 0 when they are all of them.
+  double record_tol = 0.0;
   std::vector<std::string> warnings;  // formatted, for stderr
   int nodes = 0, unknowns = 0, elements = 0;
   double seconds = 0.0;  // wall time of the engine

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "analysis/link_run.h"
@@ -101,6 +102,10 @@ int run_run(const RunArgs& a) {
   RunOptions ro;
   ro.engine = a.engine;
   ro.progress = progress;
+  // --wave rows and grid write from every engine row: the run keeps them all (memory grows with
+  // the traffic); thinned keeps what wave.csv's thinning and the checks need.
+  if (a.wave != WaveRows::Thinned) ro.record_tol = 0;
+  ro.threads = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
   StatusOr<LinkRun> run = run_link(*spec, *parts, ro);
   if (!run) return fail(run.status().with_context(a.spec));
   // The worst case over all legal traffic, beside the spec's traffic (its own verdict).

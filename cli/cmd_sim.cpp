@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <iostream>
 #include <optional>
+#include <thread>
 
 #include "analysis/simulate.h"
 #include "base/progress.h"
@@ -115,6 +116,7 @@ int run_sim(const SimArgs& a) {
   req.tstop = tstop;
   req.tmax = tmax;
   req.engine = a.engine;
+  req.lti_threads = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
   if (step) req.grid_step = *step;
   if (a.reltol > 0) req.reltol = a.reltol;
   if (a.method == "trap") req.method = IntegrationMethod::Trapezoidal;

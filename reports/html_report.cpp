@@ -158,15 +158,14 @@ size_t wave_samples_for(size_t bytes, double span) {
 namespace {
 
 // The samples kept of a record longer than max_samples: thinned with the finest tolerance that
-// fits (*tolerance set), else min/max buckets (*tolerance 0).
+// fits (*tolerance set), else min/max buckets (*tolerance 0). Each tolerance's samples are
+// counted first: the indices of a 25 ms record at 1 mV took 200 MB beside it.
 std::vector<size_t> reduce_wave(std::span<const double> t, std::span<const double> v,
                                 size_t max_samples, double* tolerance) {
   for (double tol : kHtmlThinTolerances) {
-    std::vector<size_t> keep = analysis::thin_rows(t, {v}, tol);
-    if (keep.size() <= max_samples) {
-      *tolerance = tol;
-      return keep;
-    }
+    if (analysis::thin_rows_count(t, {v}, tol) > max_samples) continue;
+    *tolerance = tol;
+    return analysis::thin_rows(t, {v}, tol);
   }
   *tolerance = 0;
   return minmax_keep(v, max_samples);

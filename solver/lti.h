@@ -173,7 +173,24 @@ class LtiResponses {
     // rows gather after the corners where a fast response bends and stay coarse elsewhere.
     double interp_tol = 1e-3;       // V for voltage probes (A/1000 for currents: 1 uA)
     std::vector<bool> grid_probes;  // which probes the rule looks at (empty = all)
-    long max_rows = 4'000'000;      // the rule stops refining here (a warning says so)
+    // The rule stops refining here (a warning says so). The reduced model's windows (below)
+    // each stop at their share of it by length; with on_rows, each window at all of it.
+    long max_rows = 4'000'000;
+    // s: the reduced model refines the grid window by window, each window's rows by the rule
+    // above on their own and the modes' state carried from the last window's end, so the work is
+    // the rows' and the corners' and the memory one window's. Windows are whole cells of the
+    // first level (at least one); 0: the whole span in one. The rows are the same whatever the
+    // window (a window's ends are rows of the first level anyway) but where max_rows stops it.
+    double window = 50e-6;
+    // Threads refining windows side by side (the rows are the same for any number).
+    int threads = 1;
+    // When set (the reduced model, step = 0), each window's rows are handed here as soon as they
+    // are made, in time order (time, then [probe][row]; a window's first row, the last one's end,
+    // is not repeated), and waveform() returns the probe names with no rows: a caller that keeps
+    // only some rows (a thinned record) holds one window at a time.
+    std::function<void(const std::vector<double>& time,
+                       const std::vector<std::vector<double>>& rows)>
+        on_rows;
     // 0: no limit. Otherwise the most probe evaluations one grid level's superposition may take:
     // before each level the rule predicts them (probes x sum over ramps of the rows inside the
     // march window), and after each it predicts the level that will meet interp_tol (the error

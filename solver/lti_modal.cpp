@@ -9,6 +9,8 @@
 #include <complex>
 #include <functional>
 #include <limits>
+#include <optional>
+#include <thread>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -58,9 +60,20 @@ class ModalMarch {
   ModalMarch(const ReducedModel& m, size_t np, size_t nk, double uniform_dt,
              const std::vector<double>* probe_weight, double threshold, std::vector<double>* rate);
 
-  // Adds the response to the corners (sorted by time) at `times` into out[p][j].
+  // Adds the response to the corners (sorted by time) at `times` into out[p][j]. A later call
+  // continues from where the last one stopped (its last query time and the corners taken so far):
+  // the next call's times and the corners passed must carry on from there (the same corners
+  // vector). `record_end`: where the queries will end (0: this call's last time); the tail's
+  // fast modes are those that decay within it.
   void run(const std::vector<Corner>& corners, const std::vector<double>& times,
-           std::vector<std::vector<double>>& out);
+           std::vector<std::vector<double>>& out, double record_end = 0.0);
+  // For the next run(): the uniform step of its queries (0: none) and where its mode rates go
+  // (nullptr: none; a march built without rates never gives them).
+  void set_pass(double uniform_dt, std::vector<double>* rate) {
+    if (uniform_dt > 0 && std::fabs(uniform_dt - uniform_.h) > 1e-9 * uniform_dt)
+      uniform_.set(m_, uniform_dt);
+    rate_ = w2_.empty() ? nullptr : rate;
+  }
   // After run() has taken every corner: each mode's state x split into its steady state
   // x_ss = -b / p and the transient d = x - x_ss (the probes' constant and amplitudes), when every
   // slope is zero; false otherwise.
@@ -106,6 +119,9 @@ class ModalMarch {
   std::array<ModalStep, 8> recent_;
   size_t next_recent_ = 0;
   bool active_ = false;              // a corner has passed: before it everything is zero
+  bool started_ = false;             // run() has been called: tc_ and c_ hold
+  double tc_ = 0.0;                  // the time of the state
+  size_t c_ = 0;                     // the corners taken
   std::vector<double> slope_scale_;  // largest |slope| a source has had
   bool tail_ = false;
   std::vector<size_t> slow_, fast_;  // mode indices in the tail; fast ones are dropped when decayed
@@ -117,6 +133,7 @@ class ModalMarch {
   // ModeRates: each mode's weight on the probes (squared, over the threshold squared), and 1 / p
   // and 1 / p^2 as real arrays, and |p|.
   std::vector<double> w2_, ipr_, ipi_, ip2r_, ip2i_, speed_;
+  std::vector<size_t> by_speed_;  // the modes by |p|, fastest first
 };
 
 ModalMarch::ModalMarch(const ReducedModel& m, size_t np, size_t nk, double uniform_dt,
@@ -443,6 +460,10 @@ void ModalMarch::start_rates(const std::vector<double>& probe_weight, double thr
     ip2r_.push_back(ip2.real()), ip2i_.push_back(ip2.imag());
     speed_.push_back(std::abs(m_.poles[i]));
   }
+  by_speed_.resize(nm_);
+  for (size_t i = 0; i < nm_; ++i) by_speed_[i] = i;
+  std::stable_sort(by_speed_.begin(), by_speed_.end(),
+                   [&](size_t a, size_t b) { return speed_[a] > speed_[b]; });
 }
 
 void ModalMarch::rate_at(size_t j) {
@@ -454,9 +475,18 @@ void ModalMarch::rate_at(size_t j) {
   const std::vector<double>&xr = xr_, &xi = xi_, &br = br_, &bi = bi_, &gr = gr_, &gi = gi_;
   const std::vector<double>&ipr = ipr_, &ipi = ipi_, &ip2r = ip2r_, &ip2i = ip2i_;
   if (!tail_) {
-    for (size_t i = 0; i < nm_; ++i)
-      consider(i, xr[i] + br[i] * ipr[i] - bi[i] * ipi[i] + gr[i] * ip2r[i] - gi[i] * ip2i[i],
-               xi[i] + br[i] * ipi[i] + bi[i] * ipr[i] + gr[i] * ip2i[i] + gi[i] * ip2r[i]);
+    // Fastest first: the first live mode is the answer (right after a corner, where most rows
+    // are, one of the first few).
+    for (size_t i : by_speed_) {
+      const double d_r =
+          xr[i] + br[i] * ipr[i] - bi[i] * ipi[i] + gr[i] * ip2r[i] - gi[i] * ip2i[i];
+      const double d_i =
+          xi[i] + br[i] * ipi[i] + bi[i] * ipr[i] + gr[i] * ip2i[i] + gi[i] * ip2r[i];
+      if (w2_[i] * (d_r * d_r + d_i * d_i) > 1.0) {
+        fastest = speed_[i];
+        break;
+      }
+    }
   } else {
     for (size_t i : slow_)
       consider(i, xr[i] + br[i] * ipr[i] - bi[i] * ipi[i], xi[i] + br[i] * ipi[i] + bi[i] * ipr[i]);
@@ -508,11 +538,16 @@ double ModalMarch::value(size_t p) const {
 }
 
 void ModalMarch::run(const std::vector<Corner>& corners, const std::vector<double>& times,
-                     std::vector<std::vector<double>>& out) {
+                     std::vector<std::vector<double>>& out, double record_end) {
   if (rate_) rate_->assign(times.size(), 0.0);
-  double tc = times.empty() ? 0.0 : times[0];
-  if (!corners.empty()) tc = std::min(tc, corners[0].t);
-  size_t c = 0;
+  if (!started_) {
+    tc_ = times.empty() ? 0.0 : times[0];
+    if (!corners.empty()) tc_ = std::min(tc_, corners[0].t);
+    started_ = true;
+  }
+  double tc = tc_;
+  size_t c = c_;
+  const double end = times.empty() ? tc : std::max(record_end, times.back());
   for (size_t j = 0; j < times.size(); ++j) {
     const double tq = times[j];
     if (tail_ && !rate_) {
@@ -539,10 +574,11 @@ void ModalMarch::run(const std::vector<Corner>& corners, const std::vector<doubl
     advance(tq - tc);
     tc = tq;
     if (!active_) continue;
-    if (c == corners.size() && j + 1 < times.size()) enter_tail(times.back() - tc);
+    if (c == corners.size() && tc < end) enter_tail(end - tc);
     rate_at(j);
     for (size_t p = 0; p < np_; ++p) out[p][j] += value(p);
   }
+  tc_ = tc, c_ = c;
 }
 
 }  // namespace
@@ -597,18 +633,32 @@ std::optional<LtiResponses::ModalTail> LtiResponses::modal_tail(
 
 namespace {
 
-// The reduced model's first grid level: the uniform grid of step dt, plus every corner inside the
-// span as a row of its own.
-std::vector<double> first_level(double tstart, double tstop, double dt,
+// The reduced model's first grid level over uniform rows i0..i1 (t = tstart + i dt) and the
+// corners (sorted) between them: one row per uniform time and per corner, where two are closer
+// than 1e-6 dt one row, a corner's time rather than a uniform one's (the first of two corners).
+// A window's ends depend only on the uniform time and the corners within 1e-6 dt of it, so two
+// windows meeting there agree on their common row.
+std::vector<double> first_level(double tstart, double dt, long i0, long i1,
                                 const std::vector<double>& corners) {
-  std::vector<double> t;
-  const long count = static_cast<long>(std::floor((tstop - tstart) / dt * (1 + 1e-12))) + 1;
-  for (long i = 0; i < count; ++i) t.push_back(tstart + static_cast<double>(i) * dt);
-  t.insert(t.end(), corners.begin(), corners.end());
-  std::sort(t.begin(), t.end());
-  std::vector<double> out;  // closer than 1e-6 dt: one row (the uniform one first)
-  for (double x : t)
-    if (out.empty() || x >= out.back() + 1e-6 * dt) out.push_back(x);
+  const double eps = 1e-6 * dt;
+  const double ta = tstart + static_cast<double>(i0) * dt,
+               tb = tstart + static_cast<double>(i1) * dt;
+  auto c = std::lower_bound(corners.begin(), corners.end(), ta - eps);
+  std::vector<double> out;
+  std::vector<char> is_corner;
+  auto add = [&](double x, bool corner) {
+    if (!out.empty() && x < out.back() + eps) {
+      if (corner && !is_corner.back()) out.back() = x, is_corner.back() = 1;
+      return;
+    }
+    out.push_back(x), is_corner.push_back(corner);
+  };
+  for (long i = i0; i <= i1; ++i) {
+    const double u = tstart + static_cast<double>(i) * dt;
+    for (; c != corners.end() && *c < u && *c <= tb + eps; ++c) add(*c, true);
+    add(u, false);
+  }
+  for (; c != corners.end() && *c <= tb + eps; ++c) add(*c, true);
   return out;
 }
 
@@ -620,11 +670,12 @@ std::vector<double> first_level(double tstart, double tstop, double dt,
 // ringing was 9 mV off that way), so an interval is also split while it is longer than 1 / |p|
 // of the fastest mode still active at either end (`evaluate` gives those rates, ModeRates): the
 // grid is sized from the circuit's time constants where they act. Returns the finest step; sets
-// `warning` when max_rows stops it.
+// *capped to the bound on linear interpolation's error (in the probes' units, mV scale as
+// interp_tol) when max_rows stops it.
 using Evaluate = std::function<Rows(const std::vector<double>&, double, std::vector<double>&)>;
 double refine_grid(std::vector<double>& times, Rows& rows, const Evaluate& evaluate,
                    const LtiResponses::GridOptions& grid, const std::vector<bool>& is_current,
-                   double dt, std::string& warning) {
+                   double dt, long max_rows, double* capped) {
   const size_t np = is_current.size();
   std::vector<double> mids, row_rate, mid_rate;
   Rows mid_values;
@@ -668,11 +719,8 @@ double refine_grid(std::vector<double>& times, Rows& rows, const Evaluate& evalu
         split[j] = 1, ++splits;
     }
     if (splits == 0) break;
-    if (static_cast<long>(times.size() + splits) > grid.max_rows) {
-      warning = fmt::format(
-          "LTI output grid stopped at {} rows (step {:g} s): linear interpolation between rows "
-          "may be off by up to {:.3g} mV, over the {:g} mV target",
-          times.size(), finest, 2e3 * worst, 1e3 * grid.interp_tol);
+    if (static_cast<long>(times.size() + splits) > max_rows) {
+      *capped = std::max(*capped, 2 * worst);
       break;
     }
     // The failing midpoints join the rows; their halves are the next pass's intervals.
@@ -712,53 +760,184 @@ double refine_grid(std::vector<double>& times, Rows& rows, const Evaluate& evalu
 
 }  // namespace
 
+// The output grid window by window: each window's first level and refinement (refine_grid) on
+// its own, the modes' state at its start carried from the last window (a march over its corners
+// alone), so the memory is one window's and the work is the rows' and corners'.
+namespace {
+
+class WindowedGrid {
+ public:
+  // corners: every input's, sorted; those strictly inside (tstart, tstop) become rows.
+  WindowedGrid(const ReducedModel& model, const std::vector<Corner>& corners, size_t np, size_t nk,
+               const std::vector<double>& base, const std::vector<double>& probe_weight,
+               double threshold, double tstart, double tstop)
+      : corners_(corners),
+        base_(base),
+        np_(np),
+        tstop_(tstop),
+        start_(model, np, nk, 0.0, &probe_weight, threshold, &scratch_) {
+    for (const Corner& c : corners)
+      if (c.t > tstart && c.t < tstop) corner_times_.push_back(c.t);
+  }
+  const std::vector<double>& corner_times() const { return corner_times_; }
+
+  // The modes' state at the present window's start (the next one's after move_to).
+  const ModalMarch& state() const { return start_; }
+  // The probes at `times` (ascending, from the start of the window whose state is `start`), and
+  // each time's mode rate.
+  Rows evaluate(const ModalMarch& start, const std::vector<double>& times, double dt,
+                std::vector<double>& rate) const {
+    Rows v(np_);
+    for (size_t p = 0; p < np_; ++p) v[p].assign(times.size(), base_[p]);
+    ModalMarch march = start;
+    march.set_pass(dt, &rate);
+    march.run(corners_, times, v, tstop_);
+    return v;
+  }
+  // The state moved on to t (the next window's start).
+  void move_to(double t) {
+    Rows dummy(np_, std::vector<double>(1, 0.0));
+    start_.set_pass(0.0, nullptr);
+    start_.run(corners_, {t}, dummy, tstop_);
+  }
+
+ private:
+  const std::vector<Corner>& corners_;
+  const std::vector<double>& base_;
+  const size_t np_;
+  const double tstop_;
+  std::vector<double> scratch_, corner_times_;
+  ModalMarch start_;
+};
+
+// One window of the output grid: its first level, refined in place (rows, the finest step, and
+// the bound when its share of max_rows stopped it).
+struct GridWindow {
+  std::vector<double> times;
+  Rows rows;
+  std::optional<ModalMarch> start;
+  long cap = 0;
+  double finest = 0.0;
+  double capped = 0.0;
+};
+
+// The index of the last uniform row tstart + i dt at or before tstop.
+long uniform_last(double tstart, double tstop, double dt) {
+  return static_cast<long>(std::floor((tstop - tstart) / dt * (1 + 1e-12)));
+}
+
+}  // namespace
+
 Waveform LtiResponses::modal_waveform(const std::vector<SourceInput>& inputs,
                                       const GridOptions& grid, const std::vector<double>& base,
                                       GridInfo& gi) const {
   const size_t np = labels_.size();
+  Waveform w;
+  w.names = labels_;
+  w.columns.resize(np);
+  auto emit = [&](std::vector<double>& t, Rows& rows, bool first) {
+    const size_t skip = first ? 0 : 1;  // a window's first row is the last one's end
+    gi.rows += static_cast<long>(t.size() - skip);
+    if (grid.on_rows) {
+      if (!first) {
+        t.erase(t.begin());
+        for (auto& r : rows) r.erase(r.begin());
+      }
+      grid.on_rows(t, rows);
+      return;
+    }
+    w.time.insert(w.time.end(), t.begin() + static_cast<long>(skip), t.end());
+    for (size_t p = 0; p < np; ++p)
+      w.columns[p].insert(w.columns[p].end(), rows[p].begin() + static_cast<long>(skip),
+                          rows[p].end());
+  };
+  if (grid.step > 0) {  // a given step: one pass over the whole grid
+    std::vector<double> times = first_level(grid.tstart, grid.step, 0,
+                                            uniform_last(grid.tstart, grid.tstop, grid.step), {});
+    Rows rows(np);
+    for (size_t p = 0; p < np; ++p) rows[p].assign(times.size(), base[p]);
+    modal_add(inputs, times, grid.step, rows);
+    gi.step = grid.step;
+    emit(times, rows, true);
+    return w;
+  }
   const double span = grid.tstop - grid.tstart;
+  double dt = span;
+  while (dt > coarsest_grid_step(span)) dt *= 0.5;
+  gi.coarse_step = dt;
+  gi.step = dt;
+  const long last = uniform_last(grid.tstart, grid.tstop, dt);
+  if (!follows_ties(inputs)) {  // the model cannot evaluate them: NaN on the first level
+    std::vector<double> times = first_level(grid.tstart, dt, 0, last, {});
+    Rows rows(np, std::vector<double>(times.size(), std::numeric_limits<double>::quiet_NaN()));
+    emit(times, rows, true);
+    return w;
+  }
   // The modes the grid must resolve: a share over a twentieth of the tolerance on a grid probe.
-  ModeRates mode_rates;
-  mode_rates.threshold = 0.05 * grid.interp_tol;
+  std::vector<double> weight;
   for (size_t p = 0; p < np; ++p) {
     const bool looked_at =
         grid.grid_probes.empty() || (p < grid.grid_probes.size() && grid.grid_probes[p]);
-    mode_rates.probe_weight.push_back(!looked_at ? 0.0 : is_current_[p] ? 1e3 : 1.0);
+    weight.push_back(!looked_at ? 0.0 : is_current_[p] ? 1e3 : 1.0);
   }
-  auto evaluate = [&](const std::vector<double>& times, double dt, std::vector<double>& rate) {
-    Rows v(np);
-    for (size_t p = 0; p < np; ++p) v[p].assign(times.size(), base[p]);
-    modal_add(inputs, times, dt, v, &mode_rates);
-    rate = std::move(mode_rates.rate);
-    return v;
+  const size_t nk = std::min(sources_.size(), inputs.size());
+  const std::vector<Corner> corners = sorted_corners(inputs, nk, tied_sources());
+  WindowedGrid wg(*model_, corners, np, nk, base, weight, 0.05 * grid.interp_tol, grid.tstart,
+                  grid.tstop);
+  // Rows gather where the response bends (after each corner, for as long as its fast modes
+  // last) and stay coarse elsewhere: 1 ns and 1 ms time constants over 5 ms take about
+  // 66,000 rows, where uniform halving went to its 4,000,000-row limit.
+  const long cells = grid.window > 0 ? std::max(1L, std::lround(grid.window / dt)) : last;
+  const size_t threads = static_cast<size_t>(std::max(1, grid.threads));
+  auto refine = [&](GridWindow& win) {
+    auto evaluate = [&](const std::vector<double>& t, double step, std::vector<double>& rate) {
+      return wg.evaluate(*win.start, t, step, rate);
+    };
+    win.finest =
+        refine_grid(win.times, win.rows, evaluate, grid, is_current_, dt, win.cap, &win.capped);
   };
-  std::vector<double> times;
-  Rows rows;
-  double dt = grid.step;
-  if (dt > 0) {
-    times = first_level(grid.tstart, grid.tstop, dt, {});
-    rows = Rows(np);
-    for (size_t p = 0; p < np; ++p) rows[p].assign(times.size(), base[p]);
-    modal_add(inputs, times, dt, rows);
-  } else {
-    // Rows gather where the response bends (after each corner, for as long as its fast modes
-    // last) and stay coarse elsewhere: 1 ns and 1 ms time constants over 5 ms take about
-    // 66,000 rows, where uniform halving went to its 4,000,000-row limit.
-    std::vector<double> corners;
-    for (const SourceInput& in : inputs)
-      for (const Ramp& ramp : in.ramps)
-        if (ramp.t > grid.tstart && ramp.t < grid.tstop) corners.push_back(ramp.t);
-    dt = span;
-    while (dt > coarsest_grid_step(span)) dt *= 0.5;
-    gi.coarse_step = dt;
-    times = first_level(grid.tstart, grid.tstop, dt, corners);
-    dt = refine_grid(times, rows, evaluate, grid, is_current_, dt, gi.warning);
+  double capped = 0.0;
+  bool first = true;
+  // Batches of windows: their starting states by a march over the corners alone, then each
+  // refined on its own (`threads` at a time), then handed on in order.
+  for (long i0 = 0; i0 < last || first;) {
+    std::vector<GridWindow> batch;
+    for (; batch.size() < 4 * threads && (i0 < last || (first && batch.empty())); i0 += cells) {
+      const long i1 = std::min(last, i0 + cells);
+      GridWindow& win = batch.emplace_back();
+      win.times = first_level(grid.tstart, dt, i0, i1, wg.corner_times());
+      // The window's share of max_rows (all of it when the rows are handed on).
+      win.cap = grid.on_rows ? grid.max_rows
+                             : std::max(static_cast<long>(win.times.size()),
+                                        static_cast<long>(static_cast<double>(grid.max_rows) *
+                                                          static_cast<double>(i1 - i0) /
+                                                          static_cast<double>(std::max(1L, last))));
+      win.start.emplace(wg.state());
+      wg.move_to(win.times.back());
+    }
+    if (threads == 1 || batch.size() == 1) {
+      for (GridWindow& win : batch) refine(win);
+    } else {
+      std::vector<std::thread> workers;
+      for (size_t k = 1; k < threads && k < batch.size(); ++k)
+        workers.emplace_back([&, k] {
+          for (size_t j = k; j < batch.size(); j += threads) refine(batch[j]);
+        });
+      for (size_t j = 0; j < batch.size(); j += threads) refine(batch[j]);
+      for (std::thread& t : workers) t.join();
+    }
+    for (GridWindow& win : batch) {
+      gi.step = std::min(gi.step, win.finest);
+      capped = std::max(capped, win.capped);
+      emit(win.times, win.rows, first);
+      first = false;
+    }
   }
-  Waveform w;
-  w.time = std::move(times);
-  for (size_t p = 0; p < np; ++p) w.add_column(labels_[p], std::move(rows[p]));
-  gi.rows = static_cast<long>(w.time.size());
-  gi.step = dt;
+  if (capped > 0)
+    gi.warning = fmt::format(
+        "LTI output grid stopped at {} rows (step {:g} s): linear interpolation between rows "
+        "may be off by up to {:.3g} mV, over the {:g} mV target",
+        gi.rows, gi.step, 1e3 * capped, 1e3 * grid.interp_tol);
   return w;
 }
 
