@@ -627,42 +627,14 @@ StatusOr<std::vector<StressScenario>> build_stress_scenarios(const link::LinkSpe
   return out;
 }
 
-Status run_stress_scenario(StressScenario& s, const link::LinkSpec& spec,
-                           const link::PartLibrary& parts) {
-  const std::vector<StressLimit> limits = stress_limits(spec);
-  SimulationRequest req;
-  // One transient at reltol 1e-4 (the spec's sim.reltol when given) instead of auto's
-  // self-check (runs at 1e-3, 1e-4, ... until two agree): on the bq79606a_tvs_2m ESD scenario
-  // the check took 45 s and one run at 1e-4 3.2 s, with the pins' peaks within 0.4 mV of the
-  // 1e-3 run; the peaks are held to ngspice in tests/cli/stress_command_test.cpp.
-  req.reltol = spec.sim.reltol.value_or(kStressReltol);
-  req.probes.push_back("v(rxp,rxn)");
-  std::vector<std::string> pins;
-  for (const auto& [node, ground] : s.pin_ground) {
-    pins.push_back(node);
-    req.probes.push_back(probe_v(node, ground));
-  }
-  const size_t diode0 = req.probes.size();
-  for (const DiodePeak& d : s.diodes) req.probes.push_back("i(" + d.ammeter + ")");
-  const size_t cap0 = req.probes.size();
-  for (const Card& c : s.link.netlist.cards)
-    if (c.letter == 'c' && (c.name == "ctxisop" || c.name == "ctxison" || c.name == "crxisop" ||
-                            c.name == "crxison")) {
-      s.caps.push_back({c.name, 0});
-      req.probes.push_back(fmt::format("v({},{})", c.nodes[0], c.nodes[1]));
-    }
-  std::vector<std::pair<size_t, size_t>> tvs_v;  // diode index, probe column
-  for (size_t i = 0; i < s.diodes.size(); ++i)
-    if (auto t = tvs_terminals(s, s.diodes[i])) {
-      tvs_v.push_back({i, req.probes.size()});
-      req.probes.push_back(probe_v(t->first, t->second));
-    }
-  StatusOr<SimulationResult> r = simulate_netlist(s.link.netlist, req);
-  if (!r) return r.status().with_context("stress scenario " + s.id);
-  const Waveform& w = r->wave;
-  s.seconds = r->seconds;
-  s.engine = engine_name(r->engine);
-  if (!r->engine_note.empty()) s.engine += " (" + r->engine_note + ")";
+namespace {
+
+// The scenario's peaks from its run: pins (and each device's common mode), diode currents and
+// TVS energies, isolation-cap voltages. Columns: 0 v(rxp,rxn), then the pins, the diodes'
+// currents from diode0, the caps from cap0; tvs_v pairs a diode with its voltage's column.
+void measure_peaks(StressScenario& s, const Waveform& w, const std::vector<std::string>& pins,
+                   size_t diode0, size_t cap0,
+                   const std::vector<std::pair<size_t, size_t>>& tvs_v) {
   s.pins.time = w.time;
   for (size_t k = 0; k < pins.size(); ++k) {
     const std::vector<double>& col = w.columns[1 + k];
@@ -696,8 +668,12 @@ Status run_stress_scenario(StressScenario& s, const link::LinkSpec& spec,
     s.diodes[i].energy_j = e;
   }
   for (size_t i = 0; i < s.caps.size(); ++i) s.caps[i].peak_v = column_max_abs(w, cap0 + i);
+}
 
-  // The verdict: every limit, in the order an engineer fixes them.
+// Every limit the scenario's peaks break, in the order an engineer fixes them, into s.broken.
+void judge_limits(StressScenario& s, const link::LinkSpec& spec, const link::PartLibrary& parts,
+                  const std::vector<std::string>& pins) {
+  const std::vector<StressLimit> limits = stress_limits(spec);
   s.broken.clear();
   const StressLimit* pin = limit(limits, "pin_abs_max_V");
   for (const std::string& node : pins) {
@@ -735,6 +711,47 @@ Status run_stress_scenario(StressScenario& s, const link::LinkSpec& spec,
           level_text(part->tvs.esd_contact), level_text(spec.stress.esd_v),
           part->figure("rating.esd") ? part->figure("rating.esd")->source : "its data sheet"));
   }
+}
+
+}  // namespace
+
+Status run_stress_scenario(StressScenario& s, const link::LinkSpec& spec,
+                           const link::PartLibrary& parts) {
+  SimulationRequest req;
+  // One transient at reltol 1e-4 (the spec's sim.reltol when given) instead of auto's
+  // self-check (runs at 1e-3, 1e-4, ... until two agree): on the bq79606a_tvs_2m ESD scenario
+  // the check took 45 s and one run at 1e-4 3.2 s, with the pins' peaks within 0.4 mV of the
+  // 1e-3 run; the peaks are held to ngspice in tests/cli/stress_command_test.cpp.
+  req.reltol = spec.sim.reltol.value_or(kStressReltol);
+  req.probes.push_back("v(rxp,rxn)");
+  std::vector<std::string> pins;
+  for (const auto& [node, ground] : s.pin_ground) {
+    pins.push_back(node);
+    req.probes.push_back(probe_v(node, ground));
+  }
+  const size_t diode0 = req.probes.size();
+  for (const DiodePeak& d : s.diodes) req.probes.push_back("i(" + d.ammeter + ")");
+  const size_t cap0 = req.probes.size();
+  for (const Card& c : s.link.netlist.cards)
+    if (c.letter == 'c' && (c.name == "ctxisop" || c.name == "ctxison" || c.name == "crxisop" ||
+                            c.name == "crxison")) {
+      s.caps.push_back({c.name, 0});
+      req.probes.push_back(fmt::format("v({},{})", c.nodes[0], c.nodes[1]));
+    }
+  std::vector<std::pair<size_t, size_t>> tvs_v;  // diode index, probe column
+  for (size_t i = 0; i < s.diodes.size(); ++i)
+    if (auto t = tvs_terminals(s, s.diodes[i])) {
+      tvs_v.push_back({i, req.probes.size()});
+      req.probes.push_back(probe_v(t->first, t->second));
+    }
+  StatusOr<SimulationResult> r = simulate_netlist(s.link.netlist, req);
+  if (!r) return r.status().with_context("stress scenario " + s.id);
+  const Waveform& w = r->wave;
+  s.seconds = r->seconds;
+  s.engine = engine_name(r->engine);
+  if (!r->engine_note.empty()) s.engine += " (" + r->engine_note + ")";
+  measure_peaks(s, w, pins, diode0, cap0, tvs_v);
+  judge_limits(s, spec, parts, pins);
   s.survives = s.broken.empty();
   if (!s.receiver_p.empty()) {
     score_traffic(s, w);
