@@ -65,6 +65,25 @@ StatusOr<std::vector<std::string>> parse_only(const std::string& text) {
   return out;
 }
 
+// The run's options from the command line (checked before: direction, jobs, only).
+analysis::StressOptions stress_options(const StressArgs& a, const std::vector<std::string>& only,
+                                       ProgressLine& line) {
+  analysis::StressOptions so;
+  so.only = only;
+  so.jobs = a.jobs;
+  if (a.direction != "both")
+    so.directions = {a.direction == "down" ? link::Direction::kDown : link::Direction::kUp};
+  so.progress = [&line](const std::string& what, double f) { line.show_fraction(what, f); };
+  return so;
+}
+
+// report.json and report.md into the bundle.
+Status write_reports(const OutputBundle& bundle, const nlohmann::ordered_json& j,
+                     const std::string& md) {
+  if (Status s = write_file_atomic(bundle.path("report.json"), j.dump(2) + "\n"); !s.ok()) return s;
+  return write_file_atomic(bundle.path("report.md"), md);
+}
+
 // A pack file: every hop's wire faults and what the ring still reaches (analysis/pack_stress.h).
 int run_pack_stress(const StressArgs& a, const std::vector<std::string>& only) {
   if (!a.spice_dir.empty())
@@ -80,22 +99,13 @@ int run_pack_stress(const StressArgs& a, const std::vector<std::string>& only) {
       a.out_dir.empty() ? "reports/out/" + safe_path_component(pack->name) + "-stress" : a.out_dir;
   StatusOr<OutputBundle> bundle = OutputBundle::open(dir, {"report.md", "report.json"});
   if (!bundle) return fail(bundle.status());
-  analysis::StressOptions so;
-  so.only = only;
-  so.jobs = a.jobs;
-  if (a.direction != "both")
-    so.directions = {a.direction == "down" ? link::Direction::kDown : link::Direction::kUp};
   ProgressLine line({.label = "isolink stress", .enabled = !a.quiet && !a.json});
-  so.progress = [&line](const std::string& what, double f) { line.show_fraction(what, f); };
+  const analysis::StressOptions so = stress_options(a, only, line);
   StatusOr<analysis::PackStressResult> r = analysis::run_pack_stress(*pack, *parts, so);
   line.finish();
   if (!r) return fail(r.status().with_context(a.spec));
   const nlohmann::ordered_json j = reports::pack_stress_json(pack->name, *r);
-  if (Status s = write_file_atomic(bundle->path("report.json"), j.dump(2) + "\n"); !s.ok())
-    return fail(s);
-  if (Status s = write_file_atomic(bundle->path("report.md"),
-                                   reports::pack_stress_markdown(pack->name, *r));
-      !s.ok())
+  if (Status s = write_reports(*bundle, j, reports::pack_stress_markdown(pack->name, *r)); !s.ok())
     return fail(s);
   if (Status s = bundle->commit(); !s.ok()) return fail(s);
   if (a.json) {
@@ -134,13 +144,8 @@ int run_stress(const StressArgs& a) {
   StatusOr<OutputBundle> bundle =
       OutputBundle::open(dir, {"report.md", "report.json", "stress.png", "report.html"});
   if (!bundle) return fail(bundle.status());
-  analysis::StressOptions so;
-  so.only = *only;
-  so.jobs = a.jobs;
-  if (a.direction != "both")
-    so.directions = {a.direction == "down" ? link::Direction::kDown : link::Direction::kUp};
   ProgressLine line({.label = "isolink stress", .enabled = !a.quiet && !a.json});
-  so.progress = [&line](const std::string& what, double f) { line.show_fraction(what, f); };
+  const analysis::StressOptions so = stress_options(a, *only, line);
 
   std::map<std::string, std::string> netlists;
   if (!a.spice_dir.empty()) {  // written first: a user can replay them even if a run fails
@@ -163,10 +168,7 @@ int run_stress(const StressArgs& a) {
   line.finish();
   if (!r) return fail(r.status().with_context(a.spec));
   const nlohmann::ordered_json j = reports::stress_json(spec->name, *r, netlists);
-  if (Status s = write_file_atomic(bundle->path("report.json"), j.dump(2) + "\n"); !s.ok())
-    return fail(s);
-  if (Status s = write_file_atomic(bundle->path("report.md"),
-                                   reports::stress_markdown(spec->name, *r, netlists));
+  if (Status s = write_reports(*bundle, j, reports::stress_markdown(spec->name, *r, netlists));
       !s.ok())
     return fail(s);
   if (Status s = reports::write_stress_png(*r, spec->name, bundle->path("stress.png")); !s.ok())
