@@ -65,12 +65,17 @@ std::string engine_accuracy(const SimulationResult& r) {
     const PortModelOptions po;
     return fmt::format(
         "port model: the linear network's transfer (port impedances, sources to ports and "
-        "probes) within {:.1e} of each pair's peak (check {:.0e}; an edge's response within "
+        "probes) within {:.1e} of each pair's peak (check {:.0e}{}; an edge's response within "
         "{:.2g} of its amplitude times the pair's peak gain); time steps under the transient's "
         "truncation-error control (trtol x reltol = {:.2g} of each port voltage's, charge's and "
         "probe's peak), the port currents linear over a step, charge conserved; within 3 mV of "
         "the converged full transient on the nonlinear test circuits",
-        r.port.model.error, po.reduced.tol, po.reduced.edge_error_bound(), r.trtol * r.reltol);
+        r.port.model.error, r.port.model.tol,
+        r.port.model.relaxed
+            ? fmt::format(", relaxed from {:.0e}: the search could add no direction",
+                          po.reduced.tol)
+            : "",
+        po.reduced.edge_error_bound(r.port.model.error), r.trtol * r.reltol);
   }
   if (r.engine == Engine::Lti && r.lti.method.empty())  // a waveform synthesized, not simulated
     return "that of the response it was synthesized from (" + r.engine_note + ")";

@@ -32,6 +32,8 @@ struct PortRef {
   const Element* element = nullptr;
   int index = 0;
   int p = 0, n = 0;
+  bool controlled = false;
+  int cp = 0, cn = 0;
 };
 
 std::vector<PortRef> collect_ports(const Circuit& circuit) {
@@ -39,9 +41,60 @@ std::vector<PortRef> collect_ports(const Circuit& circuit) {
   for (const auto& e : circuit.elements())
     for (int k = 0; k < e->nonlinear_port_count(); ++k) {
       const NonlinearPort np = e->nonlinear_port(k);
-      ports.push_back({e.get(), k, np.p, np.n});
+      ports.push_back({e.get(), k, np.p, np.n, np.controlled, np.cp, np.cn});
     }
   return ports;
+}
+
+// A switch's control: the voltage source across its control nodes, read directly instead of
+// through the model (exact), and left out of the model's inputs: its nodes are touched by
+// nothing else (the switches' controls draw no current), so it reaches no other output.
+struct ControlSource {
+  const Element* source = nullptr;
+  double sign = 1.0;  // v(cp, cn) = sign * the source's value
+};
+
+StatusOr<std::vector<ControlSource>> control_sources(const Circuit& net,
+                                                     const std::vector<PortRef>& ports) {
+  std::map<int, int> touched;  // per node: elements connected to it, switch controls aside
+  for (const auto& e : net.elements()) {
+    bool is_switch = false;
+    for (int k = 0; k < e->nonlinear_port_count(); ++k)
+      is_switch = is_switch || e->nonlinear_port(k).controlled;
+    for (size_t j = 0; j < e->nodes().size(); ++j)
+      if (!(is_switch && j >= 2)) ++touched[e->nodes()[j]];
+  }
+  std::vector<ControlSource> out;
+  for (const PortRef& pr : ports) {
+    if (!pr.controlled) continue;
+    const Element* found = nullptr;
+    double sign = 1.0;
+    for (const auto& e : net.elements()) {
+      if (!e->has_excitation() || e->branch_count() != 1 || e->nodes().size() != 2) continue;
+      const int a = e->nodes()[0], b = e->nodes()[1];
+      if ((a == pr.cp && b == pr.cn) || (a == pr.cn && b == pr.cp)) {
+        found = e.get();
+        sign = a == pr.cp ? 1.0 : -1.0;
+        break;
+      }
+    }
+    const auto alone = [&](int u) { return u == 0 || touched[u] == 1; };
+    if (found == nullptr || !found->source_function() || !alone(pr.cp) || !alone(pr.cn))
+      return Status::Error(fmt::format(
+          "{} is a voltage-controlled switch whose control is not a voltage source of its own "
+          "(one across its control nodes, connected to nothing else): the port model reads such "
+          "a source's value; the full transient runs any other control",
+          pr.element->name()));
+    out.push_back({found, sign});
+  }
+  return out;
+}
+
+// A source whose value never changes over [0, horizon]: DC, or a PWL without a corner there.
+bool is_constant(const SourceFunction& f, double horizon) {
+  using Kind = SourceFunction::Kind;
+  if (f.kind() == Kind::Dc) return true;
+  return f.kind() == Kind::Pwl && f.piecewise_linear() && f.ramps(horizon).empty();
 }
 
 // The linear network of method step 1: the cards again, each port shunted.
@@ -81,13 +134,6 @@ StatusOr<PortModel> build_port_model(const std::vector<Card>& cards, const Circu
   const auto started = std::chrono::steady_clock::now();
   const std::vector<PortRef> ports = collect_ports(circuit);
   if (ports.empty()) return Status::Error("the circuit has no nonlinear element: no ports");
-  for (const auto& e : circuit.elements())
-    for (int k = 0; k < e->nonlinear_port_count(); ++k)
-      if (e->nonlinear_port(k).controlled)
-        return Status::Error(fmt::format(
-            "{} is a voltage-controlled switch: its port depends on a control voltage, which "
-            "the port model's network does not carry (the full transient runs it)",
-            e->name()));
   if (!circuit.dc_open_branches().empty())
     return Status::Error(
         "an inductor closes a loop of voltage sources and inductors and is opened for the DC "
@@ -103,15 +149,37 @@ StatusOr<PortModel> build_port_model(const std::vector<Card>& cards, const Circu
   pm.port_shunt = options.port_shunt;
   std::vector<std::vector<double>> unit;
   const int n = net.unknown_count();
+  // The constant sources (supplies, biases, the 0 V ammeters) are no inputs: their share of
+  // every output is the linear network's DC solution for them alone, a constant offset (the
+  // modes carry the rest). As inputs they added Krylov vectors and source-to-port pairs to the
+  // check; on a stress circuit of a 15 m link (11 of 14 sources constant) the search stalled at
+  // 3.4e-5 with no new direction (order 344).
+  StatusOr<std::vector<ControlSource>> controls = control_sources(net, ports);
+  if (!controls) return controls.status();
+  for (size_t m = 0; m < ports.size(); ++m)
+    pm.port_control.push_back(ports[m].controlled ? pm.controls++ : -1);
+  std::vector<double> constant(n + 1, 0.0);
   for (const auto& e : net.elements()) {
     if (!e->has_excitation()) continue;
-    if (!e->source_function())
+    const auto control = std::find_if(controls->begin(), controls->end(),
+                                      [&](const ControlSource& c) { return c.source == e.get(); });
+    if (control != controls->end()) continue;  // read directly (control_sources)
+    const SourceFunction* f = e->source_function();
+    if (!f)
       return error_at(e->loc(), "port model: source '" + e->name() + "' has no time function");
+    if (is_constant(*f, horizon)) {
+      std::vector<double> u(n + 1, 0.0);
+      e->stamp_unit(u.data());
+      for (int i = 1; i <= n; ++i) constant[i] += f->dc_value() * u[i];
+      pm.constant_sources.push_back({e->name(), f->dc_value()});
+      continue;
+    }
     pm.source_names.push_back(e->name());
     unit.emplace_back(n + 1, 0.0);
     e->stamp_unit(unit.back().data());
     unit.back()[0] = 0.0;
   }
+  for (const ControlSource& c : *controls) pm.control_sources.push_back({c.source->name(), c.sign});
   pm.sources = static_cast<int>(unit.size());
   std::vector<Probe> outputs = probes;
   for (const PortRef& pr : ports) {
@@ -125,7 +193,16 @@ StatusOr<PortModel> build_port_model(const std::vector<Card>& cards, const Circu
   }
   pm.ports = static_cast<int>(ports.size());
   pm.probes = static_cast<int>(probes.size());
-  for (const Probe& p : probes) pm.labels.push_back(p.label);
+  for (const Probe& p : probes) {
+    pm.labels.push_back(p.label);
+    // As the transient watches states only: a voltage source's current (a 0 V ammeter in series
+    // with a diode) is a diode's current, an exponential of a watched port voltage; watched, its
+    // steep knee drove the step to 1e-18 s on ESD scenarios.
+    auto watched = [&](int u) {
+      return u == 0 || net.unknown_is_node(u) || net.unknown_is_state(u);
+    };
+    pm.probe_watched.push_back(watched(p.a) && watched(p.b));
+  }
 
   MnaSystem sys;
   if (Status s = sys.build(net); !s.ok()) return s;
@@ -137,10 +214,26 @@ StatusOr<PortModel> build_port_model(const std::vector<Card>& cards, const Circu
     if (Status s = dc_klu.solve(x.data() + 1); !s.ok()) return s;
     x[0] = 0.0;
   }
+  if (Status s = dc_klu.solve(constant.data() + 1); !s.ok()) return s;
+  constant[0] = 0.0;
+  for (const Probe& o : outputs) pm.offset.push_back(constant[o.a] - constant[o.b]);
   ReducedModelOptions ro = options.reduced;
   ro.horizon = horizon;
   ro.edge_time = 0.0;
   StatusOr<ReducedModel> model = reduce_circuit(net, unit, dc, outputs, ro);
+  if (!model && n <= ro.full_order_at_most) {
+    // The full basis's modal form can fail its check where the eigenvectors are too
+    // ill-conditioned (a 15 m link's ground-step circuit, 1,098 unknowns: 2.5e4 at 1.5 MHz),
+    // and the Krylov search can stall where the full basis passes (its hot-plug circuits): the
+    // one is tried when the other fails.
+    ReducedModelOptions krylov = ro;
+    krylov.full_order_at_most = 0;
+    StatusOr<ReducedModel> second = reduce_circuit(net, unit, dc, outputs, krylov);
+    if (!second)
+      return Status::Error(fmt::format("port model: the full basis: {}; the Krylov search: {}",
+                                       model.status().message(), second.status().message()));
+    model = std::move(second);
+  }
   if (!model) return model.status().with_context("port model");
   for (const Cplx& p : model->poles)
     if (!(std::abs(p) > 0))
@@ -178,13 +271,15 @@ struct PortState {
   std::vector<Cplx> su, sd;         // in.u and in.d at t (per mode)
   std::vector<double> u;            // sources at t
   std::vector<double> v, d, q, jq;  // per port: voltage, current, charge, charge current
+  std::vector<double> vc;           // per control: its voltage
   std::vector<double> y;            // probes
   std::vector<double> watched;      // v, q, y: what the error control watches
-  void fill_watched() {
+  void fill_watched(const std::vector<bool>& probe_watched) {
     watched.clear();
     watched.insert(watched.end(), v.begin(), v.end());
     watched.insert(watched.end(), q.begin(), q.end());
-    watched.insert(watched.end(), y.begin(), y.end());
+    for (size_t p = 0; p < y.size(); ++p)
+      if (probe_watched[p]) watched.push_back(y[p]);
   }
 };
 
@@ -196,6 +291,16 @@ class PortMarch {
  private:
   Status initial_state();
   const StepCoefs& coefs(double h);
+  // Port m at voltage v, its control (a switch's) at vc[port_control[m]].
+  PortEval eval(int m, double v, const std::vector<double>& vc) const {
+    const int c = pm_.port_control[m];
+    return c < 0 ? port_el_[m]->eval_port(pm_.port_index[m], v)
+                 : port_el_[m]->eval_controlled_port(pm_.port_index[m], v, vc[c]);
+  }
+  // The control voltages at t (their sources' values).
+  void controls_at(double t, std::vector<double>& vc) const;
+  // Whether a switch changed state from cur_ to s1 (its end is then a corner, as a breakpoint).
+  bool control_changed(const PortState& s1) const;
   // One step of h from cur_ into next_; *converged false when Newton did not converge.
   Status advance(double h, bool euler, bool* converged);
   bool newton(const StepCoefs& c, double h, bool euler, const std::vector<double>& v_oc,
@@ -210,10 +315,12 @@ class PortMarch {
   const PortModel& pm_;
   const ReducedModel& m_;
   const TransientOptions& opt_;
-  const int q_, ns_, np_, ny_;
+  const int q_, ns_, np_, ny_, nc_;
   const double tiny_;
   const StepControl control_;
   std::vector<const SourceFunction*> sources_;
+  std::vector<const SourceFunction*> controls_;  // per control: its source
+  std::vector<double> control_sign_;
   std::vector<const Element*> port_el_;
   std::map<double, StepCoefs> cache_;
   PortState cur_, next_;
@@ -239,6 +346,7 @@ PortMarch::PortMarch(const Circuit& circuit, const PortModel& pm, const Transien
       ns_(pm.sources),
       np_(pm.ports),
       ny_(pm.probes),
+      nc_(pm.controls),
       tiny_(opt.tstop * 1e-12),
       control_{.hmax = opt.effective_tmax(),
                .hmin = std::max(1e-18, opt.tstop * 1e-13),
@@ -246,6 +354,10 @@ PortMarch::PortMarch(const Circuit& circuit, const PortModel& pm, const Transien
   for (const std::string& name : pm.source_names)
     sources_.push_back(circuit.find_element(name)->source_function());
   for (const std::string& name : pm.port_elements) port_el_.push_back(circuit.find_element(name));
+  for (const auto& [name, sign] : pm.control_sources) {
+    controls_.push_back(circuit.find_element(name)->source_function());
+    control_sign_.push_back(sign);
+  }
   jac_.resize(np_, np_);
   lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(np_);
   v_oc_.assign(np_, 0.0);
@@ -256,8 +368,9 @@ PortMarch::PortMarch(const Circuit& circuit, const PortModel& pm, const Transien
   // Absolute tolerances of the watched values: port voltages, charges, probes.
   for (int m = 0; m < np_; ++m) abs_tol_.push_back(opt.vntol);
   for (int m = 0; m < np_; ++m) abs_tol_.push_back(opt.chgtol);
-  for (const std::string& l : pm.labels)
-    abs_tol_.push_back(l.rfind("i(", 0) == 0 ? opt.abstol : opt.vntol);
+  for (size_t p = 0; p < pm.labels.size(); ++p)
+    if (pm.probe_watched[p])
+      abs_tol_.push_back(pm.labels[p].rfind("i(", 0) == 0 ? opt.abstol : opt.vntol);
 }
 
 const StepCoefs& PortMarch::coefs(double h) {
@@ -305,10 +418,11 @@ Status PortMarch::initial_state() {
   s.u.resize(ns_);
   for (int k = 0; k < ns_; ++k) s.u[k] = sources_[k]->value(0.0);
   s.v.resize(np_), s.d.resize(np_), s.q.resize(np_), s.jq.assign(np_, 0.0);
+  controls_at(0.0, s.vc);
   for (int m = 0; m < np_; ++m) {
     const NonlinearPort np = port_el_[m]->nonlinear_port(pm_.port_index[m]);
     s.v[m] = x[np.p] - x[np.n];
-    const PortEval e = port_el_[m]->eval_port(pm_.port_index[m], s.v[m]);
+    const PortEval e = eval(m, s.v[m], s.vc);
     s.d[m] = e.i - pm_.port_shunt * s.v[m];
     s.q[m] = e.q;
   }
@@ -322,7 +436,7 @@ Status PortMarch::initial_state() {
   double mismatch = 0, allowed = 0;
   s.y.resize(ny_);
   for (int o = 0; o < ny_ + np_; ++o) {
-    double y = 0;
+    double y = pm_.offset[o];
     for (int i = 0; i < q_; ++i) y += (m_.output[o][i] * s.x[i]).real();
     for (int k = 0; k < ns_; ++k) y += m_.direct[k][o] * s.u[k];
     for (int m = 0; m < np_; ++m) y += m_.direct[ns_ + m][o] * s.d[m];
@@ -339,7 +453,7 @@ Status PortMarch::initial_state() {
     return Status::Error(fmt::format(
         "port model: its DC state is {:.3g} V from the circuit's operating point at a port",
         mismatch));
-  s.fill_watched();
+  s.fill_watched(pm_.probe_watched);
   peak_.assign(s.watched.size(), 0.0);
   update_tolerances(s);
   return Status::Ok();
@@ -372,9 +486,10 @@ bool PortMarch::newton(const StepCoefs& c, double h, bool euler, const std::vect
   std::vector<double>& hq = s1.jq;  // the charge current's history part, then its value
   for (int m = 0; m < np_; ++m) hq[m] = euler ? -cur_.q[m] / h : -a0 * cur_.q[m] - cur_.jq[m];
   bool small = false, limited = true;
+  controls_at(s1.t, s1.vc);
   for (int it = 0; it <= tol.max_iterations; ++it) {
     for (int m = 0; m < np_; ++m) {
-      const PortEval e = port_el_[m]->eval_port(pm_.port_index[m], v[m]);
+      const PortEval e = eval(m, v[m], s1.vc);
       s1.q[m] = e.q;
       s1.d[m] = e.i - gs * v[m] + a0 * e.q + hq[m];
       dd_[m] = e.g - gs + a0 * e.c;
@@ -438,7 +553,7 @@ Status PortMarch::advance(double h, bool euler, bool* converged) {
   std::vector<double>& v = v_;
   for (int m = 0; m < np_; ++m) {
     const Cplx* out = m_.output[ny_ + m].data();
-    double y = 0;
+    double y = pm_.offset[ny_ + m];
     for (int i = 0; i < q_; ++i) y += (out[i] * s1.x[i]).real();
     for (int k = 0; k < ns_; ++k) y += m_.direct[k][ny_ + m] * s1.u[k];
     v_oc[m] = y;
@@ -450,7 +565,7 @@ Status PortMarch::advance(double h, bool euler, bool* converged) {
     const double r = h / (s0.t - sm.t);
     for (int m = 0; m < np_; ++m) v[m] += r * (s0.v[m] - sm.v[m]);
   }
-  s1.v.resize(np_), s1.d.resize(np_), s1.q.resize(np_), s1.jq.resize(np_);
+  s1.v.resize(np_), s1.d.resize(np_), s1.q.resize(np_), s1.jq.resize(np_), s1.vc.resize(nc_);
   *converged = newton(c, h, euler, v_oc, v);
   if (!*converged) {
     ++stats_.newton_failures;
@@ -467,7 +582,7 @@ Status PortMarch::advance(double h, bool euler, bool* converged) {
   s1.y.resize(ny_);
   for (int p = 0; p < ny_; ++p) {
     const Cplx* out = m_.output[p].data();
-    double y = 0;
+    double y = pm_.offset[p];
     for (int i = 0; i < q_; ++i) y += (out[i] * s1.x[i]).real();
     for (int k = 0; k < ns_; ++k) y += m_.direct[k][p] * s1.u[k];
     for (int m = 0; m < np_; ++m) y += m_.direct[ns_ + m][p] * s1.d[m];
@@ -476,8 +591,23 @@ Status PortMarch::advance(double h, bool euler, bool* converged) {
           fmt::format("port model: non-finite value at t={:g} s ({})", s1.t, pm_.labels[p]));
     s1.y[p] = y;
   }
-  s1.fill_watched();
+  s1.fill_watched(pm_.probe_watched);
   return Status::Ok();
+}
+
+void PortMarch::controls_at(double t, std::vector<double>& vc) const {
+  vc.resize(nc_);
+  for (int c = 0; c < nc_; ++c) vc[c] = control_sign_[c] * controls_[c]->value(t);
+}
+
+bool PortMarch::control_changed(const PortState& s1) const {
+  for (int m = 0; m < np_; ++m) {
+    const int c = pm_.port_control[m];
+    if (c >= 0 && port_el_[m]->control_state(pm_.port_index[m], cur_.vc[c]) !=
+                      port_el_[m]->control_state(pm_.port_index[m], s1.vc[c]))
+      return true;
+  }
+  return false;
 }
 
 // The transient's truncation term (trapezoidal, third divided difference over four points).
@@ -560,8 +690,11 @@ StatusOr<Waveform> PortMarch::run(PortModelStats* stats_out) {
       h = control_.ladder(h);
       continue;
     }
-    const double ratio = euler ? 0.0 : truncation_ratio(next_);
-    if (hist_count_ == 2) {
+    // A switch that changed state in this step: its end is a corner of the solution, taken as a
+    // breakpoint (no error check across it, the formula restarted after it), as the transient.
+    const bool event = nc_ > 0 && control_changed(next_);
+    const double ratio = euler || event ? 0.0 : truncation_ratio(next_);
+    if (!event && hist_count_ == 2) {
       const double ratio1 = euler_start_ratio(next_);
       if (ratio1 > 1.0) {  // undo the Euler step and this one; retry the first shorter
         stats_.rejected += 2;
@@ -605,6 +738,11 @@ StatusOr<Waveform> PortMarch::run(PortModelStats* stats_out) {
     if (!lands) last_regular_h = step;
     h = control_.grow(step, ratio);
     after_bp = false;
+    if (event && !lands) {
+      after_bp = true;
+      h = control_.ladder(0.1 * std::min(last_regular_h, bp - cur_.t));
+      hist_[0] = cur_, hist_count_ = 1;
+    }
     if (lands) {
       after_bp = true;
       const double next = next_bp + 1 < bps.size() ? bps[next_bp + 1] : tstop;
@@ -627,6 +765,14 @@ StatusOr<Waveform> run_port_model(Circuit& circuit, const PortModel& model,
   for (const std::string& name : model.source_names)
     if (!circuit.find_element(name) || !circuit.find_element(name)->source_function())
       return Status::Error("port model: built from another circuit (source " + name + ")");
+  for (const auto& [name, value] : model.constant_sources) {
+    const Element* e = circuit.find_element(name);
+    if (!e || !e->source_function() || e->source_function()->dc_value() != value)
+      return Status::Error("port model: built from another circuit (constant source " + name + ")");
+  }
+  for (const auto& [name, sign] : model.control_sources)
+    if (!circuit.find_element(name) || !circuit.find_element(name)->source_function())
+      return Status::Error("port model: built from another circuit (control source " + name + ")");
   for (const std::string& name : model.port_elements)
     if (!circuit.find_element(name))
       return Status::Error("port model: built from another circuit (element " + name + ")");

@@ -30,11 +30,12 @@
 //    relative check meaningful at the ports.
 // 2. The model (solver/reduced_model.h, Krylov projection checked against the exact AC solution
 //    of the linear network at the check frequencies, refined between them): inputs = every
-//    source (its unit excitation) and every port (a unit current drawn from p into n); outputs =
-//    every port voltage and every probe. Modes x_i' = p_i x_i + sum_k in_ki w_k, outputs
-//    y = Re sum_i out_i x_i + D w. The check is the reduced model's, at tol
-//    (PortModelOptions::reduced), for every input-output pair: the port impedance matrix, the
-//    source-to-port transfers and the probes' transfers.
+//    time-varying source (its unit excitation) and every port (a unit current drawn from p into n);
+//    outputs = every port voltage and every probe. The constant sources (supplies, biases, 0 V
+//    ammeters) are no inputs: their share of each output is the network's DC solution for them, an
+//    offset. Modes x_i' = p_i x_i + sum_k in_ki w_k, outputs y = Re sum_i out_i x_i + D w. The
+//    check is the reduced model's, at tol (PortModelOptions::reduced), for every input-output pair:
+//    the port impedance matrix, the source-to-port transfers and the probes' transfers.
 // 3. Time steps: over a step the sources are linear in t (exact for PULSE and PWL between their
 //    corners, which are breakpoints; SIN and EXP within the error control) and the port currents
 //    d are linear in t from the last point to the unknown end value (trapezoidal), or constant at
@@ -49,7 +50,9 @@
 //    exactly, so charge is conserved.
 // 4. Step control: the one StepControl (solver/step_control.h), step sizes on its ladder so the
 //    coefficients and Z_h are reused; the error estimate is the transient's truncation term
-//    (third divided difference) on the port voltages, the ports' charges and the probes, against
+//    (third divided difference) on the port voltages, the ports' charges and the probes that are
+//    states (node voltages and inductor currents, as the transient watches; not a voltage source's
+//    current), against
 //    trtol (reltol peak + vntol | chgtol | abstol), the Euler start step checked one step late.
 //    Newton's failure retries at 1/8 of the step.
 //
@@ -93,7 +96,9 @@ struct PortModelOptions {
     ReducedModelOptions r;
     r.tol = 2e-6;
     r.check_points = 48;
-    r.full_order_at_most = 500;
+    r.full_order_at_most = 1200;
+    r.difference_scale = true;
+    r.stall_tol = 1e-4;
     return r;
   }();
 };
@@ -104,10 +109,21 @@ struct PortModel {
   int sources = 0;     // model inputs 0 .. sources - 1
   int ports = 0;       // model inputs sources .. sources + ports - 1; outputs probes ..
   int probes = 0;
-  std::vector<std::string> labels;         // the probes' labels
-  std::vector<std::string> source_names;   // the circuit's source elements, in input order
+  std::vector<std::string> labels;        // the probes' labels
+  std::vector<bool> probe_watched;        // per probe: a state (node voltage, inductor current)
+  std::vector<std::string> source_names;  // the circuit's time-varying sources, in input order
+  // The constant sources (DC, or PWL without a corner before the horizon) and their values: no
+  // inputs, their share of each output is `offset`.
+  std::vector<std::pair<std::string, double>> constant_sources;
+  std::vector<double> offset;  // per output (probes, then port voltages): the constant share
   std::vector<std::string> port_elements;  // per port: its element's name
   std::vector<int> port_index;             // per port: the element's port number
+  // Per port: its control's number (a switch's), -1 for an uncontrolled port.
+  std::vector<int> port_control;
+  int controls = 0;
+  // Per control: the voltage source across the switch's control nodes and the sign of
+  // v(nc+, nc-) in its value. Not a model input (it reaches no other node).
+  std::vector<std::pair<std::string, double>> control_sources;
   double port_shunt = 0.0;
   double seconds = 0.0;  // building the model (DC solves, the reduction and its check)
 };

@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -30,11 +31,17 @@ Status ReducedModelOptions::validate() const {
   if (!(horizon > 0) || !std::isfinite(horizon)) return bad("horizon", horizon, "must be positive");
   if (!(edge_time >= 0) || !std::isfinite(edge_time))
     return bad("edge_time", edge_time, "must be zero or positive");
+  if (!(stall_tol == 0 || (stall_tol >= tol && stall_tol < 1)))
+    return bad("stall_tol", stall_tol, "must be 0 (off) or in [tol, 1)");
   return Status::Ok();
 }
 
 double ReducedModelOptions::edge_error_bound() const {
-  return tol * std::log(f_max / f_min) / std::numbers::pi;
+  return edge_error_bound(tol);
+}
+
+double ReducedModelOptions::edge_error_bound(double error) const {
+  return error * std::log(f_max / f_min) / std::numbers::pi;
 }
 
 std::complex<double> ReducedModel::transfer(size_t k, size_t p, std::complex<double> s) const {
@@ -125,6 +132,14 @@ class Reducer {
   Status modal_form(ReducedModel* mod);
   StatusOr<bool> refine_checks();
   Status expand_where_worst();
+  // The search can go no further: the check's tolerance becomes opt_.stall_tol when the error is
+  // within it (and was not already). True when relaxed.
+  bool relax() {
+    if (!(opt_.stall_tol > tol_) || !(model_.stats.error <= opt_.stall_tol)) return false;
+    tol_ = opt_.stall_tol;
+    relaxed_ = true;
+    return true;
+  }
 
   const Circuit& circuit_;
   AcAnalysis& ac_;
@@ -134,7 +149,9 @@ class Reducer {
   const ReducedModelOptions& opt_;
   const int n_;
   const size_t nk_, np_;
-  std::vector<double> row_sign_;       // per unknown 1..n (index 0 = unknown 1): +1 or -1
+  double tol_;                    // the check's tolerance: opt_.tol, or opt_.stall_tol once relaxed
+  bool relaxed_ = false;          // relax() took it
+  std::vector<double> row_sign_;  // per unknown 1..n (index 0 = unknown 1): +1 or -1
   Eigen::SparseMatrix<double> g_, c_;  // the pencil in this sign form
   ReducedModelStats st_;               // factorizations and expansion points so far
   ReducedModel model_;                 // the last model built: its stats; poles when modal_
@@ -149,6 +166,9 @@ class Reducer {
   std::vector<double> freqs_;   // the check frequencies
   std::vector<std::vector<std::vector<Cplx>>> exact_;  // [check][k][p]
   std::vector<std::vector<double>> scale_;             // [k][p]: peak |H| with DC
+  // [k][p]: the peak over the grid and DC of max(|H_ka|, |H_kb|), probe p = v(a, b): what its
+  // nodes carry (opt_.difference_scale).
+  std::vector<std::vector<double>> node_scale_;
   Basis basis_;
   Eigen::MatrixXd gr_, cr_;  // V'GV and V'CV over the basis so far
   int max_order_ = 0;
@@ -169,13 +189,17 @@ Reducer::Reducer(const Circuit& circuit, AcAnalysis& ac,
       opt_(opt),
       n_(circuit.unknown_count()),
       nk_(excitations.size()),
-      np_(probes.size()) {
+      np_(probes.size()),
+      tol_(opt.tol) {
   assemble_pencil(passive_form);
   scale_.assign(nk_, std::vector<double>(np_, 0.0));
+  node_scale_.assign(nk_, std::vector<double>(np_, 0.0));
   for (size_t k = 0; k < nk_; ++k)
-    for (size_t p = 0; p < np_; ++p)
-      scale_[k][p] = std::max(
-          1e-15, std::fabs(dc_solutions_[k][probes_[p].a] - dc_solutions_[k][probes_[p].b]));
+    for (size_t p = 0; p < np_; ++p) {
+      const double a = dc_solutions_[k][probes_[p].a], b = dc_solutions_[k][probes_[p].b];
+      scale_[k][p] = std::max(1e-15, std::fabs(a - b));
+      node_scale_[k][p] = std::max(std::fabs(a), std::fabs(b));
+    }
   // The basis and its images are three dense n x q arrays: at most kMaxBasisBytes in all (their
   // capacity, grown by doubling, at most twice that).
   constexpr double kMaxBasisBytes = 384.0 * (1 << 20);
@@ -218,14 +242,19 @@ void Reducer::assemble_pencil(bool passive_form) {
 // drives two sources and reads one probe).
 Status Reducer::add_checks(const std::vector<double>& fs) {
   const bool transposed = np_ < nk_;
-  std::vector<AcAnalysis::Vector> probe_rows;  // l_p, when transposed
-  std::vector<std::vector<int>> source_rows;   // the unknowns where e_k is not 0
+  // When transposed, a node's row e_u per probe node (u = 0: ground, no row): H_kp is the
+  // difference of its two nodes' transfers, and node_scale_ the larger of them.
+  std::vector<std::array<AcAnalysis::Vector, 2>> node_rows;
+  std::vector<std::vector<int>> source_rows;  // the unknowns where e_k is not 0
   if (transposed) {
     for (size_t p = 0; p < np_; ++p) {
-      AcAnalysis::Vector& l = probe_rows.emplace_back(static_cast<size_t>(n_) + 1, 0.0);
-      l[probes_[p].a] += 1.0;
-      l[probes_[p].b] -= 1.0;
-      l[0] = 0.0;
+      std::array<AcAnalysis::Vector, 2>& rows = node_rows.emplace_back();
+      for (int side = 0; side < 2; ++side) {
+        const int u = side == 0 ? probes_[p].a : probes_[p].b;
+        if (u == 0) continue;
+        rows[side].assign(static_cast<size_t>(n_) + 1, 0.0);
+        rows[side][u] = 1.0;
+      }
     }
     for (size_t k = 0; k < nk_; ++k) {
       std::vector<int>& rows = source_rows.emplace_back();
@@ -239,22 +268,33 @@ Status Reducer::add_checks(const std::vector<double>& fs) {
     freqs_.push_back(f);
     exact_.emplace_back(nk_, std::vector<Cplx>(np_));
     std::vector<std::vector<Cplx>>& h = exact_.back();
+    // Per source and probe: the transfers to the probe's nodes a and b (0 for ground).
+    auto take = [&](size_t k, size_t p, Cplx at_a, Cplx at_b) {
+      h[k][p] = at_a - at_b;
+      scale_[k][p] = std::max(scale_[k][p], std::abs(h[k][p]));
+      node_scale_[k][p] = std::max({node_scale_[k][p], std::abs(at_a), std::abs(at_b)});
+    };
     if (transposed) {
       for (size_t p = 0; p < np_; ++p) {
-        const AcAnalysis::Vector z = ac_.solve_transposed(probe_rows[p]);
-        for (size_t k = 0; k < nk_; ++k)
-          for (int i : source_rows[k]) h[k][p] += z[i] * excitations_[k][i];
+        std::array<std::vector<Cplx>, 2> at;  // [side][k]
+        for (int side = 0; side < 2; ++side) {
+          at[side].assign(nk_, 0.0);
+          if (node_rows[p][side].empty()) continue;
+          const AcAnalysis::Vector z = ac_.solve_transposed(node_rows[p][side]);
+          for (size_t k = 0; k < nk_; ++k)
+            for (int i : source_rows[k]) at[side][k] += z[i] * excitations_[k][i];
+        }
+        for (size_t k = 0; k < nk_; ++k) take(k, p, at[0][k], at[1][k]);
       }
     } else {
       for (size_t k = 0; k < nk_; ++k) {
         AcAnalysis::Vector b(excitations_[k].begin(), excitations_[k].end());
         b[0] = 0.0;
         const AcAnalysis::Vector x = ac_.solve_factored(b);
-        for (size_t p = 0; p < np_; ++p) h[k][p] = x[probes_[p].a] - x[probes_[p].b];
+        for (size_t p = 0; p < np_; ++p)
+          take(k, p, probes_[p].a ? x[probes_[p].a] : 0.0, probes_[p].b ? x[probes_[p].b] : 0.0);
       }
     }
-    for (size_t k = 0; k < nk_; ++k)
-      for (size_t p = 0; p < np_; ++p) scale_[k][p] = std::max(scale_[k][p], std::abs(h[k][p]));
   }
   return Status::Ok();
 }
@@ -389,7 +429,8 @@ double Reducer::error_at(size_t f) const {
     double strongest = 0;
     for (size_t k = 0; k < nk_; ++k) strongest = std::max(strongest, scale_[k][p]);
     for (size_t k = 0; k < nk_; ++k) {
-      const double scale = std::max(scale_[k][p], 1e-6 * strongest);
+      double scale = std::max(scale_[k][p], 1e-6 * strongest);
+      if (opt_.difference_scale) scale = std::max(scale, node_scale_[k][p]);
       const double x = weight * std::abs(h(k, p) - exact_[f][k][p]) / scale;
       if (!(x <= e)) e = x;  // a NaN sticks: such a model never passes
     }
@@ -499,7 +540,7 @@ StatusOr<bool> Reducer::accept() {
   model_ = std::move(mod);
   modal_ = true;
   measure();
-  if (model_.stats.error <= opt_.tol) return true;
+  if (model_.stats.error <= tol_) return true;
   modal_each_step_ = true;
   return false;
 }
@@ -586,7 +627,7 @@ StatusOr<bool> Reducer::refine_checks() {
   for (size_t f = before; f < freqs_.size(); ++f) {
     const double e = error_at(f);
     errors_.push_back(e);
-    if (e > opt_.tol) {
+    if (e > tol_) {
       const auto it = std::find_if(open_.begin(), open_.end(), [&](const auto& iv) {
         return iv.first < freqs_[f] && freqs_[f] < iv.second;
       });
@@ -596,7 +637,7 @@ StatusOr<bool> Reducer::refine_checks() {
     if (!(e <= worst)) worst = e, worst_f = freqs_[f];
   }
   open_ = std::move(next);
-  if (worst <= opt_.tol) return true;
+  if (worst <= tol_) return true;
   model_.stats.error = worst;
   model_.stats.error_frequency = worst_f;
   return false;
@@ -612,14 +653,14 @@ Status Reducer::expand_where_worst() {
   for (size_t f = 0; f < freqs_.size(); ++f) {
     const double e = errors_[f];
     by_f.emplace_back(freqs_[f], e);
-    if (e > opt_.tol) ranked.emplace_back(e, freqs_[f]);
+    if (e > tol_) ranked.emplace_back(e, freqs_[f]);
   }
   std::sort(ranked.rbegin(), ranked.rend());
   std::sort(by_f.begin(), by_f.end());
   std::vector<std::pair<double, double>> peaks;  // (error, f): local maxima over tol
   for (size_t i = 0; i < by_f.size(); ++i) {
     const double e = by_f[i].second;
-    if (e > opt_.tol && !(i > 0 && by_f[i - 1].second > e) &&
+    if (e > tol_ && !(i > 0 && by_f[i - 1].second > e) &&
         !(i + 1 < by_f.size() && by_f[i + 1].second > e))
       peaks.emplace_back(e, by_f[i].first);
   }
@@ -646,6 +687,7 @@ Status Reducer::expand_where_worst() {
     used_.push_back(next->second);
     ++taken;
   }
+  if (!grew && relax()) return Status::Ok();
   if (!grew)
     return Status::Error(fmt::format(
         "reduced model: error {:.2g} at {:.4g} Hz and no expansion point adds a new direction "
@@ -661,7 +703,7 @@ StatusOr<ReducedModel> Reducer::run() {
   if (Status s = expand_at_first_points(); !s.ok()) return s;
   while (true) {
     if (Status s = build(); !s.ok()) return s;
-    if (model_.stats.error <= opt_.tol) {
+    if (model_.stats.error <= tol_) {
       StatusOr<bool> done = refine_checks();
       if (!done) return done.status();
       if (*done) {
@@ -670,6 +712,8 @@ StatusOr<ReducedModel> Reducer::run() {
         if (*accepted) break;
       }
     }
+    if ((static_cast<int>(used_.size()) >= opt_.max_points || basis_.q >= max_order_) && relax())
+      continue;
     if (static_cast<int>(used_.size()) >= opt_.max_points || basis_.q >= max_order_)
       return Status::Error(fmt::format(
           "reduced model: error {:.2g} at {:.4g} Hz after {} expansion points (order {}), over "
@@ -682,6 +726,8 @@ StatusOr<ReducedModel> Reducer::run() {
   model_.stats.expansion_points = st_.expansion_points;
   model_.stats.steps = st_.steps;
   model_.stats.points = used_;
+  model_.stats.tol = tol_;
+  model_.stats.relaxed = relaxed_;
   return model_;
 }
 

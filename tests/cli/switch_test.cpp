@@ -1,7 +1,8 @@
 // S (the voltage-controlled switch, solver/elements/switch.cpp): a 10 V source closing onto
 // 1 nF + 1 Mohm through a 100 ohm contact at 1 us and opening at 2 us, against the RC closed form
-// and ngspice (its SW model, the same netlist); auto falls back from the port model to the full
-// transient; the model's refusals at file:line:col.
+// and ngspice (its SW model, the same netlist), on both engines that run a switch: auto takes the
+// port model (the switch's control is a PWL source of its own, read directly) and the full
+// transient when asked; the model's refusals at file:line:col.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -24,16 +25,19 @@ double at_time(const Waveform& w, size_t k, double t) {
   return w.columns[k][j - 1] + f * (w.columns[k][j] - w.columns[k][j - 1]);
 }
 
-TEST(Switch, ClosesAnRcAgainstTheClosedFormAndNgspice) {
+class SwitchEngines : public ::testing::TestWithParam<analysis::Engine> {};
+
+TEST_P(SwitchEngines, ClosesAnRcAgainstTheClosedFormAndNgspice) {
   const std::string path = kData + "/switch_rc.cir";
   auto netlist = read_spice_file(path);
   ASSERT_TRUE(netlist.ok()) << netlist.status().message();
   const std::vector<std::string> probes{"v(c)", "i(vam)"};
-  analysis::SimulationRequest req{.probes = probes, .reltol = 1e-6};
+  analysis::SimulationRequest req{.probes = probes, .reltol = 1e-6, .engine = GetParam()};
   auto r = analysis::simulate_netlist(*netlist, req);
   ASSERT_TRUE(r.ok()) << r.status().message();
-  EXPECT_EQ(r->engine, analysis::Engine::Transient) << r->engine_note;
-  EXPECT_NE(r->engine_note.find("voltage-controlled switch"), std::string::npos) << r->engine_note;
+  EXPECT_EQ(r->engine, GetParam() == analysis::Engine::Auto ? analysis::Engine::PortModel
+                                                            : analysis::Engine::Transient)
+      << r->engine_note;
   // Closed form. Off (1e12 ohm against 1 Mohm): v = 10 V * 1e6 / (1e6 + 1e12) = 10 uV. From
   // t0 = 1 us (the control crosses 0.5 V 0.5 ps later) through 100 ohm || 1 Mohm:
   // v = v_inf + (v0 - v_inf) e^(-(t - t0) / tau), v_inf = 10 * 1e6 / (1e6 + 100), tau = C R || R.
@@ -71,10 +75,16 @@ TEST(Switch, ClosesAnRcAgainstTheClosedFormAndNgspice) {
   EXPECT_LT(dv, 5e-3);
   EXPECT_NEAR(ng_peak, peak, 1e-3);
   std::printf(
-      "switch_rc: closed form within %.3f mV; ngspice v(c) within %.3f mV, i(vam) %.3f mA "
+      "switch_rc (%s): closed form within %.3f mV; ngspice v(c) within %.3f mV, i(vam) %.3f mA "
       "after 1.01 us, peak %.5f A (ngspice %.5f A)\n",
-      worst * 1e3, dv * 1e3, di * 1e3, peak, ng_peak);
+      analysis::engine_name(r->engine), worst * 1e3, dv * 1e3, di * 1e3, peak, ng_peak);
 }
+
+INSTANTIATE_TEST_SUITE_P(Engines, SwitchEngines,
+                         ::testing::Values(analysis::Engine::Auto, analysis::Engine::Transient),
+                         [](const ::testing::TestParamInfo<analysis::Engine>& param) {
+                           return std::string(analysis::engine_name(param.param));
+                         });
 
 TEST(Switch, RefusesHysteresisAndBadResistances) {
   const std::pair<const char*, const char*> bad[] = {
