@@ -163,7 +163,14 @@ StatusOr<PortModel> build_port_model(const std::vector<Card>& cards, const Circu
     if (!e->has_excitation()) continue;
     const auto control = std::find_if(controls->begin(), controls->end(),
                                       [&](const ControlSource& c) { return c.source == e.get(); });
-    if (control != controls->end()) continue;  // read directly (control_sources)
+    // Read directly (control_sources), and no input unless a probe reads its nodes.
+    if (control != controls->end() &&
+        std::none_of(probes.begin(), probes.end(), [&](const Probe& p) {
+          for (int u : e->nodes())
+            if (u != 0 && (p.a == u || p.b == u)) return true;
+          return false;
+        }))
+      continue;
     const SourceFunction* f = e->source_function();
     if (!f)
       return error_at(e->loc(), "port model: source '" + e->name() + "' has no time function");

@@ -303,6 +303,11 @@ TEST(PortModel, SwitchedHotPlugMatchesTheFullTransient) {
     EXPECT_NEAR(pmin, fmin, 3e-3 + 2e-4 * std::fabs(fmin)) << k;
     EXPECT_NEAR(r.port.columns[k].back(), r.full.columns[k].back(), 3e-3) << k;
   }
+  // A probe on the control's own node: the source is then an input too, so the probe reads it.
+  Runs c = both(hot_plug(30), {"v(ctl)"}, {.tstep = 1e-9, .tstop = 1e-6});
+  ASSERT_GT(c.port.samples(), 10u);
+  EXPECT_NEAR(c.port.columns[0].front(), 0.0, 1e-9);
+  EXPECT_NEAR(c.port.columns[0].back(), 1.0, 1e-6);
   // The switch did close: the line swings by volts (the module's 30 V through its clamps).
   double swing = 0;
   for (double v : r.port.columns[0]) swing = std::max(swing, std::fabs(v));
