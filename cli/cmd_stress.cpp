@@ -77,6 +77,11 @@ analysis::StressOptions stress_options(const StressArgs& a, const std::vector<st
   return so;
 }
 
+// -o, or reports/out/NAME-stress.
+std::string report_dir(const StressArgs& a, const std::string& name) {
+  return a.out_dir.empty() ? "reports/out/" + safe_path_component(name) + "-stress" : a.out_dir;
+}
+
 // report.json and report.md into the bundle.
 Status write_reports(const OutputBundle& bundle, const nlohmann::ordered_json& j,
                      const std::string& md) {
@@ -95,8 +100,7 @@ int run_pack_stress(const StressArgs& a, const std::vector<std::string>& only) {
   if (!pack) return fail(pack.status());
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load(a.part_dirs);
   if (!parts) return fail(parts.status());
-  const std::string dir =
-      a.out_dir.empty() ? "reports/out/" + safe_path_component(pack->name) + "-stress" : a.out_dir;
+  const std::string dir = report_dir(a, pack->name);
   StatusOr<OutputBundle> bundle = OutputBundle::open(dir, {"report.md", "report.json"});
   if (!bundle) return fail(bundle.status());
   ProgressLine line({.label = "isolink stress", .enabled = !a.quiet && !a.json});
@@ -137,8 +141,7 @@ int run_stress(const StressArgs& a) {
   if (!spec) return fail(spec.status());
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load(a.part_dirs);
   if (!parts) return fail(parts.status());
-  const std::string dir =
-      a.out_dir.empty() ? "reports/out/" + safe_path_component(spec->name) + "-stress" : a.out_dir;
+  const std::string dir = report_dir(a, spec->name);
   // The report folder appears whole or not at all; opened before the (long) runs so a bad -o
   // is reported at once.
   StatusOr<OutputBundle> bundle =

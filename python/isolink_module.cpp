@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -80,6 +81,37 @@ void set_direction(link::LinkSpec& spec, const std::optional<std::string>& d) {
   if (d == "down") spec.stimulus.directions = {link::Direction::kDown};
   if (d == "up") spec.stimulus.directions = {link::Direction::kUp};
   if (d == "both") spec.stimulus.directions = {link::Direction::kDown, link::Direction::kUp};
+}
+
+// A link analysis's inputs and result (run_on_link).
+template <class Result>
+struct OnLink {
+  link::LinkSpec spec;
+  Result result;
+};
+
+// Reads the link spec (direction= applied) and the part library, then runs `analyse` on them,
+// all without the GIL (the work holds no Python object); raises the first error, the analysis's
+// with the spec's place.
+template <class Result>
+OnLink<Result> run_on_link(
+    const SpecArg& arg, const Strings& parts_dirs, const std::optional<std::string>& direction,
+    const std::function<StatusOr<Result>(const link::LinkSpec&, const link::PartLibrary&)>&
+        analyse) {
+  StatusOr<link::LinkSpec> spec = Status::Error("not read");
+  StatusOr<link::PartLibrary> parts = Status::Error("not read");
+  StatusOr<Result> r = Status::Error("not run");
+  {
+    py::gil_scoped_release nogil;
+    spec = read_link(arg);
+    if (spec) set_direction(*spec, direction);
+    if (spec) parts = link::PartLibrary::load(parts_dirs);
+    if (spec && parts) r = analyse(*spec, *parts);
+  }
+  if (!spec) raise(spec.status());
+  if (!parts) raise(parts.status());
+  if (!r) raise(r.status().with_context(arg.where()));
+  return {std::move(*spec), std::move(*r)};
 }
 
 Strings sim_warnings(const analysis::LinkRun& run) {
@@ -145,60 +177,37 @@ py::object worst(const py::object& spec_obj, const std::optional<std::string>& d
   const SpecArg arg = spec_arg(spec_obj, "spec");
   analysis::WorstOptions opt;
   if (edge_engine == "transient") opt.edge_engine = analysis::WorstOptions::EdgeEngine::Transient;
-  StatusOr<link::LinkSpec> spec = Status::Error("not read");
-  StatusOr<link::PartLibrary> parts = Status::Error("not read");
-  StatusOr<analysis::WorstResult> w = Status::Error("not run");
-  {
-    py::gil_scoped_release nogil;
-    spec = read_link(arg);
-    if (spec) set_direction(*spec, direction);
-    if (spec) parts = link::PartLibrary::load(parts_dirs);
-    if (spec && parts) w = analysis::worst_case(*spec, *parts, opt);
-  }
-  if (!spec) raise(spec.status());
-  if (!parts) raise(parts.status());
-  if (!w) raise(w.status().with_context(arg.where()));
-  return to_python(reports::worst_json(*w));
+  const OnLink<analysis::WorstResult> w = run_on_link<analysis::WorstResult>(
+      arg, parts_dirs, direction, [&](const link::LinkSpec& spec, const link::PartLibrary& parts) {
+        return analysis::worst_case(spec, parts, opt);
+      });
+  return to_python(reports::worst_json(w.result));
 }
 
 // isolink.noise: `isolink noise SPEC --json`.
 py::object noise(const py::object& spec_obj, const Strings& parts_dirs) {
   const SpecArg arg = spec_arg(spec_obj, "spec");
-  StatusOr<link::LinkSpec> spec = Status::Error("not read");
-  StatusOr<link::PartLibrary> parts = Status::Error("not read");
-  StatusOr<analysis::NoiseRun> nr = Status::Error("not run");
-  {
-    py::gil_scoped_release nogil;
-    spec = read_link(arg);
-    if (spec) parts = link::PartLibrary::load(parts_dirs);
-    if (spec && parts) nr = analysis::run_noise(*spec, *parts);
-  }
-  if (!spec) raise(spec.status());
-  if (!parts) raise(parts.status());
-  if (!nr) raise(nr.status().with_context(arg.where()));
-  py::object out = to_python(reports::noise_json(nr->noise));
-  warn_once(sim_warnings(nr->run));
+  const OnLink<analysis::NoiseRun> nr = run_on_link<analysis::NoiseRun>(
+      arg, parts_dirs, std::nullopt,
+      [](const link::LinkSpec& spec, const link::PartLibrary& parts) {
+        return analysis::run_noise(spec, parts);
+      });
+  py::object out = to_python(reports::noise_json(nr.result.noise));
+  warn_once(sim_warnings(nr.result.run));
   return out;
 }
 
 // isolink.stress: `isolink stress SPEC --json`.
 py::object stress(const py::object& spec_obj, const Strings& only, const Strings& parts_dirs) {
   const SpecArg arg = spec_arg(spec_obj, "spec");
-  StatusOr<link::LinkSpec> spec = Status::Error("not read");
-  StatusOr<link::PartLibrary> parts = Status::Error("not read");
-  StatusOr<analysis::StressResult> r = Status::Error("not run");
-  {
-    py::gil_scoped_release nogil;
-    spec = read_link(arg);
-    if (spec) parts = link::PartLibrary::load(parts_dirs);
-    analysis::StressOptions so;
-    so.only = only;
-    if (spec && parts) r = analysis::run_stress(*spec, *parts, so);
-  }
-  if (!spec) raise(spec.status());
-  if (!parts) raise(parts.status());
-  if (!r) raise(r.status().with_context(arg.where()));
-  return to_python(reports::stress_json(spec->name, *r));
+  analysis::StressOptions so;
+  so.only = only;
+  const OnLink<analysis::StressResult> r = run_on_link<analysis::StressResult>(
+      arg, parts_dirs, std::nullopt,
+      [&](const link::LinkSpec& spec, const link::PartLibrary& parts) {
+        return analysis::run_stress(spec, parts, so);
+      });
+  return to_python(reports::stress_json(r.spec.name, r.result));
 }
 
 // isolink.sim: `isolink sim NETLIST --probe ...`'s columns as numpy arrays.

@@ -18,12 +18,6 @@ constexpr int kW = 1800, kH = 1650, kFont = 20;
 constexpr Color kDirColor[2] = {kSeriesP, kSeriesN};
 constexpr Color kLimit = kFail;
 
-std::string si_label(double v) {
-  std::string s = link::format_si(v, "");
-  while (!s.empty() && s.back() == ' ') s.pop_back();
-  return s;
-}
-
 struct Panel {
   PlotArea area;
   AxisTicks xt, yt;

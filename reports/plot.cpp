@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "base/file_io.h"
+#include "netlists/link/cards.h"
 #include "reports/image_plugin.h"
 
 namespace isolink::reports {
@@ -648,6 +649,12 @@ AxisTicks make_ticks(const Axis& a, const UnitScale& u, int target) {
   const double lo = std::min(a.lo, a.hi), hi = std::max(a.lo, a.hi);
   const double step = nice_step(hi - lo, target);
   return ticks_at(tick_values(lo, hi, step), step, u);
+}
+
+std::string si_label(double v) {
+  std::string s = link::format_si(v, "");
+  while (!s.empty() && s.back() == ' ') s.pop_back();
+  return s;
 }
 
 AxisTicks decade_ticks(double lo, double hi, const std::string& unit,

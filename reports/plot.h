@@ -237,6 +237,9 @@ struct AxisTicks {
 AxisTicks make_ticks(const Axis& a, const UnitScale& u, int target = 8);
 // Ticks at the given values.
 AxisTicks ticks_at(std::vector<double> values, double step, const UnitScale& u);
+// A value with an SI prefix and neither space nor unit ("1M", "2.5k", "100m"): the decade labels
+// of decade_ticks on frequency and magnitude axes.
+std::string si_label(double v);
 // Ticks at the decades 10^k inside [lo, hi], for an axis of log10 values, each labelled
 // label(10^k) (e.g. "1M" on an axis titled in Hz).
 AxisTicks decade_ticks(double lo, double hi, const std::string& unit,

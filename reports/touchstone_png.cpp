@@ -6,7 +6,6 @@
 #include <cmath>
 #include <numbers>
 
-#include "netlists/link/cards.h"
 #include "reports/plot.h"
 
 namespace isolink::reports {
@@ -58,12 +57,6 @@ std::vector<double> unwrapped_deg(const std::vector<Cx>& v) {
     out.push_back((a + offset) * 180 / std::numbers::pi);
   }
   return out;
-}
-
-std::string si_label(double v) {
-  std::string s = link::format_si(v, "");
-  while (!s.empty() && s.back() == ' ') s.pop_back();
-  return s;
 }
 
 struct Panel {

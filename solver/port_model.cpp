@@ -572,7 +572,7 @@ Status PortMarch::advance(double h, bool euler, bool* converged) {
     const double r = h / (s0.t - sm.t);
     for (int m = 0; m < np_; ++m) v[m] += r * (s0.v[m] - sm.v[m]);
   }
-  s1.v.resize(np_), s1.d.resize(np_), s1.q.resize(np_), s1.jq.resize(np_), s1.vc.resize(nc_);
+  s1.v.resize(np_), s1.d.resize(np_), s1.q.resize(np_), s1.jq.resize(np_);
   *converged = newton(c, h, euler, v_oc, v);
   if (!*converged) {
     ++stats_.newton_failures;

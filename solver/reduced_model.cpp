@@ -242,15 +242,24 @@ void Reducer::assemble_pencil(bool passive_form) {
 // drives two sources and reads one probe).
 Status Reducer::add_checks(const std::vector<double>& fs) {
   const bool transposed = np_ < nk_;
-  // When transposed, a node's row e_u per probe node (u = 0: ground, no row): H_kp is the
-  // difference of its two nodes' transfers, and node_scale_ the larger of them.
+  // When transposed, per probe: with difference_scale, a row e_u per probe node (u = 0:
+  // ground, no row), H_kp the difference of the two nodes' transfers and node_scale_ the larger;
+  // without it, one row l_p (one solve per probe, as the LTI engine's checks need).
   std::vector<std::array<AcAnalysis::Vector, 2>> node_rows;
   std::vector<std::vector<int>> source_rows;  // the unknowns where e_k is not 0
   if (transposed) {
     for (size_t p = 0; p < np_; ++p) {
       std::array<AcAnalysis::Vector, 2>& rows = node_rows.emplace_back();
+      const int a = probes_[p].a, b = probes_[p].b;
+      if (!opt_.difference_scale) {
+        rows[0].assign(static_cast<size_t>(n_) + 1, 0.0);
+        rows[0][a] += 1.0;
+        rows[0][b] -= 1.0;
+        rows[0][0] = 0.0;
+        continue;
+      }
       for (int side = 0; side < 2; ++side) {
-        const int u = side == 0 ? probes_[p].a : probes_[p].b;
+        const int u = side == 0 ? a : b;
         if (u == 0) continue;
         rows[side].assign(static_cast<size_t>(n_) + 1, 0.0);
         rows[side][u] = 1.0;
