@@ -167,6 +167,11 @@ Status Reader::keyword(const std::string& line, int line_no) {
   } else if (key == "number of ports") {
     StatusOr<Token> a = arg(0);
     if (!a) return a.status();
+    // Once: [Reference], the matrix and the data already read are sized by the first.
+    if (out_.ports > 0)
+      return error(*a,
+                   fmt::format("[Number of Ports] again (it was {}): the standard gives it once",
+                               out_.ports));
     StatusOr<double> v = number(*a);
     if (!v) return v.status();
     if (Status s = set_ports(std::floor(*v) == *v && *v < 1e6 ? static_cast<int>(*v) : -1, *a);

@@ -117,6 +117,13 @@ TEST(Touchstone, ErrorsNameLineAndColumn) {
                 .rfind("x.s4p:2:1: error: the point at this frequency has 9 of its 33 values", 0),
             0u);
   EXPECT_NE(error_of("", "x.s2p").find("no network data"), std::string::npos);
+  // A second [Number of Ports] after data sized by the first (fuzz_touchstone's finding: the
+  // reference impedances were then read past their end).
+  EXPECT_EQ(error_of("[Version] 2.0\n# Hz S RI\n[Number of Ports] 2\n[Reference] 50 50\n"
+                     "[Network Data]\n1e6 0.1 0 0.9 0 0.9 0 0.1 0\n[Number of Ports] 3\n[End]\n",
+                     "m.ts")
+                .rfind("m.ts:7:19: error: [Number of Ports] again (it was 2)", 0),
+            0u);
 }
 
 TEST(Touchstone, WriterReadsBack) {
