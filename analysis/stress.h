@@ -94,6 +94,17 @@ struct DiodePeak {
   std::string rating_source;
 };
 
+// A hot-plug contact's current (its ammeter "vcontact<p|n>am", positive from the cable into the
+// plugged module).
+struct ContactPeak {
+  std::string contact;  // the switch card ("scontactp")
+  std::string ammeter;  // the 0 V source in series
+  // The inrush: the largest |mean i| over any 1 ns (the contact's closing time; the
+  // instantaneous peak of an ideal contact is the time step's, not the circuit's).
+  double peak_1ns_a = 0;
+  double charge_c = 0;  // integral of i dt over the record: the charge moved into the module
+};
+
 struct CapPeak {
   std::string cap;    // "ctxisop"
   double peak_v = 0;  // largest |v| across it
@@ -128,6 +139,7 @@ struct StressScenario {
   std::string peak_cm_device;                     // "rx" / "tx" (nodes' prefix)
   std::vector<DiodePeak> diodes;
   std::vector<CapPeak> caps;
+  std::vector<ContactPeak> contacts;          // hot_plug: its two contacts, first one first
   std::optional<StressTraffic> traffic;       // scenarios with traffic
   std::string receiver_p, receiver_n, rules;  // with traffic: the receiving pins and rule set
   bool survives = true;

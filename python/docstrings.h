@@ -144,7 +144,7 @@ Args:
 Returns:
     `isolink stress --json`'s object: {"verdict", "survives", "communicates", "limits": {KEY:
     {"value", "source"}}, "scenarios": [{"id", "kind", "end", "line", "level", "peak_pin_v":
-    {NODE: {"max", "min"}}, "diodes", "isolation_caps", "traffic", "survives", "communicates",
+    {NODE: {"max", "min"}}, "diodes", "isolation_caps", "contacts" (hot_plug), "traffic", "survives", "communicates",
     "first_broken", ...}]}, in SI units.)doc";
 
 inline constexpr const char* kCheck = R"doc(Score a differential waveform against receiver rules.

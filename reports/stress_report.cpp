@@ -50,6 +50,15 @@ ordered_json scenario_json(const analysis::StressScenario& s, const std::string&
   for (const analysis::CapPeak& c : s.caps)
     caps.push_back({{"cap", c.cap}, {"peak_V", num(c.peak_v)}});
   j["isolation_caps"] = caps;
+  if (!s.contacts.empty()) {
+    ordered_json contacts = ordered_json::array();
+    for (const analysis::ContactPeak& c : s.contacts)
+      contacts.push_back({{"contact", c.contact},
+                          {"probe", "i(" + c.ammeter + ")"},
+                          {"peak_1ns_A", num(c.peak_1ns_a)},
+                          {"charge_C", num(c.charge_c)}});
+    j["contacts"] = contacts;
+  }
   if (s.traffic) {
     j["receiver"] = {{"p", s.receiver_p}, {"n", s.receiver_n}, {"rules", s.rules}};
     const analysis::StressTraffic& t = *s.traffic;
@@ -139,6 +148,11 @@ std::string stress_markdown(const std::string& spec_name, const analysis::Stress
     }
     for (const analysis::CapPeak& c : s.caps)
       md += fmt::format("- isolation cap `{}`: peak {:.4g} V\n", c.cap, c.peak_v);
+    for (const analysis::ContactPeak& c : s.contacts)
+      md += fmt::format(
+          "- contact `{}`: inrush {} (largest mean over 1 ns), {} moved into the "
+          "module\n",
+          c.contact, link::format_si(c.peak_1ns_a, "A"), link::format_si(c.charge_c, "C"));
     if (s.traffic) {
       const analysis::StressTraffic& t = *s.traffic;
       md += fmt::format(

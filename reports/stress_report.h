@@ -7,7 +7,9 @@
 // JSON shape (issue 42): {"spec", "verdict", "survives", "communicates", "limits": {KEY:
 // {"value", "source"}}, "scenarios": [{"id", "kind", "end", "line", "level": {KEY_UNIT: v},
 // "description", "window_s": [start, end], "peak_pin_v": {NODE: {"max", "min"}}, "pin_ground":
-// {NODE: GROUND}, "peak_cm_V", "diodes": [...], "isolation_caps": [...], "receiver": {"p", "n",
+// {NODE: GROUND}, "peak_cm_V", "diodes": [...], "isolation_caps": [...], hot_plug's "contacts":
+// [{"contact", "probe", "peak_1ns_A", "charge_C"}] (current positive into the plugged module),
+// "receiver": {"p", "n",
 // "rules"}, "traffic": {...}, "survives", "communicates", "first_broken", "broken", "engine",
 // "seconds", "netlist"}]}.
 

@@ -8,6 +8,8 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <optional>
+#include <utility>
 
 #include "solver/elements/source_function.h"
 #include "solver/mna.h"
@@ -95,6 +97,47 @@ bool is_constant(const SourceFunction& f, double horizon) {
   using Kind = SourceFunction::Kind;
   if (f.kind() == Kind::Dc) return true;
   return f.kind() == Kind::Pwl && f.piecewise_linear() && f.ramps(horizon).empty();
+}
+
+// Probe `p` when it is the current of a voltage source in series with a port's element: one of
+// the source's nodes is touched by the two alone, and the element's current enters at one
+// terminal and leaves at the other (a diode: its port from the anode, or the internal node
+// behind its series resistance, to the cathode; a switch: its port across its two switched
+// terminals, its control terminals drawing nothing). The source's current is then the port's,
+// with the sign returned (PortModel::PortCurrentProbe).
+std::optional<std::pair<int, double>> series_port_current(const Circuit& circuit,
+                                                          const std::vector<PortRef>& ports,
+                                                          const Probe& p) {
+  if (p.b != 0 || p.a == 0 || circuit.unknown_is_node(p.a)) return std::nullopt;
+  const Element* source = nullptr;
+  for (const auto& e : circuit.elements())
+    if (e->has_excitation() && e->branch_count() == 1 && e->branches()[0] == p.a &&
+        e->nodes().size() == 2)
+      source = e.get();
+  if (source == nullptr) return std::nullopt;
+  std::map<int, int> touched;
+  for (const auto& e : circuit.elements())
+    for (int u : e->nodes()) ++touched[u];
+  for (size_t m = 0; m < ports.size(); ++m) {
+    const PortRef& pr = ports[m];
+    const Element& el = *pr.element;
+    const size_t terminals = el.nodes().size() - el.internal_node_names().size();
+    const bool two_terminals = !pr.controlled && terminals == 2;
+    const bool a_switch = pr.controlled && terminals == 4 && pr.p == el.nodes()[0] &&
+                          pr.cp == el.nodes()[2] && pr.cn == el.nodes()[3];
+    if (el.nonlinear_port_count() != 1 || !(two_terminals || a_switch) || pr.n != el.nodes()[1] ||
+        el.nodes()[0] == el.nodes()[1])
+      continue;
+    for (int side = 0; side < 2; ++side) {
+      const int u = source->nodes()[side];
+      if (u == 0 || touched[u] != 2 || (u != el.nodes()[0] && u != el.nodes()[1])) continue;
+      // The source's current flows from its first node through it to its second; the port's
+      // from the element's first terminal through it to its second.
+      const double into_element = u == el.nodes()[0] ? 1.0 : -1.0;
+      return std::make_pair(static_cast<int>(m), side == 1 ? into_element : -into_element);
+    }
+  }
+  return std::nullopt;
 }
 
 // The linear network of method step 1: the cards again, each port shunted.
@@ -188,7 +231,25 @@ StatusOr<PortModel> build_port_model(const std::vector<Card>& cards, const Circu
   }
   for (const ControlSource& c : *controls) pm.control_sources.push_back({c.source->name(), c.sign});
   pm.sources = static_cast<int>(unit.size());
-  std::vector<Probe> outputs = probes;
+  std::vector<Probe> outputs;
+  for (size_t c = 0; c < probes.size(); ++c) {
+    pm.labels.push_back(probes[c].label);
+    if (auto port = series_port_current(circuit, ports, probes[c])) {
+      pm.port_current_probes.push_back({static_cast<int>(c), port->first, port->second});
+      continue;
+    }
+    const Probe& p = probes[c];
+    outputs.push_back(p);
+    pm.probe_column.push_back(static_cast<int>(c));
+    // As the transient watches states only: a voltage source's current (a 0 V ammeter in series
+    // with a diode) is a diode's current, an exponential of a watched port voltage; watched, its
+    // steep knee drove the step to 1e-18 s on ESD scenarios.
+    auto watched = [&](int u) {
+      return u == 0 || net.unknown_is_node(u) || net.unknown_is_state(u);
+    };
+    pm.probe_watched.push_back(watched(p.a) && watched(p.b));
+  }
+  pm.probes = static_cast<int>(outputs.size());
   for (const PortRef& pr : ports) {
     unit.emplace_back(n + 1, 0.0);
     unit.back()[pr.p] -= 1.0;  // the port's current leaves p through the element into n
@@ -199,17 +260,6 @@ StatusOr<PortModel> build_port_model(const std::vector<Card>& cards, const Circu
     outputs.push_back({"port(" + pr.element->name() + ")", pr.p, pr.n});
   }
   pm.ports = static_cast<int>(ports.size());
-  pm.probes = static_cast<int>(probes.size());
-  for (const Probe& p : probes) {
-    pm.labels.push_back(p.label);
-    // As the transient watches states only: a voltage source's current (a 0 V ammeter in series
-    // with a diode) is a diode's current, an exponential of a watched port voltage; watched, its
-    // steep knee drove the step to 1e-18 s on ESD scenarios.
-    auto watched = [&](int u) {
-      return u == 0 || net.unknown_is_node(u) || net.unknown_is_state(u);
-    };
-    pm.probe_watched.push_back(watched(p.a) && watched(p.b));
-  }
 
   MnaSystem sys;
   if (Status s = sys.build(net); !s.ok()) return s;
@@ -228,17 +278,20 @@ StatusOr<PortModel> build_port_model(const std::vector<Card>& cards, const Circu
   ro.horizon = horizon;
   ro.edge_time = 0.0;
   StatusOr<ReducedModel> model = reduce_circuit(net, unit, dc, outputs, ro);
-  if (!model && n <= ro.full_order_at_most) {
-    // The full basis's modal form can fail its check where the eigenvectors are too
-    // ill-conditioned (a 15 m link's ground-step circuit, 1,098 unknowns: 2.5e4 at 1.5 MHz),
-    // and the Krylov search can stall where the full basis passes (its hot-plug circuits): the
-    // one is tried when the other fails.
-    ReducedModelOptions krylov = ro;
-    krylov.full_order_at_most = 0;
-    StatusOr<ReducedModel> second = reduce_circuit(net, unit, dc, outputs, krylov);
+  if (!model && n <= options.full_basis_at_most) {
+    // The Krylov search can stall where the full basis passes (a 15 m link's hot-plug circuit,
+    // 1,100 unknowns: at 1.3e-4), and the full basis's modal form can fail where the search
+    // passes (eigenvectors too ill-conditioned: its ground-step circuit, 1,098 unknowns, 39 at
+    // 62 kHz after 15 s): the one is tried when the other fails.
+    ReducedModelOptions other = ro;
+    other.full_order_at_most = n <= ro.full_order_at_most ? 0 : options.full_basis_at_most;
+    StatusOr<ReducedModel> second = reduce_circuit(net, unit, dc, outputs, other);
+    const bool full_first = n <= ro.full_order_at_most;
     if (!second)
-      return Status::Error(fmt::format("port model: the full basis: {}; the Krylov search: {}",
-                                       model.status().message(), second.status().message()));
+      return Status::Error(fmt::format(
+          "port model: {}: {}; {}: {}", full_first ? "the full basis" : "the Krylov search",
+          model.status().message(), full_first ? "the Krylov search" : "the full basis",
+          second.status().message()));
     model = std::move(second);
   }
   if (!model) return model.status().with_context("port model");
@@ -375,9 +428,10 @@ PortMarch::PortMarch(const Circuit& circuit, const PortModel& pm, const Transien
   // Absolute tolerances of the watched values: port voltages, charges, probes.
   for (int m = 0; m < np_; ++m) abs_tol_.push_back(opt.vntol);
   for (int m = 0; m < np_; ++m) abs_tol_.push_back(opt.chgtol);
-  for (size_t p = 0; p < pm.labels.size(); ++p)
+  for (int p = 0; p < pm.probes; ++p)
     if (pm.probe_watched[p])
-      abs_tol_.push_back(pm.labels[p].rfind("i(", 0) == 0 ? opt.abstol : opt.vntol);
+      abs_tol_.push_back(pm.labels[pm.probe_column[p]].rfind("i(", 0) == 0 ? opt.abstol
+                                                                           : opt.vntol);
 }
 
 const StepCoefs& PortMarch::coefs(double h) {
@@ -478,7 +532,9 @@ void PortMarch::update_tolerances(const PortState& s) {
 void PortMarch::record(const PortState& s) {
   if (s.t < opt_.tstart - tiny_) return;
   w_.time.push_back(s.t);
-  for (int p = 0; p < ny_; ++p) w_.columns[p].push_back(s.y[p]);
+  for (int p = 0; p < ny_; ++p) w_.columns[pm_.probe_column[p]].push_back(s.y[p]);
+  for (const PortModel::PortCurrentProbe& c : pm_.port_current_probes)  // d + g_s v: the port's
+    w_.columns[c.column].push_back(c.sign * (s.d[c.port] + pm_.port_shunt * s.v[c.port]));
 }
 
 // Newton on the port voltages: v = v_oc + Z_h d(v), d the port current with its charge's
@@ -594,8 +650,8 @@ Status PortMarch::advance(double h, bool euler, bool* converged) {
     for (int k = 0; k < ns_; ++k) y += m_.direct[k][p] * s1.u[k];
     for (int m = 0; m < np_; ++m) y += m_.direct[ns_ + m][p] * s1.d[m];
     if (!std::isfinite(y))
-      return Status::Error(
-          fmt::format("port model: non-finite value at t={:g} s ({})", s1.t, pm_.labels[p]));
+      return Status::Error(fmt::format("port model: non-finite value at t={:g} s ({})", s1.t,
+                                       pm_.labels[pm_.probe_column[p]]));
     s1.y[p] = y;
   }
   s1.fill_watched(pm_.probe_watched);

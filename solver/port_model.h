@@ -31,9 +31,10 @@
 // 2. The model (solver/reduced_model.h, Krylov projection checked against the exact AC solution
 //    of the linear network at the check frequencies, refined between them): inputs = every
 //    time-varying source (its unit excitation) and every port (a unit current drawn from p into n);
-//    outputs = every port voltage and every probe. The constant sources (supplies, biases, 0 V
-//    ammeters) are no inputs: their share of each output is the network's DC solution for them, an
-//    offset. Modes x_i' = p_i x_i + sum_k in_ki w_k, outputs y = Re sum_i out_i x_i + D w. The
+//    outputs = every port voltage and every probe but a series ammeter's current (read from its
+//    diode's port current, PortModel::PortCurrentProbe). The constant sources (supplies, biases, 0
+//    V ammeters) are no inputs: their share of each output is the network's DC solution for them,
+//    an offset. Modes x_i' = p_i x_i + sum_k in_ki w_k, outputs y = Re sum_i out_i x_i + D w. The
 //    check is the reduced model's, at tol (PortModelOptions::reduced), for every input-output pair:
 //    the port impedance matrix, the source-to-port transfers and the probes' transfers.
 // 3. Time steps: over a step the sources are linear in t (exact for PULSE and PWL between their
@@ -91,16 +92,21 @@ struct PortModelOptions {
   // 48 check points, refined between them as the reduced model's check is: 128 took 0.15 s of
   // a 12 m link's 0.21 s, the model at full order either way. Up to 500 unknowns the model
   // starts from the full basis: the 50 m clamp hop (436 unknowns) reached full order through 23
-  // expansion points in 2.5 s, diagonalised in full it takes 0.8 s.
+  // expansion points in 2.5 s, diagonalised in full it takes 0.8 s. Above, the Krylov search
+  // comes first: on a 15 m link's stress circuits (1,100 unknowns) it passed in 0.4-3.6 s where
+  // the full basis took 3.4-16 s (2 cores busy), the peaks within 0.4 mV of each other.
   ReducedModelOptions reduced = [] {
     ReducedModelOptions r;
     r.tol = 2e-6;
     r.check_points = 48;
-    r.full_order_at_most = 1200;
+    r.full_order_at_most = 500;
     r.difference_scale = true;
     r.stall_tol = 1e-4;
     return r;
   }();
+  // When the first model fails its check, the other is tried on a network of at most this many
+  // unknowns: the full basis after the Krylov search, or the search after the full basis.
+  int full_basis_at_most = 1200;
 };
 
 // The model and what run_port_model needs to step it.
@@ -108,9 +114,21 @@ struct PortModel {
   ReducedModel model;  // inputs: sources, then ports; outputs: probes, then port voltages
   int sources = 0;     // model inputs 0 .. sources - 1
   int ports = 0;       // model inputs sources .. sources + ports - 1; outputs probes ..
-  int probes = 0;
-  std::vector<std::string> labels;        // the probes' labels
-  std::vector<bool> probe_watched;        // per probe: a state (node voltage, inductor current)
+  int probes = 0;      // the probes read through the model: its outputs 0 .. probes - 1
+  std::vector<std::string> labels;  // every probe's label, in the caller's order (the columns)
+  std::vector<int> probe_column;    // per model probe output: its column
+  std::vector<bool> probe_watched;  // per model probe: a state (node voltage, inductor current)
+  // A probe read from a port instead of the model: the current of a voltage source in series
+  // with a diode (a 0 V ammeter: one of its nodes is touched by the two alone) is, by Kirchhoff's
+  // current law, sign x the diode's current. Through the model such a probe's transfer from any
+  // other source is 0 but for rounding, and its check stalled (a 15 m link's ground step: the
+  // full basis 2.5e4 and the Krylov search 1.4e4 off at one ammeter).
+  struct PortCurrentProbe {
+    int column = 0;
+    int port = 0;
+    double sign = 1.0;
+  };
+  std::vector<PortCurrentProbe> port_current_probes;
   std::vector<std::string> source_names;  // the circuit's time-varying sources, in input order
   // The constant sources (DC, or PWL without a corner before the horizon) and their values: no
   // inputs, their share of each output is `offset`.

@@ -145,6 +145,20 @@ TEST(Stress, HotPlugMovesTheSeriesCapsCharge) {
               junction, vj);
   EXPECT_EQ(s.pin_ground.at("txp"), "gplug");
   EXPECT_EQ(s.pin_ground.at("rxp"), "0");
+  // The whole scenario as stress runs it, both contacts closed and settled: the lines end
+  // alike (the common mode's final state), so each contact has moved the same q out of the
+  // module over the record (contacts' charge_C, positive into the module).
+  ASSERT_TRUE(run_stress_scenario(s, *spec, *parts).ok());
+  ASSERT_EQ(s.contacts.size(), 2u);
+  EXPECT_EQ(s.contacts[0].contact, "scontactp");  // P first
+  EXPECT_EQ(s.contacts[1].contact, "scontactn");
+  for (const ContactPeak& c : s.contacts) {
+    EXPECT_NEAR(-c.charge_c, q, 0.02 * q) << c.contact;
+    // The inrush is at least the mean current that moves q within the settling (under 3 us).
+    EXPECT_GT(c.peak_1ns_a, q / 3e-6) << c.contact;
+    std::printf("%s: %.4g C (closed form %.4g), inrush %.4g A over 1 ns\n", c.contact.c_str(),
+                -c.charge_c, q, c.peak_1ns_a);
+  }
 }
 
 TEST(Stress, ScenarioSetPerKindAndDirection) {

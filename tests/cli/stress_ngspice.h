@@ -59,6 +59,7 @@ inline StressAgreement stress_vs_ngspice(const link::LinkSpec& spec, const std::
   for (const auto& [node, ground] : s.pin_ground)
     probes.push_back(ground == "0" ? "v(" + node + ")" : "v(" + node + "," + ground + ")");
   for (const analysis::DiodePeak& d : s.diodes) probes.push_back("i(" + d.ammeter + ")");
+  for (const analysis::ContactPeak& c : s.contacts) probes.push_back("i(" + c.ammeter + ")");
   if (s.traffic) probes.push_back("v(" + s.receiver_p + "," + s.receiver_n + ")");
   StatusOr<Waveform> ng = run_ngspice(path, probes, work, ".options reltol=1e-4");
   EXPECT_TRUE(ng.ok()) << ng.status().message();
@@ -84,6 +85,23 @@ inline StressAgreement stress_vs_ngspice(const link::LinkSpec& spec, const std::
     EXPECT_NEAR(d.peak_a, mx, std::max(0.05, 0.05 * mx)) << id << " " << d.diode;
     out.worst_diode_a = std::max(out.worst_diode_a, std::abs(d.peak_a - mx));
     std::printf("%s %s: peak %.4g A (ngspice %.4g)\n", id.c_str(), d.diode.c_str(), d.peak_a, mx);
+  }
+  for (const analysis::ContactPeak& c : s.contacts) {  // hot_plug: inrush and charge moved
+    const std::vector<double>& a = ng->columns[k++];
+    const std::vector<double>& t = ng->time;
+    std::vector<double> q(a.size(), 0.0);  // ngspice's running charge
+    for (size_t j = 1; j < a.size(); ++j)
+      q[j] = q[j - 1] + 0.5 * (a[j] + a[j - 1]) * (t[j] - t[j - 1]);
+    double mx = 0;  // the largest |charge| over 1 ns, from each sample to 1 ns later
+    for (size_t j = 0, e = 0; j < a.size() && t[j] + 1e-9 <= t.back(); ++j) {
+      while (e + 1 < a.size() && t[e + 1] < t[j] + 1e-9) ++e;
+      const double qe = q[e] + (t[j] + 1e-9 - t[e]) / (t[e + 1] - t[e]) * (q[e + 1] - q[e]);
+      mx = std::max(mx, std::abs(qe - q[j]) / 1e-9);
+    }
+    EXPECT_NEAR(c.peak_1ns_a, mx, 0.05 * mx) << id << " " << c.contact;
+    EXPECT_NEAR(c.charge_c, q.back(), 0.05 * std::abs(q.back())) << id << " " << c.contact;
+    std::printf("%s %s: inrush %.4g A over 1 ns (ngspice %.4g), charge %.4g C (ngspice %.4g)\n",
+                id.c_str(), c.contact.c_str(), c.peak_1ns_a, mx, c.charge_c, q.back());
   }
   if (!s.traffic) return out;
   // The checker on ngspice's receiver waveform gives the scenario's verdict.

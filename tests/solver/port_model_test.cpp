@@ -11,6 +11,7 @@
 #include <memory>
 #include <numbers>
 #include <random>
+#include <tuple>
 
 #include "solver/transient.h"
 #include "test_cards.h"
@@ -168,6 +169,51 @@ TEST(PortModel, RectifierWithChargeStorageMatchesTheFullTransient) {
   for (size_t k = 0; k < 2; ++k) EXPECT_LT(max_difference(r.port, r.full, k), 3e-3) << k;
 }
 
+TEST(PortModel, SeriesAmmetersReadTheirDiodesCurrentWithTheSign) {
+  // 0 V ammeters in series with diodes (as isolink stress puts one before every clamp): vam1
+  // from a into d1's anode (i(vam1) = +i(d1)), vam2 from ground into d2's cathode node (the
+  // diode's current enters vam2 at its n- node: i(vam2) = -i(d2)). Both are read from the
+  // ports, not through the model; against the full transient's branch currents at 1e-6.
+  const auto d = model({{"is", 1e-8},
+                        {"n", 1.05},
+                        {"rs", 0.3},
+                        {"cjo", 30e-12},
+                        {"vj", 0.5},
+                        {"m", 0.45},
+                        {"tt", 5e-9}});
+  const std::vector<Card> cards = {card("v1", {"in", "0"}, {call("sin", {0, 5, 1e6})}),
+                                   card("rs", {"in", "a"}, {num(10)}),
+                                   card("vam1", {"a", "da"}, {num(0)}),
+                                   diode("d1", {"da", "out"}, d),
+                                   card("rl", {"out", "0"}, {num(2e3)}),
+                                   card("cl", {"out", "0"}, {num(1e-9)}),
+                                   diode("d2", {"out", "kb"}, d),
+                                   card("vam2", {"0", "kb"}, {num(0)})};
+  const std::vector<std::string> texts = {"i(vam1)", "v(out)", "i(vam2)"};
+  Circuit c;
+  ASSERT_EQ(build(c, cards), "");
+  StatusOr<PortModel> m = build_port_model(cards, c, probes(c, texts), 5e-6, {});
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  ASSERT_EQ(m->port_current_probes.size(), 2u);
+  EXPECT_EQ(m->port_current_probes[0].column, 0);
+  EXPECT_EQ(m->port_current_probes[0].sign, 1.0);
+  EXPECT_EQ(m->port_current_probes[1].column, 2);
+  EXPECT_EQ(m->port_current_probes[1].sign, -1.0);
+  EXPECT_EQ(m->probes, 1);  // v(out) alone through the model
+  Runs r = both(cards, texts, {.tstep = 1e-9, .tstop = 5e-6});
+  ASSERT_GT(r.port.samples(), 100u);
+  double peak1 = 0, peak2 = 0;
+  for (size_t i = 0; i < r.full.samples(); ++i) {
+    peak1 = std::max(peak1, std::fabs(r.full.columns[0][i]));
+    peak2 = std::max(peak2, std::fabs(r.full.columns[2][i]));
+  }
+  ASSERT_GT(peak1, 1e-3);  // mA through the rectifier: the comparison is not of zeros
+  ASSERT_GT(peak2, 1e-3);
+  EXPECT_LT(max_difference(r.port, r.full, 0), 0.01 * peak1);
+  EXPECT_LT(max_difference(r.port, r.full, 1), 3e-3);
+  EXPECT_LT(max_difference(r.port, r.full, 2), 0.01 * peak2);
+}
+
 TEST(PortModel, ZenerClipperInSeriesMatchesTheFullTransient) {
   // A diode in series with a zener: their junction node is reached by the diodes only.
   const auto sig = model({{"is", 2.52e-9},
@@ -312,6 +358,29 @@ TEST(PortModel, SwitchedHotPlugMatchesTheFullTransient) {
   double swing = 0;
   for (double v : r.port.columns[0]) swing = std::max(swing, std::fabs(v));
   EXPECT_GT(swing, 1.0);
+  // A 0 V ammeter between the cable and the contact (as isolink stress measures the inrush):
+  // read from the switch's port, positive from the cable into the module.
+  std::vector<Card> metered = hot_plug(30);
+  for (Card& k : metered)
+    if (k.name == "s1") k.nodes[0] = "smid";
+  metered.push_back(card("vam", {"n0", "smid"}, {num(0)}));
+  Circuit mc;
+  ASSERT_EQ(build(mc, metered), "");
+  StatusOr<PortModel> pm = build_port_model(metered, mc, probes(mc, {"i(vam)"}), 1e-6, {});
+  ASSERT_TRUE(pm.ok()) << pm.status().message();
+  ASSERT_EQ(pm->port_current_probes.size(), 1u);
+  EXPECT_EQ(pm->port_current_probes[0].sign, 1.0);
+  Runs a = both(metered, {"i(vam)"}, {.tstep = 1e-9, .tstop = 1e-6});
+  double pmax = 0, fmax = 0, pq = 0, fq = 0;
+  for (const auto& [w, peak, charge] : {std::tie(a.port, pmax, pq), std::tie(a.full, fmax, fq)})
+    for (size_t j = 1; j < w.samples(); ++j) {
+      peak = std::max(peak, std::fabs(w.columns[0][j]));
+      charge += 0.5 * (w.columns[0][j] + w.columns[0][j - 1]) * (w.time[j] - w.time[j - 1]);
+    }
+  ASSERT_GT(fmax, 0.1);  // amperes of inrush: the comparison is not of zeros
+  EXPECT_NEAR(pmax, fmax, 0.01 * fmax);
+  EXPECT_NEAR(pq, fq, 0.01 * std::fabs(fq));
+  EXPECT_LT(fq, 0.0);  // the module at 30 V pushes charge out into the cable
 }
 
 TEST(PortModel, RefusesASwitchWhoseControlIsNotASourceOfItsOwn) {
