@@ -60,6 +60,7 @@ StatusOr<PackStressResult> run_pack_stress(const PackSpec& pack, const link::Par
         "isolink stress on a pack runs wire faults per hop: --only must include 'wire' (got {})",
         fmt::join(so.only, ",")));
   so.only = {"wire"};
+  so.results_only = true;
   StatusOr<PackTiming> timing = pack_timing(pack);
   if (!timing) return timing.status();
   // Every hop's scenarios built; identical circuits (the same spec on several hops) run once.

@@ -825,6 +825,10 @@ Status run_stress_scenarios(std::vector<StressScenario>& scenarios,
               opt.progress(s.id, static_cast<double>(done) / scenarios.size());
             }
             status[i] = run_stress_scenario(s, *specs[i], parts);
+            if (opt.results_only) {
+              s.link = link::ExpandedLink{};
+              s.pins = Waveform{};
+            }
             std::lock_guard<std::mutex> lock(progress_mu);
             ++done;
           }

@@ -166,6 +166,10 @@ struct StressOptions {
   std::vector<link::Direction> directions;
   // Scenarios run at once (oneTBB; 0: all cores).
   int jobs = 1;
+  // Drop each scenario's circuit (link) and pin waveforms (pins) once it has run: a pack's
+  // hundreds of scenarios are reported by their figures alone (with them, the 16-module example
+  // pack's stress took 4.6 GB).
+  bool results_only = false;
   // Progress for a display: the scenario's id and the fraction done (0-1).
   std::function<void(const std::string& what, double fraction)> progress;
 };

@@ -58,6 +58,9 @@ std::vector<std::string> worst_columns() {
   return c;
 }
 const std::vector<std::string> kWorstColumns = worst_columns();
+const std::vector<std::string> kStressColumns = {
+    "stress.verdict",  "stress.scenarios",   "stress.breaking",    "stress.max_pin_V",
+    "stress.max_cm_V", "stress.max_diode_A", "stress.first_broken"};
 
 double now_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -89,6 +92,32 @@ std::string first_line(const std::string& s) {
   return s.substr(0, s.find('\n'));
 }
 
+// A count written by results_row ("" when the point has none).
+bool parse_count(const std::string& s, int* out) {
+  if (s.empty()) return (*out = 0, true);
+  char* end = nullptr;
+  const long v = std::strtol(s.c_str(), &end, 10);
+  *out = static_cast<int>(v);
+  return end != s.c_str() && *end == '\0' && v >= 0 && v < (1L << 30);
+}
+
+// The stress.* fields from f[*k] on (results_row's order), into r->stress.
+Status parse_stress_cells(const std::vector<std::string>& f, size_t* k, PointResult* r) {
+  PointResult::Stress st;
+  st.verdict = f[(*k)++];
+  if (st.verdict != "pass" && st.verdict != "fail" && !st.verdict.empty())
+    return Status::Error("stress.verdict is not pass, fail or empty: '" + st.verdict + "'");
+  bool ok = parse_count(f[(*k)++], &st.scenarios);
+  ok = parse_count(f[(*k)++], &st.breaking) && ok;
+  ok = parse_double(f[(*k)++], &st.max_pin_v) && ok;
+  ok = parse_double(f[(*k)++], &st.max_cm_v) && ok;
+  ok = parse_double(f[(*k)++], &st.max_diode_a) && ok;
+  st.first_broken = f[(*k)++];
+  if (!ok) return Status::Error("bad stress column");
+  r->stress = st;
+  return Status::Ok();
+}
+
 }  // namespace
 
 std::vector<std::string> results_header(const SweepSpec& s) {
@@ -97,6 +126,7 @@ std::vector<std::string> results_header(const SweepSpec& s) {
   h.insert(h.end(), kResultColumns.begin(), kResultColumns.begin() + kBeforeNoise);
   if (s.noise_outputs) h.insert(h.end(), kNoiseColumns.begin(), kNoiseColumns.end());
   if (s.worst_outputs) h.insert(h.end(), kWorstColumns.begin(), kWorstColumns.end());
+  if (s.stress_outputs) h.insert(h.end(), kStressColumns.begin(), kStressColumns.end());
   h.insert(h.end(), kResultColumns.begin() + kBeforeNoise, kResultColumns.end());
   for (const std::string& c : pack_columns(s)) h.push_back(c);
   return h;
@@ -104,13 +134,14 @@ std::vector<std::string> results_header(const SweepSpec& s) {
 
 size_t RowShape::columns() const {
   return 1 + cells + kResultColumns.size() + (noise ? kNoiseColumns.size() : 0) +
-         (worst ? kWorstColumns.size() : 0) + extra;
+         (worst ? kWorstColumns.size() : 0) + (stress ? kStressColumns.size() : 0) + extra;
 }
 
 RowShape row_shape(const SweepSpec& s) {
   return {.cells = s.point_columns().size(),
           .noise = s.noise_outputs,
           .worst = s.worst_outputs,
+          .stress = s.stress_outputs,
           .extra = pack_columns(s).size()};
 }
 
@@ -170,6 +201,16 @@ std::string results_row(const PointResult& r) {
     for (size_t d = 0; d < 2; ++d)
       for (size_t m = 0; m < kWorstMetrics.size(); ++m)
         add(num(w.margin[d][m] * kWorstCsvScale[m]));
+  }
+  if (r.stress) {
+    const PointResult::Stress& st = *r.stress;
+    add(st.verdict);
+    add(st.verdict.empty() ? "" : fmt::format("{}", st.scenarios));
+    add(st.verdict.empty() ? "" : fmt::format("{}", st.breaking));
+    add(num(st.max_pin_v));
+    add(num(st.max_cm_v));
+    add(num(st.max_diode_a));
+    add(st.first_broken);
   }
   add(fmt::format("{:.2f}", r.seconds));
   add(r.error);
@@ -237,6 +278,9 @@ StatusOr<PointResult> parse_results_row(std::string_view line, const RowShape& s
       }
     if (!ok) return Status::Error("bad worst column");
     r.worst = w;
+  }
+  if (shape.stress) {
+    if (Status st = parse_stress_cells(f, &k, &r); !st.ok()) return st;
   }
   if (!parse_double(f[k++], &r.seconds)) return Status::Error("bad seconds");
   if (std::isnan(r.seconds)) r.seconds = 0;
@@ -343,6 +387,23 @@ PointResult::Worst worst_cells(const WorstResult& r) {
   return w;
 }
 
+PointResult::Stress stress_cells(const StressResult& r) {
+  PointResult::Stress st;
+  st.scenarios = static_cast<int>(r.scenarios.size());
+  auto grow = [](double& to, double v) {
+    if (std::isfinite(v) && (std::isnan(to) || std::abs(v) > to)) to = std::abs(v);
+  };
+  for (const StressScenario& s : r.scenarios) {
+    for (const auto& [node, p] : s.peak_pin_v) grow(st.max_pin_v, std::max(-p.min, p.max));
+    grow(st.max_cm_v, s.peak_cm_v);
+    for (const DiodePeak& d : s.diodes) grow(st.max_diode_a, d.peak_a);
+    if (s.broken.empty()) continue;
+    if (st.breaking++ == 0) st.first_broken = s.id + ": " + s.broken.front();
+  }
+  st.verdict = st.breaking == 0 ? "pass" : "fail";
+  return st;
+}
+
 namespace {
 
 // Why a point must be simulated rather than synthesized from its edge responses, or empty.
@@ -428,6 +489,8 @@ PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t
     if (s.noise_outputs) r.noise.emplace();
     r.worst.reset();
     if (s.worst_outputs) r.worst.emplace();
+    r.stress.reset();
+    if (s.stress_outputs) r.stress.emplace();
     r.extra.clear();
     r.seconds = now_seconds() - t0;
     return r;
@@ -483,6 +546,11 @@ PointResult run_point(const SweepSpec& s, const link::PartLibrary& parts, size_t
           worst_case(po.point.spec, parts, wopt, std::move(edges), same_circuits(*run));
       if (!w) return fail("worst: " + w.status().message());
       r.worst = worst_cells(*w);
+    }
+    if (s.stress_outputs) {
+      StatusOr<StressResult> st = run_stress(po.point.spec, parts, StressOptions{});
+      if (!st) return fail("stress: " + st.status().message());
+      r.stress = stress_cells(*st);
     }
     if (!opt.waves_dir.empty()) {
       const Waveform w = run_waveforms(*run, po.point.spec.sim.tstep);
@@ -589,6 +657,8 @@ void ResultLog::add(const PointResult& in) {
   if (!shape_.noise) padded.noise.reset();
   if (shape_.worst && !padded.worst) padded.worst.emplace();
   if (!shape_.worst) padded.worst.reset();
+  if (shape_.stress && !padded.stress) padded.stress.emplace();
+  if (!shape_.stress) padded.stress.reset();
   padded.extra.resize(shape_.extra);  // an error's: empty
   const PointResult r = round_trip(padded, shape_);
   const std::string row = results_row(r);

@@ -58,6 +58,19 @@
 // Empty where a direction was not run or the point is an error. `verdict` stays the spec
 // traffic's, so the two can be compared point by point. A worst case that cannot be computed
 // makes the point an error ("worst: ..."), as a noise analysis that fails does.
+// With `outputs: [stress]`, each point also runs isolink stress on its spec (run_stress with the
+// default StressOptions: the spec's stress: levels and `only`, both directions, one scenario at
+// a time: the points already fill the cores) and these columns follow (after the worst ones):
+//   stress.verdict                pass | fail: pass when no scenario breaks a limit or a rule
+//   stress.scenarios              the scenarios run
+//   stress.breaking               those that break something (StressScenario::broken)
+//   stress.max_pin_V              the largest |peak| of a COM pin against its device's ground
+//   stress.max_cm_V               the largest |common mode| of either device's pins
+//   stress.max_diode_A            the largest peak current of a TVS part or pin clamp
+//   stress.first_broken           "<scenario id>: <what>", the first scenario that breaks
+//                                 something and its first limit or rule, in words
+// Stress levels and parts are sweep keys as any spec key (stress.esd, stress.ground_step,
+// ends.esd: a TVS part number); a stress run that fails makes the point an error ("stress:").
 // A point whose spec is invalid or whose simulation fails has verdict "error", the message's
 // first line in `error` (CSV-quoted) and empty margins; the sweep goes on. Numbers are written with
 // 6 significant digits and every total (summary.json, plots) is computed from the rows as written,
@@ -89,6 +102,7 @@
 #include "analysis/link_run.h"
 #include "analysis/noise.h"
 #include "analysis/pack.h"
+#include "analysis/stress.h"
 #include "analysis/sweep_spec.h"
 #include "analysis/worst.h"
 #include "base/csv.h"
@@ -130,6 +144,18 @@ struct PointWorst {
   }
 };
 
+// A point's stress columns (PointResult::stress); at namespace scope like PointNoise.
+struct PointStress {
+  std::string verdict;  // pass | fail | "": pass when no scenario breaks a limit or rule
+  int scenarios = 0, breaking = 0;  // run, and those that break something
+  // The largest |peak| over the scenarios: a COM pin against its own ground, a device's common
+  // mode, a TVS or clamp diode's current.
+  double max_pin_v = std::numeric_limits<double>::quiet_NaN();
+  double max_cm_v = std::numeric_limits<double>::quiet_NaN();
+  double max_diode_a = std::numeric_limits<double>::quiet_NaN();
+  std::string first_broken;  // "<scenario id>: <the first limit or rule it breaks>", or ""
+};
+
 struct PointResult {
   size_t index = 0;
   std::vector<std::string> cells;  // SweepSpec::point_columns()
@@ -156,6 +182,10 @@ struct PointResult {
   // them.
   using Worst = PointWorst;
   std::optional<Worst> worst;
+  // The stress columns (`outputs: [stress]`); present (maybe empty) exactly when the sweep has
+  // them.
+  using Stress = PointStress;
+  std::optional<Stress> stress;
   // A pack sweep's extra cells (pack_columns()): weakest_hop, failing_hops, hop_<K>_margin_rel.
   std::vector<std::string> extra;
 };
@@ -174,6 +204,7 @@ struct RowShape {
   size_t cells = 0;        // point_columns().size()
   bool noise = false;      // the noise columns
   bool worst = false;      // the worst.* columns
+  bool stress = false;     // the stress.* columns
   size_t extra = 0;        // pack_columns().size()
   size_t columns() const;  // results_header().size()
 };
@@ -194,6 +225,8 @@ PointResult score_run(const LinkRun& run);
 PointResult::Noise noise_cells(const NoiseResult& r);
 // The worst-case columns of a worst-case result (analysis/worst.h).
 PointResult::Worst worst_cells(const WorstResult& r);
+// The stress columns of a stress result (analysis/stress.h).
+PointResult::Stress stress_cells(const StressResult& r);
 
 struct PointOptions {
   RunOptions run;

@@ -755,11 +755,14 @@ Status read_top_keys(const YamlDoc& doc, SweepSpec* s, SweepKeys* keys) {
       s->noise_outputs = true;
     else if (o == "worst")
       s->worst_outputs = true;
+    else if (o == "stress")
+      s->stress_outputs = true;
     else
       return doc.error(on.IsSequence() ? YAML::Node(on[i]) : on,
                        fmt::format("key 'outputs': '{}' is not a result family; the ones known "
-                                   "are noise (the noise-immunity columns) and worst (the worst "
-                                   "case over all legal traffic)",
+                                   "are noise (the noise-immunity columns), worst (the worst "
+                                   "case over all legal traffic) and stress (isolink stress's "
+                                   "verdict and peaks)",
                                    o));
   }
   s->mode = mode == "zip" ? Mode::kZip : Mode::kGrid;
@@ -823,7 +826,8 @@ Status read_base_spec(const YamlDoc& doc, const SweepKeys& keys, const std::stri
                      "key 'monte_carlo': not available when the base is a pack spec "
                      "(sweep the hops' keys on a grid instead)");
   for (const auto& [on, family] :
-       {std::pair{s->noise_outputs, "noise"}, std::pair{s->worst_outputs, "worst"}})
+       {std::pair{s->noise_outputs, "noise"}, std::pair{s->worst_outputs, "worst"},
+        std::pair{s->stress_outputs, "stress"}})
     if (on)
       return doc.error(doc.root()["outputs"],
                        fmt::format("key 'outputs': {0} is not available when the base is a "

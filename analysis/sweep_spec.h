@@ -21,7 +21,10 @@
 //   mode: grid                        # grid: every combination | zip: the i-th values together
 //   outputs: [noise, worst]           # more result columns per point (sweep_run.h): noise = the
 //                                     # point's noise immunity (isolink noise on its spec); worst =
-//                                     # the worst case over all legal traffic (isolink worst on it)
+//                                     # the worst case over all legal traffic (isolink worst on
+//                                     # it); stress = what breaks it in the field (isolink stress
+//                                     # on it: stress.esd, stress.ground_step... and
+//                                     # ends.isolation.esd, the TVS part, as keys)
 // A pack base (base: pack.yaml, a pack spec file): keys are hops.<K>.<key> (hop K, 1..N, N + 1
 // the ring's return hop) or hops.*.<key> (every hop), e.g. hops.9.cable.length: [1, 5, 10];
 // each point is a pack run (PointSpec::pack); no Monte Carlo, no outputs.
@@ -140,6 +143,9 @@ struct SweepSpec {
   // `outputs: [worst]`: every point also runs the worst case over all legal traffic
   // (analysis/worst.h, default WorstOptions) on its spec, and results.csv gets the worst.* columns.
   bool worst_outputs = false;
+  // `outputs: [stress]`: every point also runs isolink stress (analysis/stress.h) on its spec
+  // (the spec's stress: block, its `only` included), and results.csv gets the stress.* columns.
+  bool stress_outputs = false;
 
   size_t grid_size() const;  // points before Monte Carlo (1 without axes)
   size_t samples() const { return mc.samples > 0 ? static_cast<size_t>(mc.samples) : 1; }

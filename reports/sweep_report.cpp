@@ -262,6 +262,22 @@ nlohmann::ordered_json sweep_summary_json(const SweepSpec& s,
                                w["worst_metric"] = r.worst->worst_metric;
                                w["margin_rel"] = r.worst->margin_rel;
                              });
+  // Its worst point: the most scenarios broken, then the highest pin peak (x / (1 + x) < 1).
+  if (s.stress_outputs)
+    j["stress"] = family([](const PointResult& r) { return r.stress.has_value(); },
+                         [](const PointResult& r) { return r.stress->verdict; },
+                         [](const PointResult& r) {
+                           const PointResult::Stress& st = *r.stress;
+                           if (st.verdict.empty()) return std::numeric_limits<double>::quiet_NaN();
+                           const double pin = std::isfinite(st.max_pin_v) ? st.max_pin_v : 0.0;
+                           return -(st.breaking + pin / (1 + pin));
+                         },
+                         [](const PointResult& r, ordered_json& w) {
+                           w["breaking"] = r.stress->breaking;
+                           w["scenarios"] = r.stress->scenarios;
+                           w["max_pin_V"] = r.stress->max_pin_v;
+                           w["first_broken"] = r.stress->first_broken;
+                         });
   return j;
 }
 

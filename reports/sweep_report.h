@@ -28,7 +28,8 @@ nlohmann::ordered_json sweep_path_counts(const std::vector<analysis::sweep::Poin
 // the paths, the worst point (smallest worst_margin_rel), the yield per grid point (Monte Carlo),
 // the pass/fail boundary along the first varying axis (its crossing interpolated to 4 significant
 // digits, on a log scale for log axes; null for zip or no varying axis), and with the result
-// families the noise and worst_case counts and lowest points. results: by point index, as
+// families the noise, worst_case and stress counts and lowest points (stress: the most scenarios
+// broken, then the highest pin peak). results: by point index, as
 // results.csv holds them (a resumed or MPI sweep gives the same summary as a threaded one).
 nlohmann::ordered_json sweep_summary_json(const analysis::sweep::SweepSpec& s,
                                           const std::vector<analysis::sweep::PointResult>& results);

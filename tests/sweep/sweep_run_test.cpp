@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -256,6 +257,56 @@ TEST(SweepSim, WorstColumnsEqualWorstCaseOnThePointsSpec) {
     // The spec's frames are legal traffic: its VSTART cannot be lower than the worst case's.
     EXPECT_LE(d.metric("vstart")->margin, r.margin[0] + 1e-3) << "point " << i;
   }
+}
+
+// `outputs: [stress]` with the ESD level as the key, on a link whose 1 uF Y caps keep every
+// clamp off (tests/analysis/stress_test.cpp: the connector peaks at Q / C): the circuit is linear
+// in the level, so the highest pin peak moves in proportion, (m8 - m2) / (m2 - m1) = 6 whatever
+// the pins' idle level. Point 8 kV's columns are those of run_stress on its spec, through the CSV.
+TEST(SweepSim, StressColumnsFollowTheSweptEsdLevel) {
+  const std::string text =
+      "base:\n  name: ycap\n  tx: {device: bq79600, y_cap: 1u}\n  rx: {device: bq7961x, y_cap: "
+      "1u}\n"
+      "  cable: {length: 2}\n  stress: {only: [esd]}\n"
+      "sweep:\n  stress.esd: [1kV, 2kV, 8kV]\noutputs: [stress]\n";
+  StatusOr<SweepSpec> s = read_sweep_text(text, "sweep.yaml");
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
+  ASSERT_TRUE(parts.ok()) << parts.status().message();
+  const RowShape shape = row_shape(*s);
+  std::vector<PointResult> back;
+  for (size_t i = 0; i < s->size(); ++i) {
+    const PointResult r = run_point(*s, *parts, i, {});
+    ASSERT_NE(r.verdict, "error") << r.error;
+    const std::string row = results_row(r);
+    StatusOr<PointResult> b = parse_results_row(row.substr(0, row.size() - 1), shape);
+    ASSERT_TRUE(b.ok()) << b.status().message();
+    ASSERT_TRUE(b->stress.has_value());
+    EXPECT_EQ(b->stress->scenarios, 8) << i;  // 2 ends x 2 lines x 2 polarities
+    EXPECT_EQ(b->stress->verdict, "pass") << i << ": " << b->stress->first_broken;
+    EXPECT_EQ(b->stress->breaking, 0) << i;
+    back.push_back(*b);
+  }
+  const double m1 = back[0].stress->max_pin_v, m2 = back[1].stress->max_pin_v,
+               m8 = back[2].stress->max_pin_v;
+  ASSERT_GT(m2 - m1, 0.01);  // tens of mV per kV: a ratio of real swings
+  EXPECT_NEAR((m8 - m2) / (m2 - m1), 6.0, 0.06) << m1 << " " << m2 << " " << m8;
+  std::printf("highest pin peak: %.5f V at 1 kV, %.5f V at 2 kV, %.5f V at 8 kV: ratio %.4f\n", m1,
+              m2, m8, (m8 - m2) / (m2 - m1));
+  const PointOutcome po = make_point(*s, 2);
+  ASSERT_TRUE(po.status.ok());
+  StatusOr<StressResult> direct = run_stress(po.point.spec, *parts, {});
+  ASSERT_TRUE(direct.ok()) << direct.status().message();
+  double pin = 0, cm = 0, diode = 0;
+  for (const StressScenario& sc : direct->scenarios) {
+    EXPECT_DOUBLE_EQ(std::abs(sc.level.front().second), 8.0) << sc.id;  // contact_kV
+    for (const auto& [node, p] : sc.peak_pin_v) pin = std::max({pin, p.max, -p.min});
+    cm = std::max(cm, sc.peak_cm_v);
+    for (const DiodePeak& d : sc.diodes) diode = std::max(diode, d.peak_a);
+  }
+  EXPECT_NEAR(m8, pin, 1e-5 * pin);
+  EXPECT_NEAR(back[2].stress->max_cm_v, cm, 1e-5 * cm);
+  EXPECT_NEAR(back[2].stress->max_diode_a, diode, 1e-5 * diode);
 }
 
 // Every point's reduced model starts from point 0's expansion points, per direction: exactly

@@ -171,10 +171,15 @@ TEST(SweepSpec, OutputsAddTheNoiseAndWorstFamiliesAndRefuseUnknownOnes) {
   }
   const std::string e = read_error(kBase + "sweep: {cable.length: [1]}\noutputs: [noise, nosie]\n");
   EXPECT_NE(e.find("sweep.yaml:8:18: error: key 'outputs': 'nosie' is not a result family; the "
-                   "ones known are noise (the noise-immunity columns) and worst (the worst case "
-                   "over all legal traffic)"),
+                   "ones known are noise (the noise-immunity columns), worst (the worst case "
+                   "over all legal traffic) and stress (isolink stress's verdict and peaks)"),
             std::string::npos)
       << e;
+  StatusOr<SweepSpec> st =
+      read_sweep_text(kBase + "sweep: {cable.length: [1, 2]}\noutputs: [stress]\n", "sweep.yaml");
+  ASSERT_TRUE(st.ok()) << st.status().message();
+  EXPECT_TRUE(st->stress_outputs);
+  EXPECT_FALSE(st->worst_outputs || st->noise_outputs || plain->stress_outputs);
   // worst alone and both.
   StatusOr<SweepSpec> w =
       read_sweep_text(kBase + "sweep: {cable.length: [1, 2]}\noutputs: [worst]\n", "sweep.yaml");
@@ -186,6 +191,22 @@ TEST(SweepSpec, OutputsAddTheNoiseAndWorstFamiliesAndRefuseUnknownOnes) {
       kBase + "sweep: {cable.length: [1, 2]}\noutputs: [worst, noise]\n", "sweep.yaml");
   ASSERT_TRUE(both.ok()) << both.status().message();
   EXPECT_TRUE(both->worst_outputs && both->noise_outputs);
+}
+
+// The example that sweeps the TVS part against the ESD level reads: 3 parts x 3 levels, the
+// stress columns, the part and the level landing in the point's spec.
+TEST(SweepSpec, EsdTvsExampleReads) {
+  StatusOr<SweepSpec> s =
+      read_sweep_file(std::string(ISOLINK_EXAMPLES_DIR) + "/sweep_esd_tvs.yaml");
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  EXPECT_TRUE(s->stress_outputs);
+  EXPECT_EQ(s->size(), 9u);
+  const PointOutcome p = make_point(*s, 5);  // ESD24VS2U at 15 kV
+  ASSERT_TRUE(p.status.ok()) << p.status.message();
+  EXPECT_EQ(p.point.cells, (std::vector<std::string>{"ESD24VS2U", "15kV"}));
+  EXPECT_DOUBLE_EQ(p.point.spec.stress.esd_v, 15e3);
+  EXPECT_EQ(p.point.spec.tx.isolation.esd_part, "ESD24VS2U");
+  EXPECT_EQ(p.point.spec.rx.isolation.esd_part, "ESD24VS2U");
 }
 
 // The example that sweeps TI's chokes against BCI immunity reads: 4 isolation variants x 3
