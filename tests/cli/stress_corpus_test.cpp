@@ -77,5 +77,42 @@ TEST(StressCorpus, EsdPeaksAgreeWithNgspiceOnEightSeededLinks) {
               100 * worst_share);
 }
 
+// The scenarios with traffic on four more seeded links (seed 4243), one short frame each way: two
+// module-ground steps, an inverter square and a wire fault (the end, fault and direction drawn),
+// isolink's peaks held to ngspice's and its `communicates` to the checker on ngspice's receiver
+// waveform (stress_ngspice.h). About 5 min (ngspice's transient of the traffic): labelled
+// `corpus` too, run by hand (`ctest --test-dir build -L corpus`), not in CI's slow step.
+TEST(StressCorpus, TrafficScenariosAgreeWithNgspiceAndTheChecker) {
+  std::mt19937 rng(4243);
+  double worst_v = 0;
+  int communicates = 0;
+  for (int i = 0; i < 4; ++i) {
+    CorpusLink c = draw(rng, 10 + i);
+    c.spec += "stimulus: {frames: [\"single-read dev=1 reg=0x0215 n=1\"]}\n";
+    auto pick = [&](std::initializer_list<const char*> xs) {
+      return std::string(xs.begin()[std::uniform_int_distribution<size_t>(0, xs.size() - 1)(rng)]);
+    };
+    const std::string kind = i == 1 ? "cm_wave" : i == 2 ? "wire" : "cm_step";
+    if (kind == "wire")
+      c.scenario = "wire_" + pick({"open_p", "short_pn", "n_to_ground", "p_to_chassis", "leak_n"}) +
+                   "_" + pick({"down", "up"});
+    else
+      c.scenario = kind + "_" + pick({"tx", "rx"});
+    SCOPED_TRACE(c.spec + c.scenario);
+    StatusOr<link::LinkSpec> spec = link::read_link_spec_text(c.spec, "corpus.yaml");
+    ASSERT_TRUE(spec.ok()) << spec.status().message();
+    const testing::StressAgreement a = testing::stress_vs_ngspice(*spec, c.scenario);
+    std::string flat = c.spec;
+    std::replace(flat.begin(), flat.end(), '\n', ' ');
+    std::printf("link %d %s(%s): pins within %.3f V (%.0f %% of the allowance), communicates %d\n",
+                i, flat.c_str(), c.scenario.c_str(), a.worst_pin_v, 100 * a.worst_pin_share,
+                a.communicates);
+    worst_v = std::max(worst_v, a.worst_pin_v);
+    communicates += a.communicates ? 1 : 0;
+  }
+  std::printf("traffic corpus: pins within %.3f V of ngspice; %d of 4 communicate\n", worst_v,
+              communicates);
+}
+
 }  // namespace
 }  // namespace isolink

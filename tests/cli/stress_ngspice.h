@@ -30,6 +30,8 @@ struct StressAgreement {
   double worst_pin_v = 0;      // V
   double worst_pin_share = 0;  // of its allowance
   double worst_diode_a = 0;    // A
+  bool communicates = false;   // the scenario's verdict (traffic scenarios; checked equal to
+                               // the checker's on ngspice's waveform)
 };
 
 inline StressAgreement stress_vs_ngspice(const link::LinkSpec& spec, const std::string& id) {
@@ -115,6 +117,7 @@ inline StressAgreement stress_vs_ngspice(const link::LinkSpec& spec, const std::
   EXPECT_TRUE(s.communicates.has_value());
   if (!check || !s.communicates) return out;
   EXPECT_EQ(check->pass, *s.communicates) << id;
+  out.communicates = *s.communicates;
   std::printf("%s: communicates %d (the checker on ngspice's waveform: %d)\n", id.c_str(),
               *s.communicates, check->pass);
   return out;
