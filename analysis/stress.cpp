@@ -497,20 +497,26 @@ double column_max_abs(const Waveform& w, size_t k) {
   return m;
 }
 
-// The largest |mean| of column k over any window of `span` seconds (the charge moved in it over
-// span), from the trapezoidal running integral, its far end interpolated linearly.
-double window_mean_max_abs(const Waveform& w, size_t k, double span) {
+// The trapezoidal running integral of column k from the first row (a current's charge).
+std::vector<double> running_integral(const Waveform& w, size_t k) {
   const std::vector<double>& a = w.columns[k];
-  const size_t n = w.samples();
-  std::vector<double> q(n, 0.0);
-  for (size_t j = 1; j < n; ++j)
+  std::vector<double> q(w.samples(), 0.0);
+  for (size_t j = 1; j < q.size(); ++j)
     q[j] = q[j - 1] + 0.5 * (a[j] + a[j - 1]) * (w.time[j] - w.time[j - 1]);
+  return q;
+}
+
+// The largest |mean| over any window of `span` seconds of the column whose running integral is
+// q (the charge moved in the window over span), the window's far end interpolated linearly.
+double window_mean_max_abs(const Waveform& w, const std::vector<double>& q, double span) {
+  const size_t n = q.size();
   double best = 0;
   size_t e = 0;
   for (size_t j = 0; j < n && w.time[j] + span <= w.time[n - 1]; ++j) {
     const double t = w.time[j] + span;
     while (e + 1 < n && w.time[e + 1] < t) ++e;
-    const double f = (t - w.time[e]) / (w.time[e + 1] - w.time[e]);
+    const double dt = w.time[e + 1] - w.time[e];
+    const double f = dt > 0 ? (t - w.time[e]) / dt : 1.0;
     best = std::max(best, std::abs(q[e] + f * (q[e + 1] - q[e]) - q[j]) / span);
   }
   return best;
@@ -698,12 +704,9 @@ void measure_peaks(StressScenario& s, const Waveform& w, const std::vector<std::
   }
   for (size_t i = 0; i < s.caps.size(); ++i) s.caps[i].peak_v = column_max_abs(w, cap0 + i);
   for (size_t i = 0; i < s.contacts.size(); ++i) {
-    const std::vector<double>& a = w.columns[contact0 + i];
-    double q = 0;
-    for (size_t j = 1; j < w.samples(); ++j)
-      q += 0.5 * (a[j] + a[j - 1]) * (w.time[j] - w.time[j - 1]);
-    s.contacts[i].peak_1ns_a = window_mean_max_abs(w, contact0 + i, kContactWindow);
-    s.contacts[i].charge_c = q;
+    const std::vector<double> q = running_integral(w, contact0 + i);
+    s.contacts[i].peak_1ns_a = window_mean_max_abs(w, q, kContactWindow);
+    s.contacts[i].charge_c = q.empty() ? 0.0 : q.back();
   }
 }
 

@@ -9,9 +9,8 @@
 // "description", "window_s": [start, end], "peak_pin_v": {NODE: {"max", "min"}}, "pin_ground":
 // {NODE: GROUND}, "peak_cm_V", "diodes": [...], "isolation_caps": [...], hot_plug's "contacts":
 // [{"contact", "probe", "peak_1ns_A", "charge_C"}] (current positive into the plugged module),
-// "receiver": {"p", "n",
-// "rules"}, "traffic": {...}, "survives", "communicates", "first_broken", "broken", "engine",
-// "seconds", "netlist"}]}.
+// "receiver": {"p", "n", "rules"}, "traffic": {...}, "survives", "communicates", "first_broken",
+// "broken", "engine", "seconds", "netlist"}]}.
 
 #include <map>
 #include <nlohmann/json.hpp>

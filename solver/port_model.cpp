@@ -56,16 +56,29 @@ struct ControlSource {
   double sign = 1.0;  // v(cp, cn) = sign * the source's value
 };
 
-StatusOr<std::vector<ControlSource>> control_sources(const Circuit& net,
-                                                     const std::vector<PortRef>& ports) {
-  std::map<int, int> touched;  // per node: elements connected to it, switch controls aside
-  for (const auto& e : net.elements()) {
+// Per node: the elements that can carry current into it (a switch's control terminals draw
+// none and are left out), counted on the circuit itself (the linear network adds the shunts).
+using NodeTouches = std::map<int, int>;
+NodeTouches current_touches(const Circuit& circuit) {
+  NodeTouches touched;
+  for (const auto& e : circuit.elements()) {
     bool is_switch = false;
     for (int k = 0; k < e->nonlinear_port_count(); ++k)
       is_switch = is_switch || e->nonlinear_port(k).controlled;
     for (size_t j = 0; j < e->nodes().size(); ++j)
       if (!(is_switch && j >= 2)) ++touched[e->nodes()[j]];
   }
+  return touched;
+}
+
+int touches(const NodeTouches& t, int node) {
+  const auto it = t.find(node);
+  return it == t.end() ? 0 : it->second;
+}
+
+StatusOr<std::vector<ControlSource>> control_sources(const Circuit& net,
+                                                     const std::vector<PortRef>& ports,
+                                                     const NodeTouches& touched) {
   std::vector<ControlSource> out;
   for (const PortRef& pr : ports) {
     if (!pr.controlled) continue;
@@ -80,7 +93,7 @@ StatusOr<std::vector<ControlSource>> control_sources(const Circuit& net,
         break;
       }
     }
-    const auto alone = [&](int u) { return u == 0 || touched[u] == 1; };
+    const auto alone = [&](int u) { return u == 0 || touches(touched, u) == 1; };
     if (found == nullptr || !found->source_function() || !alone(pr.cp) || !alone(pr.cn))
       return Status::Error(fmt::format(
           "{} is a voltage-controlled switch whose control is not a voltage source of its own "
@@ -107,6 +120,7 @@ bool is_constant(const SourceFunction& f, double horizon) {
 // with the sign returned (PortModel::PortCurrentProbe).
 std::optional<std::pair<int, double>> series_port_current(const Circuit& circuit,
                                                           const std::vector<PortRef>& ports,
+                                                          const NodeTouches& touched,
                                                           const Probe& p) {
   if (p.b != 0 || p.a == 0 || circuit.unknown_is_node(p.a)) return std::nullopt;
   const Element* source = nullptr;
@@ -115,9 +129,6 @@ std::optional<std::pair<int, double>> series_port_current(const Circuit& circuit
         e->nodes().size() == 2)
       source = e.get();
   if (source == nullptr) return std::nullopt;
-  std::map<int, int> touched;
-  for (const auto& e : circuit.elements())
-    for (int u : e->nodes()) ++touched[u];
   for (size_t m = 0; m < ports.size(); ++m) {
     const PortRef& pr = ports[m];
     const Element& el = *pr.element;
@@ -130,7 +141,8 @@ std::optional<std::pair<int, double>> series_port_current(const Circuit& circuit
       continue;
     for (int side = 0; side < 2; ++side) {
       const int u = source->nodes()[side];
-      if (u == 0 || touched[u] != 2 || (u != el.nodes()[0] && u != el.nodes()[1])) continue;
+      if (u == 0 || touches(touched, u) != 2 || (u != el.nodes()[0] && u != el.nodes()[1]))
+        continue;
       // The source's current flows from its first node through it to its second; the port's
       // from the element's first terminal through it to its second.
       const double into_element = u == el.nodes()[0] ? 1.0 : -1.0;
@@ -197,7 +209,8 @@ StatusOr<PortModel> build_port_model(const std::vector<Card>& cards, const Circu
   // modes carry the rest). As inputs they added Krylov vectors and source-to-port pairs to the
   // check; on a stress circuit of a 15 m link (11 of 14 sources constant) the search stalled at
   // 3.4e-5 with no new direction (order 344).
-  StatusOr<std::vector<ControlSource>> controls = control_sources(net, ports);
+  const NodeTouches touched = current_touches(circuit);
+  StatusOr<std::vector<ControlSource>> controls = control_sources(net, ports, touched);
   if (!controls) return controls.status();
   for (size_t m = 0; m < ports.size(); ++m)
     pm.port_control.push_back(ports[m].controlled ? pm.controls++ : -1);
@@ -234,7 +247,7 @@ StatusOr<PortModel> build_port_model(const std::vector<Card>& cards, const Circu
   std::vector<Probe> outputs;
   for (size_t c = 0; c < probes.size(); ++c) {
     pm.labels.push_back(probes[c].label);
-    if (auto port = series_port_current(circuit, ports, probes[c])) {
+    if (auto port = series_port_current(circuit, ports, touched, probes[c])) {
       pm.port_current_probes.push_back({static_cast<int>(c), port->first, port->second});
       continue;
     }

@@ -23,13 +23,15 @@ struct CorpusLink {
   std::string scenario;
 };
 
+std::string pick_one(std::mt19937& rng, std::initializer_list<const char*> xs) {
+  return std::string(xs.begin()[std::uniform_int_distribution<size_t>(0, xs.size() - 1)(rng)]);
+}
+
 // symmetric: the same isolation at both ends (as a real link has; the traffic corpus), else
 // each end's drawn on its own.
 CorpusLink draw(std::mt19937& rng, int index, bool symmetric = false) {
   std::uniform_real_distribution<double> u(0, 1);
-  auto pick = [&](std::initializer_list<const char*> xs) {
-    return std::string(xs.begin()[std::uniform_int_distribution<size_t>(0, xs.size() - 1)(rng)]);
-  };
+  auto pick = [&](std::initializer_list<const char*> xs) { return pick_one(rng, xs); };
   const double length = 0.5 * std::pow(30.0, u(rng));  // 0.5 .. 15 m
   const std::string material = pick({"pp", "pvc"});
   auto isolation = [&] {
@@ -64,17 +66,24 @@ CorpusLink draw(std::mt19937& rng, int index, bool symmetric = false) {
   return c;
 }
 
+// The link's scenario replayed in ngspice (stress_ngspice.h), and the spec on one line for the
+// log.
+testing::StressAgreement replay(const CorpusLink& c, std::string* flat) {
+  StatusOr<link::LinkSpec> spec = link::read_link_spec_text(c.spec, "corpus.yaml");
+  EXPECT_TRUE(spec.ok()) << spec.status().message();
+  *flat = c.spec;
+  std::replace(flat->begin(), flat->end(), '\n', ' ');
+  return spec.ok() ? testing::stress_vs_ngspice(*spec, c.scenario) : testing::StressAgreement{};
+}
+
 TEST(StressCorpus, EsdPeaksAgreeWithNgspiceOnEightSeededLinks) {
   std::mt19937 rng(4242);
   double worst_v = 0, worst_share = 0;
   for (int i = 0; i < 8; ++i) {
     const CorpusLink c = draw(rng, i);
     SCOPED_TRACE(c.spec + c.scenario);
-    StatusOr<link::LinkSpec> spec = link::read_link_spec_text(c.spec, "corpus.yaml");
-    ASSERT_TRUE(spec.ok()) << spec.status().message();
-    const testing::StressAgreement a = testing::stress_vs_ngspice(*spec, c.scenario);
-    std::string flat = c.spec;
-    std::replace(flat.begin(), flat.end(), '\n', ' ');
+    std::string flat;
+    const testing::StressAgreement a = replay(c, &flat);
     std::printf("link %d %s(%s): pins within %.3f V (%.0f %% of the allowance), diodes %.3g A\n", i,
                 flat.c_str(), c.scenario.c_str(), a.worst_pin_v, 100 * a.worst_pin_share,
                 a.worst_diode_a);
@@ -100,9 +109,7 @@ TEST(StressCorpus, TrafficScenariosAgreeWithNgspiceAndTheChecker) {
   for (int i = 0; i < 4; ++i) {
     CorpusLink c = draw(rng, 10 + i, true);
     c.spec += "stimulus: {frames: [\"single-read dev=1 reg=0x0215 n=1\"]}\n";
-    auto pick = [&](std::initializer_list<const char*> xs) {
-      return std::string(xs.begin()[std::uniform_int_distribution<size_t>(0, xs.size() - 1)(rng)]);
-    };
+    auto pick = [&](std::initializer_list<const char*> xs) { return pick_one(rng, xs); };
     const std::string kind = i == 1 ? "cm_wave" : i == 2 ? "wire" : "cm_step";
     if (kind == "wire")
       c.scenario = "wire_" + pick({"open_p", "short_pn", "n_to_ground", "p_to_chassis", "leak_n"}) +
@@ -110,11 +117,8 @@ TEST(StressCorpus, TrafficScenariosAgreeWithNgspiceAndTheChecker) {
     else
       c.scenario = kind + "_" + pick({"tx", "rx"});
     SCOPED_TRACE(c.spec + c.scenario);
-    StatusOr<link::LinkSpec> spec = link::read_link_spec_text(c.spec, "corpus.yaml");
-    ASSERT_TRUE(spec.ok()) << spec.status().message();
-    const testing::StressAgreement a = testing::stress_vs_ngspice(*spec, c.scenario);
-    std::string flat = c.spec;
-    std::replace(flat.begin(), flat.end(), '\n', ' ');
+    std::string flat;
+    const testing::StressAgreement a = replay(c, &flat);
     std::printf("link %d %s(%s): pins within %.3f V (%.0f %% of the allowance), communicates %d\n",
                 i, flat.c_str(), c.scenario.c_str(), a.worst_pin_v, 100 * a.worst_pin_share,
                 a.communicates);

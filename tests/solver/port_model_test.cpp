@@ -152,14 +152,20 @@ TEST(PortModel, ClipperFollowsItsKneeOnASlowRamp) {
   EXPECT_NEAR(w->columns[1].back(), 0.6929, 1e-3);
 }
 
+// A rectifier diode with series resistance, junction capacitance and transit time (charge
+// storage), shared by the rectifier and the series-ammeter tests.
+std::shared_ptr<const CardModel> rectifier_diode() {
+  return model({{"is", 1e-8},
+                {"n", 1.05},
+                {"rs", 0.3},
+                {"cjo", 30e-12},
+                {"vj", 0.5},
+                {"m", 0.45},
+                {"tt", 5e-9}});
+}
+
 TEST(PortModel, RectifierWithChargeStorageMatchesTheFullTransient) {
-  const auto d = model({{"is", 1e-8},
-                        {"n", 1.05},
-                        {"rs", 0.3},
-                        {"cjo", 30e-12},
-                        {"vj", 0.5},
-                        {"m", 0.45},
-                        {"tt", 5e-9}});
+  const auto d = rectifier_diode();
   const std::vector<Card> cards = {card("v1", {"in", "0"}, {call("sin", {0, 5, 1e6})}),
                                    card("rs", {"in", "a"}, {num(10)}), diode("d1", {"a", "out"}, d),
                                    card("rl", {"out", "0"}, {num(2e3)}),
@@ -174,13 +180,7 @@ TEST(PortModel, SeriesAmmetersReadTheirDiodesCurrentWithTheSign) {
   // from a into d1's anode (i(vam1) = +i(d1)), vam2 from ground into d2's cathode node (the
   // diode's current enters vam2 at its n- node: i(vam2) = -i(d2)). Both are read from the
   // ports, not through the model; against the full transient's branch currents at 1e-6.
-  const auto d = model({{"is", 1e-8},
-                        {"n", 1.05},
-                        {"rs", 0.3},
-                        {"cjo", 30e-12},
-                        {"vj", 0.5},
-                        {"m", 0.45},
-                        {"tt", 5e-9}});
+  const auto d = rectifier_diode();
   const std::vector<Card> cards = {card("v1", {"in", "0"}, {call("sin", {0, 5, 1e6})}),
                                    card("rs", {"in", "a"}, {num(10)}),
                                    card("vam1", {"a", "da"}, {num(0)}),
