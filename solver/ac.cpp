@@ -38,6 +38,9 @@ struct AcAnalysis::Impl {
   klu_numeric* numeric = nullptr;
   bool paired = true;     // `symbolic` is the paired ordering (else COLAMD's)
   double frequency = -1;  // of the current factorization, -1: none
+  // The current factorization failed the backward-error probe even with fresh, stricter pivots:
+  // each solve refines itself (header: Accuracy).
+  bool refine = false;
   ~Impl() {
     if (numeric) klu_z_free_numeric(&numeric, &common);
     if (symbolic) klu_free_symbolic(&symbolic, &common);
@@ -45,9 +48,23 @@ struct AcAnalysis::Impl {
   }
   klu_symbolic* analyze_paired();
   bool keep_cheaper_ordering(bool factored);
+  double probe_backward_error();
+  bool factor_fresh();
+  void multiply(const std::vector<double>& x, std::vector<double>& y, bool transposed) const;
+  double backward_error(const std::vector<double>& x, const std::vector<double>& rhs,
+                        bool transposed, std::vector<double>& residual) const;
+  void solve_scaled(std::vector<double>& x, bool transposed);
+  AcAnalysis::Vector solve(const AcAnalysis::Vector& b, bool transposed);
 };
 
 namespace {
+
+// Accuracy (header): the largest backward error a factorization's probe solve may leave (a
+// stable LU leaves about n eps), KLU's pivot threshold after one that left more (its default is
+// 0.001), and the refinement steps a solve takes when even that factorization is inaccurate.
+constexpr double kBackwardErrorBound = 1e-11;
+constexpr double kStrictPivotTolerance = 0.1;
+constexpr int kRefinementSteps = 3;
 
 // |g| + |c| of the pattern's entry (row, col) (0-based), 0 where the pattern has none.
 double entry_size(const MnaPattern& pattern, const std::vector<double>& g,
@@ -262,15 +279,94 @@ Status AcAnalysis::factor(double frequency) {
     if (!ok) klu_z_free_numeric(&m.numeric, &m.common);
   }
   if (!ok) {
-    m.numeric = klu_z_factor(ap, ai, m.a.data(), m.symbolic, &m.common);
-    ok = m.numeric != nullptr && m.common.status == KLU_OK;
+    ok = m.factor_fresh();
     if (m.candidate) ok = m.keep_cheaper_ordering(ok);
+  }
+  // Accuracy (header): a factorization whose probe solve leaves a residual is redone with fresh
+  // pivots at KLU's strict threshold; if that is still inaccurate, every solve refines itself.
+  m.refine = false;
+  if (ok && m.probe_backward_error() > kBackwardErrorBound) {
+    m.common.tol = kStrictPivotTolerance;  // kept for this analysis's later factorizations
+    ok = m.factor_fresh();
+    m.refine = ok && m.probe_backward_error() > kBackwardErrorBound;
   }
   if (!ok)
     return Status::Error(fmt::format("ac analysis at {:g} Hz: singular matrix (KLU status {})",
                                      frequency, m.common.status));
   m.frequency = frequency;
   return Status::Ok();
+}
+
+// A full factorization (new pivots) of `a` on `symbolic`, the previous one freed.
+bool AcAnalysis::Impl::factor_fresh() {
+  if (numeric) klu_z_free_numeric(&numeric, &common);
+  numeric = klu_z_factor(ap.data(), ai.data(), a.data(), symbolic, &common);
+  return numeric != nullptr && common.status == KLU_OK;
+}
+
+// y = S x or S^T x (S = R A, the scaled matrix `a`), complex vectors interleaved re, im.
+void AcAnalysis::Impl::multiply(const std::vector<double>& x, std::vector<double>& y,
+                                bool transposed) const {
+  std::fill(y.begin(), y.end(), 0.0);
+  const int n = pattern.size();
+  for (int col = 0; col < n; ++col)
+    for (int k = ap[col]; k < ap[col + 1]; ++k) {
+      const double are = a[2 * k], aim = a[2 * k + 1];
+      const size_t from = 2 * static_cast<size_t>(transposed ? ai[k] : col);
+      const size_t to = 2 * static_cast<size_t>(transposed ? col : ai[k]);
+      y[to] += are * x[from] - aim * x[from + 1];
+      y[to + 1] += are * x[from + 1] + aim * x[from];
+    }
+}
+
+// The normwise backward error of x as a solution of S x = rhs (S^T x = rhs):
+// max|rhs - S x| / (max|S| max|x| + max|rhs|), max|S| at most 1 (each row's largest entry is
+// scaled into [0.5, 1), and |re| + |im| bounds an entry). `residual` is left holding rhs - S x.
+double AcAnalysis::Impl::backward_error(const std::vector<double>& x,
+                                        const std::vector<double>& rhs, bool transposed,
+                                        std::vector<double>& residual) const {
+  residual.resize(x.size());
+  multiply(x, residual, transposed);
+  double r = 0, xm = 0, bm = 0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    residual[i] = rhs[i] - residual[i];
+    r = std::max(r, std::fabs(residual[i]));
+    xm = std::max(xm, std::fabs(x[i]));
+    bm = std::max(bm, std::fabs(rhs[i]));
+  }
+  const double scale = 2 * xm + bm;
+  if (!std::isfinite(r) || !std::isfinite(scale)) return std::numeric_limits<double>::infinity();
+  return scale > 0 ? r / scale : 0;
+}
+
+// The backward error of the factorization's solve for a fixed right-hand side, b = S x0.
+double AcAnalysis::Impl::probe_backward_error() {
+  const size_t n = static_cast<size_t>(pattern.size());
+  std::vector<double> x0(2 * n), b(2 * n), x, residual;
+  for (size_t i = 0; i < n; ++i) x0[2 * i] = 1.0 + 0.1 * (i % 7), x0[2 * i + 1] = 0.2 * (i % 5);
+  multiply(x0, b, false);
+  x = b;
+  klu_z_solve(symbolic, numeric, pattern.size(), 1, x.data(), &common);
+  return backward_error(x, b, false, residual);
+}
+
+// x := S^-1 x (S^-T x), with up to kRefinementSteps of iterative refinement when `refine`.
+void AcAnalysis::Impl::solve_scaled(std::vector<double>& x, bool transposed) {
+  const int n = pattern.size();
+  const auto klu = [&](std::vector<double>& v) {
+    if (transposed)
+      klu_z_tsolve(symbolic, numeric, n, 1, v.data(), 0, &common);  // S^T, not conjugated
+    else
+      klu_z_solve(symbolic, numeric, n, 1, v.data(), &common);
+  };
+  const std::vector<double> rhs = refine ? x : std::vector<double>{};
+  klu(x);
+  std::vector<double> residual;
+  for (int step = 0; refine && step < kRefinementSteps; ++step) {
+    if (backward_error(x, rhs, transposed, residual) <= kBackwardErrorBound) break;
+    klu(residual);
+    for (size_t i = 0; i < x.size(); ++i) x[i] += residual[i];
+  }
 }
 
 double AcAnalysis::factored_frequency() const {
@@ -287,39 +383,29 @@ const char* AcAnalysis::ordering_name() const {
   return impl_->paired ? "paired AMD" : "COLAMD";
 }
 
-namespace {
-
 // A x = b as (R A) x = R b; A^T x = b as (R A)^T y = b, x = R y (R: Impl::row_scale).
-AcAnalysis::Vector klu_solve(const AcAnalysis::Vector& b, int n, bool transposed,
-                             const std::vector<double>& rs, klu_symbolic* symbolic,
-                             klu_numeric* numeric, klu_common* common) {
-  std::vector<double> x(2 * static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i) {
-    const double r = transposed ? 1.0 : rs[i];
-    x[2 * i] = r * b[i + 1].real(), x[2 * i + 1] = r * b[i + 1].imag();
-  }
-  if (transposed)
-    klu_z_tsolve(symbolic, numeric, n, 1, x.data(), 0, common);  // A^T, not conjugated
-  else
-    klu_z_solve(symbolic, numeric, n, 1, x.data(), common);
-  AcAnalysis::Vector out(n + 1, 0.0);
-  for (int i = 0; i < n; ++i) {
-    const double r = transposed ? rs[i] : 1.0;
-    out[i + 1] = {r * x[2 * i], r * x[2 * i + 1]};
-  }
-  return out;
-}
-
-}  // namespace
-
 AcAnalysis::Vector AcAnalysis::solve_factored(const Vector& b) const {
-  Impl& m = *impl_;
-  return klu_solve(b, m.pattern.size(), false, m.row_scale, m.symbolic, m.numeric, &m.common);
+  return impl_->solve(b, false);
 }
 
 AcAnalysis::Vector AcAnalysis::solve_transposed(const Vector& c) const {
-  Impl& m = *impl_;
-  return klu_solve(c, m.pattern.size(), true, m.row_scale, m.symbolic, m.numeric, &m.common);
+  return impl_->solve(c, true);
+}
+
+AcAnalysis::Vector AcAnalysis::Impl::solve(const Vector& b, bool transposed) {
+  const int n = pattern.size();
+  std::vector<double> x(2 * static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const double r = transposed ? 1.0 : row_scale[i];
+    x[2 * i] = r * b[i + 1].real(), x[2 * i + 1] = r * b[i + 1].imag();
+  }
+  solve_scaled(x, transposed);
+  Vector out(n + 1, 0.0);
+  for (int i = 0; i < n; ++i) {
+    const double r = transposed ? row_scale[i] : 1.0;
+    out[i + 1] = {r * x[2 * i], r * x[2 * i + 1]};
+  }
+  return out;
 }
 
 const std::vector<double>& AcAnalysis::g_values() const {
