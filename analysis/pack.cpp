@@ -81,13 +81,7 @@ namespace {
 StatusOr<std::vector<std::string>> host_commands(const std::vector<std::string>& frames) {
   std::vector<std::string> out;
   for (const std::string& text : frames) {
-    std::vector<std::string_view> tok;
-    for (size_t i = 0; i < text.size();) {
-      const size_t j = text.find_first_of(" \t", i);
-      const size_t e = j == std::string::npos ? text.size() : j;
-      if (e > i) tok.emplace_back(text.data() + i, e - i);
-      i = e + 1;
-    }
+    const std::vector<std::string_view> tok = traffic::split_ws(text);
     if (!tok.empty() && tok[0] == "responses") continue;
     if (!tok.empty() && tok[0] == "auto-address") {
       StatusOr<std::vector<std::string>> cmds =

@@ -14,6 +14,7 @@
 #include <fstream>
 #include <numbers>
 
+#include "builtin_library.h"
 #include "netlists/link/cards.h"
 #include "solver/ac.h"
 
@@ -23,14 +24,7 @@ namespace {
 namespace fs = std::filesystem;
 constexpr double kPi = std::numbers::pi;
 
-const PartLibrary& builtin() {
-  static const PartLibrary lib = [] {
-    StatusOr<PartLibrary> l = PartLibrary::load({});
-    EXPECT_TRUE(l.ok()) << l.status().message();
-    return l.ok() ? *l : PartLibrary{};
-  }();
-  return lib;
-}
+using testing::builtin;
 
 // |V| / 1 A at node "in" (I source "iin" from ground into "in") of cards plus the source.
 class Impedance {

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "builtin_library.h"
 #include "netlists/link/cards.h"
 #include "netlists/link/expand.h"
 #include "netlists/link/link_spec.h"
@@ -22,14 +23,7 @@
 namespace isolink::link {
 namespace {
 
-const PartLibrary& builtin() {
-  static const PartLibrary lib = [] {
-    StatusOr<PartLibrary> l = PartLibrary::load({});
-    EXPECT_TRUE(l.ok()) << l.status().message();
-    return l.ok() ? *l : PartLibrary{};
-  }();
-  return lib;
-}
+using testing::builtin;
 
 std::vector<const Part*> tvs_parts() {
   std::vector<const Part*> out;
