@@ -54,9 +54,9 @@ Poles starting_poles(int n, double f_lo) {
 }
 
 struct Data {
-  std::vector<cd> s;               // scaled: j f / f_max
-  std::vector<double> w;           // row weights
-  std::vector<std::vector<cd>> f;  // [entry][frequency], upper triangle row-major
+  std::vector<cd> s;                   // scaled: j f / f_max
+  std::vector<std::vector<double>> w;  // [entry][frequency]: the rows' weights
+  std::vector<std::vector<cd>> f;      // [entry][frequency], upper triangle row-major
   std::vector<std::pair<int, int>> ij;
   int ports = 0;
 };
@@ -72,7 +72,7 @@ Poles relocate(const Data& d, const Poles& poles) {
   for (int e = 0; e < ne; ++e) {
     for (int i = 0; i < ns; ++i) {
       basis(d.s[i], poles, phi.data());
-      const double w = d.w[i];
+      const double w = d.w[e][i];
       const cd fw = w * d.f[e][i];
       norm += std::norm(fw);
       for (int k = 0; k <= n; ++k) {
@@ -137,31 +137,32 @@ Poles relocate(const Data& d, const Poles& poles) {
   return out;
 }
 
-// Residues and D with the poles fixed: one least squares, every entry a right-hand side.
+// Residues and D with the poles fixed: one least squares per entry (each weighted its own way).
 Eigen::MatrixXd residues(const Data& d, const Poles& poles) {
   const int n = state_count(poles), ns = static_cast<int>(d.s.size());
   const int ne = static_cast<int>(d.f.size());
-  Eigen::MatrixXd a(2 * ns, n + 1), b(2 * ns, ne);
+  Eigen::MatrixXd x(n + 1, ne);
+  Eigen::MatrixXd a(2 * ns, n + 1);
+  Eigen::VectorXd b(2 * ns);
   std::vector<cd> phi(n);
-  for (int i = 0; i < ns; ++i) {
-    basis(d.s[i], poles, phi.data());
-    for (int k = 0; k <= n; ++k) {
-      const cd v = d.w[i] * (k < n ? phi[k] : cd(1, 0));
-      a(2 * i, k) = v.real(), a(2 * i + 1, k) = v.imag();
-    }
-    for (int e = 0; e < ne; ++e) {
-      const cd v = d.w[i] * d.f[e][i];
-      b(2 * i, e) = v.real(), b(2 * i + 1, e) = v.imag();
-    }
-  }
   Eigen::VectorXd scale(n + 1);
-  for (int k = 0; k <= n; ++k) {
-    scale[k] = a.col(k).norm();
-    if (!(scale[k] > 0)) scale[k] = 1;
-    a.col(k) /= scale[k];
+  for (int e = 0; e < ne; ++e) {
+    for (int i = 0; i < ns; ++i) {
+      basis(d.s[i], poles, phi.data());
+      for (int k = 0; k <= n; ++k) {
+        const cd v = d.w[e][i] * (k < n ? phi[k] : cd(1, 0));
+        a(2 * i, k) = v.real(), a(2 * i + 1, k) = v.imag();
+      }
+      const cd v = d.w[e][i] * d.f[e][i];
+      b[2 * i] = v.real(), b[2 * i + 1] = v.imag();
+    }
+    for (int k = 0; k <= n; ++k) {
+      scale[k] = a.col(k).norm();
+      if (!(scale[k] > 0)) scale[k] = 1;
+      a.col(k) /= scale[k];
+    }
+    x.col(e) = a.colPivHouseholderQr().solve(b).cwiseQuotient(scale);
   }
-  Eigen::MatrixXd x = a.colPivHouseholderQr().solve(b);
-  for (int k = 0; k <= n; ++k) x.row(k) /= scale[k];
   return x;
 }
 
@@ -242,6 +243,11 @@ StatusOr<FitResult> vector_fit(const std::vector<double>& freqs,
   for (int i = 0; i < d.ports; ++i)
     for (int j = i; j < d.ports; ++j) d.ij.push_back({i, j});
   d.f.assign(d.ij.size(), {});
+  d.w.assign(d.ij.size(), {});
+  const Eigen::MatrixXd& t = opt.transform;
+  if (t.size() && (t.rows() != d.ports || t.cols() != d.ports ||
+                   !(t * t.transpose()).isApprox(Eigen::MatrixXd::Identity(d.ports, d.ports))))
+    return Status::Error("vector fit: the transform must be an orthogonal N x N matrix");
   const double f_max = freqs.back();
   std::vector<Eigen::MatrixXcd> s_data;
   for (int i = 0; i < ns; ++i) {
@@ -250,9 +256,15 @@ StatusOr<FitResult> vector_fit(const std::vector<double>& freqs,
     const Eigen::MatrixXcd ys = (y[i] + y[i].transpose()) / 2.0;
     if (!ys.allFinite()) return Status::Error("vector fit: non-finite data");
     d.s.push_back(cd(0, freqs[i] / f_max));
-    d.w.push_back(1.0 / (1.0 / opt.z0 + ys.cwiseAbs().maxCoeff()));
-    for (size_t e = 0; e < d.ij.size(); ++e) d.f[e].push_back(ys(d.ij[e].first, d.ij[e].second));
     s_data.push_back(s_from_y(ys, opt.z0));
+    // Header, Weighting: the fitted entries are those of T Y T^T when a transform is given.
+    const Eigen::MatrixXcd yt = t.size() ? Eigen::MatrixXcd(t * ys * t.transpose()) : ys;
+    const double row = 1.0 / (1.0 / opt.z0 + ys.cwiseAbs().maxCoeff());
+    for (size_t e = 0; e < d.ij.size(); ++e) {
+      const cd v = yt(d.ij[e].first, d.ij[e].second);
+      d.f[e].push_back(v);
+      d.w[e].push_back(t.size() ? 1.0 / (1.0 / opt.z0 + std::abs(v)) : row);
+    }
   }
   const double w0 = kTwoPi * f_max;
   FitResult best;
@@ -264,6 +276,10 @@ StatusOr<FitResult> vector_fit(const std::vector<double>& freqs,
     for (int it = 0; it < opt.iterations; ++it) poles = relocate(d, poles);
     FitResult r;
     r.model = to_model(d, poles, residues(d, poles), w0);
+    if (t.size()) {  // back from T Y T^T: Y = T^T (T Y T^T) T
+      for (Eigen::MatrixXcd& res : r.model.residues) res = t.transpose() * res * t;
+      r.model.d = t.transpose() * r.model.d * t;
+    }
     score(r.model, freqs, s_data, opt.z0, r);
     best.orders_tried.push_back(n);
     best.errors.push_back(r.rms_error);

@@ -20,8 +20,12 @@
 //   converged when its error is within the tolerance. The fit error is the RMS of |S_fit - S| over
 //   the entries and the band (robust to a measurement's noise); the largest |S_fit - S| is reported
 //   beside it.
-// - Rows are weighted per frequency by 1 / (1/z0 + max |Y_ij|): the error that matters is in the
-//   scattering parameters, and dS ~ dY / (1 + z0 |Y|).
+// - Weighting: rows are weighted per frequency by 1 / (1/z0 + max |Y_ij|): the error that
+//   matters is in the scattering parameters, and dS ~ dY / (1 + z0 |Y|). With a transform T
+//   (FitOptions::transform), the fitted entries are those of T Y T^T, each weighted by
+//   1 / (1/z0 + |its own value|): a line's admittance in its tx + rx and tx - rx combinations
+//   has a large block (the series path, 1/R at DC) and a small one (the shunt capacitance, j w C),
+//   and a weight shared per frequency fits the small one only to the large one's rounding.
 // - The error reported is in S (reference z0): max over the band of |S_fit - S| per entry.
 // - Passivity of an admittance: the eigenvalues of Re Y(j w) (real symmetric for a reciprocal
 //   N-port) non-negative at every w. Checked on a dense sweep from DC to 10 times the band's top
@@ -59,6 +63,9 @@ struct FitOptions {
   int order_step = 8;
   int max_order = 160;
   int iterations = 8;  // pole relocations per order
+  // Header, Weighting: an orthogonal N x N matrix T (empty: none). The fit is of T Y T^T, each
+  // entry weighted by 1 / (1/z0 + |entry|), and the model returned is of Y.
+  Eigen::MatrixXd transform;
 };
 
 struct FitResult {
