@@ -52,6 +52,22 @@ StatusOr<Engine> parse_engine(const std::string& text) {
   return Status::Error("engine '" + text + "' is not one of " + choices);
 }
 
+// What the self-check (transient_check.h) did; `agreement`: its absolute allowance, in words.
+std::string tightening_text(const TransientConvergence& c, const char* agreement) {
+  return fmt::format(
+      "checked by tightening: reltol {:g} -> {:g} and largest step {:g} -> {:g} s in {} runs; the "
+      "kept run is {:.3g} m from the run before it (V or A, the probe nearest its allowance){}",
+      c.reltols.front(), c.reltols.back(), c.tmaxes.front(), c.tmaxes.back(), c.reltols.size(),
+      1e3 * c.deviations.back(),
+      c.agreed ? fmt::format(", within its allowance of {:.3g} m ({} or 0.1 % of the probe's "
+                             "peak): converged to about that, as the error shrinks at least "
+                             "twofold per round",
+                             1e3 * c.allowed.back(), agreement)
+               : fmt::format(", NOT within its allowance of {:.3g} m: the tightening stopped at "
+                             "reltol {:g} or at the step limit; treat small differences with care",
+                             1e3 * c.allowed.back(), c.reltols.back()));
+}
+
 std::string engine_accuracy(const SimulationResult& r) {
   if (r.engine == Engine::Lti && r.lti.method == "reduced model") {
     const double bound = ReducedModelOptions{}.edge_error_bound();
@@ -68,14 +84,16 @@ std::string engine_accuracy(const SimulationResult& r) {
         "probes) within {:.1e} of each pair's peak (check {:.0e}{}; an edge's response within "
         "{:.2g} of its amplitude times the pair's peak gain); time steps under the transient's "
         "truncation-error control (trtol x reltol = {:.2g} of each port voltage's, charge's and "
-        "probe's peak), the port currents linear over a step, charge conserved; within 3 mV of "
-        "the converged full transient on the nonlinear test circuits",
+        "probe's peak), the port currents linear over a step, charge conserved{}",
         r.port.model.error, r.port.model.tol,
         r.port.model.relaxed
             ? fmt::format(", relaxed from {:.0e}: the search could add no direction",
                           po.reduced.tol)
             : "",
-        po.reduced.edge_error_bound(r.port.model.error), r.trtol * r.reltol);
+        po.reduced.edge_error_bound(r.port.model.error), r.trtol * r.reltol,
+        r.convergence && !r.convergence->deviations.empty()
+            ? "; " + tightening_text(*r.convergence, "3 mV")
+            : "");
   }
   if (r.engine == Engine::Lti && r.lti.method.empty())  // a waveform synthesized, not simulated
     return "that of the response it was synthesized from (" + r.engine_note + ")";
@@ -87,23 +105,8 @@ std::string engine_accuracy(const SimulationResult& r) {
         "100 m link); linear interpolation between rows within 1 mV",
         lo.step_reltol, lo.step_abstol);
   }
-  if (r.convergence && !r.convergence->deviations.empty()) {
-    const TransientConvergence& c = *r.convergence;
-    return fmt::format(
-        "transient, checked by tightening: reltol {:g} -> {:g} and largest "
-        "step {:g} -> {:g} s in {} runs; the kept run is {:.3g} m from the run before it (V or "
-        "A, the probe nearest its allowance){}",
-        c.reltols.front(), c.reltols.back(), c.tmaxes.front(), c.tmaxes.back(), c.reltols.size(),
-        1e3 * c.deviations.back(),
-        c.agreed ? fmt::format(", within its allowance of {:.3g} m (5 mV or 0.1 % of the "
-                               "probe's peak): converged to about that, as the error shrinks at "
-                               "least twofold per round",
-                               1e3 * c.allowed.back())
-                 : fmt::format(", NOT within its allowance of {:.3g} m: the tightening stopped "
-                               "at reltol {:g} or at the step limit; treat small differences "
-                               "with care",
-                               1e3 * c.allowed.back(), c.reltols.back()));
-  }
+  if (r.convergence && !r.convergence->deviations.empty())
+    return "transient, " + tightening_text(*r.convergence, "5 mV");
   return fmt::format(
       "transient: local truncation error per step within trtol x reltol = {:.2g} of each "
       "unknown's peak (reltol {:g}); a local bound, not a global one: at reltol 1e-3 the links "
@@ -529,9 +532,26 @@ Status run_port(const Netlist& netlist, const EngineRun& run, SimulationResult& 
       build_port_model(netlist.cards, run.circuit, run.probes, opt.tstop, po);
   if (!model) return refuse(model.status());
   TransientOptions port_opt = opt;
-  if (!req.reltol && !netlist_sets_reltol(netlist)) port_opt.reltol = po.default_reltol;
+  const bool at_defaults = !req.reltol && !netlist_sets_reltol(netlist);
+  if (at_defaults) port_opt.reltol = po.default_reltol;
   StatusOr<Waveform> wave = run_port_model(run.circuit, *model, port_opt, &result.port);
   if (!wave) return refuse(wave.status());
+  if (at_defaults) {
+    // No tolerance of the user's: the run checks its own convergence as the transient does
+    // (transient_check.h), at the nonlinear bound of 3 mV.
+    TransientConvergence conv;
+    wave = converge_runs(
+        port_opt, std::move(*wave),
+        [&](const TransientOptions& o) -> StatusOr<Waveform> {
+          PortModelStats tighter;
+          StatusOr<Waveform> w = run_port_model(run.circuit, *model, o, &tighter);
+          if (w) result.port = tighter;
+          return w;
+        },
+        TransientConvergence::kPortAgreementV, &conv);
+    port_opt.reltol = conv.reltols.back();
+    result.convergence = std::move(conv);
+  }
   result.wave = std::move(*wave);
   result.engine = Engine::PortModel;
   result.reltol = port_opt.reltol;

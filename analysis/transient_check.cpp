@@ -17,13 +17,13 @@ double max_deviation(const Waveform& coarse, const Waveform& fine, size_t k) {
 namespace {
 
 // The column whose deviation is nearest its allowance (or furthest past it): {deviation, allowed}.
-std::pair<double, double> worst_column(const Waveform& coarse, const Waveform& fine) {
-  std::pair<double, double> worst{0.0, TransientConvergence::kAgreementV};
+std::pair<double, double> worst_column(const Waveform& coarse, const Waveform& fine,
+                                       double agreement_v) {
+  std::pair<double, double> worst{0.0, agreement_v};
   for (size_t k = 0; k < fine.columns.size(); ++k) {
     double peak = 0.0;
     for (double v : fine.columns[k]) peak = std::max(peak, std::abs(v));
-    const double allowed =
-        std::max(TransientConvergence::kAgreementV, TransientConvergence::kAgreementRel * peak);
+    const double allowed = std::max(agreement_v, TransientConvergence::kAgreementRel * peak);
     const double dev = max_deviation(coarse, fine, k);
     if (dev / allowed > worst.first / worst.second) worst = {dev, allowed};
   }
@@ -32,9 +32,8 @@ std::pair<double, double> worst_column(const Waveform& coarse, const Waveform& f
 
 }  // namespace
 
-StatusOr<Waveform> converge_transient(Circuit& circuit, TransientOptions opt,
-                                      const std::vector<Probe>& probes, Waveform first,
-                                      TransientStats* stats, TransientConvergence* out) {
+Waveform converge_runs(TransientOptions opt, Waveform first, const CheckedRun& run,
+                       double agreement_v, TransientConvergence* out) {
   *out = TransientConvergence{};
   out->reltols.push_back(opt.reltol);
   out->tmaxes.push_back(opt.effective_tmax());
@@ -42,22 +41,34 @@ StatusOr<Waveform> converge_transient(Circuit& circuit, TransientOptions opt,
   while (opt.reltol / 10 >= TransientConvergence::kReltolFloor * (1 - 1e-9)) {
     opt.reltol /= 10;
     opt.tmax = opt.effective_tmax() / 2;  // the step limit may bind rather than the tolerance
-    TransientStats tighter_stats;
-    StatusOr<Waveform> tighter = run_transient(circuit, opt, probes, &tighter_stats);
+    StatusOr<Waveform> tighter = run(opt);
     if (!tighter) return kept;  // it did not finish (max_steps): the last run stands
     out->reltols.push_back(opt.reltol);
     out->tmaxes.push_back(opt.tmax);
-    const auto [dev, allowed] = worst_column(kept, *tighter);
+    const auto [dev, allowed] = worst_column(kept, *tighter, agreement_v);
     out->deviations.push_back(dev);
     out->allowed.push_back(allowed);
     kept = std::move(*tighter);
-    *stats = tighter_stats;
     if (dev <= allowed) {
       out->agreed = true;
       break;
     }
   }
   return kept;
+}
+
+StatusOr<Waveform> converge_transient(Circuit& circuit, TransientOptions opt,
+                                      const std::vector<Probe>& probes, Waveform first,
+                                      TransientStats* stats, TransientConvergence* out) {
+  return converge_runs(
+      opt, std::move(first),
+      [&](const TransientOptions& o) -> StatusOr<Waveform> {
+        TransientStats tighter_stats;
+        StatusOr<Waveform> w = run_transient(circuit, o, probes, &tighter_stats);
+        if (w) *stats = tighter_stats;
+        return w;
+      },
+      TransientConvergence::kAgreementV, out);
 }
 
 }  // namespace isolink::analysis
