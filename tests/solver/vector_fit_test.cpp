@@ -56,6 +56,45 @@ TEST(VectorFit, RecoversKnownPolesAndResponse) {
   }
 }
 
+// A line as its pi section, one conductor, ports tx and rx: a series R + s L between them and at
+// each end a shunt C (with 1 ohm in series, so that Y is proper and exactly rational). Its Y has
+// a large block (tx - rx: the series path, 1/R at DC) and a small one (tx + rx: the shunt,
+// j w C): the fit in the ends' sum and difference (FitOptions::transform) must return the model
+// of Y itself, the shunt at 10 kHz (3 uS beside 5.9 S) to 1e-6 of itself.
+TEST(VectorFit, TransformedFitReturnsTheModelOfY) {
+  const double r = 0.17, l = 0.5e-6, c = 50e-12, rs = 1;
+  auto line = [&](double f) {
+    const cd s(0, kTwoPi * f);
+    const cd series = 1.0 / (r + s * l), shunt = s * c / (1.0 + s * rs * c);
+    Eigen::MatrixXcd y(2, 2);
+    y << series + shunt, -series, -series, series + shunt;
+    return y;
+  };
+  std::vector<double> f;
+  std::vector<Eigen::MatrixXcd> y;
+  for (int i = 0; i < 200; ++i) {
+    f.push_back(1e4 * std::pow(5e4, i / 199.0));  // 10 kHz .. 500 MHz
+    y.push_back(line(f.back()));
+  }
+  FitOptions o;
+  const double k = 1 / std::sqrt(2.0);
+  o.transform = (Eigen::MatrixXd(2, 2) << k, k, k, -k).finished();
+  StatusOr<FitResult> fit = vector_fit(f, y, o);
+  ASSERT_TRUE(fit.ok()) << fit.status().message();
+  EXPECT_TRUE(fit->converged);
+  for (double x : {1e4, 3.3e5, 12e6, 480e6}) {
+    const Eigen::MatrixXcd want = line(x), got = fit->model.eval(cd(0, kTwoPi * x));
+    EXPECT_LT((got - want).cwiseAbs().maxCoeff(), 1e-6 * want.cwiseAbs().maxCoeff()) << x;
+    const cd shunt_want = want(0, 0) + want(0, 1), shunt_got = got(0, 0) + got(0, 1);
+    EXPECT_LT(std::abs(shunt_got - shunt_want), 1e-6 * std::abs(shunt_want)) << x;
+  }
+  // Not orthogonal: refused.
+  o.transform(1, 1) = k;
+  StatusOr<FitResult> bad = vector_fit(f, y, o);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("orthogonal"), std::string::npos);
+}
+
 TEST(VectorFit, SFromYOfASeriesResistor) {
   // A 50 ohm series resistor between two 50 ohm ports: S11 = 1/3, S21 = 2/3.
   Eigen::MatrixXcd y(2, 2);
