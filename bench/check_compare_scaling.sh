@@ -12,6 +12,8 @@
 #
 #   bash bench/check_compare_scaling.sh [build/cli/isolink] [N ...]    # default N: 10 100 1000
 set -euo pipefail
+# shellcheck source=bench/frames_spec.sh
+source "$(dirname "$0")/frames_spec.sh"
 exe=${1:-build/cli/isolink}
 shift || true
 counts=("$@")
@@ -32,12 +34,7 @@ echo "| frames | wave.csv (MB) | wave.csv rows | check (s) | check max RSS (MB) 
 echo "|---|---|---|---|---|---|---|---|---|---|---|"
 for n in "${counts[@]}"; do
   spec="$work/cap_$n.yaml"
-  {
-    echo "name: cap-$n"
-    echo "cable: {length: 2}"
-    printf 'stimulus:\n  direction: down\n  frames:\n'
-    for ((i = 0; i < n; ++i)); do echo '    - "stack-write reg=0x0100 data=02B778BC"'; done
-  } >"$spec"
+  write_frames_spec "$n" "$spec"
   "$exe" run "$spec" -o "$work/run_$n" -q --no-worst --no-images >/dev/null 2>&1 || true
   wave="$work/run_$n/wave.csv"
   mb=$(awk -v b="$(stat -c %s "$wave")" 'BEGIN{printf "%.1f", b / 1e6}')

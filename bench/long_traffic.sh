@@ -7,6 +7,8 @@
 #   bash bench/long_traffic.sh [build/cli/isolink] [N ...]        # default N: 1 10 100 1000 2000
 #   EXTRA="--wave rows" bash bench/long_traffic.sh build/cli/isolink 100
 set -euo pipefail
+# shellcheck source=bench/frames_spec.sh
+source "$(dirname "$0")/frames_spec.sh"
 exe=${1:-build/cli/isolink}
 shift || true
 counts=("$@")
@@ -17,12 +19,7 @@ echo "| frames | traffic (ms) | isolink run (s) | engine (s) | engine rows | max
 echo "|---|---|---|---|---|---|---|---|---|---|---|"
 for n in "${counts[@]}"; do
   spec="$work/cap_$n.yaml"
-  {
-    echo "name: cap-$n"
-    echo "cable: {length: 2}"
-    printf 'stimulus:\n  direction: down\n  frames:\n'
-    for ((i = 0; i < n; ++i)); do echo '    - "stack-write reg=0x0100 data=02B778BC"'; done
-  } >"$spec"
+  write_frames_spec "$n" "$spec"
   out="$work/out_$n"
   set +e
   /usr/bin/time -f '%e %M' -o "$work/time" "$exe" run "$spec" -o "$out" -q ${EXTRA:-} 2>"$work/err"

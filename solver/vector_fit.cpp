@@ -137,23 +137,26 @@ Poles relocate(const Data& d, const Poles& poles) {
   return out;
 }
 
-// Residues and D with the poles fixed: one least squares per entry (each weighted its own way).
+// Residues and D with the poles fixed: one least squares per entry (each weighted its own way),
+// on the basis evaluated once.
 Eigen::MatrixXd residues(const Data& d, const Poles& poles) {
   const int n = state_count(poles), ns = static_cast<int>(d.s.size());
   const int ne = static_cast<int>(d.f.size());
-  Eigen::MatrixXd x(n + 1, ne);
-  Eigen::MatrixXd a(2 * ns, n + 1);
-  Eigen::VectorXd b(2 * ns);
+  Eigen::MatrixXcd basis_rows(ns, n + 1);  // row i: the basis at s_i, then 1 (for D)
   std::vector<cd> phi(n);
-  Eigen::VectorXd scale(n + 1);
+  for (int i = 0; i < ns; ++i) {
+    basis(d.s[i], poles, phi.data());
+    for (int k = 0; k < n; ++k) basis_rows(i, k) = phi[k];
+    basis_rows(i, n) = 1;
+  }
+  Eigen::MatrixXd x(n + 1, ne), a(2 * ns, n + 1);
+  Eigen::VectorXd b(2 * ns), scale(n + 1);
   for (int e = 0; e < ne; ++e) {
     for (int i = 0; i < ns; ++i) {
-      basis(d.s[i], poles, phi.data());
-      for (int k = 0; k <= n; ++k) {
-        const cd v = d.w[e][i] * (k < n ? phi[k] : cd(1, 0));
-        a(2 * i, k) = v.real(), a(2 * i + 1, k) = v.imag();
-      }
-      const cd v = d.w[e][i] * d.f[e][i];
+      const double w = d.w[e][i];
+      a.row(2 * i) = w * basis_rows.row(i).real();
+      a.row(2 * i + 1) = w * basis_rows.row(i).imag();
+      const cd v = w * d.f[e][i];
       b[2 * i] = v.real(), b[2 * i + 1] = v.imag();
     }
     for (int k = 0; k <= n; ++k) {

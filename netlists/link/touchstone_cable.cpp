@@ -99,16 +99,13 @@ Eigen::MatrixXd end_sum_and_difference(int n) {
   return t;
 }
 
-// The RMS of |S_model - S| over the fitted points (y's S at reference z0): the model as it is
-// simulated, after the passivity enforcement.
+// The RMS of |S_model - S| over the fitted points (s_data: the data's S at reference z0): the
+// model as it is simulated, after the passivity enforcement.
 double enforced_rms_error(const RationalModel& m, const std::vector<double>& freqs,
-                          const std::vector<Eigen::MatrixXcd>& y, double z0) {
+                          const std::vector<Eigen::MatrixXcd>& s_data, double z0) {
   double sum = 0;
-  for (size_t k = 0; k < freqs.size(); ++k) {
-    const Eigen::MatrixXcd ds =
-        s_from_y(m.eval(cd(0, 2 * std::numbers::pi * freqs[k])), z0) - s_from_y(y[k], z0);
-    sum += ds.squaredNorm();
-  }
+  for (size_t k = 0; k < freqs.size(); ++k)
+    sum += (s_from_y(m.eval(cd(0, 2 * std::numbers::pi * freqs[k])), z0) - s_data[k]).squaredNorm();
   const double r = std::sqrt(sum / (double(freqs.size()) * m.ports * m.ports));
   return std::isfinite(r) ? r : INFINITY;
 }
@@ -125,9 +122,11 @@ double enforced_rms_error(const RationalModel& m, const std::vector<double>& fre
 constexpr double kEnforcedErrorRatio = 10;
 void refit_until_passive(const std::vector<double>& freqs, const std::vector<Eigen::MatrixXcd>& y,
                          const FitOptions& opt, TouchstoneCable* out) {
+  std::vector<Eigen::MatrixXcd> s_data;
+  for (const Eigen::MatrixXcd& yk : y) s_data.push_back(s_from_y(yk, opt.z0));
   const double own = out->passivity.added_conductance > 1e-9
                          ? INFINITY
-                         : enforced_rms_error(out->fit.model, freqs, y, opt.z0);
+                         : enforced_rms_error(out->fit.model, freqs, s_data, opt.z0);
   if (own <= kEnforcedErrorRatio * out->fit.rms_error) return;
   const std::vector<int> orders = out->fit.orders_tried;
   const std::vector<double> errors = out->fit.errors;
@@ -153,7 +152,7 @@ void refit_until_passive(const std::vector<double>& freqs, const std::vector<Eig
     if (!refit || !refit->converged) continue;
     PassivityReport report = enforce_passivity(refit->model, freqs);
     if (report.added_conductance > 1e-9) continue;
-    const double e = enforced_rms_error(refit->model, freqs, y, opt.z0);
+    const double e = enforced_rms_error(refit->model, freqs, s_data, opt.z0);
     if (!(e < kept_error)) continue;
     kept = std::move(*refit);
     kept_report = report;

@@ -72,6 +72,14 @@ void check_file(const std::string& path, const Case& c) {
   }
 }
 
+// A link spec's circuit, down, with the built-in part library.
+StatusOr<link::ExpandedLink> expand_down(const StatusOr<link::LinkSpec>& spec) {
+  if (!spec) return spec.status();
+  StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
+  if (!parts) return parts.status();
+  return link::expand_link(*spec, *parts, link::Direction::kDown);
+}
+
 void check(const Case& c) {
   check_file(kData + "/" + c.netlist, c);
 }
@@ -102,10 +110,7 @@ TEST(NonlinearCompare, TvsLinkFromASpec) {
       "cable: {length: 1}\n"
       "stimulus: {frames: [\"raw 5A nocrc\"], direction: down}\n",
       "tvs_one.yaml");
-  ASSERT_TRUE(spec.ok()) << spec.status().message();
-  StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
-  ASSERT_TRUE(parts.ok()) << parts.status().message();
-  StatusOr<link::ExpandedLink> x = link::expand_link(*spec, *parts, link::Direction::kDown);
+  StatusOr<link::ExpandedLink> x = expand_down(spec);
   ASSERT_TRUE(x.ok()) << x.status().message();
   const std::string path = ::testing::TempDir() + "/tvs_one.cir";
   std::ofstream(path) << write_spice(x->netlist);
@@ -129,10 +134,7 @@ TEST(NonlinearCompare, PortModelChecksItselfOnACorpusTvsLink) {
       "cable: {length: 1.796, material: pvc, gauge: 24, temperature: 25}\n"
       "stimulus: {frames: [\"stack-write reg=0x0100 data=02B778BC\"]}\n",
       "corpus_004_tvs.yaml");
-  ASSERT_TRUE(spec.ok()) << spec.status().message();
-  StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
-  ASSERT_TRUE(parts.ok()) << parts.status().message();
-  StatusOr<link::ExpandedLink> x = link::expand_link(*spec, *parts, link::Direction::kDown);
+  StatusOr<link::ExpandedLink> x = expand_down(spec);
   ASSERT_TRUE(x.ok()) << x.status().message();
   auto run = [&](std::optional<double> reltol, analysis::Engine engine) {
     analysis::SimulationRequest req{.probes = {"v(rxp,rxn)"}, .reltol = reltol, .engine = engine};
