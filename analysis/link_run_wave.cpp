@@ -57,9 +57,10 @@ void thin_pass(std::span<const double> time, const std::vector<std::span<const d
   for (size_t j = 1; j < n; ++j) {
     const double dt = time[j] - time[a];
     bool reach = anchor_finite && finite_row(j) && dt > 0;
+    // The slope to j within [lo, hi], as d within [lo dt, hi dt] (dt > 0): no division per row.
     for (size_t c = 0; c < nc && reach; ++c) {
-      const double s = (columns[c][j] - columns[c][a]) / dt;
-      reach = s >= lo[c] && s <= hi[c];
+      const double d = columns[c][j] - columns[c][a];
+      reach = d >= lo[c] * dt && d <= hi[c] * dt;
     }
     if (!reach && j - 1 > a) {
       // Row j cannot be reached from a in one straight line: j - 1 (which could) is kept and
@@ -78,11 +79,11 @@ void thin_pass(std::span<const double> time, const std::vector<std::span<const d
       anchor_finite = finite_row(a);
       continue;
     }
-    const double dtj = time[j] - time[a];
+    const double inv_dt = 1.0 / (time[j] - time[a]);
     for (size_t c = 0; c < nc; ++c) {
       const double d = columns[c][j] - columns[c][a];
-      lo[c] = std::max(lo[c], (d - tolerances[c]) / dtj);
-      hi[c] = std::min(hi[c], (d + tolerances[c]) / dtj);
+      lo[c] = std::max(lo[c], (d - tolerances[c]) * inv_dt);
+      hi[c] = std::min(hi[c], (d + tolerances[c]) * inv_dt);
     }
   }
   if (a != n - 1) keep(n - 1);
@@ -104,6 +105,18 @@ size_t thin_rows_count(std::span<const double> time,
   size_t count = 0;
   thin_pass(time, columns, tolerances, [&](size_t) { ++count; });
   return count;
+}
+
+size_t finest_fitting(std::span<const double> ladder, const std::function<bool(double)>& fits) {
+  size_t lo = 0, hi = ladder.size();  // every rung below lo fails; hi fits (or is past the end)
+  while (lo < hi) {
+    const size_t mid = lo + (hi - lo) / 2;
+    if (fits(ladder[mid]))
+      hi = mid;
+    else
+      lo = mid + 1;
+  }
+  return hi;
 }
 
 namespace {
@@ -207,22 +220,21 @@ WaveFile run_wave_file(const LinkRun& run, const WaveFileOptions& opt) {
     if (opt.tolerance > 0) ladder = {opt.tolerance};
     // Each tolerance's rows counted without keeping their indices (a long record's would take
     // hundreds of MB beside it), then the chosen one's kept.
-    double chosen = ladder.back();
-    for (double tol : ladder) {
+    const size_t k = finest_fitting(ladder, [&](double tol) {
       size_t rows = 0;
       for (const DirectionRun& d : run.directions) {
         const Waveform& w = d.sim.wave;
         std::vector<std::span<const double>> cols(w.columns.begin(), w.columns.end());
         rows += thin_rows_count(w.time, cols, tol);
       }
-      chosen = tol;
-      // Within tol of the record's rows, which are within record_tol of the engine's: the kept
-      // line and the record's differ by at most tol at the record's rows and are straight between
-      // them.
-      f.tolerance = tol + record_tol;
-      f.over_budget = wave_file_bytes(rows, columns) > kWaveFileBytes;
-      if (!f.over_budget) break;
-    }
+      return wave_file_bytes(rows, columns) <= kWaveFileBytes;
+    });
+    f.over_budget = k == ladder.size();
+    const double chosen = f.over_budget ? ladder.back() : ladder[k];
+    // Within chosen of the record's rows, which are within record_tol of the engine's: the kept
+    // line and the record's differ by at most chosen at the record's rows and are straight
+    // between them.
+    f.tolerance = chosen + record_tol;
     size_t rows = 0;
     kept = thin_each(run, chosen, &rows);
   }

@@ -25,6 +25,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -78,6 +79,10 @@ std::vector<size_t> thin_rows(std::span<const double> time,
 // How many rows thin_rows keeps (nothing kept in memory).
 size_t thin_rows_count(std::span<const double> time,
                        const std::vector<std::span<const double>>& columns, double tolerance);
+// The index of the finest tolerance of `ladder` (ascending) that fits(tol) accepts, or
+// ladder.size() when none does. By bisection, since a coarser tolerance never keeps more rows:
+// a long record's rows are counted about log2 of the ladder's length times, not once per rung.
+size_t finest_fitting(std::span<const double> ladder, const std::function<bool(double)>& fits);
 // The same with a tolerance per column.
 std::vector<size_t> thin_rows(std::span<const double> time,
                               const std::vector<std::span<const double>>& columns,

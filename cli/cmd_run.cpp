@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <future>
 #include <optional>
 #include <string>
 #include <thread>
@@ -126,13 +127,16 @@ int run_run(const RunArgs& a) {
   }
 
   line.finish();
+  // The images and wave.csv both only read the run: drawn on a second thread while this one
+  // thins and writes the waveform (a long record's eye and its thinning take seconds each).
   std::vector<std::string> images;
-  if (!a.no_images) {
-    if (Status s = render_run_images(*spec, *run, bundle->staging(), &images); !s.ok())
-      return fail(s);
-  }
-  const WaveFile wave = run_wave_file(*run, {.rows = a.wave, .grid_step = spec->sim.tstep});
-  if (Status s = write_waveform_csv(wave.wave, bundle->path("wave.csv")); !s.ok()) return fail(s);
+  std::future<Status> drawn = std::async(std::launch::async, [&] {
+    return a.no_images ? Status::Ok() : render_run_images(*spec, *run, bundle->staging(), &images);
+  });
+  WaveFile wave = run_wave_file(*run, {.rows = a.wave, .grid_step = spec->sim.tstep});
+  Status csv = write_waveform_csv(wave.wave, bundle->path("wave.csv"));
+  if (Status s = drawn.get(); !s.ok()) return fail(s);
+  if (!csv.ok()) return fail(csv);
   nlohmann::ordered_json json = run_report_json(*spec, *run);
   json["wave_csv"] = {{"rows", wave.wave.time.size()},
                       {"engine_rows", wave.engine_rows},
@@ -140,6 +144,7 @@ int run_run(const RunArgs& a) {
                       {"tolerance_v", wave.tolerance}};
   std::string md = run_report_markdown(*spec, *run, images);
   md += "\n" + wave_file_note(wave) + ".\n";
+  wave.wave = Waveform{};  // written and described: its rows are not held beside report.html's
   if (worst) {
     json["worst_case"] = reports::worst_json(*worst);
     md += "\n## Worst case over all traffic\n\n" + reports::worst_markdown(*worst);

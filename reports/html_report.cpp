@@ -85,7 +85,12 @@ std::string script_json(const ordered_json& j) {
 }
 
 std::string html_page(const std::string& kind, const std::string& title, const ordered_json& data) {
+  // The data (tens of MB for a long record) joins a page reserved to its size: appended to a
+  // growing string it would be held up to three times over.
+  const std::string json = script_json(data);
   std::string p;
+  p.reserve(json.size() + detail::dygraph_css().size() + detail::page_css().size() +
+            detail::dygraph_js().size() + detail::page_js().size() + 4096);
   p += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
   p += "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n";
   p += "<title>" + html_escape(title) + "</title>\n<style>\n";
@@ -98,7 +103,7 @@ std::string html_page(const std::string& kind, const std::string& title, const o
        "beside this file has the same figures.</p></noscript>\n";
   p += "<main id=\"app\"></main>\n";
   p += "<script type=\"application/json\" id=\"isolink-data\">";
-  p += script_json(data);
+  p += json;
   p += "</script>\n<script>\n";
   p += detail::dygraph_js();
   p += "\n</script>\n<script>\n";
@@ -162,10 +167,12 @@ namespace {
 // counted first: the indices of a 25 ms record at 1 mV took 200 MB beside it.
 std::vector<size_t> reduce_wave(std::span<const double> t, std::span<const double> v,
                                 size_t max_samples, double* tolerance) {
-  for (double tol : kHtmlThinTolerances) {
-    if (analysis::thin_rows_count(t, {v}, tol) > max_samples) continue;
-    *tolerance = tol;
-    return analysis::thin_rows(t, {v}, tol);
+  const size_t k = analysis::finest_fitting(kHtmlThinTolerances, [&](double tol) {
+    return analysis::thin_rows_count(t, {v}, tol) <= max_samples;
+  });
+  if (k < std::size(kHtmlThinTolerances)) {
+    *tolerance = kHtmlThinTolerances[k];
+    return analysis::thin_rows(t, {v}, *tolerance);
   }
   *tolerance = 0;
   return minmax_keep(v, max_samples);

@@ -929,6 +929,30 @@ std::vector<ColumnRange> column_ranges(const PlotArea& a, std::span<const double
   return out;
 }
 
+std::vector<ColumnRange> mean_column_ranges(const PlotArea& a, std::span<const double> x,
+                                            std::span<const double> y1,
+                                            std::span<const double> y2) {
+  constexpr size_t kBlock = 1 << 16;
+  const size_t n = std::min({x.size(), y1.size(), y2.size()});
+  std::vector<ColumnRange> all(static_cast<size_t>(std::max(a.rect.width(), 0)));
+  std::vector<double> mean;
+  for (size_t i0 = 0; i0 < n; i0 += kBlock) {
+    const size_t i1 = std::min(n, i0 + kBlock + 1);  // + 1: the next block's first sample
+    mean.resize(i1 - i0);
+    for (size_t i = i0; i < i1; ++i) mean[i - i0] = 0.5 * (y1[i] + y2[i]);
+    const std::vector<ColumnRange> block = column_ranges(a, x.subspan(i0, i1 - i0), mean);
+    for (size_t k = 0; k < block.size() && k < all.size(); ++k) {
+      if (!block[k].valid) continue;
+      ColumnRange& r = all[k];
+      r.lo = r.valid ? std::min(r.lo, block[k].lo) : block[k].lo;
+      r.hi = r.valid ? std::max(r.hi, block[k].hi) : block[k].hi;
+      r.valid = true;
+    }
+    if (i1 == n) break;
+  }
+  return all;
+}
+
 }  // namespace isolink::reports
 
 namespace isolink::reports {

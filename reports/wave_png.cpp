@@ -319,14 +319,12 @@ void draw_panel(Canvas& c, const WavePanelLayout& L, const WavePanel& p) {
 
   if (!L.pins) return;
   const PlotArea& b = *L.pins;
-  std::vector<double> cm(p.p.size());
-  for (size_t i = 0; i < cm.size(); ++i) cm[i] = 0.5 * (p.p[i] + p.n[i]);
   const AxisTicks bt = make_ticks(b.x, tu, 10);
   const AxisTicks byt = make_ticks(b.y, UnitScale{1, "V"}, 6);
   draw_grid(c, b, bt, byt, kGrid);
   c.series(b, p.time, p.p, LineStyle{.color = kSeriesP, .width = 2});
   c.series(b, p.time, p.n, LineStyle{.color = kSeriesN, .width = 2});
-  c.series(b, p.time, cm, LineStyle{.color = kSeriesCm, .width = 2});
+  c.envelope(b, mean_column_ranges(b, p.time, p.p, p.n), LineStyle{.color = kSeriesCm, .width = 2});
   draw_axes(c, b, bt, byt, "time", "pins", style::kLabelSize);
   draw_legend(c, L.side.x0, b.rect.y0,
               {{"v(P)", {.color = kSeriesP, .width = 2}},

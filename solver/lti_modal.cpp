@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <complex>
+#include <cstring>
 #include <functional>
 #include <limits>
 #include <optional>
@@ -19,6 +20,15 @@
 #include "solver/lti_internal.h"
 
 namespace isolink {
+
+// The march's hot loops built twice on x86-64, for AVX2 with FMA and for the baseline, the
+// loader picking one for the machine (GCC's and Clang's function multiversioning): the same
+// binary runs anywhere and uses four lanes where it can.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define ISOLINK_WIDE_SIMD __attribute__((target_clones("arch=x86-64-v3", "default")))
+#else
+#define ISOLINK_WIDE_SIMD
+#endif
 
 using lti_internal::coarsest_grid_step;
 using lti_internal::Phi;
@@ -34,19 +44,46 @@ struct Corner {
   double slope;
 };
 
+// The modes' poles p and their reciprocals 1 / p as real and imaginary parts: a step's factors
+// without a complex division (ModalStep::set).
+struct ModePoles {
+  std::vector<double> pr, pi, ipr, ipi;
+  explicit ModePoles(const ReducedModel& m) {
+    for (const std::complex<double> p : m.poles) {
+      const std::complex<double> ip = 1.0 / p;
+      pr.push_back(p.real()), pi.push_back(p.imag());
+      ipr.push_back(ip.real()), ipi.push_back(ip.imag());
+    }
+  }
+};
+
 // One step h of every mode: e^{ph}, h phi1(ph), h^2 phi2(ph) as real and imaginary parts.
+// Away from ph = 0 (|ph| >= 1e-2, where phi's series is used): h phi1 = (e^{ph} - 1) / p and
+// h^2 phi2 = (h phi1 - h) / p, from 1 / p, the same values as phi() gives (lti_internal.h) up
+// to rounding, without its complex divisions (a long record sets millions of steps: the gaps
+// to and from its corners).
 struct ModalStep {
   double h = -1;
   std::vector<double> er, ei, f1r, f1i, f2r, f2i;
-  void set(const ReducedModel& m, double step) {
+  void set(const ModePoles& m, double step) {
     h = step;
-    const size_t n = m.poles.size();
+    const size_t n = m.pr.size();
     for (auto* v : {&er, &ei, &f1r, &f1i, &f2r, &f2i}) v->resize(n);
     for (size_t i = 0; i < n; ++i) {
-      const Phi f = phi(m.poles[i] * step);
-      const std::complex<double> f1 = step * f.phi1, f2 = step * step * f.phi2;
-      er[i] = f.e.real(), ei[i] = f.e.imag();
-      f1r[i] = f1.real(), f1i[i] = f1.imag(), f2r[i] = f2.real(), f2i[i] = f2.imag();
+      const double xr = m.pr[i] * step, xi = m.pi[i] * step;
+      if (xr * xr + xi * xi < 1e-4) {
+        const Phi f = phi({xr, xi});
+        const std::complex<double> f1 = step * f.phi1, f2 = step * step * f.phi2;
+        er[i] = f.e.real(), ei[i] = f.e.imag();
+        f1r[i] = f1.real(), f1i[i] = f1.imag(), f2r[i] = f2.real(), f2i[i] = f2.imag();
+        continue;
+      }
+      const double mag = std::exp(xr);
+      er[i] = mag * std::cos(xi), ei[i] = mag * std::sin(xi);  // one sincos call (GCC)
+      const double ar = er[i] - 1.0, ai = ei[i];               // (e - 1) / p
+      f1r[i] = ar * m.ipr[i] - ai * m.ipi[i], f1i[i] = ar * m.ipi[i] + ai * m.ipr[i];
+      const double br = f1r[i] - step, bi = f1i[i];  // (h phi1 - h) / p
+      f2r[i] = br * m.ipr[i] - bi * m.ipi[i], f2i[i] = br * m.ipi[i] + bi * m.ipr[i];
     }
   }
 };
@@ -71,7 +108,7 @@ class ModalMarch {
   // (nullptr: none; a march built without rates never gives them).
   void set_pass(double uniform_dt, std::vector<double>* rate) {
     if (uniform_dt > 0 && std::fabs(uniform_dt - uniform_.h) > 1e-9 * uniform_dt)
-      uniform_.set(m_, uniform_dt);
+      uniform_.set(poles_, uniform_dt);
     rate_ = w2_.empty() ? nullptr : rate;
   }
   // After run() has taken every corner: each mode's state x split into its steady state
@@ -106,6 +143,7 @@ class ModalMarch {
   static constexpr double kTailTol = 1e-13;
 
   const ReducedModel& m_;
+  ModePoles poles_;
   const size_t nm_, np_, nk_;
   std::vector<double>* rate_;
   // Per mode, as real and imaginary parts in separate arrays (the loops below vectorise): its
@@ -134,12 +172,17 @@ class ModalMarch {
   // and 1 / p^2 as real arrays, and |p|.
   std::vector<double> w2_, ipr_, ipi_, ip2r_, ip2i_, speed_;
   std::vector<size_t> by_speed_;  // the modes by |p|, fastest first
+  // rate_at: the first by_speed_[0..dead_) found below the threshold since the last corner. Between
+  // corners each mode's transient part decays (d <- e^{ph} d, |e^{ph}| <= 1 when every pole is
+  // stable: decays_), so a mode found below it stays below until the next corner.
+  size_t dead_ = 0;
+  bool decays_ = false;
 };
 
 ModalMarch::ModalMarch(const ReducedModel& m, size_t np, size_t nk, double uniform_dt,
                        const std::vector<double>* probe_weight, double threshold,
                        std::vector<double>* rate)
-    : m_(m), nm_(m.poles.size()), np_(np), nk_(nk), rate_(rate) {
+    : m_(m), poles_(m), nm_(m.poles.size()), np_(np), nk_(nk), rate_(rate) {
   const size_t nm = nm_;
   for (auto* v : {&xr_, &xi_, &br_, &bi_, &gr_, &gi_}) v->assign(nm, 0.0);
   outr_.assign(np, std::vector<double>(nm));
@@ -150,7 +193,7 @@ ModalMarch::ModalMarch(const ReducedModel& m, size_t np, size_t nk, double unifo
   u_.assign(nk, 0.0);
   slope_.assign(nk, 0.0);
   slope_scale_.assign(nk, 0.0);
-  if (uniform_dt > 0) uniform_.set(m, uniform_dt);
+  if (uniform_dt > 0) uniform_.set(poles_, uniform_dt);
   if (rate_) start_rates(*probe_weight, threshold);
 }
 
@@ -163,11 +206,11 @@ const ModalStep* ModalMarch::step_for(double h) {
     if (std::fabs(h - st.h) <= 1e-9 * st.h) return &st;
   ModalStep& st = recent_[next_recent_];
   next_recent_ = (next_recent_ + 1) % recent_.size();
-  st.set(m_, h);
+  st.set(poles_, h);
   return &st;
 }
 
-void ModalMarch::advance(double h) {
+ISOLINK_WIDE_SIMD void ModalMarch::advance(double h) {
   if (!(h > 0) || !active_) return;
   const ModalStep* st = step_for(h);
   const double *er = st->er.data(), *ei = st->ei.data(), *f1r = st->f1r.data(),
@@ -191,6 +234,7 @@ void ModalMarch::take_corner(const Corner& corner) {
   slope_[corner.k] += corner.slope;
   slope_scale_[corner.k] =
       std::max({slope_scale_[corner.k], std::fabs(corner.slope), std::fabs(slope_[corner.k])});
+  dead_ = 0;
   const auto& in = m_.input[corner.k];
   for (size_t i = 0; i < nm_; ++i)
     gr_[i] += in[i].real() * corner.slope, gi_[i] += in[i].imag() * corner.slope;
@@ -464,6 +508,8 @@ void ModalMarch::start_rates(const std::vector<double>& probe_weight, double thr
   for (size_t i = 0; i < nm_; ++i) by_speed_[i] = i;
   std::stable_sort(by_speed_.begin(), by_speed_.end(),
                    [&](size_t a, size_t b) { return speed_[a] > speed_[b]; });
+  decays_ = std::all_of(m_.poles.begin(), m_.poles.end(),
+                        [](std::complex<double> p) { return p.real() <= 0.0; });
 }
 
 void ModalMarch::rate_at(size_t j) {
@@ -476,8 +522,10 @@ void ModalMarch::rate_at(size_t j) {
   const std::vector<double>&ipr = ipr_, &ipi = ipi_, &ip2r = ip2r_, &ip2i = ip2i_;
   if (!tail_) {
     // Fastest first: the first live mode is the answer (right after a corner, where most rows
-    // are, one of the first few).
-    for (size_t i : by_speed_) {
+    // are, one of the first few), past those already found dead since the last corner.
+    size_t k = dead_;
+    for (; k < nm_; ++k) {
+      const size_t i = by_speed_[k];
       const double d_r =
           xr[i] + br[i] * ipr[i] - bi[i] * ipi[i] + gr[i] * ip2r[i] - gi[i] * ip2i[i];
       const double d_i =
@@ -487,6 +535,7 @@ void ModalMarch::rate_at(size_t j) {
         break;
       }
     }
+    if (decays_) dead_ = k;
   } else {
     for (size_t i : slow_)
       consider(i, xr[i] + br[i] * ipr[i] - bi[i] * ipi[i], xi[i] + br[i] * ipi[i] + bi[i] * ipr[i]);
@@ -521,18 +570,21 @@ double ModalMarch::tail_value(size_t p) const {
 }
 
 // Probe p's value before the tail.
-double ModalMarch::value(size_t p) const {
+ISOLINK_WIDE_SIMD double ModalMarch::value(size_t p) const {
   const double *orr = outr_[p].data(), *oi = outi_[p].data();
   const double *xr = xr_.data(), *xi = xi_.data();
   const size_t nm = nm_;
-  double y0 = 0, y1 = 0;  // two partial sums: a shorter dependency chain
+  // Four partial sums in one vector (lane k: the modes i = k mod 4), then the rest.
+  using Quad = double __attribute__((vector_size(32)));
+  Quad y{0, 0, 0, 0}, a, b, c, e;
   size_t i = 0;
-  for (; i + 1 < nm; i += 2) {
-    y0 += orr[i] * xr[i] - oi[i] * xi[i];
-    y1 += orr[i + 1] * xr[i + 1] - oi[i + 1] * xi[i + 1];
+  for (; i + 4 <= nm; i += 4) {
+    std::memcpy(&a, orr + i, sizeof a), std::memcpy(&b, xr + i, sizeof b);
+    std::memcpy(&c, oi + i, sizeof c), std::memcpy(&e, xi + i, sizeof e);
+    y += a * b - c * e;
   }
-  if (i < nm) y0 += orr[i] * xr[i] - oi[i] * xi[i];
-  double d = y0 + y1;
+  double d = (y[0] + y[1]) + (y[2] + y[3]);
+  for (; i < nm; ++i) d += orr[i] * xr[i] - oi[i] * xi[i];
   for (size_t k = 0; k < nk_; ++k) d += m_.direct[k][p] * u_[k];
   return d;
 }

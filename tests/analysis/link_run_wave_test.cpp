@@ -21,6 +21,23 @@ double between_kept(const std::vector<double>& t, const std::vector<double>& v,
   return v[a] + (t[i] - t[a]) / (t[b] - t[a]) * (v[b] - v[a]);
 }
 
+// The ladder's finest fitting tolerance by bisection: the answer of a scan from the finest, for
+// every place the fitting rungs may start (none, the first, ..., the last), in at most
+// ceil(log2(n + 1)) calls.
+TEST(FinestFitting, FindsTheFirstFittingRungByBisection) {
+  const std::vector<double> ladder{1e-3, 2e-3, 5e-3, 10e-3, 20e-3, 50e-3};
+  for (size_t first = 0; first <= ladder.size(); ++first) {
+    int calls = 0;
+    const size_t k = finest_fitting(ladder, [&](double tol) {
+      ++calls;
+      return first < ladder.size() && tol >= ladder[first];
+    });
+    EXPECT_EQ(k, first);
+    EXPECT_LE(calls, 3) << first;  // ceil(log2(7))
+  }
+  EXPECT_EQ(finest_fitting({}, [](double) { return true; }), 0u);
+}
+
 TEST(ThinRows, AStraightLineKeepsItsEnds) {
   std::vector<double> t, v;
   for (int i = 0; i <= 1000; ++i) t.push_back(i * 1e-9), v.push_back(0.5 + 3e6 * t.back());

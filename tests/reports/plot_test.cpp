@@ -196,6 +196,36 @@ TEST(ColumnRanges, CoverTheSamplesAndConnectNeighbours) {
   EXPECT_DOUBLE_EQ(s[44].hi, 0.0);
 }
 
+// The common mode's ranges block by block (mean_column_ranges) against column_ranges of the mean
+// formed whole: 300,001 samples are four blocks of 65,536 and a remainder. Where two blocks meet
+// (sample 65,536) the samples jump 0.1 s, 64 columns: those columns hold only the line between
+// the two blocks, and a spike sits on the meeting sample.
+TEST(ColumnRanges, MeanByBlocksMatchesTheMeanFormedWhole) {
+  const PlotArea a = PlotArea::make({0, 0, 640, 100}, 0, 1, -2, 2);
+  std::vector<double> x, p, n, mean;
+  for (int i = 0; i <= 300000; ++i) {
+    x.push_back(0.9 * i / 300000.0 + (i >= 65536 ? 0.1 : 0.0));
+    p.push_back(std::sin(0.001 * i) + (i == 65536 ? 3.0 : 0.0));
+    n.push_back(0.5 * std::cos(0.0037 * i));
+    mean.push_back(0.5 * (p.back() + n.back()));
+  }
+  const std::vector<ColumnRange> whole = column_ranges(a, x, mean);
+  const std::vector<ColumnRange> blocks = mean_column_ranges(a, x, p, n);
+  ASSERT_EQ(blocks.size(), whole.size());
+  for (size_t k = 0; k < whole.size(); ++k) {
+    ASSERT_TRUE(whole[k].valid) << k;
+    ASSERT_TRUE(blocks[k].valid) << k;
+    EXPECT_DOUBLE_EQ(blocks[k].lo, whole[k].lo) << k;
+    EXPECT_DOUBLE_EQ(blocks[k].hi, whole[k].hi) << k;
+  }
+  // The jump: from x = 0.9 * 65535 / 300000 = 0.196605 (column 125) to 0.296608 (column 189); the
+  // columns between hold the straight line up to the spike's mean.
+  const double spike = 0.5 * (std::sin(65.536) + 3.0 + 0.5 * std::cos(0.0037 * 65536));
+  EXPECT_NEAR(blocks[189].hi, spike, 1e-12);
+  EXPECT_GT(blocks[160].hi, 0.5);
+  EXPECT_LT(blocks[160].hi, spike);
+}
+
 TEST(Canvas, SeriesDrawsAnEnvelopePerColumn) {
   Canvas c = canvas(300, 200);
   const PlotArea a = PlotArea::make({0, 0, 300, 200}, 0, 1, -1, 1);
