@@ -6,6 +6,10 @@
 #
 #   bash bench/long_traffic.sh [build/cli/isolink] [N ...]        # default N: 1 10 100 1000 2000
 #   EXTRA="--wave rows" bash bench/long_traffic.sh build/cli/isolink 100
+#   NGSPICE_FRAMES="1 10" bash bench/long_traffic.sh build/cli/isolink 1 10 100
+# For each N in NGSPICE_FRAMES (default: none) ngspice is timed in the same run on the spec's
+# netlist (`isolink export-spice`, the down direction, ngspice's defaults plus rshunt=1e12 as
+# bench/sim_vs_ngspice.sh runs it), stopped after NGSPICE_TIMEOUT s (default 900; "> T" then).
 set -euo pipefail
 # shellcheck source=bench/frames_spec.sh
 source "$(dirname "$0")/frames_spec.sh"
@@ -15,8 +19,26 @@ counts=("$@")
 [ ${#counts[@]} -eq 0 ] && counts=(1 10 100 1000 2000)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-echo "| frames | traffic (ms) | isolink run (s) | engine (s) | engine rows | max RSS (MB) | wave.csv (MB) | wave.csv rows, tolerance | report.html (MB) | report.json (MB) | exit |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|"
+ngspice_frames=" ${NGSPICE_FRAMES:-} "
+ng_timeout=${NGSPICE_TIMEOUT:-900}
+# ngspice's wall time on the spec's netlist, in s ("-" when N is not asked for, "> T" past T).
+time_ngspice() {
+  [[ $ngspice_frames == *" $1 "* ]] || { echo "-"; return; }
+  "$exe" export-spice "$2" --direction down -o "$work/deck.cir" >/dev/null
+  sed -i '/^\.[eE][nN][dD]\s*$/d' "$work/deck.cir"
+  printf '.options rshunt=1e12\n.end\n' >>"$work/deck.cir"
+  local s e
+  s=$(date +%s%N)
+  if timeout "$ng_timeout" ngspice -b "$work/deck.cir" >/dev/null 2>&1; then
+    e=$(date +%s%N)
+    awk -v ns=$((e - s)) 'BEGIN{printf "%.1f", ns / 1e9}'
+  else
+    echo "> $ng_timeout"
+  fi
+}
+echo "<!-- $(date -u +%Y-%m-%d), $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg) -->"
+echo "| frames | traffic (ms) | isolink run (s) | engine (s) | engine rows | max RSS (MB) | wave.csv (MB) | wave.csv rows, tolerance | report.html (MB) | report.json (MB) | exit | ngspice (s) |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
 for n in "${counts[@]}"; do
   spec="$work/cap_$n.yaml"
   write_frames_spec "$n" "$spec"
@@ -39,5 +61,5 @@ print(f"{span:.2f} | {s['seconds']:.1f} | {s.get('rows', '-')} | "
 PY
 )
   IFS='|' read -r traffic engine rows wrows <<<"$facts"
-  echo "| $n |$traffic| $secs |$engine|$rows| $((kb / 1024)) | $(size wave.csv) |$wrows| $(size report.html) | $(size report.json) | $rc |"
+  echo "| $n |$traffic| $secs |$engine|$rows| $((kb / 1024)) | $(size wave.csv) |$wrows| $(size report.html) | $(size report.json) | $rc | $(time_ngspice "$n" "$spec") |"
 done

@@ -177,6 +177,7 @@ class ModalMarch {
   // stable: decays_), so a mode found below it stays below until the next corner.
   size_t dead_ = 0;
   bool decays_ = false;
+  bool sloped_ = false;  // some source's slope is not zero (take_corner)
 };
 
 ModalMarch::ModalMarch(const ReducedModel& m, size_t np, size_t nk, double uniform_dt,
@@ -217,6 +218,14 @@ ISOLINK_WIDE_SIMD void ModalMarch::advance(double h) {
                *f1i = st->f1i.data(), *f2r = st->f2r.data(), *f2i = st->f2i.data();
   double *xr = xr_.data(), *xi = xi_.data(), *br = br_.data(), *bi = bi_.data();
   const double *gr = gr_.data(), *gi = gi_.data();
+  if (!sloped_) {  // every input flat: x <- e x + h phi1 b, b constant
+    for (size_t i = 0; i < nm_; ++i) {
+      const double nr = er[i] * xr[i] - ei[i] * xi[i] + f1r[i] * br[i] - f1i[i] * bi[i];
+      const double ni = er[i] * xi[i] + ei[i] * xr[i] + f1r[i] * bi[i] + f1i[i] * br[i];
+      xr[i] = nr, xi[i] = ni;
+    }
+    return;
+  }
   for (size_t i = 0; i < nm_; ++i) {
     const double nr = er[i] * xr[i] - ei[i] * xi[i] + f1r[i] * br[i] - f1i[i] * bi[i] +
                       f2r[i] * gr[i] - f2i[i] * gi[i];
@@ -228,13 +237,24 @@ ISOLINK_WIDE_SIMD void ModalMarch::advance(double h) {
   for (size_t k = 0; k < nk_; ++k) u_[k] += slope_[k] * h;
 }
 
-// The corner's slope change joins its source's slope and every mode's input slope g.
+// The corner's slope change joins its source's slope and every mode's input slope g. A ramp's
+// end brings its source's slope back to zero up to rounding (1e-12 of the largest it has had,
+// as slopes_ended tests): it is then set to zero, and once every source is flat, g is zero and
+// advance takes its shorter form (no f2 g term, b constant) until the next ramp starts.
 void ModalMarch::take_corner(const Corner& corner) {
   active_ = true;
-  slope_[corner.k] += corner.slope;
+  double& slope = slope_[corner.k];
+  slope += corner.slope;
   slope_scale_[corner.k] =
-      std::max({slope_scale_[corner.k], std::fabs(corner.slope), std::fabs(slope_[corner.k])});
+      std::max({slope_scale_[corner.k], std::fabs(corner.slope), std::fabs(slope)});
+  if (std::fabs(slope) <= 1e-12 * slope_scale_[corner.k]) slope = 0.0;
   dead_ = 0;
+  sloped_ = std::any_of(slope_.begin(), slope_.end(), [](double g) { return g != 0.0; });
+  if (!sloped_) {
+    std::fill(gr_.begin(), gr_.end(), 0.0);
+    std::fill(gi_.begin(), gi_.end(), 0.0);
+    return;
+  }
   const auto& in = m_.input[corner.k];
   for (size_t i = 0; i < nm_; ++i)
     gr_[i] += in[i].real() * corner.slope, gi_[i] += in[i].imag() * corner.slope;
