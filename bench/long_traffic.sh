@@ -24,16 +24,20 @@ ng_timeout=${NGSPICE_TIMEOUT:-900}
 # ngspice's wall time on the spec's netlist, in s ("-" when N is not asked for, "> T" past T).
 time_ngspice() {
   [[ $ngspice_frames == *" $1 "* ]] || { echo "-"; return; }
-  "$exe" export-spice "$2" --direction down -o "$work/deck.cir" >/dev/null
+  "$exe" export-spice "$2" --direction down -o "$work/deck.cir" >/dev/null 2>&1
   sed -i '/^\.[eE][nN][dD]\s*$/d' "$work/deck.cir"
-  printf '.options rshunt=1e12\n.end\n' >>"$work/deck.cir"
-  local s e
+  # A .control block runs the .tran in batch mode (without one, or a .print, ngspice runs nothing).
+  printf '.options rshunt=1e12\n.control\nrun\n.endc\n.end\n' >>"$work/deck.cir"
+  local s e rc=0
   s=$(date +%s%N)
-  if timeout "$ng_timeout" ngspice -b "$work/deck.cir" >/dev/null 2>&1; then
-    e=$(date +%s%N)
-    awk -v ns=$((e - s)) 'BEGIN{printf "%.1f", ns / 1e9}'
-  else
+  timeout "$ng_timeout" ngspice -b "$work/deck.cir" >"$work/ngspice.log" 2>&1 || rc=$?
+  e=$(date +%s%N)
+  if ((rc == 124)); then
     echo "> $ng_timeout"
+  elif ! grep -q "No. of Data Rows" "$work/ngspice.log"; then  # its exit status is 1 even then
+    echo "failed"
+  else
+    awk -v ns=$((e - s)) 'BEGIN{printf "%.1f", ns / 1e9}'
   fi
 }
 echo "<!-- $(date -u +%Y-%m-%d), $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg) -->"

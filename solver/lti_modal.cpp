@@ -23,7 +23,9 @@ namespace isolink {
 
 // The march's hot loops built twice on x86-64, for AVX2 with FMA and for the baseline, the
 // loader picking one for the machine (GCC's and Clang's function multiversioning): the same
-// binary runs anywhere and uses four lanes where it can.
+// binary runs anywhere and uses four lanes where it can. The two may differ in the last bits (a
+// fused multiply-add rounds once): a run is the same on every machine of one kind, and within
+// rounding across kinds.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define ISOLINK_WIDE_SIMD __attribute__((target_clones("arch=x86-64-v3", "default")))
 #else
