@@ -196,6 +196,78 @@ std::vector<double> noise_frequencies(const link::NoiseSpec& n) {
   return f;
 }
 
+namespace {
+
+// The volts per ampere of calibrated clamp current a clamp induces in each wire, by wire p or n:
+// the jig's loop (calibration_r) plus the clamp's own impedance; bci both the same, dm half each,
+// opposite.
+double clamp_volts(const link::NoiseSpec& ns, char side) {
+  const double v = ns.calibration_r + ns.clamp_r;
+  if (ns.injection != "dm") return v;
+  return side == 'n' ? -v / 2 : v / 2;
+}
+
+// Adds the clamp's source and impedance in series in each wire between node `a_side` (toward
+// the link's transmitting end) and `b_side`, as sources vnoisep / vnoisen.
+void add_clamp(const link::NoiseSpec& ns, char side, const std::string& a_side,
+               const std::string& b_side, NoiseCircuit& out) {
+  std::vector<Card>& cards = out.link.netlist.cards;
+  const std::string name = fmt::format("vnoise{}", side), mid = fmt::format("noise_{}_r", side);
+  cards.push_back(link::make_card('v', name, {b_side, mid}, {link::number_arg(0)}));
+  cards.push_back(link::make_card('r', fmt::format("rnoise{}", side), {mid, a_side},
+                                  {link::number_arg(2 * ns.clamp_r)}));
+  out.sources.push_back({name, clamp_volts(ns, side)});
+}
+
+}  // namespace
+
+Status measured_cable_injection(const link::LinkSpec& spec) {
+  const link::NoiseSpec& ns = spec.noise;
+  if (spec.cable.touchstone.empty() || ns.injection == "ground_shift" || ns.position == 0.0 ||
+      ns.position == 1.0)
+    return Status::Ok();
+  return Status::Error(fmt::format(
+      "noise: {} injection at position {:g} needs a node inside the cable, and a measured cable "
+      "(cable.touchstone: {}) has only its two ends: set noise.position to 0 (the clamp at the "
+      "tx end's connector) or 1 (at the rx end's), or use injection: ground_shift",
+      ns.injection, ns.position, spec.cable.touchstone));
+}
+
+namespace {
+
+// bci / dm on a measured cable (measured_cable_injection: position 0 or 1): the clamp between the
+// module's connector and the cable's port at that end. The cable's cards (named g/c/r + "cab_")
+// attach to a node of their own there, and the clamp joins it to the module's.
+Status inject_at_measured_cable_end(const link::LinkSpec& spec, link::Direction d,
+                                    NoiseCircuit& out) {
+  if (Status s = measured_cable_injection(spec); !s.ok()) return s;
+  const link::NoiseSpec& ns = spec.noise;
+  const double x = d == link::Direction::kDown ? ns.position : 1 - ns.position;
+  const bool at_from_end = x < 0.5;  // the link's transmitting end (0) or receiving end (1)
+  for (int w = 0; w < 2; ++w) {
+    const char side = w == 0 ? 'p' : 'n';
+    const std::string& module = out.link.cable_ends[at_from_end ? w : 2 + w];
+    const std::string port = fmt::format("noise_cab_{}", side);
+    bool moved = false;
+    for (Card& c : out.link.netlist.cards) {
+      if (!(starts_with(c.name, "gcab_") || starts_with(c.name, "ccab_") ||
+            starts_with(c.name, "rcab_")))
+        continue;
+      for (std::string& node : c.nodes)
+        if (node == module) node = port, moved = true;
+    }
+    if (!moved)
+      return Status::Error(fmt::format("noise: no card of the measured cable at {}", module));
+    if (at_from_end)
+      add_clamp(ns, side, module, port, out);
+    else
+      add_clamp(ns, side, port, module, out);
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
 StatusOr<NoiseCircuit> build_noise_circuit(const link::LinkSpec& spec,
                                            const link::PartLibrary& parts, link::Direction d,
                                            const NoiseOptions& opt) {
@@ -217,6 +289,10 @@ StatusOr<NoiseCircuit> build_noise_circuit(const link::LinkSpec& spec,
     out.sources = {{"vnoise", 1.0}};
     return out;
   }
+  if (!spec.cable.touchstone.empty()) {
+    if (Status s = inject_at_measured_cable_end(spec, d, out); !s.ok()) return s;
+    return out;
+  }
   // bci / dm: at the cable node nearest the position (from the spec's tx end).
   const int n = out.link.cable_segments;
   if (n < 2)
@@ -228,8 +304,6 @@ StatusOr<NoiseCircuit> build_noise_circuit(const link::LinkSpec& spec,
   const int k = std::clamp(static_cast<int>(std::lround(x * n)), 1, n - 1);
   // The clamp induces the same series voltage in both wires: a source in each conductor between
   // segment k and segment k + 1 (whose first series element is re-attached to the source).
-  // V per A of calibrated current: the jig's loop (calibration_r) plus the clamp's own impedance.
-  const double v = ns.calibration_r + ns.clamp_r;
   for (char side : {'p', 'n'}) {
     const std::string node = fmt::format("cab_{}{}", side, k);
     const std::string inner = fmt::format("noise_{}", side);
@@ -244,13 +318,7 @@ StatusOr<NoiseCircuit> build_noise_circuit(const link::LinkSpec& spec,
       return Status::Error(
           fmt::format("noise: no series element of cable segment {} at {}", k + 1, node));
     // The clamp's source impedance (common mode: both wires' resistors in parallel).
-    const std::string name = fmt::format("vnoise{}", side), mid = inner + "_r";
-    cards.push_back(link::make_card('v', name, {inner, mid}, {link::number_arg(0)}));
-    cards.push_back(link::make_card('r', fmt::format("rnoise{}", side), {mid, node},
-                                    {link::number_arg(2 * ns.clamp_r)}));
-    out.sources.push_back({name, side == 'n' && ns.injection == "dm" ? -v / 2
-                                 : ns.injection == "dm"              ? v / 2
-                                                                     : v});
+    add_clamp(ns, side, node, inner, out);
   }
   return out;
 }
@@ -561,6 +629,7 @@ StatusOr<NoiseResult> analyze_noise(const link::LinkSpec& spec, const link::Part
   // capacitance: the user says which by giving esd a capacitance.
   if (std::string why = link::linear_only(spec, "noise (a small-signal analysis)"); !why.empty())
     return Status::Error(why);
+  if (Status s = measured_cable_injection(spec); !s.ok()) return s;
   NoiseResult r;
   r.spec = spec.noise;
   r.peak_factor = noise_peak_factor(spec.noise);
@@ -598,6 +667,7 @@ StatusOr<NoiseRun> run_noise(const link::LinkSpec& spec, const link::PartLibrary
   // Refused before the (long) run of a nonlinear link's traffic, as analyze_noise would after.
   if (std::string why = link::linear_only(spec, "noise (a small-signal analysis)"); !why.empty())
     return Status::Error(why);
+  if (Status s = measured_cable_injection(spec); !s.ok()) return s;
   NoiseRun out;
   StatusOr<LinkRun> run = run_link(spec, parts);
   if (!run) return run.status();

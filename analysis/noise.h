@@ -234,9 +234,15 @@ struct NoiseCircuit {
   std::vector<std::pair<std::string, double>> sources;
   std::string tx_ground = "gtx", rx_ground = "grx";
 };
+// A measured cable (cable.touchstone) has no node inside it: bci and dm inject at its ends only,
+// the clamp between the module's connector and the cable's port (noise.position 0: the spec's tx
+// end, 1: its rx end), and ground_shift as on any cable.
 StatusOr<NoiseCircuit> build_noise_circuit(const link::LinkSpec& spec,
                                            const link::PartLibrary& parts, link::Direction d,
                                            const NoiseOptions& opt = {});
+// Whether the spec's injection can be placed on its cable: an error naming the position and what
+// to set instead for bci / dm between the ends of a measured cable (checked before any run).
+Status measured_cable_injection(const link::LinkSpec& spec);
 // ngspice text of the noise circuit with the sources' AC amplitudes, `.options rshunt=1e12`
 // and `.ac dec N f_start f_stop`, for comparison runs.
 std::string noise_spice(const NoiseCircuit& c, const link::NoiseSpec& n);

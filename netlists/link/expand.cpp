@@ -283,6 +283,7 @@ StatusOr<ExpandedLink> expand_link(const LinkSpec& spec, const PartLibrary& part
                            opt.driver.edge, &out.cable_segments);
       !s.ok())
     return at(spec.cable_loc, "cable: " + s.message());
+  out.cable_ends = {a->first, a->second, b->first, b->second};
   const size_t load_start = cards.size();
   if (Status s = add_rx_load(cards, "rx", "rxp", "rxn", load); !s.ok())
     return s.with_context("rx load");

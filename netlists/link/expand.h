@@ -15,6 +15,7 @@
 // Node names follow the role in this direction: txp/txn always drive, rxp/rxn always receive.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -61,8 +62,11 @@ struct ExpandedLink {
   Netlist netlist;                    // cards, .tran, options
   traffic::Drive drive;               // what the transmitter sends
   std::vector<uint8_t> expected;      // data bytes sent, in order
-  int cable_segments = 0;             // sections the cable was split into
-  std::string tx_bom, rx_bom;         // each spec end's parts as built, in words
+  int cable_segments = 0;             // sections the cable was split into (0: a measured cable)
+  // The cable's end nodes: the transmitting end's P and N, the receiving end's P and N (where a
+  // measured cable's ports attach).
+  std::array<std::string, 4> cable_ends;
+  std::string tx_bom, rx_bom;  // each spec end's parts as built, in words
 };
 
 StatusOr<ExpandedLink> expand_link(const LinkSpec& spec, const PartLibrary& parts, Direction d,
