@@ -78,7 +78,9 @@ StatusOr<std::pair<double, double>> fit_bounds(const CompareOptions& opt, const 
 
 // Capture time minus drive time that best lays the simulation on (ts, vs): a squared-error scan
 // of integer lags of a 1 ns grid within [offset0 - before, offset0 + after], then a
-// golden-section search of the continuous offset within +/-1.5 grid steps of the best lag.
+// golden-section search of the continuous offset within +/-1.5 grid steps of the best lag. Both
+// over the first 2 ms of (ts, vs) only: one offset needs no more, and a long record's grid would
+// otherwise be a double per nanosecond of it, twice.
 double align(const EdgeResponse& e, const EdgeList& edges, std::span<const double> ts,
              std::span<const double> vs, double offset0, double before, double after,
              const Clipping& clip);

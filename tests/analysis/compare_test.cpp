@@ -322,6 +322,39 @@ TEST(CompareModel, SuperpositionAtAnyTimeEqualsTheGridSynthesis) {
     EXPECT_NEAR(mid[i], (w.columns[0][i] + w.columns[0][i + 1]) / 2, 1e-9);
 }
 
+// The alignment of a record longer than its 2 ms span (align: the span's grid and refinement):
+// 40 frames over 4 ms, sampled every 2 ns within each frame's window, laid at a sub-nanosecond
+// offset and guessed 0.6 us off: the offset comes back to 1 ps.
+TEST(CompareModel, AlignmentOfALongRecordUsesItsFirstSpan) {
+  StatusOr<link::LinkSpec> spec = link::read_link_spec_text(kCapLink, "cap.yaml");
+  ASSERT_TRUE(spec.ok());
+  StatusOr<EdgeResponse> e = edge_response(*spec, parts(), link::Direction::kDown, {});
+  ASSERT_TRUE(e.ok()) << e.status().message();
+  traffic::EncodingOptions enc;
+  compare_detail::EdgeList edges;
+  std::vector<double> ts;
+  for (int f = 0; f < 40; ++f) {
+    const uint8_t byte = static_cast<uint8_t>(0x35 + 17 * f);
+    const std::vector<int> hb = traffic::byte_half_bits(byte, enc);
+    const double t0 = 10e-6 + 100e-6 * f;
+    int level = 0;
+    for (size_t j = 0; j <= hb.size(); ++j) {
+      const int next = j < hb.size() ? hb[j] : 0;
+      if (next != level) edges.t.push_back(t0 + j * enc.half_bit), edges.dl.push_back(next - level);
+      level = next;
+    }
+    const double t1 = t0 + static_cast<double>(hb.size()) * enc.half_bit;
+    edges.frames.push_back({t0, t1});
+    for (double t = t0 - 1e-6; t < t1 + 2e-6; t += 2e-9) ts.push_back(t + 3.3e-6);
+  }
+  const double truth = 3.3e-6 + 0.37e-9;
+  std::vector<double> vs(ts.size());
+  compare_detail::synth_at(*e, edges, truth, ts, vs);
+  ASSERT_GT(ts.back() - ts.front(), 3.9e-3);
+  const double found = compare_detail::align(*e, edges, ts, vs, truth + 0.6e-6, 1e-6, 200e-9, {});
+  EXPECT_NEAR(found, truth, 1e-12);
+}
+
 TEST(Compare, NominalCaptureMatchesAndTheTriggerOffsetIsRecovered) {
   const std::string spec = write_spec("cap.yaml", kCapLink);
   testing::ScopeModel scope;  // 2.5 GS/s, 300 MHz, 10 mV, 8 bits over +/-5 V, 3.3 us
