@@ -31,6 +31,9 @@ Args:
     direction: "down", "up" or "both": overrides the spec's stimulus.direction.
     engine: "auto" (LTI where it is the cheaper engine, else transient), "lti", "transient".
     worst: also the worst case over all legal traffic, under "worst_case" (as worst()).
+    wave: "thinned" (the run's record: every engine row up to 2 million, then the rows that
+        linear interpolation needs within 1 mV) or "rows" (every engine row, as `isolink run
+        --wave rows`: memory grows with the traffic, 40 bytes a row).
     parts: extra part-library folders.
 
 Returns:

@@ -24,6 +24,7 @@ def run(
     direction: Optional[str] = None,
     engine: str = "auto",
     worst: bool = False,
+    wave: str = "thinned",
     parts: Sequence[str] = [],
 ) -> dict[str, Any]:
     """`isolink run SPEC --no-worst` (worst=True: with the worst case): report.json's content,

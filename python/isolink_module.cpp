@@ -123,11 +123,17 @@ Strings sim_warnings(const analysis::LinkRun& run) {
 
 // isolink.run: `isolink run SPEC [--no-worst]`'s report.json, with waveforms and bools.
 py::dict run(const py::object& spec_obj, const std::optional<std::string>& direction,
-             const std::string& engine, bool worst, const Strings& parts_dirs) {
+             const std::string& engine, bool worst, const std::string& wave,
+             const Strings& parts_dirs) {
   check_direction(direction);
   const SpecArg arg = spec_arg(spec_obj, "spec");
   analysis::RunOptions ro;
   ro.engine = take(analysis::parse_engine(engine));
+  // wave="rows": every engine row (as `isolink run --wave rows`); "thinned": the run's record.
+  if (wave == "rows")
+    ro.record_tol = 0;
+  else if (wave != "thinned")
+    raise(Status::Error("wave: error: '" + wave + "' is none of thinned, rows"));
   bool pack = false;
   StatusOr<link::LinkSpec> spec = Status::Error("not read");
   StatusOr<link::PartLibrary> parts = Status::Error("not read");
@@ -442,8 +448,8 @@ PYBIND11_MODULE(isolink, m) {
   set_error_type(error.ptr());
   const auto no_parts = std::vector<std::string>{};
   m.def("run", &run, py::arg("spec"), py::kw_only(), py::arg("direction") = py::none(),
-        py::arg("engine") = "auto", py::arg("worst") = false, py::arg("parts") = no_parts,
-        doc::kRun);
+        py::arg("engine") = "auto", py::arg("worst") = false, py::arg("wave") = "thinned",
+        py::arg("parts") = no_parts, doc::kRun);
   m.def("worst", &worst, py::arg("spec"), py::kw_only(), py::arg("direction") = py::none(),
         py::arg("edge_engine") = "auto", py::arg("parts") = no_parts, doc::kWorst);
   m.def("noise", &noise, py::arg("spec"), py::kw_only(), py::arg("parts") = no_parts, doc::kNoise);

@@ -83,3 +83,33 @@ def test_direction_and_engine_options():
         isolink.run(str(SPEC), direction="sideways")
     with pytest.raises(isolink.Error, match="fast"):
         isolink.run(str(SPEC), engine="fast")
+
+
+def test_wave_rows_keeps_every_engine_row():
+    """wave="rows" (as `isolink run --wave rows`): every LTI engine row, where the default record
+    keeps every row up to 2 million and thins the rest within 1 mV. 24 stack writes on a 2 m cap
+    link make about 3.5 million rows."""
+    spec = {
+        "name": "py-long",
+        "cable": {"length": 2},
+        "stimulus": {
+            "frames": ["stack-write reg=0x0100 data=02B778BC"] * 24,
+            "direction": "down",
+        },
+    }
+    with pytest.warns(UserWarning, match="the record keeps .* within 1 mV of every engine row"):
+        thinned = isolink.run(spec, engine="lti")["directions"][0]
+    full = isolink.run(spec, engine="lti", wave="rows")["directions"][0]
+    rows = full["solver"]["rows"]
+    assert rows == thinned["solver"]["rows"] > 2_000_000
+    assert len(full["wave"]["time"]) == rows
+    assert 2_000_000 < len(thinned["wave"]["time"]) < rows
+    # The kept rows are engine rows: the same values at the same times.
+    t_full, t_thin = full["wave"]["time"], thinned["wave"]["time"]
+    idx = np.searchsorted(t_full, t_thin[-1000:])
+    assert np.array_equal(t_full[idx], t_thin[-1000:])
+    for name in thinned["wave"]:
+        assert np.array_equal(full["wave"][name][idx], thinned["wave"][name][-1000:]), name
+    with pytest.raises(isolink.Error, match="wave: error: 'grid' is none of thinned, rows"):
+        isolink.run(spec, wave="grid")
+
