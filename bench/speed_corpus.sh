@@ -14,7 +14,8 @@
 # engine line isolink printed (the reduced model's order, or why it marched). The accuracy of the
 # same engine on the same corpus is bench/lti_corpus.sh's and tests/analysis/fast_path_test.cpp's.
 # ISOLINK=PATH runs another binary than build/cli/isolink. SPECS="049 166" runs those specs
-# instead (any length; e.g. the slowest directions of bench/lti_corpus.sh).
+# instead (any length; e.g. the slowest directions of bench/lti_corpus.sh); LINKS="a.yaml b.yaml"
+# runs those link specs (bench/ngspice_links/: issue 41's two long linear links).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 N=${1:-3} COUNT=${2:-12} SEED=${3:-1}
@@ -42,7 +43,10 @@ echo "<!-- $(date -u +%Y-%m-%dT%H:%MZ), $(nproc) cores, load $(cut -d' ' -f1-3 /
 echo "| spec | length (m) | tx / rx isolation | unknowns | isolink ms (CPU) | ngspice ms (CPU) | wall ratio | CPU ratio | isolink engine |"
 echo "|---|---|---|---|---|---|---|---|---|"
 ratios=() cpu_ratios=() done_count=0
-if [[ -n ${SPECS:-} ]]; then
+if [[ -n ${LINKS:-} ]]; then
+  read -r -a specs <<<"$LINKS"
+  COUNT=${#specs[@]}
+elif [[ -n ${SPECS:-} ]]; then
   specs=() && for i in $SPECS; do specs+=("$work/link_$i.yaml"); done
   COUNT=${#specs[@]}
 else
@@ -51,7 +55,7 @@ fi
 for spec in "${specs[@]}"; do
   ((done_count >= COUNT)) && break
   len=$(sed -n 's/^cable: {length: \([0-9.]*\).*/\1/p' "$spec")
-  [[ -n ${SPECS:-} ]] || awk -v l="$len" 'BEGIN { exit !(l >= 10 && l <= 50) }' || continue
+  [[ -n ${SPECS:-}${LINKS:-} ]] || awk -v l="$len" 'BEGIN { exit !(l >= 10 && l <= 50) }' || continue
   name=$(basename "$spec" .yaml)
   iso=$(sed -n 's/^\(tx\|rx\):.*type: \([a-z]*\).*/\2/p' "$spec" | paste -sd/)
   "$ISOLINK" export-spice "$spec" --direction down -o "$work/l.cir" >/dev/null 2>&1

@@ -60,8 +60,10 @@ struct HtmlWave {
 inline constexpr size_t kHtmlWaveBytes = 32'000'000;
 inline constexpr double kFloat32TimeSpan = 100e-6;
 // The tolerances a record is thinned with, finest first (V): analysis/link_run_wave.h thin_rows,
-// linear interpolation between the kept samples within the tolerance of every sample.
-inline constexpr double kHtmlThinTolerances[] = {1e-3, 2e-3, 5e-3, 10e-3, 20e-3};
+// linear interpolation between the kept samples within the tolerance of every sample. Up to
+// 100 mV (2.5 % of a 4 V pulse) so that a 200 ms record (2,000 frames, 364,000 pulses) still
+// keeps its pulses' shape when zoomed to a frame, rather than each bucket's extremes.
+inline constexpr double kHtmlThinTolerances[] = {1e-3, 2e-3, 5e-3, 10e-3, 20e-3, 50e-3, 100e-3};
 // A wave as JSON: {direction, samples, kept, t0, and dt, t_last (a uniform grid: times t0 + i dt
 // within 1e-6 of dt, the last sample at t_last), or t (base64 Float32 offsets from t0) or t64
 // (base64 Float64 offsets, records longer than kFloat32TimeSpan), v (base64 Float32), and

@@ -46,6 +46,13 @@
     return Number(x).toPrecision(digits || 4).replace(/(\.\d*?)0+(e|$)/, '$1$2').replace(/\.(e|$)/, '$1');
   }
   function signed(x, digits) { return x == null || !isFinite(x) ? '-' : (x >= 0 ? '+' : '') + fmt(x, digits); }
+  // A long text (a whole stack read's decoded bytes or traffic) cut to its first `max` characters,
+  // saying how much is left out and where it is: uncut, a 2,000-frame record's would push the
+  // waveforms 10,000 pixels down the page.
+  function clipText(s, max, where) {
+    if (!s || s.length <= max) return s;
+    return s.slice(0, max) + ' ... (' + (s.length - max) + ' more characters: ' + where + ')';
+  }
   // Seconds with an SI prefix ("12.5 us").
   function si(x, unit) {
     if (x == null || !isFinite(x)) return '-';
@@ -271,7 +278,7 @@
       const cell = m => w[m] ? fmt(w[m].value, 4) + ' ' + w[m].unit + ' (' + signed(w[m].margin, 3) + ')' : '-';
       return {cells: [d.direction + ': ' + d.transmitter + ' -> ' + d.receiver, d.rules, verdictBadge(d.verdict),
         cell('vstart'), cell('vend'), cell('width'), cell('edge'),
-        c.decoded ? c.decoded.bytes || '-' : '-']};
+        c.decoded ? clipText(c.decoded.bytes, 160, 'report.json, decoded.bytes') || '-' : '-']};
     });
     why.append(table(['direction', 'rules', 'verdict', 'worst VSTART', 'worst VEND', 'worst width', 'slowest edge', 'bytes decoded'], dirRows));
     for (const d of r.directions) {
@@ -309,7 +316,8 @@
     const bom = section('Bill of materials and cable', 'bom');
     bom.append(table(['end', 'as simulated'], [{cells: ['tx', x.bom && x.bom.tx]}, {cells: ['rx', x.bom && x.bom.rx]}]));
     if (x.cable) bom.append(el('p', {text: 'Cable: ' + x.cable}));
-    if (r.spec && r.spec.stimulus) bom.append(el('p', {}, ['Traffic: ', el('code', {text: x.traffic || ''})]));
+    if (r.spec && r.spec.stimulus)
+      bom.append(el('p', {}, ['Traffic: ', el('code', {text: clipText(x.traffic || '', 400, 'the spec and report.md')})]));
     solverSection(r.directions);
   }
 

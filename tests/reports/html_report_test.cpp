@@ -154,7 +154,7 @@ TEST(HtmlReport, WaveJsonRoundTrips) {
     const double f = std::clamp((x - off[k]) / (off[k + 1] - off[k]), 0.0, 1.0);
     ASSERT_NEAR(vf[k] + f * (vf[k + 1] - vf[k]), v[i], 2e-3 + 1e-5) << i;
   }
-  // Noise of 1 V that no tolerance up to 20 mV thins enough: min/max buckets, the extremes kept.
+  // Noise of 1 V that no tolerance up to 100 mV thins enough: min/max buckets, the extremes kept.
   for (size_t i = 0; i < v.size(); ++i)
     v[i] = static_cast<double>(i * 7919 % 1000) * 1e-3 - 0.5 + (i == 321 ? 3 : 0);
   j = wave_json({"down", t, v}, 100);
