@@ -21,11 +21,11 @@
 
 namespace isolink {
 
-// The march's hot loops built twice on x86-64, for AVX2 with FMA and for the baseline, the
-// loader picking one for the machine (GCC's and Clang's function multiversioning): the same
-// binary runs anywhere and uses four lanes where it can. The two may differ in the last bits (a
-// fused multiply-add rounds once): a run is the same on every machine of one kind, and within
-// rounding across kinds.
+// The march's hot loops built twice on x86-64 by GCC, for AVX2 with FMA and for the baseline, the
+// loader picking one for the machine (function multiversioning; other compilers and machines
+// build the baseline alone): the same binary runs anywhere and uses four lanes where it can. The
+// two may differ in the last bits (a fused multiply-add rounds once): a run is the same on every
+// machine of one kind, and within rounding across kinds.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define ISOLINK_WIDE_SIMD __attribute__((target_clones("arch=x86-64-v3", "default")))
 #else
@@ -174,7 +174,7 @@ class ModalMarch {
   // and 1 / p^2 as real arrays, and |p|.
   std::vector<double> w2_, ipr_, ipi_, ip2r_, ip2i_, speed_;
   std::vector<size_t> by_speed_;  // the modes by |p|, fastest first
-  // rate_at: the first by_speed_[0..dead_) found below the threshold since the last corner. Between
+  // rate_at: by_speed_[0..dead_) were found below the threshold since the last corner. Between
   // corners each mode's transient part decays (d <- e^{ph} d, |e^{ph}| <= 1 when every pole is
   // stable: decays_), so a mode found below it stays below until the next corner.
   size_t dead_ = 0;
