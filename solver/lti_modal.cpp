@@ -170,9 +170,9 @@ class ModalMarch {
   std::vector<double> tail_scale_;   // per probe: |tail_const| + sum |out d| at the tail's start
   std::vector<double> live_limit2_;  // per probe: (kTailTol tail_scale)^2
   std::vector<std::vector<double>> out_norm2_;  // [p][mode]: |output|^2
-  // ModeRates: each mode's weight on the probes (squared, over the threshold squared), and 1 / p
-  // and 1 / p^2 as real arrays, and |p|.
-  std::vector<double> w2_, ipr_, ipi_, ip2r_, ip2i_, speed_;
+  // ModeRates: each mode's weight on the probes (squared, over the threshold squared), 1 / p^2 as
+  // real arrays (1 / p: poles_), and |p|.
+  std::vector<double> w2_, ip2r_, ip2i_, speed_;
   std::vector<size_t> by_speed_;  // the modes by |p|, fastest first
   // rate_at: by_speed_[0..dead_) were found below the threshold since the last corner. Between
   // corners each mode's transient part decays (d <- e^{ph} d, |e^{ph}| <= 1 when every pole is
@@ -521,8 +521,7 @@ void ModalMarch::start_rates(const std::vector<double>& probe_weight, double thr
       w2_[i] = std::max(w2_[i], probe_weight[p] * std::abs(m_.output[p][i]));
   for (size_t i = 0; i < nm_; ++i) {
     w2_[i] = w2_[i] * w2_[i] / (threshold * threshold);
-    const std::complex<double> ip = 1.0 / m_.poles[i], ip2 = ip * ip;
-    ipr_.push_back(ip.real()), ipi_.push_back(ip.imag());
+    const std::complex<double> ip(poles_.ipr[i], poles_.ipi[i]), ip2 = ip * ip;
     ip2r_.push_back(ip2.real()), ip2i_.push_back(ip2.imag());
     speed_.push_back(std::abs(m_.poles[i]));
   }
@@ -541,7 +540,7 @@ void ModalMarch::rate_at(size_t j) {
     if (w2_[i] * (d_r * d_r + d_i * d_i) > 1.0) fastest = std::max(fastest, speed_[i]);
   };
   const std::vector<double>&xr = xr_, &xi = xi_, &br = br_, &bi = bi_, &gr = gr_, &gi = gi_;
-  const std::vector<double>&ipr = ipr_, &ipi = ipi_, &ip2r = ip2r_, &ip2i = ip2i_;
+  const std::vector<double>&ipr = poles_.ipr, &ipi = poles_.ipi, &ip2r = ip2r_, &ip2i = ip2i_;
   if (!tail_) {
     // Fastest first: the first live mode is the answer (right after a corner, where most rows
     // are, one of the first few), past those already found dead since the last corner.
