@@ -25,6 +25,7 @@ struct TouchstoneArgs {
   std::vector<int> ports;
   double tolerance = 1e-3;
   bool json = false;
+  bool rational = false;
   std::string plot;  // PNG path, "" for none
 };
 
@@ -70,7 +71,21 @@ nlohmann::json fit_json(const link::TouchstoneCable& c) {
   j["simulated_rms_error"] = k.rms_error;
   j["simulated_max_error"] = k.max_error;
   j["simulated_max_error_hz"] = k.max_error_hz;
-  j["delay_extracted"] = false;
+  j["uniform_line"] = c.line.has_value();
+  if (c.line) {
+    const link::CableModel& m = c.line->model;
+    j["delay_diff_s"] = c.line->delay_diff;
+    j["z_diff_ohm"] = c.line->z_diff;
+    if (!c.differential) {
+      j["delay_cm_s"] = c.line->delay_cm;
+      j["z_cm_ohm"] = c.line->z_cm;
+    }
+    j["r_dc_ohm"] = m.r_dc;
+    j["skin_sections"] = m.skin.size();
+    j["dielectric_branches"] = m.dielectric.size();
+  } else if (c.line_rms_error > 0) {
+    j["uniform_line_rms_error"] = c.line_rms_error;
+  }
   return j;
 }
 
@@ -80,7 +95,7 @@ int run_touchstone(const TouchstoneArgs& a) {
     std::fprintf(stderr, "%s\n", t.status().message().c_str());
     return 2;
   }
-  auto c = link::fit_touchstone_cable(*t, a.ports, a.tolerance);
+  auto c = link::fit_touchstone_cable(*t, a.ports, a.tolerance, !a.rational);
   if (!c) {
     std::fprintf(stderr, "%s\n", c.status().message().c_str());
     return 2;
@@ -101,12 +116,15 @@ int run_touchstone(const TouchstoneArgs& a) {
               t->freqs.front(), t->freqs.back(), t->z0);
   std::printf("fit: %zu poles (%d states), RMS |S_fit - S| %.3g, largest %.3g at %.4g Hz\n",
               f.model.poles.size(), f.model.order(), f.rms_error, f.error, f.error_frequency);
-  std::printf(
-      "passivity: %s (smallest eigenvalue of Re Y %.3g S at %.4g Hz); after %d "
-      "perturbations %.3g S\n",
-      cable.passivity.passive ? "passive as fitted" : "enforced", cable.passivity.min_eigenvalue,
-      cable.passivity.at_frequency, cable.passivity.perturbation_iterations,
-      cable.passivity.enforced_min_eigenvalue);
+  if (cable.line)
+    std::printf("passivity: by construction (every R, L and C of the line's ladder is >= 0)\n");
+  else
+    std::printf(
+        "passivity: %s (smallest eigenvalue of Re Y %.3g S at %.4g Hz); after %d "
+        "perturbations %.3g S\n",
+        cable.passivity.passive ? "passive as fitted" : "enforced", cable.passivity.min_eigenvalue,
+        cable.passivity.at_frequency, cable.passivity.perturbation_iterations,
+        cable.passivity.enforced_min_eigenvalue);
   if (!cable.passivity.passive) {
     const reports::TouchstoneCurves k = reports::touchstone_curves(cable);
     std::printf(
@@ -120,7 +138,20 @@ int run_touchstone(const TouchstoneArgs& a) {
         "%.4g ohm (N)\n",
         t->freqs.front(), cable.dc_resistance(0, 0),
         cable.dc_resistance(cable.dc_resistance.rows() - 1, cable.dc_resistance.cols() - 1));
-  std::printf("delay: not extracted (the fit is rational)\n");
+  if (cable.line) {
+    const link::MeasuredLine& l = *cable.line;
+    std::printf(
+        "a uniform line (no poles): its delay carried by the native cable's ladder; differential "
+        "%.4g ns at %.4g ohm",
+        l.delay_diff * 1e9, l.z_diff);
+    if (!cable.differential)
+      std::printf(", common mode %.4g ns at %.4g ohm", l.delay_cm * 1e9, l.z_cm);
+    std::printf("; DC %.4g ohm per line, %zu skin sections, %zu dielectric branches\n",
+                l.model.r_dc, l.model.skin.size(), l.model.dielectric.size());
+  } else if (cable.line_rms_error > 0) {
+    std::printf("as a uniform line: %.3g RMS off, above the tolerance; fitted rationally\n",
+                cable.line_rms_error);
+  }
   if (!a.plot.empty()) std::printf("plot: %s\n", a.plot.c_str());
   return 0;
 }
@@ -170,6 +201,9 @@ void add_touchstone_command(CLI::App& app, int* exit_code) {
   cmd->add_option("--tolerance", args->tolerance, "Largest RMS |S_fit - S| accepted")
       ->check(CLI::Range(1e-9, 0.5));
   cmd->add_flag("--json", args->json, "JSON on standard output");
+  cmd->add_flag("--rational", args->rational,
+                "Fit a long line rationally, not as a uniform line first (cable.uniform_line: "
+                "false)");
   cmd->add_option("--plot", args->plot,
                   "Draw the file against the fit (differential magnitude and phase, the error "
                   "per frequency) into this PNG");

@@ -94,8 +94,7 @@ TouchstoneCurves touchstone_curves(const link::TouchstoneCable& c) {
   double sum2 = 0, n = 0;
   for (size_t i = 0; i < k.freqs.size(); ++i) {
     const Eigen::MatrixXcd s = file_s(c, i);
-    const Eigen::MatrixXcd fit =
-        s_from_y(c.fit.model.eval(Cx(0, 2 * std::numbers::pi * k.freqs[i])), c.data.z0);
+    const Eigen::MatrixXcd fit = s_from_y(c.y(k.freqs[i]), c.data.z0);
     const auto [t_file, r_file] = differential(s);
     const auto [t_fit, r_fit] = differential(fit);
     k.sdd21_file.push_back(t_file), k.sdd11_file.push_back(r_file);
@@ -129,15 +128,20 @@ Status write_touchstone_png(const link::TouchstoneCable& c, const std::string& p
           VAlign::kTop);
   cn.text(
       40, 66,
-      fmt::format("{}-port {}, {} points {} .. {}Hz, reference {:g} ohm; fit: {} poles, RMS "
+      fmt::format("{}-port {}, {} points {} .. {}Hz, reference {:g} ohm; fit: {}, RMS "
                   "|S_fit - S| {:.3g}, largest {:.3g} at {}Hz{}",
                   c.data.ports, c.differential ? "(differential)" : "(single-ended)",
                   k.freqs.size(), si_label(k.freqs.front()), si_label(k.freqs.back()), c.data.z0,
-                  f.model.poles.size(), f.rms_error, f.error, si_label(f.error_frequency),
+                  c.line ? fmt::format("a uniform line, {:.4g} ns, {:.4g} ohm differential",
+                                       c.line->delay_diff * 1e9, c.line->z_diff)
+                         : fmt::format("{} poles", f.model.poles.size()),
+                  f.rms_error, f.error, si_label(f.error_frequency),
                   c.dc_extrapolated ? "; DC extrapolated below the first point" : ""),
       kFont - 2, kInk, FontFace::kSans, HAlign::kLeft, VAlign::kTop);
   cn.text(40, 94,
-          c.passivity.passive
+          c.line ? std::string("passive by construction (every R, L and C of the line's ladder "
+                               "is >= 0): the model simulated is the fit")
+          : c.passivity.passive
               ? std::string("passive as fitted: the model simulated is the fit")
               : fmt::format("passivity enforced ({} perturbations): the model simulated has RMS "
                             "|S_fit - S| {:.3g}, largest {:.3g} at {}Hz (drawn below)",

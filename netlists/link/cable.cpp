@@ -12,6 +12,7 @@
 
 #include "netlists/link/cards.h"
 #include "netlists/link/touchstone_cable.h"
+#include "solver/nnls.h"
 
 namespace isolink::link {
 
@@ -64,59 +65,6 @@ cd bessel_j1_over_j0(cd z) {
   cd r = 0;
   for (int n = n_max; n >= 1; --n) r = 1.0 / (2.0 * n / z - r);
   return r;
-}
-
-// Lawson-Hanson non-negative least squares: min |A x - b|, x >= 0.
-Eigen::VectorXd nnls(const Eigen::MatrixXd& a_in, const Eigen::VectorXd& b) {
-  const int n = static_cast<int>(a_in.cols());
-  // Column scaling for conditioning.
-  Eigen::VectorXd scale(n);
-  Eigen::MatrixXd a = a_in;
-  for (int j = 0; j < n; ++j) {
-    const double s = a.col(j).norm();
-    scale[j] = s > 0 ? s : 1.0;
-    a.col(j) /= scale[j];
-  }
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
-  std::vector<bool> passive(n, false);
-  const double tol = 1e-12 * std::max(1.0, b.norm());
-  auto solve_passive = [&](Eigen::VectorXd& s) {
-    std::vector<int> idx;
-    for (int j = 0; j < n; ++j)
-      if (passive[j]) idx.push_back(j);
-    Eigen::MatrixXd ap(a.rows(), static_cast<Eigen::Index>(idx.size()));
-    for (size_t k = 0; k < idx.size(); ++k) ap.col(static_cast<Eigen::Index>(k)) = a.col(idx[k]);
-    Eigen::VectorXd sp = ap.colPivHouseholderQr().solve(b);
-    s.setZero(n);
-    for (size_t k = 0; k < idx.size(); ++k) s[idx[k]] = sp[static_cast<Eigen::Index>(k)];
-  };
-  for (int outer = 0; outer < 3 * n; ++outer) {
-    Eigen::VectorXd w = a.transpose() * (b - a * x);
-    int best = -1;
-    for (int j = 0; j < n; ++j)
-      if (!passive[j] && w[j] > tol && (best < 0 || w[j] > w[best])) best = j;
-    if (best < 0) break;
-    passive[best] = true;
-    for (int inner = 0; inner < 3 * n; ++inner) {
-      Eigen::VectorXd s;
-      solve_passive(s);
-      bool feasible = true;
-      for (int j = 0; j < n; ++j)
-        if (passive[j] && s[j] <= 0) feasible = false;
-      if (feasible) {
-        x = s;
-        break;
-      }
-      double alpha = 1.0;
-      for (int j = 0; j < n; ++j)
-        if (passive[j] && s[j] <= 0) alpha = std::min(alpha, x[j] / (x[j] - s[j]));
-      x += alpha * (s - x);
-      for (int j = 0; j < n; ++j)
-        if (passive[j] && x[j] <= 1e-15) passive[j] = false, x[j] = 0;
-    }
-  }
-  for (int j = 0; j < n; ++j) x[j] /= scale[j];
-  return x;
 }
 
 std::vector<double> log_space(double lo, double hi, int n) {
@@ -500,14 +448,19 @@ Status add_cable(std::vector<Card>& cards, const std::string& prefix, const std:
   if (!(edge_time > 0) || !std::isfinite(edge_time))
     return Status::Error(fmt::format("cable {}: edge time {:g} s must be > 0", prefix, edge_time));
   if (!spec.touchstone.empty()) {
-    if (segments != nullptr) *segments = 0;
-    return add_touchstone_cable(cards, prefix, a_p, a_n, b_p, b_n, spec);
+    return add_touchstone_cable(cards, prefix, a_p, a_n, b_p, b_n, spec, edge_time, segments);
   }
   StatusOr<CableModel> model = cable_model(spec);
   if (!model) return model.status();
-  const CableModel& m = *model;
-  const int n = cable_segments(spec, m, edge_time);
+  const int n = cable_segments(spec, *model, edge_time);
   if (segments != nullptr) *segments = n;
+  add_cable_ladder(cards, prefix, a_p, a_n, b_p, b_n, *model, n, loss_stride(spec, n));
+  return Status::Ok();
+}
+
+void add_cable_ladder(std::vector<Card>& cards, const std::string& prefix, const std::string& a_p,
+                      const std::string& a_n, const std::string& b_p, const std::string& b_n,
+                      const CableModel& m, int n, int stride) {
   const double dz = m.length / n;
 
   auto node = [&](char side, int j) -> std::string {
@@ -528,7 +481,6 @@ Status add_cable(std::vector<Card>& cards, const std::string& prefix, const std:
   // segment's R, L and C, so they are lumped every `stride` segments (their values scaled by the
   // length they stand for) instead of in every segment: most of a segment's unknowns are in its
   // ladders, and the wave's timing needs the fine LC segments, not fine loss sections.
-  const int stride = loss_stride(spec, n);
   // Segment i (1..n) carries the skin ladder of segments i - stride + 1 .. i (and the last one
   // the rest).
   auto series_loss_length = [&](int i) -> double {
@@ -573,16 +525,18 @@ Status add_cable(std::vector<Card>& cards, const std::string& prefix, const std:
         from = to;
       }
     }
-    cards.push_back(card('k', fmt::format("k{}_{}", prefix, i), {}, m.k_pn,
-                         {fmt::format("l{}_p{}", prefix, i), fmt::format("l{}_n{}", prefix, i)}));
+    if (m.k_pn != 0)  // 0 on a measured 2-port's delay line
+      cards.push_back(card('k', fmt::format("k{}_{}", prefix, i), {}, m.k_pn,
+                           {fmt::format("l{}_p{}", prefix, i), fmt::format("l{}_n{}", prefix, i)}));
     if (i < n && kappa > 0) {
       const double k_adj = kappa * l_seg / std::sqrt(l_of(i) * l_of(i + 1));
       for (auto [a, b, k] :
            {std::tuple{'p', 'p', k_adj}, std::tuple{'n', 'n', k_adj},
             std::tuple{'p', 'n', k_adj * m.k_pn}, std::tuple{'n', 'p', k_adj * m.k_pn}})
-        cards.push_back(card(
-            'k', fmt::format("k{}_{}{}{}", prefix, a, b, i), {}, k,
-            {fmt::format("l{}_{}{}", prefix, a, i), fmt::format("l{}_{}{}", prefix, b, i + 1)}));
+        if (k != 0)
+          cards.push_back(card(
+              'k', fmt::format("k{}_{}{}{}", prefix, a, b, i), {}, k,
+              {fmt::format("l{}_{}{}", prefix, a, i), fmt::format("l{}_{}{}", prefix, b, i + 1)}));
     }
   }
 
@@ -601,10 +555,11 @@ Status add_cable(std::vector<Card>& cards, const std::string& prefix, const std:
           card('r', fmt::format("r{}_pn{}_d{}", prefix, j, b), {p, mid}, m.dielectric[b].tau / cb));
       cards.push_back(card('c', fmt::format("c{}_pn{}_d{}", prefix, j, b), {mid, q}, cb));
     }
-    cards.push_back(card('c', fmt::format("c{}_gp{}", prefix, j), {p, "0"}, m.c_g * len));
-    cards.push_back(card('c', fmt::format("c{}_gn{}", prefix, j), {q, "0"}, m.c_g * len));
+    if (m.c_g > 0) {  // none on a measured 2-port's delay line (its common mode is open)
+      cards.push_back(card('c', fmt::format("c{}_gp{}", prefix, j), {p, "0"}, m.c_g * len));
+      cards.push_back(card('c', fmt::format("c{}_gn{}", prefix, j), {q, "0"}, m.c_g * len));
+    }
   }
-  return Status::Ok();
 }
 
 }  // namespace isolink::link

@@ -69,6 +69,7 @@ struct CableSpec {
   std::string touchstone;
   std::vector<int> ports;
   double fit_tolerance = 1e-3;
+  bool uniform_line = true;  // a long line tried as a uniform line first (touchstone_cable.h)
 
   // Names the field, its value and the rule: "cable.length = -1: must be > 0".
   Status validate() const;
@@ -185,5 +186,12 @@ int loss_stride(const CableSpec& spec, int segments);  // spec.loss_stride when 
 Status add_cable(std::vector<Card>& cards, const std::string& prefix, const std::string& a_p,
                  const std::string& a_n, const std::string& b_p, const std::string& b_n,
                  const CableSpec& spec, double edge_time = 10e-9, int* segments = nullptr);
+
+// add_cable's ladder for a resolved model: n segments, the loss ladders every `stride` of them.
+// A model with c_g = 0 gets no capacitance to the reference (a measured 2-port's extracted delay
+// line, touchstone_cable.h).
+void add_cable_ladder(std::vector<Card>& cards, const std::string& prefix, const std::string& a_p,
+                      const std::string& a_n, const std::string& b_p, const std::string& b_n,
+                      const CableModel& m, int n, int stride);
 
 }  // namespace isolink::link

@@ -205,7 +205,7 @@ Status read_end(const YamlDoc& doc, const YAML::Node& node, const std::string& p
 Status read_touchstone_keys(const YamlDoc& doc, const YAML::Node& node,
                             const std::vector<std::string>& ports, CableSpec* cable) {
   if (cable->touchstone.empty()) {
-    for (const char* k : {"ports", "tolerance"})
+    for (const char* k : {"ports", "tolerance", "uniform_line"})
       if (node.IsMap() && node[k])
         return doc.error(node[k], fmt::format("key 'cable.{}' needs cable.touchstone", k));
     return Status::Ok();
@@ -250,6 +250,7 @@ Status read_cable(const YamlDoc& doc, const YAML::Node& node, CableSpec* cable) 
           {"touchstone", read_text(doc, &cable->touchstone)},
           {"ports", read_text_list(doc, &ports)},
           {"tolerance", read_quantity(doc, Unit::kNone, Rule::kPositive, &cable->fit_tolerance)},
+          {"uniform_line", read_bool(doc, &cable->uniform_line)},
       });
   if (!s.ok()) return s;
   if (Status t = read_touchstone_keys(doc, node, ports, cable); !t.ok()) return t;

@@ -99,6 +99,26 @@ Eigen::MatrixXd end_sum_and_difference(int n) {
   return t;
 }
 
+// The RMS of |S_line - S| over freqs (y: the file's admittances), S at reference z0; fit's error
+// fields set to the line's.
+double line_rms_error(const MeasuredLine& line, const std::vector<double>& freqs,
+                      const std::vector<Eigen::MatrixXcd>& y, double z0, FitResult* fit) {
+  const int n = static_cast<int>(y[0].rows());
+  fit->entry_error = Eigen::MatrixXd::Zero(n, n);
+  fit->error = 0;
+  double sum = 0;
+  for (size_t k = 0; k < freqs.size(); ++k) {
+    const Eigen::MatrixXd e =
+        (s_from_y(uniform_line_y(line, freqs[k]), z0) - s_from_y(y[k], z0)).cwiseAbs();
+    fit->entry_error = fit->entry_error.cwiseMax(e);
+    sum += e.squaredNorm();
+    if (e.maxCoeff() > fit->error) fit->error = e.maxCoeff(), fit->error_frequency = freqs[k];
+  }
+  fit->rms_error = std::sqrt(sum / (double(freqs.size()) * n * n));
+  if (!std::isfinite(fit->rms_error)) fit->rms_error = INFINITY;
+  return fit->rms_error;
+}
+
 // The RMS of |S_model - S| over the fitted points (s_data: the data's S at reference z0): the
 // model as it is simulated, after the passivity enforcement.
 double enforced_rms_error(const RationalModel& m, const std::vector<double>& freqs,
@@ -171,9 +191,15 @@ void refit_until_passive(const std::vector<double>& freqs, const std::vector<Eig
 
 }  // namespace
 
+Eigen::MatrixXcd TouchstoneCable::y(double f) const {
+  if (line) return uniform_line_y(*line, f);
+  return fit.model.eval(cd(0, 2 * std::numbers::pi * f));
+}
+
 StatusOr<std::shared_ptr<const TouchstoneCable>> fit_touchstone_cable(const Touchstone& data,
                                                                       std::vector<int> ports,
-                                                                      double tolerance) {
+                                                                      double tolerance,
+                                                                      bool long_line) {
   auto out = std::make_shared<TouchstoneCable>();
   out->data = data;
   const std::string& name = data.source;
@@ -236,6 +262,22 @@ StatusOr<std::shared_ptr<const TouchstoneCable>> fit_touchstone_cable(const Touc
           name));
     out->dc_extrapolated = true;
   }
+  // A long line: first as a uniform line, kept when within the tolerance of the file.
+  if (long_line)
+    if (std::optional<MeasuredLine> line = fit_uniform_line(freqs, y, out->differential);
+        line && line->delay_diff * freqs.back() >= kLongLineCycles) {
+      FitResult scored;
+      out->line_rms_error = line_rms_error(*line, freqs, y, data.z0, &scored);
+      if (out->line_rms_error <= tolerance) {
+        scored.model.ports = n;
+        scored.model.d = Eigen::MatrixXd::Zero(n, n);
+        scored.converged = true;
+        out->fit = std::move(scored);
+        out->line = std::move(line);
+        out->dc_conductance = out->y(0).real();
+        return std::shared_ptr<const TouchstoneCable>(std::move(out));
+      }
+    }
   FitOptions opt;
   opt.tolerance = tolerance;
   opt.z0 = data.z0;
@@ -245,9 +287,12 @@ StatusOr<std::shared_ptr<const TouchstoneCable>> fit_touchstone_cable(const Touc
   if (!fit->converged)
     return Status::Error(fmt::format(
         "{}: the rational fit reached {} poles with an RMS S error of {:.3g}, above the tolerance "
-        "{:.3g} (a long line over a wide band needs more poles than isolink fits; give a narrower "
-        "band or a larger cable.tolerance)",
-        name, fit->model.poles.size(), fit->rms_error, tolerance));
+        "{:.3g} ({}; give a narrower band or a larger cable.tolerance)",
+        name, fit->model.poles.size(), fit->rms_error, tolerance,
+        out->line_rms_error > 0
+            ? fmt::format("as a uniform line it is {:.3g} RMS off: not uniform enough",
+                          out->line_rms_error)
+            : "a long line over a wide band needs more poles than isolink fits"));
   out->fit = std::move(*fit);
   out->passivity = enforce_passivity(out->fit.model, freqs);
   refit_until_passive(freqs, y, opt, out.get());
@@ -259,7 +304,7 @@ StatusOr<std::shared_ptr<const TouchstoneCable>> fit_touchstone_cable(const Touc
         "residue perturbation did not make it so; a measurement's noise is the usual cause "
         "(a larger cable.tolerance lets a lower order smooth it)",
         name, out->passivity.min_eigenvalue, out->passivity.at_frequency));
-  out->dc_conductance = out->fit.model.eval(cd(0, 0)).real();
+  out->dc_conductance = out->y(0).real();
   if (!out->fit.model.d.allFinite() || !out->dc_conductance.allFinite())
     return Status::Error(fmt::format("{}: the fit is not finite", name));
   return std::shared_ptr<const TouchstoneCable>(std::move(out));
@@ -268,8 +313,8 @@ StatusOr<std::shared_ptr<const TouchstoneCable>> fit_touchstone_cable(const Touc
 StatusOr<std::shared_ptr<const TouchstoneCable>> touchstone_cable(const CableSpec& spec) {
   StatusOr<std::string> text = read_input_file(spec.touchstone);
   if (!text) return text.status();
-  std::string key = fmt::format("{:x}|{}|{:a}|", std::hash<std::string>{}(*text), spec.touchstone,
-                                spec.fit_tolerance);
+  std::string key = fmt::format("{:x}|{}|{:a}|{}|", std::hash<std::string>{}(*text),
+                                spec.touchstone, spec.fit_tolerance, spec.uniform_line);
   for (int p : spec.ports) key += fmt::format("{},", p);
   static std::mutex mutex;
   static std::map<std::string, std::shared_ptr<const TouchstoneCable>> kept;
@@ -279,7 +324,7 @@ StatusOr<std::shared_ptr<const TouchstoneCable>> touchstone_cable(const CableSpe
   }
   StatusOr<Touchstone> data = read_touchstone_text(*text, spec.touchstone);
   if (!data) return data.status();
-  auto fit = fit_touchstone_cable(*data, spec.ports, spec.fit_tolerance);
+  auto fit = fit_touchstone_cable(*data, spec.ports, spec.fit_tolerance, spec.uniform_line);
   if (!fit) return fit.status();
   std::lock_guard<std::mutex> lock(mutex);
   if (kept.size() >= 16) kept.clear();
@@ -338,15 +383,23 @@ void add_rational_cards(std::vector<Card>& cards, const std::string& prefix, con
 
 Status add_touchstone_cable(std::vector<Card>& cards, const std::string& prefix,
                             const std::string& a_p, const std::string& a_n, const std::string& b_p,
-                            const std::string& b_n, const CableSpec& spec) {
+                            const std::string& b_n, const CableSpec& spec, double edge_time,
+                            int* segments) {
   auto cable = touchstone_cable(spec);
   if (!cable) return cable.status();
   const TouchstoneCable& c = **cable;
-  if (c.differential)
+  int n = 0;
+  if (c.line) {
+    const double delay = std::max(c.line->delay_diff, c.line->delay_cm);
+    n = static_cast<int>(std::clamp(std::ceil(delay / (edge_time / 10) - 1e-9), 2.0, 200.0));
+    add_cable_ladder(cards, prefix, a_p, a_n, b_p, b_n, c.line->model, n, loss_stride(n));
+  } else if (c.differential) {
     add_rational_cards(cards, prefix, c.fit.model, {{a_p, a_n}, {b_p, b_n}});
-  else
+  } else {
     add_rational_cards(cards, prefix, c.fit.model,
                        {{a_p, "0"}, {a_n, "0"}, {b_p, "0"}, {b_n, "0"}});
+  }
+  if (segments != nullptr) *segments = n;
   return Status::Ok();
 }
 

@@ -21,6 +21,12 @@
 // (stated in `isolink touchstone`'s output with the DC conductances). A fit that does not reach
 // the tolerance is an error naming the error reached.
 //
+// Long lines (docs/touchstone.md, "Long lines"): a line of many wavelengths over the band (its
+// differential delay times the top frequency at least kLongLineCycles) would need hundreds of
+// poles. It is fitted first as a uniform line (netlists/link/measured_line.h) and built as the
+// native cable's ladder, which carries the delay; when that line is not within the tolerance of
+// the file (connectors, splices), the rational fit below is tried as for any file.
+//
 // Realization (docs/touchstone.md): Y(s) = D + sum_k R_k / (s - p_k). For each pole and each
 // port j a state node z with C = 1/|Re p| and 1 ohm to ground, driven by a G card with the
 // port's voltage (so z = |Re p| v_j / (s - p), at most |v_j|); a pair's two states are coupled
@@ -29,16 +35,22 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "base/status.h"
 #include "netlists/link/cable.h"
+#include "netlists/link/measured_line.h"
 #include "netlists/touchstone.h"
 #include "solver/card.h"
 #include "solver/vector_fit.h"
 
 namespace isolink::link {
+
+// A file is tried as a uniform line when the line's differential delay spans at least this many
+// periods of the band's top frequency (a rational fit needs about 4 poles a period).
+inline constexpr double kLongLineCycles = 8;
 
 struct TouchstoneCable {
   Touchstone data;            // as read, ports in the file's order
@@ -49,24 +61,33 @@ struct TouchstoneCable {
   Eigen::MatrixXd dc_conductance;  // Y(0) of the fitted model, S
   bool dc_extrapolated = false;    // the file has no DC point: Y(0) from dc_resistance
   Eigen::MatrixXd dc_resistance;   // ohm, the conductors' series R extrapolated to DC (P, N)
+  // A long line fitted as a uniform line: the cable is its ladder, fit.model has no poles and
+  // fit's errors are the line's. Else the rational fit alone.
+  std::optional<MeasuredLine> line;
+  double line_rms_error = 0;  // the uniform line's RMS |S - S_file| where one was tried, else 0
+  // The model's admittance at f (Hz) in the link's port order (the line's exact, not its ladder).
+  Eigen::MatrixXcd y(double f) const;
 };
 
-// Reads and fits a spec's file (spec.touchstone, spec.ports, spec.fit_tolerance). Fits are
-// kept, keyed by the file's bytes, the ports and the tolerance.
+// Reads and fits a spec's file (spec.touchstone, spec.ports, spec.fit_tolerance,
+// spec.uniform_line). Fits are kept, keyed by the file's bytes and those.
 StatusOr<std::shared_ptr<const TouchstoneCable>> touchstone_cable(const CableSpec& spec);
 // The same from data in memory (isolink touchstone, tests).
 StatusOr<std::shared_ptr<const TouchstoneCable>> fit_touchstone_cable(const Touchstone& data,
                                                                       std::vector<int> ports,
-                                                                      double tolerance);
+                                                                      double tolerance,
+                                                                      bool long_line = true);
 
 // The equivalent network of a fitted model between port node pairs (plus, minus): minus "0" for
 // a single-ended port. Element and node names start with prefix as add_cable's do.
 void add_rational_cards(std::vector<Card>& cards, const std::string& prefix, const RationalModel& m,
                         const std::vector<std::pair<std::string, std::string>>& port_nodes);
 
-// The cable's cards between the ends (a_p, a_n) and (b_p, b_n).
+// The cable's cards between the ends (a_p, a_n) and (b_p, b_n); a uniform line as a ladder whose
+// segments are at most edge_time / 10 of delay (within [2, 200]; their count to *segments).
 Status add_touchstone_cable(std::vector<Card>& cards, const std::string& prefix,
                             const std::string& a_p, const std::string& a_n, const std::string& b_p,
-                            const std::string& b_n, const CableSpec& spec);
+                            const std::string& b_n, const CableSpec& spec, double edge_time,
+                            int* segments = nullptr);
 
 }  // namespace isolink::link
