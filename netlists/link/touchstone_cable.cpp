@@ -121,12 +121,19 @@ double line_rms_error(const MeasuredLine& line, const std::vector<double>& freqs
 
 // The RMS of |S_model - S| over the fitted points (s_data: the data's S at reference z0): the
 // model as it is simulated, after the passivity enforcement.
+// The largest entry error goes to *largest when given.
 double enforced_rms_error(const RationalModel& m, const std::vector<double>& freqs,
-                          const std::vector<Eigen::MatrixXcd>& s_data, double z0) {
-  double sum = 0;
-  for (size_t k = 0; k < freqs.size(); ++k)
-    sum += (s_from_y(m.eval(cd(0, 2 * std::numbers::pi * freqs[k])), z0) - s_data[k]).squaredNorm();
+                          const std::vector<Eigen::MatrixXcd>& s_data, double z0,
+                          double* largest = nullptr) {
+  double sum = 0, top = 0;
+  for (size_t k = 0; k < freqs.size(); ++k) {
+    const Eigen::MatrixXcd e =
+        s_from_y(m.eval(cd(0, 2 * std::numbers::pi * freqs[k])), z0) - s_data[k];
+    sum += e.squaredNorm();
+    top = std::max(top, e.cwiseAbs().maxCoeff());
+  }
   const double r = std::sqrt(sum / (double(freqs.size()) * m.ports * m.ports));
+  if (largest != nullptr) *largest = std::isfinite(top) ? top : INFINITY;
   return std::isfinite(r) ? r : INFINITY;
 }
 
@@ -136,18 +143,25 @@ double enforced_rms_error(const RationalModel& m, const std::vector<double>& fre
 // the data elsewhere (cap_2m, 43 poles: a 6 uS violation at 562 MHz, and the model after it
 // 6.5e-4 off S at 10 kHz, 7 mV on the link). Another order within the tolerance bends
 // differently: when the enforced model is more than kEnforcedErrorRatio times the fit's error
-// off the data (or needed a shunt), the best order's neighbours (then the other orders tried
+// off the data, in RMS or in its largest entry error (or needed a shunt), the best order's
+// neighbours (then the other orders tried
 // that met the tolerance) are fitted and enforced, and the one closest to the data after
 // enforcement is kept, `out`'s own among them. Leaves `out` as it was when none does better.
 constexpr double kEnforcedErrorRatio = 10;
+constexpr double kEnforcedLargestRatio = 5;
 void refit_until_passive(const std::vector<double>& freqs, const std::vector<Eigen::MatrixXcd>& y,
                          const FitOptions& opt, TouchstoneCable* out) {
   std::vector<Eigen::MatrixXcd> s_data;
   for (const Eigen::MatrixXcd& yk : y) s_data.push_back(s_from_y(yk, opt.z0));
+  double own_largest = INFINITY;
   const double own = out->passivity.added_conductance > 1e-9
                          ? INFINITY
-                         : enforced_rms_error(out->fit.model, freqs, s_data, opt.z0);
-  if (own <= kEnforcedErrorRatio * out->fit.rms_error) return;
+                         : enforced_rms_error(out->fit.model, freqs, s_data, opt.z0, &own_largest);
+  // The largest error too: a perturbation that moves one band (the python tests' 1 m cable: 1.6e-4
+  // at 2 MHz, 6.7 times the fit's largest, 5.1 times its RMS) moves the waveform by millivolts.
+  if (own <= kEnforcedErrorRatio * out->fit.rms_error &&
+      own_largest <= kEnforcedLargestRatio * out->fit.error)
+    return;
   const std::vector<int> orders = out->fit.orders_tried;
   const std::vector<double> errors = out->fit.errors;
   const size_t best =
@@ -161,10 +175,12 @@ void refit_until_passive(const std::vector<double>& freqs, const std::vector<Eig
   std::optional<FitResult> kept;
   PassivityReport kept_report;
   int kept_order = 0;
-  double kept_error = own;
+  double kept_error = own, kept_largest = own_largest;
   for (size_t c = 0; c < candidates.size(); ++c) {
-    // A neighbour made passive within the ratio of its fit: enough.
-    if (kept && c >= 6 && kept_error <= kEnforcedErrorRatio * kept->rms_error) break;
+    // A neighbour made passive within the ratios of its fit: enough.
+    if (kept && c >= 6 && kept_error <= kEnforcedErrorRatio * kept->rms_error &&
+        kept_largest <= kEnforcedLargestRatio * kept->error)
+      break;
     const int order = candidates[c];
     FitOptions one = opt;
     one.min_order = one.max_order = order;
@@ -172,12 +188,14 @@ void refit_until_passive(const std::vector<double>& freqs, const std::vector<Eig
     if (!refit || !refit->converged) continue;
     PassivityReport report = enforce_passivity(refit->model, freqs);
     if (report.added_conductance > 1e-9) continue;
-    const double e = enforced_rms_error(refit->model, freqs, s_data, opt.z0);
+    double largest = INFINITY;
+    const double e = enforced_rms_error(refit->model, freqs, s_data, opt.z0, &largest);
     if (!(e < kept_error)) continue;
     kept = std::move(*refit);
     kept_report = report;
     kept_order = order;
     kept_error = e;
+    kept_largest = largest;
   }
   if (kept) {
     kept->orders_tried = orders;
