@@ -67,13 +67,6 @@ cd bessel_j1_over_j0(cd z) {
   return r;
 }
 
-std::vector<double> log_space(double lo, double hi, int n) {
-  std::vector<double> out(n);
-  for (int i = 0; i < n; ++i)
-    out[i] = n == 1 ? lo : lo * std::pow(hi / lo, static_cast<double>(i) / (n - 1));
-  return out;
-}
-
 // Fit points: a little wider than the band so the band's ends are not the fit's ends; the
 // fits are then scored on the band itself.
 std::vector<double> fit_frequencies() {
@@ -432,6 +425,13 @@ int loss_stride(int segments) {
 }
 int loss_stride(const CableSpec& spec, int segments) {
   return spec.loss_stride > 0 ? spec.loss_stride : loss_stride(segments);
+}
+
+std::vector<double> log_space(double lo, double hi, int n) {
+  std::vector<double> out(n);
+  for (int i = 0; i < n; ++i)
+    out[i] = n == 1 ? lo : lo * std::pow(hi / lo, static_cast<double>(i) / (n - 1));
+  return out;
 }
 
 int cable_segments(const CableSpec& spec, const CableModel& m, double edge_time) {

@@ -168,6 +168,10 @@ struct CableModel {
 // overrides that do not fit the geometry (an l of 4 l_cm or more, a c below c_g / 2).
 StatusOr<CableModel> cable_model(const CableSpec& spec);
 
+// n points from lo to hi, evenly spaced in log (the ladders' corners and fit frequencies; a
+// measured line's too, measured_line.cpp).
+std::vector<double> log_space(double lo, double hi, int n);
+
 // Segment count: spec.segments when > 0, else the smallest count whose segment delay
 // (length / velocity / n) is at most edge_time / 10, within [2, 200] (200 for an edge_time that
 // is not > 0).
@@ -182,7 +186,8 @@ int loss_stride(const CableSpec& spec, int segments);  // spec.loss_stride when 
 // style, as the pin models: "lcab_p3", "kcab_3", "ccab_pn0"); internal nodes are
 // "<prefix>_...". edge_time (s, > 0) sets the segment count when spec.segments is 0; the count
 // used goes to *segments when given. A spec with a touchstone file adds its fitted network
-// (add_touchstone_cable) and reports 0 segments.
+// (add_touchstone_cable) and reports its ladder's segments when it was read as a uniform line,
+// else 0.
 Status add_cable(std::vector<Card>& cards, const std::string& prefix, const std::string& a_p,
                  const std::string& a_n, const std::string& b_p, const std::string& b_n,
                  const CableSpec& spec, double edge_time = 10e-9, int* segments = nullptr);

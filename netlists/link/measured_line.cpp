@@ -61,13 +61,6 @@ std::optional<ModeData> read_mode(const std::vector<double>& freqs,
   return out;
 }
 
-std::vector<double> log_space(double lo, double hi, int n) {
-  std::vector<double> out(n);
-  for (int i = 0; i < n; ++i)
-    out[i] = n == 1 ? lo : lo * std::pow(hi / lo, static_cast<double>(i) / (n - 1));
-  return out;
-}
-
 // Corners for the ladders: kCornersPerDecade over the band (from its first point above 0, at
 // least 1 kHz) widened by a factor 2 each side, 3 to 14 of them.
 std::vector<double> corners(const std::vector<double>& f) {

@@ -35,6 +35,28 @@ double max_difference(const Waveform& a, const Waveform& b, size_t k) {
   return worst;
 }
 
+// An example spec, sent down only.
+StatusOr<link::LinkSpec> example_down(const std::string& name) {
+  StatusOr<link::LinkSpec> spec =
+      link::read_link_spec_file(std::string(ISOLINK_EXAMPLES_DIR) + "/" + name);
+  if (spec.ok()) spec->stimulus.directions = {link::Direction::kDown};
+  return spec;
+}
+
+StatusOr<LinkRun> run_lti(const link::LinkSpec& spec, const link::PartLibrary& parts) {
+  RunOptions ro;
+  ro.engine = Engine::Lti;
+  return run_link(spec, parts, ro);
+}
+
+// The spec with its cable replaced by the Touchstone file at path.
+link::LinkSpec with_measured_cable(const link::LinkSpec& spec, const std::string& path) {
+  link::LinkSpec measured = spec;
+  measured.cable = link::CableSpec{};
+  measured.cable.touchstone = path;
+  return measured;
+}
+
 struct Case {
   const char* spec;
   double f_start;
@@ -42,15 +64,11 @@ struct Case {
 };
 
 void check_case(const Case& c, double limit_mv) {
-  StatusOr<link::LinkSpec> spec =
-      link::read_link_spec_file(std::string(ISOLINK_EXAMPLES_DIR) + "/" + c.spec);
+  StatusOr<link::LinkSpec> spec = example_down(c.spec);
   ASSERT_TRUE(spec.ok()) << spec.status().message();
-  spec->stimulus.directions = {link::Direction::kDown};
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
   ASSERT_TRUE(parts.ok());
-  RunOptions ro;
-  ro.engine = Engine::Lti;
-  StatusOr<LinkRun> native = run_link(*spec, *parts, ro);
+  StatusOr<LinkRun> native = run_lti(*spec, *parts);
   ASSERT_TRUE(native.ok()) << native.status().message();
 
   TouchstoneExportOptions o;
@@ -66,9 +84,7 @@ void check_case(const Case& c, double limit_mv) {
   const std::string path = temp_path(fmt::format("{}.s4p", c.f_start));
   ASSERT_TRUE(write_file_atomic(path, write_touchstone(*t, "test")).ok());
 
-  link::LinkSpec measured = *spec;
-  measured.cable = link::CableSpec{};
-  measured.cable.touchstone = path;
+  const link::LinkSpec measured = with_measured_cable(*spec, path);
   auto fit = link::touchstone_cable(measured.cable);
   ASSERT_TRUE(fit.ok()) << c.spec << " " << c.f_start << " " << fit.status().message();
   std::printf(
@@ -78,7 +94,7 @@ void check_case(const Case& c, double limit_mv) {
       (*fit)->fit.error, (*fit)->fit.error_frequency, (*fit)->passivity.passive,
       (*fit)->passivity.min_eigenvalue, (*fit)->passivity.at_frequency,
       (*fit)->passivity.perturbation_iterations, (*fit)->passivity.added_conductance);
-  StatusOr<LinkRun> run = run_link(measured, *parts, ro);
+  StatusOr<LinkRun> run = run_lti(measured, *parts);
   ASSERT_TRUE(run.ok()) << run.status().message();
   std::printf("native %s %.2f s, fitted %s %.2f s (method %s, note %s, model %.2f s order %d)\n",
               engine_name(native->directions[0].sim.engine), native->directions[0].sim.seconds,
@@ -128,15 +144,11 @@ TEST(TouchstoneExport, NoisyFileWithin2mV) {
 // segments. Measured 2026-12-05: 2.67 mV, the line's S within 3.3e-4 RMS of the file; the
 // rational fit of the same file (`uniform_line: false`: 71 poles, 95 s) was 36 mV off.
 TEST(TouchstoneExport, Long15mLinkReadsBackAsAUniformLine) {
-  StatusOr<link::LinkSpec> spec =
-      link::read_link_spec_file(std::string(ISOLINK_EXAMPLES_DIR) + "/transformer_15m.yaml");
+  StatusOr<link::LinkSpec> spec = example_down("transformer_15m.yaml");
   ASSERT_TRUE(spec.ok()) << spec.status().message();
-  spec->stimulus.directions = {link::Direction::kDown};
   StatusOr<link::PartLibrary> parts = link::PartLibrary::load({});
   ASSERT_TRUE(parts.ok());
-  RunOptions ro;
-  ro.engine = Engine::Lti;
-  StatusOr<LinkRun> native = run_link(*spec, *parts, ro);
+  StatusOr<LinkRun> native = run_lti(*spec, *parts);
   ASSERT_TRUE(native.ok()) << native.status().message();
 
   TouchstoneExportOptions o;
@@ -147,9 +159,7 @@ TEST(TouchstoneExport, Long15mLinkReadsBackAsAUniformLine) {
   ASSERT_TRUE(t.ok()) << t.status().message();
   const std::string path = temp_path("long.s4p");
   ASSERT_TRUE(write_file_atomic(path, write_touchstone(*t, "test")).ok());
-  link::LinkSpec measured = *spec;
-  measured.cable = link::CableSpec{};
-  measured.cable.touchstone = path;
+  const link::LinkSpec measured = with_measured_cable(*spec, path);
   auto fit = link::touchstone_cable(measured.cable);
   ASSERT_TRUE(fit.ok()) << fit.status().message();
   ASSERT_TRUE((*fit)->line.has_value());
@@ -157,7 +167,7 @@ TEST(TouchstoneExport, Long15mLinkReadsBackAsAUniformLine) {
   std::printf("as a uniform line: RMS |S - S_file| %.3g, delay %.4g ns, %.4g ohm\n",
               (*fit)->fit.rms_error, (*fit)->line->delay_diff * 1e9, (*fit)->line->z_diff);
   EXPECT_LT((*fit)->fit.rms_error, 1e-3);
-  StatusOr<LinkRun> run = run_link(measured, *parts, ro);
+  StatusOr<LinkRun> run = run_lti(measured, *parts);
   ASSERT_TRUE(run.ok()) << run.status().message();
   const double diff =
       max_difference(native->directions[0].sim.wave, run->directions[0].sim.wave, 0);
@@ -187,9 +197,7 @@ TEST(TouchstoneExport, NoiseWithAMeasuredCable) {
   ASSERT_TRUE(t.ok()) << t.status().message();
   const std::string path = temp_path("noise.s4p");
   ASSERT_TRUE(write_file_atomic(path, write_touchstone(*t, "test")).ok());
-  link::LinkSpec measured = *spec;
-  measured.cable = link::CableSpec{};
-  measured.cable.touchstone = path;
+  const link::LinkSpec measured = with_measured_cable(*spec, path);
   link::LinkSpec native = *spec;
   native.cable.segments = 100;
 
