@@ -43,9 +43,9 @@ struct MeasuredLine {
 };
 
 // The uniform line that best fits y (the link's port order: tx P, tx N, rx P, rx N, or tx, rx of
-// a 2-port) over freqs (points at 0 Hz are skipped), or nothing where a mode cannot be followed
-// (its phase unwrapped, its attenuation under 40 dB) over the band or a fitted term is not
-// physical (an inductance or capacitance that is not positive).
+// a 2-port) over freqs (points at 0 Hz are skipped; the band is read up to where a mode is
+// attenuated by 40 dB), or nothing where a mode is not finite, has under 10 points, or a fitted
+// term is not physical (an inductance or capacitance that is not positive).
 std::optional<MeasuredLine> fit_uniform_line(const std::vector<double>& freqs,
                                              const std::vector<Eigen::MatrixXcd>& y,
                                              bool differential);
