@@ -7,12 +7,24 @@
 #include <cmath>
 #include <numbers>
 
+#include "solver/nnls.h"
+
 namespace isolink {
 
 namespace {
 
 using cd = std::complex<double>;
 constexpr double kTwoPi = 2 * std::numbers::pi;
+// Relative to the largest |eigenvalue| of Re Y over the sweep (the model's scale): below
+// -kRoundingFloor an eigenvalue is a violation, above it rounding; a perturbation lifts every
+// constrained eigenvalue to kMargin, well clear of the floor.
+constexpr double kRoundingFloor = 1e-12;
+constexpr double kMargin = 1e-9;
+constexpr int kPerturbations = 20;
+// Rounds of constraint generation in one perturbation.
+constexpr int kConstraintRounds = 8;
+// A perturbation's change above the band counts this much against one in it.
+constexpr double kOutOfBandWeight = 0.01;
 
 // Poles in scaled frequency (s / w0): real ones and one of each pair (Im > 0).
 using Poles = std::vector<cd>;
@@ -318,144 +330,269 @@ std::vector<double> passivity_sweep(const RationalModel& m, double f_top) {
   return f;
 }
 
-struct Violation {
+// One eigenvalue of Re Y at one sweep frequency, with its eigenvector.
+struct Eigenpair {
   double f;           // Hz (infinity: D)
-  double lambda;      // the smallest eigenvalue of Re Y there
-  Eigen::VectorXd u;  // its eigenvector
+  double lambda;      // S
+  Eigen::VectorXd u;  // unit eigenvector
+  double target;      // S: where a perturbation must leave it, at least
+  bool seed;          // a violation, or at infinity: in the first solution's constraints
 };
 
-// The smallest eigenvalue of Re Y at each sweep frequency; the violations are the local minima
-// below zero.
-std::vector<Violation> violations(const RationalModel& m, const std::vector<double>& f,
-                                  PassivityReport* r) {
-  std::vector<Violation> all;
-  auto test = [&](const Eigen::MatrixXd& g, double at) {
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es((g + g.transpose()) / 2);
-    Violation v{at, es.eigenvalues()[0], es.eigenvectors().col(0)};
-    all.push_back(v);
-  };
-  for (double x : f) test(m.eval(cd(0, kTwoPi * x)).real(), x);
-  test(m.d, INFINITY);
-  std::vector<Violation> out;
+// Re Y over the sweep: the eigenpairs a perturbation is constrained by, the model's scale and the
+// floor below which an eigenvalue is a violation.
+struct Scan {
+  std::vector<Eigenpair> pairs;
+  double largest = 0;  // S, the largest |eigenvalue| over the sweep
+  double floor = 0;    // S, -kRoundingFloor * largest
+  double margin = 0;   // S, kMargin * largest
+};
+
+Scan scan(const RationalModel& m, const std::vector<double>& f, PassivityReport* r) {
+  Scan out;
   r->min_eigenvalue = INFINITY;
-  for (size_t i = 0; i < all.size(); ++i) {
-    if (all[i].lambda < r->min_eigenvalue)
-      r->min_eigenvalue = all[i].lambda, r->at_frequency = all[i].f;
-    const bool minimum = (i == 0 || all[i].lambda <= all[i - 1].lambda) &&
-                         (i + 1 >= all.size() || all[i].lambda <= all[i + 1].lambda);
-    if (all[i].lambda < 0 && (minimum || i + 1 == all.size())) out.push_back(all[i]);
+  std::vector<double> at(f);
+  at.push_back(INFINITY);
+  std::vector<Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>> es;
+  for (double x : at) {
+    const Eigen::MatrixXd g =
+        std::isfinite(x) ? Eigen::MatrixXd(m.eval(cd(0, kTwoPi * x)).real()) : m.d;
+    es.emplace_back((g + g.transpose()) / 2);
+    out.largest = std::max(out.largest, es.back().eigenvalues().cwiseAbs().maxCoeff());
+    if (es.back().eigenvalues()[0] < r->min_eigenvalue)
+      r->min_eigenvalue = es.back().eigenvalues()[0], r->at_frequency = x;
   }
-  r->sweep_points = static_cast<int>(all.size());
-  r->passive = r->min_eigenvalue >= 0;
+  // An eigenvalue within the rounding of the largest is zero: a cable without a shunt conductance
+  // has Re Y's common-mode eigenvalue exactly 0 at DC, evaluated as -1e-15 S, and lifting it would
+  // add a conductance the data does not have.
+  out.floor = -kRoundingFloor * out.largest;
+  // Every eigenpair is a constraint: a violation (below the floor) is to rise to the margin, any
+  // other to stay where it is or above the margin. The violations and the eigenvalues at infinity
+  // seed the first solution; the others join where a solution would take them below.
+  const double margin = kMargin * out.largest;
+  const size_t np = at.size();
+  for (size_t i = 0; i < np; ++i)
+    for (int k = 0; k < es[i].eigenvalues().size(); ++k) {
+      const double lambda = es[i].eigenvalues()[k];
+      const bool violation = lambda < out.floor;
+      out.pairs.push_back({at[i], lambda, es[i].eigenvectors().col(k),
+                           violation ? margin : std::min(lambda, margin),
+                           violation || i + 1 == np});
+    }
+  out.margin = margin;
+  r->sweep_points = static_cast<int>(np);
+  r->passive = r->min_eigenvalue >= out.floor;
   return out;
 }
 
-// One residue perturbation: the smallest change of the residues and D, in absolute siemens (a
-// small conductance between P and N moves a waveform as much as a large one) over the
-// passivity sweep (DC to 10 f_top: the
-// band alone would let the poles below it trade their residues against D, and move DC), that
-// lifts each violation's eigenvalue
-// to a small positive margin (the eigenvector held fixed: the first-order change of the
-// eigenvalue). Gustavsen, "Fast passivity enforcement ... residue perturbation", 2008, with the
-// constraints as heavily weighted equations.
-void perturb(RationalModel& m, const std::vector<double>& freqs, double f_top,
-             const std::vector<Violation>& v, double margin) {
-  Poles poles;
-  const double w0 = kTwoPi * f_top;
-  for (const cd& p : m.poles) poles.push_back(p / w0);
-  const int n = state_count(poles), np = m.ports, ns = static_cast<int>(freqs.size());
-  std::vector<std::pair<int, int>> ij;
-  for (int i = 0; i < np; ++i)
-    for (int j = i; j < np; ++j) ij.push_back({i, j});
-  const int ne = static_cast<int>(ij.size()), cols = n + 1;
-  // The objective's factor, the same for every entry: R of the weighted basis.
-  Eigen::MatrixXd a(2 * ns, cols);
-  std::vector<cd> phi(n);
-  for (int i = 0; i < ns; ++i) {
-    basis(cd(0, freqs[i] / f_top), poles, phi.data());
-    for (int k = 0; k < cols; ++k) {
-      const cd b = k < n ? phi[k] : cd(1, 0);
-      a(2 * i, k) = b.real(), a(2 * i + 1, k) = b.imag();
-    }
+// One residue perturbation (Gustavsen, "Fast passivity enforcement ... residue perturbation",
+// 2008): the smallest change x of the residues and D such that every eigenvalue of Re Y at every
+// sweep point, linearised with its eigenvector held (the change u^T dG u, linear in x), ends at
+// the target or above. The constraints are inequalities at every point, so a point already
+// passive is held above the target but left free, and a fix at one frequency cannot push another
+// below zero (as equalities at the violations alone did: a clean 1 m line to 100 MHz bounced from
+// one violation to the next and was refused).
+//
+// The change is measured as the fit measures its error: Y's change over the sweep weighted by
+// 1 / (1/z0 + |Y|) (dS ~ dY / (1 + z0 |Y|)), from DC (the band alone would let the poles below it
+// trade their residues against D, and move DC), and above the band, where there is no data to
+// keep, at kOutOfBandWeight. Solved exactly as a least-distance problem through NNLS (Lawson and
+// Hanson, Solving Least Squares Problems, ch. 23): with R the objective's triangular factor and
+// z = R x, min |z| subject to F z >= h.
+class ResiduePerturbation {
+ public:
+  ResiduePerturbation(const RationalModel& m, const std::vector<double>& sweep, double f_top,
+                      double z0)
+      : w0_(kTwoPi * f_top), f_top_(f_top) {
+    for (const cd& p : m.poles) poles_.push_back(p / w0_);
+    n_ = state_count(poles_);
+    for (int i = 0; i < m.ports; ++i)
+      for (int j = i; j < m.ports; ++j) ij_.push_back({i, j});
+    factor(m, sweep, z0);
   }
-  Eigen::HouseholderQR<Eigen::MatrixXd> qr(a);
-  const Eigen::MatrixXd r = qr.matrixQR().topRows(cols).triangularView<Eigen::Upper>();
-  const int nv = static_cast<int>(v.size());
-  Eigen::MatrixXd big = Eigen::MatrixXd::Zero(ne * cols + nv, ne * cols);
-  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(ne * cols + nv);
-  for (int e = 0; e < ne; ++e) big.block(e * cols, e * cols, cols, cols) = r;
-  const double heavy = 1e3 * r.norm();
-  for (int c = 0; c < nv; ++c) {
-    if (std::isfinite(v[c].f)) basis(cd(0, v[c].f / f_top), poles, phi.data());
-    for (int e = 0; e < ne; ++e) {
-      const auto [i, j] = ij[e];
-      const double uu = (i == j ? 1.0 : 2.0) * v[c].u[i] * v[c].u[j];
-      for (int k = 0; k < cols; ++k) {
-        const double re = k == n ? 1.0 : std::isfinite(v[c].f) ? phi[k].real() : 0.0;
-        big(ne * cols + c, e * cols + k) = heavy * uu * re;
+
+  // The change for the constraints c: each eigenvalue to the target or above. The least-distance
+  // problem is solved on the seeded constraints first (the violations and infinity); the change is
+  // then predicted at every constraint, those it would take below the target join, and it is
+  // solved again (constraint generation: the solution of the whole set from a fraction of it).
+  // x per entry (cols each); empty when no constraint asks for a change or they cannot be met.
+  Eigen::VectorXd solve(const std::vector<Eigenpair>& c, double margin) const {
+    const int cols = n_ + 1, ne = static_cast<int>(ij_.size()), nc = static_cast<int>(c.size());
+    // B R^-1: each constraint's row of Re phi through the factor, shared by the entries, and
+    // its weight per entry, uu_e = (2 - [i == j]) u_i u_j (u^T dG u = sum_e uu_e dG_e).
+    Eigen::MatrixXd b(nc, cols), uu(nc, ne);
+    std::vector<cd> phi(n_);
+    for (int q = 0; q < nc; ++q) {
+      if (std::isfinite(c[q].f)) basis(cd(0, c[q].f / f_top_), poles_, phi.data());
+      for (int k = 0; k < n_; ++k) b(q, k) = std::isfinite(c[q].f) ? phi[k].real() : 0.0;
+      b(q, n_) = 1.0;  // D
+      for (int k = 0; k < ne; ++k) {
+        const auto [i, j] = ij_[k];
+        uu(q, k) = (i == j ? 1.0 : 2.0) * c[q].u[i] * c[q].u[j];
       }
     }
-    rhs[ne * cols + c] = heavy * (margin - v[c].lambda);
-  }
-  const Eigen::VectorXd dx = big.colPivHouseholderQr().solve(rhs);
-  for (int e = 0; e < ne; ++e) {
-    const auto [i, j] = ij[e];
-    int k = 0;
-    for (size_t q = 0; q < m.poles.size(); ++q) {
-      const bool pair = m.poles[q].imag() > 0;
-      const cd d = pair ? cd(dx[e * cols + k], dx[e * cols + k + 1]) : cd(dx[e * cols + k], 0);
-      m.residues[q](i, j) += d * w0;
-      if (i != j) m.residues[q](j, i) = m.residues[q](i, j);
-      k += pair ? 2 : 1;
+    const Eigen::MatrixXd br =
+        r_.transpose().triangularView<Eigen::Lower>().solve(b.transpose()).transpose();
+    std::vector<int> active;
+    for (int q = 0; q < nc; ++q)
+      if (c[q].seed) active.push_back(q);
+    Eigen::VectorXd z;
+    for (int round = 0; round < kConstraintRounds; ++round) {
+      if (!least_distance(c, br, uu, active, &z)) return {};
+      // The eigenvalues the change predicts, at every constraint.
+      const Eigen::MatrixXd zk = Eigen::Map<const Eigen::MatrixXd>(z.data(), cols, ne);
+      const Eigen::VectorXd moved = (uu.array() * (br * zk).array()).rowwise().sum();
+      std::vector<bool> in(nc, false);
+      for (int q : active) in[q] = true;
+      const size_t before = active.size();
+      for (int q = 0; q < nc; ++q)
+        if (!in[q] && c[q].lambda + moved[q] < c[q].target - 0.5 * margin) active.push_back(q);
+      if (active.size() == before) break;
     }
-    m.d(i, j) += dx[e * cols + n];
-    if (i != j) m.d(j, i) = m.d(i, j);
+    if (z.size() == 0) return {};
+    Eigen::VectorXd x(ne * cols);
+    for (int k = 0; k < ne; ++k)
+      x.segment(k * cols, cols) =
+          r_.triangularView<Eigen::Upper>().solve(Eigen::VectorXd(z.segment(k * cols, cols)));
+    return x;
   }
+
+  // m plus alpha times the change x.
+  void apply(RationalModel& m, const Eigen::VectorXd& x, double alpha) const {
+    const int cols = n_ + 1;
+    for (size_t k = 0; k < ij_.size(); ++k) {
+      const auto [i, j] = ij_[k];
+      const Eigen::VectorXd dx = alpha * x.segment(static_cast<Eigen::Index>(k) * cols, cols);
+      int col = 0;
+      for (size_t q = 0; q < m.poles.size(); ++q) {
+        const bool pair = m.poles[q].imag() > 0;
+        m.residues[q](i, j) += (pair ? cd(dx[col], dx[col + 1]) : cd(dx[col], 0)) * w0_;
+        m.residues[q](j, i) = m.residues[q](i, j);
+        col += pair ? 2 : 1;
+      }
+      m.d(i, j) += dx[n_];
+      m.d(j, i) = m.d(i, j);
+    }
+  }
+
+ private:
+  // min |z| subject to F z >= h over the constraints `active` (F's row q, entry e's block
+  // uu_e(q) (B R^-1)_q; h_q = target - lambda_q), through NNLS on E = [F^T; h^T] (Lawson and
+  // Hanson's LDP): u = argmin |E u - e_last|, u >= 0, r = E u - e_last, z = -r_head / r_last.
+  // E's Gram matrix has the constraints' structure, (B R^-1 (B R^-1)^T) .* (U U^T) + h h^T, and
+  // is formed from it. False when none asks for a change or they are incompatible.
+  bool least_distance(const std::vector<Eigenpair>& c, const Eigen::MatrixXd& br,
+                      const Eigen::MatrixXd& uu, const std::vector<int>& active,
+                      Eigen::VectorXd* z) const {
+    const int cols = n_ + 1, ne = static_cast<int>(ij_.size());
+    const int na = static_cast<int>(active.size());
+    Eigen::MatrixXd bra(na, cols), ua(na, ne);
+    Eigen::VectorXd h(na);
+    for (int a = 0; a < na; ++a) {
+      bra.row(a) = br.row(active[a]);
+      ua.row(a) = uu.row(active[a]);
+      h[a] = c[active[a]].target - c[active[a]].lambda;
+    }
+    if (!(h.maxCoeff() > 0)) return false;
+    auto gram_column = [&](int j) -> Eigen::VectorXd {
+      return ((bra * bra.row(j).transpose()).array() * (ua * ua.row(j).transpose()).array())
+                 .matrix() +
+             h * h[j];
+    };
+    const Eigen::VectorXd diagonal =
+        (bra.rowwise().squaredNorm().array() * ua.rowwise().squaredNorm().array()).matrix() +
+        h.cwiseAbs2();
+    const Eigen::VectorXd u = nnls_gram(gram_column, diagonal, h);
+    // r_head, entry k: sum_a u_a uu_k(a) (B R^-1)_a; r_last = h . u - 1.
+    const Eigen::MatrixXd head = bra.transpose() * (ua.array().colwise() * u.array()).matrix();
+    const double last = h.dot(u) - 1;
+    if (!(std::abs(last) > 1e-12) || !head.allFinite()) return false;  // incompatible
+    *z = -Eigen::Map<const Eigen::VectorXd>(head.data(), cols * ne) / last;
+    return true;
+  }
+
+  // R of the weighted basis over the sweep, with a ridge so that poles close together (columns
+  // nearly alike) leave it invertible.
+  void factor(const RationalModel& m, const std::vector<double>& sweep, double z0) {
+    const int cols = n_ + 1, ns = static_cast<int>(sweep.size());
+    Eigen::MatrixXd a(2 * ns + cols, cols);
+    std::vector<cd> phi(n_);
+    for (int i = 0; i < ns; ++i) {
+      const double w = (sweep[i] <= f_top_ ? 1.0 : kOutOfBandWeight) /
+                       (1 / z0 + m.eval(cd(0, kTwoPi * sweep[i])).cwiseAbs().maxCoeff());
+      basis(cd(0, sweep[i] / f_top_), poles_, phi.data());
+      for (int k = 0; k < cols; ++k) {
+        const cd v = w * (k < n_ ? phi[k] : cd(1, 0));
+        a(2 * i, k) = v.real(), a(2 * i + 1, k) = v.imag();
+      }
+    }
+    const double ridge = 1e-9 * a.topRows(2 * ns).cwiseAbs().maxCoeff();
+    a.bottomRows(cols) = ridge * Eigen::MatrixXd::Identity(cols, cols);
+    r_ = Eigen::HouseholderQR<Eigen::MatrixXd>(a)
+             .matrixQR()
+             .topRows(cols)
+             .triangularView<Eigen::Upper>();
+  }
+
+  double w0_, f_top_;
+  Poles poles_;  // scaled by w0
+  int n_ = 0;    // real basis functions
+  std::vector<std::pair<int, int>> ij_;
+  Eigen::MatrixXd r_;
+};
+
+// One perturbation of m, the step halved until it leaves the smallest eigenvalue higher than it
+// found it (the linearisation holds for small changes only). False when no step does.
+bool perturb(RationalModel& m, const std::vector<double>& sweep, double f_top, double z0,
+             const Scan& now, double min_eigenvalue) {
+  const ResiduePerturbation rp(m, sweep, f_top, z0);
+  const Eigen::VectorXd x = rp.solve(now.pairs, now.margin);
+  if (x.size() == 0) return false;
+  for (double alpha = 1; alpha > 1e-3; alpha /= 2) {
+    RationalModel trial = m;
+    rp.apply(trial, x, alpha);
+    PassivityReport after;
+    scan(trial, sweep, &after);
+    if (after.min_eigenvalue > min_eigenvalue) {
+      m = std::move(trial);
+      return true;
+    }
+  }
+  return false;
 }
 
 }  // namespace
 
 PassivityReport check_passivity(const RationalModel& m, double f_top) {
   PassivityReport r;
-  violations(m, passivity_sweep(m, f_top), &r);
+  scan(m, passivity_sweep(m, f_top), &r);
   return r;
 }
 
-PassivityReport enforce_passivity(RationalModel& m, const std::vector<double>& freqs) {
+PassivityReport enforce_passivity(RationalModel& m, const std::vector<double>& freqs, double z0) {
   const double f_top = freqs.back();
-  PassivityReport first = check_passivity(m, f_top);
-  if (first.passive) return first;
-  const double scale = m.d.cwiseAbs().maxCoeff() + 1e-12;
-  // The constrained frequencies accumulate over the iterations (a violation fixed at one
-  // frequency must not come back there while another is fixed): each is held at
-  // max(lambda, margin) - lambda or more, linearised with its current eigenvector.
-  std::vector<double> held;
   const std::vector<double> sweep = passivity_sweep(m, f_top);
-  for (int it = 0; it < 20; ++it) {
-    PassivityReport now;
-    const std::vector<Violation> v = violations(m, sweep, &now);
-    if (now.passive) {
-      first.perturbation_iterations = it;
-      first.enforced_min_eigenvalue = now.min_eigenvalue;
+  PassivityReport first;
+  Scan now = scan(m, sweep, &first);
+  if (first.passive) return first;
+  // Each perturbation is linear in the eigenvalues; what the linearisation missed (the
+  // eigenvectors turn) is taken up by the next.
+  double min_eigenvalue = first.min_eigenvalue;
+  for (int it = 1; it <= kPerturbations; ++it) {
+    if (!perturb(m, sweep, f_top, z0, now, min_eigenvalue)) break;
+    first.perturbation_iterations = it;
+    PassivityReport after;
+    now = scan(m, sweep, &after);
+    min_eigenvalue = after.min_eigenvalue;
+    if (after.passive) {
+      first.enforced_min_eigenvalue = after.min_eigenvalue;
       return first;
     }
-    for (const Violation& x : v)
-      if (std::find(held.begin(), held.end(), x.f) == held.end()) held.push_back(x.f);
-    const double margin = 1e-9 * scale + 0.01 * std::abs(now.min_eigenvalue);
-    std::vector<Violation> c;
-    for (double f : held) {
-      const Eigen::MatrixXd g =
-          std::isfinite(f) ? Eigen::MatrixXd(m.eval(cd(0, kTwoPi * f)).real()) : m.d;
-      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es((g + g.transpose()) / 2);
-      c.push_back({f, std::min(es.eigenvalues()[0], margin), es.eigenvectors().col(0)});
-    }
-    perturb(m, sweep, f_top, c, margin);
   }
   // Not passive after the perturbations: the shunt conductance that lifts every eigenvalue.
-  PassivityReport now = check_passivity(m, f_top);
-  first.perturbation_iterations = 20;
-  if (!now.passive) {
-    const double add = -now.min_eigenvalue * 1.01 + 1e-12;
+  PassivityReport after = check_passivity(m, f_top);
+  if (!after.passive) {
+    const double add = -after.min_eigenvalue * 1.01 + 1e-12;
     m.d += add * Eigen::MatrixXd::Identity(m.ports, m.ports);
     first.added_conductance = add;
   }

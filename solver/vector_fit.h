@@ -28,11 +28,13 @@
 //   and a weight shared per frequency fits the small one only to the large one's rounding.
 // - The error reported is in S (reference z0): max over the band of |S_fit - S| per entry.
 // - Passivity of an admittance: the eigenvalues of Re Y(j w) (real symmetric for a reciprocal
-//   N-port) non-negative at every w. Checked on a dense sweep from DC to 10 times the band's top
-//   and at infinity (D); enforced by residue perturbation (the smallest weighted change of the
-//   residues and D that lifts every violation's eigenvalue, linearised, iterated), and only
-//   when that fails by a shunt conductance at each port, which lifts every eigenvalue at every
-//   frequency by the same amount.
+//   N-port) non-negative at every w, an eigenvalue above -1e-12 times the largest counting as
+//   rounding. Checked on a dense sweep from DC to 10 times the band's top and at infinity (D);
+//   enforced by residue perturbation: the smallest change of the residues and D (weighted as the
+//   fit's error in the band, lightly above it) that keeps every eigenvalue at every sweep point,
+//   linearised, at a small margin or above (inequalities, solved exactly as a least-distance
+//   problem), iterated; only when that fails by a shunt conductance at each port, which lifts
+//   every eigenvalue at every frequency by the same amount.
 #pragma once
 
 #include <Eigen/Dense>
@@ -101,9 +103,11 @@ struct PassivityReport {
 // The check alone; f_top (Hz) the band's top (the sweep goes to 10 f_top).
 PassivityReport check_passivity(const RationalModel& m, double f_top);
 // The check, then, while it fails (at most 20 times), the residue perturbation: the smallest
-// change of the residues and D (absolute, over DC .. 10 f_top) that lifts each violation's
-// eigenvalue to a small margin. As the last resort D += (violation + margin) I. The report is the
-// first check's, with the perturbations and any added conductance.
-PassivityReport enforce_passivity(RationalModel& m, const std::vector<double>& freqs);
+// change of the residues and D (Y's change over DC .. 10 f_top weighted by 1 / (1/z0 + |Y|),
+// a hundredth above f_top) that keeps every eigenvalue at or above a small margin. As the last
+// resort D += (violation + margin) I. The report is the first check's, with the perturbations and
+// any added conductance.
+PassivityReport enforce_passivity(RationalModel& m, const std::vector<double>& freqs,
+                                  double z0 = 50);
 
 }  // namespace isolink

@@ -119,6 +119,12 @@ double line_rms_error(const MeasuredLine& line, const std::vector<double>& freqs
   return fit->rms_error;
 }
 
+std::vector<Eigen::MatrixXcd> scattering(const std::vector<Eigen::MatrixXcd>& y, double z0) {
+  std::vector<Eigen::MatrixXcd> s;
+  for (const Eigen::MatrixXcd& yk : y) s.push_back(s_from_y(yk, z0));
+  return s;
+}
+
 // The RMS of |S_model - S| over the fitted points (s_data: the data's S at reference z0): the
 // model as it is simulated, after the passivity enforcement.
 // The largest entry error goes to *largest when given.
@@ -151,8 +157,7 @@ constexpr double kEnforcedErrorRatio = 10;
 constexpr double kEnforcedLargestRatio = 5;
 void refit_until_passive(const std::vector<double>& freqs, const std::vector<Eigen::MatrixXcd>& y,
                          const FitOptions& opt, TouchstoneCable* out) {
-  std::vector<Eigen::MatrixXcd> s_data;
-  for (const Eigen::MatrixXcd& yk : y) s_data.push_back(s_from_y(yk, opt.z0));
+  const std::vector<Eigen::MatrixXcd> s_data = scattering(y, opt.z0);
   double own_largest = INFINITY;
   const double own = out->passivity.added_conductance > 1e-9
                          ? INFINITY
@@ -186,7 +191,7 @@ void refit_until_passive(const std::vector<double>& freqs, const std::vector<Eig
     one.min_order = one.max_order = order;
     StatusOr<FitResult> refit = vector_fit(freqs, y, one);
     if (!refit || !refit->converged) continue;
-    PassivityReport report = enforce_passivity(refit->model, freqs);
+    PassivityReport report = enforce_passivity(refit->model, freqs, opt.z0);
     if (report.added_conductance > 1e-9) continue;
     double largest = INFINITY;
     const double e = enforced_rms_error(refit->model, freqs, s_data, opt.z0, &largest);
@@ -312,7 +317,7 @@ StatusOr<std::shared_ptr<const TouchstoneCable>> fit_touchstone_cable(const Touc
                           out->line_rms_error)
             : "a long line over a wide band needs more poles than isolink fits"));
   out->fit = std::move(*fit);
-  out->passivity = enforce_passivity(out->fit.model, freqs);
+  out->passivity = enforce_passivity(out->fit.model, freqs, opt.z0);
   refit_until_passive(freqs, y, opt, out.get());
   // The last resort's shunt conductance changes the link (a 1 uS shunt is 1 Mohm at each port,
   // against the cable's 10 Mohm bleed): refused beyond a nanosiemens.
@@ -322,6 +327,13 @@ StatusOr<std::shared_ptr<const TouchstoneCable>> fit_touchstone_cable(const Touc
         "residue perturbation did not make it so; a measurement's noise is the usual cause "
         "(a larger cable.tolerance lets a lower order smooth it)",
         name, out->passivity.min_eigenvalue, out->passivity.at_frequency));
+  // The model as simulated is the enforced one: it must meet the tolerance the fit did.
+  if (const double e = enforced_rms_error(out->fit.model, freqs, scattering(y, opt.z0), opt.z0);
+      e > tolerance)
+    return Status::Error(fmt::format(
+        "{}: made passive, the fit is {:.3g} RMS off the file, above the tolerance {:.3g} (the "
+        "fit itself: {:.3g}); a larger cable.tolerance lets a lower order smooth it",
+        name, e, tolerance, out->fit.rms_error));
   out->dc_conductance = out->y(0).real();
   if (!out->fit.model.d.allFinite() || !out->dc_conductance.allFinite())
     return Status::Error(fmt::format("{}: the fit is not finite", name));
