@@ -343,9 +343,10 @@ struct Eigenpair {
 // floor below which an eigenvalue is a violation.
 struct Scan {
   std::vector<Eigenpair> pairs;
-  double largest = 0;  // S, the largest |eigenvalue| over the sweep
-  double floor = 0;    // S, -kRoundingFloor * largest
-  double margin = 0;   // S, kMargin * largest
+  double largest = 0;          // S, the largest |eigenvalue| over the sweep
+  double floor = 0;            // S, -kRoundingFloor * largest
+  double margin = 0;           // S, kMargin * largest
+  std::vector<double> y_size;  // S, max |Y_ij| at each finite sweep point (the change's weights)
 };
 
 Scan scan(const RationalModel& m, const std::vector<double>& f, PassivityReport* r) {
@@ -355,8 +356,12 @@ Scan scan(const RationalModel& m, const std::vector<double>& f, PassivityReport*
   at.push_back(INFINITY);
   std::vector<Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>> es;
   for (double x : at) {
-    const Eigen::MatrixXd g =
-        std::isfinite(x) ? Eigen::MatrixXd(m.eval(cd(0, kTwoPi * x)).real()) : m.d;
+    Eigen::MatrixXd g = m.d;
+    if (std::isfinite(x)) {
+      const Eigen::MatrixXcd y = m.eval(cd(0, kTwoPi * x));
+      out.y_size.push_back(y.cwiseAbs().maxCoeff());
+      g = y.real();
+    }
     es.emplace_back((g + g.transpose()) / 2);
     out.largest = std::max(out.largest, es.back().eigenvalues().cwiseAbs().maxCoeff());
     if (es.back().eigenvalues()[0] < r->min_eigenvalue)
@@ -401,14 +406,15 @@ Scan scan(const RationalModel& m, const std::vector<double>& f, PassivityReport*
 // z = R x, min |z| subject to F z >= h.
 class ResiduePerturbation {
  public:
-  ResiduePerturbation(const RationalModel& m, const std::vector<double>& sweep, double f_top,
-                      double z0)
+  // y_size: max |Y_ij| of m at each sweep point (Scan::y_size).
+  ResiduePerturbation(const RationalModel& m, const std::vector<double>& sweep,
+                      const std::vector<double>& y_size, double f_top, double z0)
       : w0_(kTwoPi * f_top), f_top_(f_top) {
     for (const cd& p : m.poles) poles_.push_back(p / w0_);
     n_ = state_count(poles_);
     for (int i = 0; i < m.ports; ++i)
       for (int j = i; j < m.ports; ++j) ij_.push_back({i, j});
-    factor(m, sweep, z0);
+    factor(sweep, y_size, z0);
   }
 
   // The change for the constraints c: each eigenvalue to the target or above. The least-distance
@@ -513,13 +519,12 @@ class ResiduePerturbation {
 
   // R of the weighted basis over the sweep, with a ridge so that poles close together (columns
   // nearly alike) leave it invertible.
-  void factor(const RationalModel& m, const std::vector<double>& sweep, double z0) {
+  void factor(const std::vector<double>& sweep, const std::vector<double>& y_size, double z0) {
     const int cols = n_ + 1, ns = static_cast<int>(sweep.size());
     Eigen::MatrixXd a(2 * ns + cols, cols);
     std::vector<cd> phi(n_);
     for (int i = 0; i < ns; ++i) {
-      const double w = (sweep[i] <= f_top_ ? 1.0 : kOutOfBandWeight) /
-                       (1 / z0 + m.eval(cd(0, kTwoPi * sweep[i])).cwiseAbs().maxCoeff());
+      const double w = (sweep[i] <= f_top_ ? 1.0 : kOutOfBandWeight) / (1 / z0 + y_size[i]);
       basis(cd(0, sweep[i] / f_top_), poles_, phi.data());
       for (int k = 0; k < cols; ++k) {
         const cd v = w * (k < n_ ? phi[k] : cd(1, 0));
@@ -545,7 +550,7 @@ class ResiduePerturbation {
 // found it (the linearisation holds for small changes only). False when no step does.
 bool perturb(RationalModel& m, const std::vector<double>& sweep, double f_top, double z0,
              const Scan& now, double min_eigenvalue) {
-  const ResiduePerturbation rp(m, sweep, f_top, z0);
+  const ResiduePerturbation rp(m, sweep, now.y_size, f_top, z0);
   const Eigen::VectorXd x = rp.solve(now.pairs, now.margin);
   if (x.size() == 0) return false;
   for (double alpha = 1; alpha > 1e-3; alpha /= 2) {

@@ -155,9 +155,10 @@ double enforced_rms_error(const RationalModel& m, const std::vector<double>& fre
 // enforcement is kept, `out`'s own among them. Leaves `out` as it was when none does better.
 constexpr double kEnforcedErrorRatio = 10;
 constexpr double kEnforcedLargestRatio = 5;
+// s_data: the data's S at opt.z0.
 void refit_until_passive(const std::vector<double>& freqs, const std::vector<Eigen::MatrixXcd>& y,
-                         const FitOptions& opt, TouchstoneCable* out) {
-  const std::vector<Eigen::MatrixXcd> s_data = scattering(y, opt.z0);
+                         const std::vector<Eigen::MatrixXcd>& s_data, const FitOptions& opt,
+                         TouchstoneCable* out) {
   double own_largest = INFINITY;
   const double own = out->passivity.added_conductance > 1e-9
                          ? INFINITY
@@ -318,7 +319,8 @@ StatusOr<std::shared_ptr<const TouchstoneCable>> fit_touchstone_cable(const Touc
             : "a long line over a wide band needs more poles than isolink fits"));
   out->fit = std::move(*fit);
   out->passivity = enforce_passivity(out->fit.model, freqs, opt.z0);
-  refit_until_passive(freqs, y, opt, out.get());
+  const std::vector<Eigen::MatrixXcd> s_data = scattering(y, opt.z0);
+  refit_until_passive(freqs, y, s_data, opt, out.get());
   // The last resort's shunt conductance changes the link (a 1 uS shunt is 1 Mohm at each port,
   // against the cable's 10 Mohm bleed): refused beyond a nanosiemens.
   if (out->passivity.added_conductance > 1e-9)
@@ -328,8 +330,7 @@ StatusOr<std::shared_ptr<const TouchstoneCable>> fit_touchstone_cable(const Touc
         "(a larger cable.tolerance lets a lower order smooth it)",
         name, out->passivity.min_eigenvalue, out->passivity.at_frequency));
   // The model as simulated is the enforced one: it must meet the tolerance the fit did.
-  if (const double e = enforced_rms_error(out->fit.model, freqs, scattering(y, opt.z0), opt.z0);
-      e > tolerance)
+  if (const double e = enforced_rms_error(out->fit.model, freqs, s_data, opt.z0); e > tolerance)
     return Status::Error(fmt::format(
         "{}: made passive, the fit is {:.3g} RMS off the file, above the tolerance {:.3g} (the "
         "fit itself: {:.3g}); a larger cable.tolerance lets a lower order smooth it",

@@ -50,6 +50,17 @@ StatusOr<LinkRun> run_lti(const link::LinkSpec& spec, const link::PartLibrary& p
 }
 
 // The spec with its cable replaced by the Touchstone file at path.
+// The cable exported to 200 MHz (500 points) as a temporary .s4p: its path.
+StatusOr<std::string> exported_to_200mhz(const link::CableSpec& cable, const char* name) {
+  TouchstoneExportOptions o;
+  o.f_stop = 200e6;
+  StatusOr<Touchstone> t = cable_touchstone(cable, o);
+  if (!t.ok()) return t.status();
+  const std::string path = temp_path(name);
+  if (Status w = write_file_atomic(path, write_touchstone(*t, "test")); !w.ok()) return w;
+  return path;
+}
+
 link::LinkSpec with_measured_cable(const link::LinkSpec& spec, const std::string& path) {
   link::LinkSpec measured = spec;
   measured.cable = link::CableSpec{};
@@ -154,15 +165,11 @@ TEST(TouchstoneExport, Long15mLinkReadsBackAsAUniformLine) {
   StatusOr<LinkRun> native = run_lti(*spec, *parts);
   ASSERT_TRUE(native.ok()) << native.status().message();
 
-  TouchstoneExportOptions o;
-  o.f_stop = 200e6;
   link::CableSpec fine = spec->cable;
   fine.segments = 1000;
-  StatusOr<Touchstone> t = cable_touchstone(fine, o);
-  ASSERT_TRUE(t.ok()) << t.status().message();
-  const std::string path = temp_path("long.s4p");
-  ASSERT_TRUE(write_file_atomic(path, write_touchstone(*t, "test")).ok());
-  const link::LinkSpec measured = with_measured_cable(*spec, path);
+  StatusOr<std::string> path = exported_to_200mhz(fine, "long.s4p");
+  ASSERT_TRUE(path.ok()) << path.status().message();
+  const link::LinkSpec measured = with_measured_cable(*spec, *path);
   auto fit = link::touchstone_cable(measured.cable);
   ASSERT_TRUE(fit.ok()) << fit.status().message();
   ASSERT_TRUE((*fit)->line.has_value());
@@ -177,7 +184,7 @@ TEST(TouchstoneExport, Long15mLinkReadsBackAsAUniformLine) {
   std::printf("15 m as a uniform line: |dv(rxp,rxn)| <= %.3f mV (%d segments)\n", diff * 1e3,
               run->directions[0].link.cable_segments);
   EXPECT_LT(diff, 5e-3);
-  std::remove(path.c_str());
+  std::remove(path->c_str());
 }
 
 // The same file fitted rationally (`uniform_line: false`): 72 poles, a violation of -20 mS just
@@ -194,13 +201,9 @@ TEST(TouchstoneExport, Long15mLinkFittedRationallyMatchesItsOwnLadder) {
   StatusOr<LinkRun> native = run_lti(*spec, *parts);
   ASSERT_TRUE(native.ok()) << native.status().message();
 
-  TouchstoneExportOptions o;
-  o.f_stop = 200e6;
-  StatusOr<Touchstone> t = cable_touchstone(spec->cable, o);
-  ASSERT_TRUE(t.ok()) << t.status().message();
-  const std::string path = temp_path("long_rational.s4p");
-  ASSERT_TRUE(write_file_atomic(path, write_touchstone(*t, "test")).ok());
-  link::LinkSpec measured = with_measured_cable(*spec, path);
+  StatusOr<std::string> path = exported_to_200mhz(spec->cable, "long_rational.s4p");
+  ASSERT_TRUE(path.ok()) << path.status().message();
+  link::LinkSpec measured = with_measured_cable(*spec, *path);
   measured.cable.uniform_line = false;
   auto fit = link::touchstone_cable(measured.cable);
   ASSERT_TRUE(fit.ok()) << fit.status().message();
@@ -215,7 +218,7 @@ TEST(TouchstoneExport, Long15mLinkFittedRationallyMatchesItsOwnLadder) {
   std::printf("15 m fitted rationally: |dv(rxp,rxn)| <= %.3f mV against 1000 segments\n",
               diff * 1e3);
   EXPECT_LT(diff, 2e-3);
-  std::remove(path.c_str());
+  std::remove(path->c_str());
 }
 
 // `isolink noise` with a measured cable (analysis/noise.h): the 2 m cap link's own cable as a

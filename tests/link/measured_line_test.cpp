@@ -76,6 +76,16 @@ double rms_s_error(const MeasuredLine& line, const Sweep& s) {
   return std::sqrt(sum / (double(s.f.size()) * s.y[0].size()));
 }
 
+// A pair drawn over the model's range: 20-28 AWG, PP or PVC, -40..85 degC.
+CableSpec random_pair(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0, 1);
+  CableSpec spec;
+  spec.gauge = 20 + 2 * static_cast<int>(u(rng) * 5);
+  spec.material = u(rng) < 0.5 ? "pp" : "pvc";
+  spec.temperature = -40 + 125 * u(rng);
+  return spec;
+}
+
 // 15 m of 24 AWG PP to 200 MHz, 500 points: 27 periods of its delay, where a rational fit takes
 // about 70 poles and a minute. As a uniform line: the DC resistance to 0.5 %, the differential
 // phase at the top (the delay the far end sees) to 1e-4 of its 37 rad, and S within 1e-3 RMS.
@@ -122,10 +132,7 @@ TEST(MeasuredLine, SeededCorpusOfLinesFitsTheClosedForm) {
   double worst = 0;
   int within = 0;
   for (int k = 0; k < 24; ++k) {
-    CableSpec spec;
-    spec.gauge = 20 + 2 * static_cast<int>(u(rng) * 5);
-    spec.material = u(rng) < 0.5 ? "pp" : "pvc";
-    spec.temperature = -40 + 125 * u(rng);
+    const CableSpec spec = random_pair(rng);
     StatusOr<CableModel> m = cable_model(spec);
     ASSERT_TRUE(m.ok()) << m.status().message();
     const double len = 5 * std::pow(20.0, u(rng));  // 5..100 m
@@ -244,10 +251,7 @@ TEST(MeasuredLine, SeededCorpusOfShortLinesFitsAndIsPassive) {
   std::uniform_real_distribution<double> u(0, 1);
   const double tops[] = {50e6, 100e6, 200e6, 300e6, 500e6};
   for (int k = 0; k < 12; ++k) {
-    CableSpec spec;
-    spec.gauge = 20 + 2 * static_cast<int>(u(rng) * 5);
-    spec.material = u(rng) < 0.5 ? "pp" : "pvc";
-    spec.temperature = -40 + 125 * u(rng);
+    const CableSpec spec = random_pair(rng);
     StatusOr<CableModel> m = cable_model(spec);
     ASSERT_TRUE(m.ok()) << m.status().message();
     const double len = 0.3 * std::pow(5 / 0.3, u(rng));
