@@ -321,8 +321,9 @@ namespace {
 // Exact integration coefficients of the modes over a step h (method step 3): for an input
 // linear in t from w0 to w1, x1 = e x0 + a w0 + b w1; for an input constant at w1, x1 = e x0 +
 // be w1. With z = p h: e = e^z, be = h (e^z - 1) / z, b = h (e^z - 1 - z) / z^2, a = be - b.
+// Complex coefficients are held as real and imaginary arrays (the march's products vectorise).
 struct StepCoefs {
-  std::vector<Cplx> e, a, b, be;
+  Eigen::ArrayXd er, ei, ar, ai, br, bi, ber, bei;
   Eigen::MatrixXd z_trap, z_euler;  // port voltages per unit of end port current
 };
 
@@ -340,13 +341,13 @@ void phi12(Cplx z, Cplx* phi1, Cplx* phi2) {
 // The marching state at one accepted time point.
 struct PortState {
   double t = 0;
-  std::vector<Cplx> x;              // modes
-  std::vector<Cplx> su, sd;         // in.u and in.d at t (per mode)
-  std::vector<double> u;            // sources at t
-  std::vector<double> v, d, q, jq;  // per port: voltage, current, charge, charge current
-  std::vector<double> vc;           // per control: its voltage
-  std::vector<double> y;            // probes
-  std::vector<double> watched;      // v, q, y: what the error control watches
+  Eigen::ArrayXd xr, xi;              // modes (real and imaginary parts)
+  Eigen::ArrayXd sur, sui, sdr, sdi;  // in.u and in.d at t (per mode)
+  std::vector<double> u;              // sources at t
+  std::vector<double> v, d, q, jq;    // per port: voltage, current, charge, charge current
+  std::vector<double> vc;             // per control: its voltage
+  std::vector<double> y;              // probes
+  std::vector<double> watched;        // v, q, y: what the error control watches
   void fill_watched(const std::vector<bool>& probe_watched) {
     watched.clear();
     watched.insert(watched.end(), v.begin(), v.end());
@@ -408,6 +409,16 @@ class PortMarch {
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
   Eigen::VectorXd f_, dv_;
   std::vector<double> dd_, v_oc_, v_;
+  // The model as real matrices (complex ones split): inputs (sources, then ports) by column,
+  // outputs (probes, then port voltages) by row.
+  Eigen::MatrixXd in_re_, in_im_;    // modes x inputs
+  Eigen::MatrixXd out_re_, out_im_;  // outputs x modes
+  Eigen::MatrixXd direct_;           // outputs x inputs
+  Eigen::VectorXd offset_;           // per output
+  Eigen::ArrayXd scratch_r_, scratch_i_;
+  // in.u and in.d of state s (its u and d).
+  void modal_inputs(const PortState& s, Eigen::ArrayXd& sur, Eigen::ArrayXd& sui,
+                    Eigen::ArrayXd& sdr, Eigen::ArrayXd& sdi) const;
 };
 
 PortMarch::PortMarch(const Circuit& circuit, const PortModel& pm, const TransientOptions& opt)
@@ -431,6 +442,19 @@ PortMarch::PortMarch(const Circuit& circuit, const PortModel& pm, const Transien
     controls_.push_back(circuit.find_element(name)->source_function());
     control_sign_.push_back(sign);
   }
+  const int nin = ns_ + np_, nout = ny_ + np_;
+  in_re_.resize(q_, nin), in_im_.resize(q_, nin);
+  for (int k = 0; k < nin; ++k)
+    for (int i = 0; i < q_; ++i)
+      in_re_(i, k) = m_.input[k][i].real(), in_im_(i, k) = m_.input[k][i].imag();
+  out_re_.resize(nout, q_), out_im_.resize(nout, q_);
+  for (int o = 0; o < nout; ++o)
+    for (int i = 0; i < q_; ++i)
+      out_re_(o, i) = m_.output[o][i].real(), out_im_(o, i) = m_.output[o][i].imag();
+  direct_.resize(nout, nin);
+  for (int k = 0; k < nin; ++k)
+    for (int o = 0; o < nout; ++o) direct_(o, k) = m_.direct[k][o];
+  offset_ = Eigen::Map<const Eigen::VectorXd>(pm.offset.data(), nout);
   jac_.resize(np_, np_);
   lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(np_);
   v_oc_.assign(np_, 0.0);
@@ -452,15 +476,20 @@ const StepCoefs& PortMarch::coefs(double h) {
   if (it != cache_.end()) return it->second;
   if (cache_.size() > 256) cache_.clear();
   StepCoefs c;
-  c.e.resize(q_), c.a.resize(q_), c.b.resize(q_), c.be.resize(q_);
+  for (auto* v : {&c.er, &c.ei, &c.ar, &c.ai, &c.br, &c.bi, &c.ber, &c.bei}) v->resize(q_);
+  std::vector<Cplx> b(q_), be(q_);
   for (int i = 0; i < q_; ++i) {
     const Cplx z = m_.poles[i] * h;
     Cplx p1, p2;
     phi12(z, &p1, &p2);
-    c.e[i] = std::exp(z);
-    c.be[i] = h * p1;
-    c.b[i] = h * p2;
-    c.a[i] = c.be[i] - c.b[i];
+    const Cplx e = std::exp(z);
+    be[i] = h * p1;
+    b[i] = h * p2;
+    const Cplx a = be[i] - b[i];
+    c.er[i] = e.real(), c.ei[i] = e.imag();
+    c.ar[i] = a.real(), c.ai[i] = a.imag();
+    c.br[i] = b[i].real(), c.bi[i] = b[i].imag();
+    c.ber[i] = be[i].real(), c.bei[i] = be[i].imag();
   }
   c.z_trap.setZero(np_, np_);
   c.z_euler.setZero(np_, np_);
@@ -471,8 +500,8 @@ const StepCoefs& PortMarch::coefs(double h) {
       Cplx st = 0, se = 0;
       for (int i = 0; i < q_; ++i) {
         const Cplx oi = out[i] * in[i];
-        st += oi * c.b[i];
-        se += oi * c.be[i];
+        st += oi * b[i];
+        se += oi * be[i];
       }
       const double dir = m_.direct[ns_ + mi][ny_ + mo];
       c.z_trap(mo, mi) = st.real() + dir;
@@ -480,6 +509,13 @@ const StepCoefs& PortMarch::coefs(double h) {
     }
   ++stats_.step_sizes;
   return cache_.emplace(h, std::move(c)).first->second;
+}
+
+void PortMarch::modal_inputs(const PortState& s, Eigen::ArrayXd& sur, Eigen::ArrayXd& sui,
+                             Eigen::ArrayXd& sdr, Eigen::ArrayXd& sdi) const {
+  const Eigen::Map<const Eigen::VectorXd> u(s.u.data(), ns_), d(s.d.data(), np_);
+  sur = (in_re_.leftCols(ns_) * u).array(), sui = (in_im_.leftCols(ns_) * u).array();
+  sdr = (in_re_.rightCols(np_) * d).array(), sdi = (in_im_.rightCols(np_) * d).array();
 }
 
 Status PortMarch::initial_state() {
@@ -500,18 +536,18 @@ Status PortMarch::initial_state() {
     s.d[m] = e.i - pm_.port_shunt * s.v[m];
     s.q[m] = e.q;
   }
-  s.x.assign(q_, 0.0), s.su.assign(q_, 0.0), s.sd.assign(q_, 0.0);
+  s.xr.resize(q_), s.xi.resize(q_);
+  modal_inputs(s, s.sur, s.sui, s.sdr, s.sdi);
   for (int i = 0; i < q_; ++i) {
-    for (int k = 0; k < ns_; ++k) s.su[i] += m_.input[k][i] * s.u[k];
-    for (int m = 0; m < np_; ++m) s.sd[i] += m_.input[ns_ + m][i] * s.d[m];
-    s.x[i] = -(s.su[i] + s.sd[i]) / m_.poles[i];
+    const Cplx xm = -Cplx(s.sur[i] + s.sdr[i], s.sui[i] + s.sdi[i]) / m_.poles[i];
+    s.xr[i] = xm.real(), s.xi[i] = xm.imag();
   }
   // The model's outputs in that steady state against the circuit's operating point.
+  const Eigen::VectorXd modal = out_re_ * s.xr.matrix() - out_im_ * s.xi.matrix();
   double mismatch = 0, allowed = 0;
   s.y.resize(ny_);
   for (int o = 0; o < ny_ + np_; ++o) {
-    double y = pm_.offset[o];
-    for (int i = 0; i < q_; ++i) y += (m_.output[o][i] * s.x[i]).real();
+    double y = pm_.offset[o] + modal(o);
     for (int k = 0; k < ns_; ++k) y += m_.direct[k][o] * s.u[k];
     for (int m = 0; m < np_; ++m) y += m_.direct[ns_ + m][o] * s.d[m];
     if (o < ny_) {
@@ -613,26 +649,28 @@ Status PortMarch::advance(double h, bool euler, bool* converged) {
   s1.t = s0.t + h;
   s1.u.resize(ns_);
   for (int k = 0; k < ns_; ++k) s1.u[k] = sources_[k]->value(s1.t);
-  s1.su.assign(q_, 0.0);
-  s1.x.resize(q_);
-  for (int k = 0; k < ns_; ++k) {
-    const Cplx* in = m_.input[k].data();
-    const double u = s1.u[k];
-    if (u != 0.0)
-      for (int i = 0; i < q_; ++i) s1.su[i] += in[i] * u;
+  const Eigen::Map<const Eigen::VectorXd> u1(s1.u.data(), ns_);
+  s1.sur.matrix().noalias() = in_re_.leftCols(ns_) * u1;
+  s1.sui.matrix().noalias() = in_im_.leftCols(ns_) * u1;
+  // x1 = e x0 + a (su0 [+ sd0]) + b su1, complex products in real arrays.
+  Eigen::ArrayXd& wr = scratch_r_;
+  Eigen::ArrayXd& wi = scratch_i_;
+  if (euler) {
+    wr = s0.sur, wi = s0.sui;
+  } else {
+    wr = s0.sur + s0.sdr, wi = s0.sui + s0.sdi;
   }
-  for (int i = 0; i < q_; ++i) {
-    s1.x[i] = c.e[i] * s0.x[i] + c.a[i] * s0.su[i] + c.b[i] * s1.su[i];
-    if (!euler) s1.x[i] += c.a[i] * s0.sd[i];
-  }
+  s1.xr = c.er * s0.xr - c.ei * s0.xi + c.ar * wr - c.ai * wi + c.br * s1.sur - c.bi * s1.sui;
+  s1.xi = c.er * s0.xi + c.ei * s0.xr + c.ar * wi + c.ai * wr + c.br * s1.sui + c.bi * s1.sur;
   std::vector<double>& v_oc = v_oc_;
   std::vector<double>& v = v_;
-  for (int m = 0; m < np_; ++m) {
-    const Cplx* out = m_.output[ny_ + m].data();
-    double y = pm_.offset[ny_ + m];
-    for (int i = 0; i < q_; ++i) y += (out[i] * s1.x[i]).real();
-    for (int k = 0; k < ns_; ++k) y += m_.direct[k][ny_ + m] * s1.u[k];
-    v_oc[m] = y;
+  {
+    const auto rows = Eigen::seqN(ny_, np_);
+    Eigen::Map<Eigen::VectorXd> voc(v_oc.data(), np_);
+    voc.noalias() = out_re_(rows, Eigen::all) * s1.xr.matrix();
+    voc.noalias() -= out_im_(rows, Eigen::all) * s1.xi.matrix();
+    voc.noalias() += direct_(rows, Eigen::seqN(0, ns_)) * u1;
+    voc += offset_.segment(ny_, np_);
   }
   // The first iterate: the last point moved along the last step's slope.
   v = s0.v;
@@ -647,25 +685,28 @@ Status PortMarch::advance(double h, bool euler, bool* converged) {
     ++stats_.newton_failures;
     return Status::Ok();
   }
-  s1.sd.assign(q_, 0.0);
-  for (int m = 0; m < np_; ++m) {
-    const Cplx* in = m_.input[ns_ + m].data();
-    const double d = s1.d[m];
-    for (int i = 0; i < q_; ++i) s1.sd[i] += in[i] * d;
-  }
-  const std::vector<Cplx>& bd = euler ? c.be : c.b;
-  for (int i = 0; i < q_; ++i) s1.x[i] += bd[i] * s1.sd[i];
+  const Eigen::Map<const Eigen::VectorXd> d1(s1.d.data(), np_);
+  s1.sdr.matrix().noalias() = in_re_.rightCols(np_) * d1;
+  s1.sdi.matrix().noalias() = in_im_.rightCols(np_) * d1;
+  const Eigen::ArrayXd& bdr = euler ? c.ber : c.br;
+  const Eigen::ArrayXd& bdi = euler ? c.bei : c.bi;
+  s1.xr += bdr * s1.sdr - bdi * s1.sdi;
+  s1.xi += bdr * s1.sdi + bdi * s1.sdr;
   s1.y.resize(ny_);
+  if (ny_ > 0) {
+    const auto rows = Eigen::seqN(0, ny_);
+    Eigen::Map<Eigen::VectorXd> y1(s1.y.data(), ny_);
+    y1.noalias() = out_re_(rows, Eigen::all) * s1.xr.matrix();
+    y1.noalias() -= out_im_(rows, Eigen::all) * s1.xi.matrix();
+    y1.noalias() += direct_(rows, Eigen::seqN(0, ns_)) * u1;
+    y1.noalias() += direct_(rows, Eigen::seqN(ns_, np_)) * d1;
+    y1 += offset_.head(ny_);
+  }
   for (int p = 0; p < ny_; ++p) {
-    const Cplx* out = m_.output[p].data();
-    double y = pm_.offset[p];
-    for (int i = 0; i < q_; ++i) y += (out[i] * s1.x[i]).real();
-    for (int k = 0; k < ns_; ++k) y += m_.direct[k][p] * s1.u[k];
-    for (int m = 0; m < np_; ++m) y += m_.direct[ns_ + m][p] * s1.d[m];
+    const double y = s1.y[p];
     if (!std::isfinite(y))
       return Status::Error(fmt::format("port model: non-finite value at t={:g} s ({})", s1.t,
                                        pm_.labels[pm_.probe_column[p]]));
-    s1.y[p] = y;
   }
   s1.fill_watched(pm_.probe_watched);
   return Status::Ok();
