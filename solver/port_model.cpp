@@ -598,6 +598,7 @@ bool PortMarch::newton(const StepCoefs& c, double h, bool euler, const std::vect
   std::vector<double>& hq = s1.jq;  // the charge current's history part, then its value
   for (int m = 0; m < np_; ++m) hq[m] = euler ? -cur_.q[m] / h : -a0 * cur_.q[m] - cur_.jq[m];
   bool small = false, limited = true;
+  double last_fnorm = 0.0;
   controls_at(s1.t, s1.vc);
   for (int it = 0; it <= tol.max_iterations; ++it) {
     for (int m = 0; m < np_; ++m) {
@@ -622,9 +623,15 @@ bool PortMarch::newton(const StepCoefs& c, double h, bool euler, const std::vect
       return true;
     }
     if (it == tol.max_iterations) break;
-    for (int mi = 0; mi < np_; ++mi) jac_.col(mi) = -z.col(mi) * dd_[mi];
-    jac_.diagonal().array() += 1.0;
-    lu_.compute(jac_);
+    // The Jacobian is factored on the first iteration and again whenever the last update was
+    // limited or did not halve the residual; otherwise its factors are reused (chord steps).
+    const double fnorm = f_.lpNorm<Eigen::Infinity>();
+    if (it == 0 || limited || !(fnorm < 0.5 * last_fnorm)) {
+      for (int mi = 0; mi < np_; ++mi) jac_.col(mi) = -z.col(mi) * dd_[mi];
+      jac_.diagonal().array() += 1.0;
+      lu_.compute(jac_);
+    }
+    last_fnorm = fnorm;
     f_ = -f_;
     dv_ = lu_.solve(f_);
     ++stats_.newton_iterations;
