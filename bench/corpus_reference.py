@@ -2,7 +2,9 @@
 """isolink at its defaults against a converged reference on the random link corpus (issue 41).
 
     python3 bench/corpus_reference.py MODE [ISOLINK] [SEED] [FIRST] [COUNT] [TSTOP] [MAX_LENGTH]
-    (defaults: build/cli/isolink 7 0 14 20u, every length; MAX_LENGTH in m skips longer cables)
+                                      [MIN_LENGTH]
+    (defaults: build/cli/isolink 7 0 14 20u, every length; MAX_LENGTH and MIN_LENGTH in m skip
+    longer and shorter cables; TSTOP `full` runs the netlist's own .tran, the whole frame)
 
 MODE:
 - `defaults` (item 3, "the transient's defaults within 10 mV of a converged reference on every
@@ -12,6 +14,13 @@ MODE:
   given a TVS part of the library (`esd:`, in turn PESD2CAN, ESD24VS2U, ESDCAN24-2BLY) and its
   pins' clamps (`pin_clamps: rails`), then `isolink sim` at its defaults (auto: the port model,
   its fallback the transient).
+- `nonlinear-speed` (item 4, "at least 10x ngspice's default time on every nonlinear link of 3 m
+  or more"): the links of `nonlinear`, `isolink sim` at its defaults and ngspice at its defaults
+  (`ngspice -b`, `.options rshunt=1e12` as bench/speed_corpus.sh, `wrdata` of v(rxp,rxn)), each
+  timed once with process start; the reference is the port model at reltol 1e-6 and 1e-7 with
+  0.25 ns steps at most (two tolerances that agree: the full transient at 1e-6 does not finish in
+  minutes on these links; the port model's linear network is checked against the exact AC
+  solution, its check printed by isolink), and both runs' deviations from it are printed.
 For specs FIRST..FIRST+COUNT-1 of the random link corpus (tools/link_corpus.py, drawn with SEED:
 links none of the examples are), the exported netlist (down direction) through that run and the
 reference, twice: `--engine transient --reltol 1e-6` with trapezoidal and with Gear-2 steps (two
@@ -31,7 +40,7 @@ import time
 here = os.path.dirname(os.path.abspath(__file__))
 args = sys.argv[1:]
 mode = args.pop(0) if args else ""
-if mode not in ("defaults", "nonlinear"):
+if mode not in ("defaults", "nonlinear", "nonlinear-speed"):
     sys.exit(__doc__)
 isolink = os.path.abspath(args[0] if len(args) > 0 else os.path.join(here, "..", "build", "cli",
                                                                      "isolink"))
@@ -40,6 +49,7 @@ first = int(args[2]) if len(args) > 2 else 0
 count = int(args[3]) if len(args) > 3 else 14
 tstop = args[4] if len(args) > 4 else "20u"
 max_length = float(args[5]) if len(args) > 5 else float("inf")
+min_length = float(args[6]) if len(args) > 6 else 0.0
 LIMIT_MV = 10.0 if mode == "defaults" else 3.0
 TVS = ["PESD2CAN", "ESD24VS2U", "ESDCAN24-2BLY"]
 
@@ -78,36 +88,82 @@ def deviation(ref, other):
 
 def sim(cir, out, *args):
     start = time.monotonic()
-    r = subprocess.run([isolink, "sim", cir, "-p", "v(rxp,rxn)", "-o", out, "--tstop", tstop,
-                        *args], capture_output=True, text=True)
+    span = [] if tstop == "full" else ["--tstop", tstop]
+    r = subprocess.run([isolink, "sim", cir, "-p", "v(rxp,rxn)", "-o", out, *span, *args],
+                       capture_output=True, text=True)
     if r.returncode != 0:
         sys.exit("isolink sim %s %s: %s" % (cir, " ".join(args), r.stderr.strip()))
     return load(out), time.monotonic() - start, r.stderr
+
+
+def ngspice(cir, out):
+    """ngspice at its defaults on the netlist (its .tran span cut to TSTOP): (rows, seconds)."""
+    lines = [l for l in open(cir).read().splitlines() if l.strip().lower() != ".end"]
+    if tstop != "full":
+        lines = [" ".join(l.split()[:2] + [tstop]) if l.lower().startswith(".tran") else l
+                 for l in lines]
+    lines += [".options rshunt=1e12", ".control", "set wr_singlescale", "run",
+              "wrdata %s v(rxp,rxn)" % out, ".endc", ".end"]
+    with open(cir + ".ng.cir", "w") as f:
+        f.write("\n".join(lines) + "\n")
+    start = time.monotonic()
+    subprocess.run(["ngspice", "-b", cir + ".ng.cir"], capture_output=True, text=True)
+    seconds = time.monotonic() - start
+    rows = [l.split() for l in open(out) if l.strip()]
+    return ([float(r[0]) for r in rows], [float(r[1]) for r in rows]), seconds
+
+
+def speed_row(i, cir, length, iso):
+    """nonlinear-speed: one table row; returns isolink's deviation (V)."""
+    d, t_d, err = sim(cir, cir + ".d.csv")
+    unknowns = int(err.split(" unknowns")[0].split()[-1])
+    ng, t_ng = ngspice(cir, cir + ".ng.txt")
+    ref = ["--engine", "port", "--tmax", "2.5e-10", "--reltol"]
+    fine, t_fine, _ = sim(cir, cir + ".r7.csv", *ref, "1e-7")
+    coarse, _, _ = sim(cir, cir + ".r6.csv", *ref, "1e-6")
+    dev, ng_dev = deviation(fine, d), deviation(fine, ng)
+    print("| link_%03d | %s | %s | %d | %.2f | %.2f | %.1f | %.2f | %.2f | %.3f | %.1f |"
+          % (i, length, " / ".join(iso), unknowns, t_d, t_ng, t_ng / t_d, dev * 1e3,
+             ng_dev * 1e3, deviation(fine, coarse) * 1e3, t_fine), flush=True)
+    return dev
 
 
 with tempfile.TemporaryDirectory() as work:
     subprocess.run([sys.executable, os.path.join(here, "..", "tools", "link_corpus.py"), "--seed",
                     str(seed), "--first", str(first), "--count", str(count), "--out", work],
                    check=True)
-    print("| spec | length (m) | tx / rx isolation | unknowns | defaults s | engine, final reltol "
-          "| reference (trap) s | reference (gear) s | trap - gear (mV) | defaults - reference (mV) |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    if mode == "nonlinear-speed":
+        print("| spec | length (m) | tx / rx isolation | unknowns | isolink s | ngspice s | ngspice / "
+              "isolink | isolink - reference (mV) | ngspice - reference (mV) | reference 1e-6 - 1e-7 "
+              "(mV) | reference s |")
+        print("|---|---|---|---|---|---|---|---|---|---|---|")
+    else:
+        print("| spec | length (m) | tx / rx isolation | unknowns | defaults s | engine, final "
+              "reltol | reference (trap) s | reference (gear) s | trap - gear (mV) | defaults - "
+              "reference (mV) |")
+        print("|---|---|---|---|---|---|---|---|---|---|")
     worst_all, failures = 0.0, []
     for i in range(first, first + count):
         spec = os.path.join(work, "link_%03d.yaml" % i)
         text = open(spec).read()
-        if mode == "nonlinear":
+        if mode != "defaults":
             text = make_nonlinear(text, i)
             with open(spec, "w") as f:
                 f.write(text)
         length = text.split("length: ")[1].split(",")[0].split("}")[0]
-        if float(length) > max_length:
+        if not min_length <= float(length) <= max_length:
             continue
         iso = [l.split("type: ")[1].split(",")[0].split("}")[0]
                for l in text.splitlines() if l.startswith(("tx:", "rx:")) and "type: " in l]
         cir = os.path.join(work, "link_%03d.cir" % i)
         subprocess.run([isolink, "export-spice", spec, "--direction", "down", "-o", cir],
                        check=True, capture_output=True)
+        if mode == "nonlinear-speed":
+            dev = speed_row(i, cir, length, iso)
+            worst_all = max(worst_all, dev)
+            if dev * 1e3 > LIMIT_MV:
+                failures.append("link_%03d: %.2f mV" % (i, dev * 1e3))
+            continue
         d, t_d, err = sim(cir, cir + ".d.csv", *(["--engine", "transient"] if mode == "defaults"
                                                  else []))
         unknowns = int(err.split(" unknowns")[0].split()[-1])

@@ -230,12 +230,16 @@ double CableModel::velocity_cm() const {
   return 1.0 / std::sqrt(l_cm * c_cm());
 }
 
+cd round_wire_skin_factor(double x) {
+  const cd z = std::sqrt(cd(0, -x));
+  return std::abs(z) < 1e-8 ? cd(1.0) : (z / 2.0) / bessel_j1_over_j0(z);
+}
+
 cd CableModel::target_internal_impedance(double f) const {
   if (!skin_effect || r_dc <= 0) return r_dc;
   // Round wire: Z = R_dc (z / 2) J0(z) / J1(z), z^2 = -j w mu0 / (pi R_dc) = -j w mu0 sigma a^2;
   // the frequency-dependent part scaled by the pair's proximity factor.
-  const cd z = std::sqrt(cd(0, -2 * kPi * f * kMu0 / (kPi * r_dc)));
-  const cd isolated = r_dc * (z / 2.0) / bessel_j1_over_j0(z);
+  const cd isolated = r_dc * round_wire_skin_factor(f * 2 * kMu0 / r_dc);
   return r_dc + proximity * (isolated - r_dc);
 }
 

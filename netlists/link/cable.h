@@ -168,6 +168,11 @@ struct CableModel {
 // overrides that do not fit the geometry (an l of 4 l_cm or more, a c below c_g / 2).
 StatusOr<CableModel> cable_model(const CableSpec& spec);
 
+// A solid round wire's internal impedance over its DC resistance, (z / 2) J0(z) / J1(z) with
+// z^2 = -j x, x = f / f_s (f_s = R_dc / (2 mu0) for R_dc in ohm per metre): 1 at DC, rising as
+// sqrt(x) with an equal reactance in the skin-effect regime.
+std::complex<double> round_wire_skin_factor(double x);
+
 // n points from lo to hi, evenly spaced in log (the ladders' corners and fit frequencies; a
 // measured line's too, measured_line.cpp).
 std::vector<double> log_space(double lo, double hi, int n);

@@ -69,6 +69,18 @@ struct TouchstoneCable {
   Eigen::MatrixXcd y(double f) const;
 };
 
+// Below the first frequency a VNA measures (10-300 kHz): the cable as its lumped pi section,
+// exact as f -> 0 for any line. freqs (ascending, the first > 0) and y (admittances in the link's
+// port order, 2h x 2h: the ends' h lines) gain points at DC and from 1e-3 of the first frequency
+// up to it, 4 a decade; *r_dc becomes the conductors' series resistance at DC (h x h). The
+// series impedance is taken from the lowest points over which the cable is electrically short
+// (|Z Y| <= 0.15, up to 5, at least 1), corrected to second order for a line's distribution, and
+// fitted as a round wire's skin effect plus an inductance (each point weighted by the first
+// frequency over its own); each end's shunt is j w C. At DC: R alone, no conductance to the
+// chassis or between the lines. Error (empty message): the DC resistance is not positive.
+Status extend_below_band(std::vector<double>& freqs, std::vector<Eigen::MatrixXcd>& y,
+                         Eigen::MatrixXd* r_dc);
+
 // Reads and fits a spec's file (spec.touchstone, spec.ports, spec.fit_tolerance,
 // spec.uniform_line). Fits are kept, keyed by the file's bytes and those.
 StatusOr<std::shared_ptr<const TouchstoneCable>> touchstone_cable(const CableSpec& spec);
