@@ -206,7 +206,12 @@ def test_long_calls_release_the_gil():
     worker.join()
     gaps = np.diff([start] + ticks + [time.monotonic()])
     assert min(calls) > 0.03, calls  # else a held GIL would not show
-    assert gaps.max() < min(calls) / 2, (gaps.max(), calls, len(ticks))
+    # With the GIL held, every call is one gap as long as itself: nearly all the time in gaps of
+    # half a call or more. A loaded machine deschedules this thread now and then (the suite's
+    # `python` test failed once at -j2 beside a package install; the single largest gap was the
+    # criterion then): a quarter of the time in such gaps is allowed.
+    long_gaps = gaps[gaps >= min(calls) / 2].sum()
+    assert long_gaps < 0.25 * gaps.sum(), (long_gaps, gaps.sum(), calls, len(ticks))
 
 
 CLIPPER = """* clipper: a 0 -> 5 V ramp over 1 ms through 1 kohm into a diode to ground
