@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <map>
+#include <mutex>
 #include <span>
 
 #include "analysis/link_run_wave.h"
@@ -534,24 +536,34 @@ Status run_port(const Netlist& netlist, const EngineRun& run, SimulationResult& 
   TransientOptions port_opt = opt;
   const bool at_defaults = !req.reltol && !netlist_sets_reltol(netlist);
   if (at_defaults) port_opt.reltol = po.default_reltol;
-  StatusOr<Waveform> wave = run_port_model(run.circuit, *model, port_opt, &result.port);
-  if (!wave) return refuse(wave.status());
-  if (at_defaults) {
+  for (const auto& e : run.circuit.elements()) e->bind_time(opt.tstep, opt.tstop);
+  StatusOr<Waveform> wave = Status::Ok();
+  if (!at_defaults) {
+    wave = run_port_model_bound(run.circuit, *model, port_opt, &result.port);
+  } else {
     // No tolerance of the user's: the run checks its own convergence as the transient does
-    // (transient_check.h), at the nonlinear bound of 3 mV.
+    // (transient_check.h), at the nonlinear bound of 3 mV, its first two runs at once. Each
+    // run's statistics are kept by its reltol; the kept run's become the result's.
+    std::mutex mutex;
+    std::map<double, PortModelStats> stats;
     TransientConvergence conv;
-    wave = converge_runs(
-        port_opt, std::move(*wave),
+    wave = converge_runs_two_at_once(
+        port_opt,
         [&](const TransientOptions& o) -> StatusOr<Waveform> {
-          PortModelStats tighter;
-          StatusOr<Waveform> w = run_port_model(run.circuit, *model, o, &tighter);
-          if (w) result.port = tighter;
+          PortModelStats st;
+          StatusOr<Waveform> w = run_port_model_bound(run.circuit, *model, o, &st);
+          const std::lock_guard<std::mutex> lock(mutex);
+          if (w) stats[o.reltol] = st;
           return w;
         },
         TransientConvergence::kPortAgreementV, &conv);
-    port_opt.reltol = conv.reltols.back();
-    result.convergence = std::move(conv);
+    if (wave) {
+      port_opt.reltol = conv.reltols.back();
+      result.port = stats[port_opt.reltol];
+      result.convergence = std::move(conv);
+    }
   }
+  if (!wave) return refuse(wave.status());
   result.wave = std::move(*wave);
   result.engine = Engine::PortModel;
   result.reltol = port_opt.reltol;

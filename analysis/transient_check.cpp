@@ -1,7 +1,10 @@
 #include "analysis/transient_check.h"
 
+#include <tbb/parallel_invoke.h>
+
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 namespace isolink::analysis {
@@ -32,15 +35,27 @@ std::pair<double, double> worst_column(const Waveform& coarse, const Waveform& f
 
 }  // namespace
 
+namespace {
+
+// The options of the run after one at `opt` (a tenth of the reltol, half the largest step: the
+// step limit may bind rather than the tolerance); none below kReltolFloor.
+std::optional<TransientOptions> tightened(TransientOptions opt) {
+  if (!(opt.reltol / 10 >= TransientConvergence::kReltolFloor * (1 - 1e-9))) return std::nullopt;
+  opt.reltol /= 10;
+  opt.tmax = opt.effective_tmax() / 2;
+  return opt;
+}
+
+}  // namespace
+
 Waveform converge_runs(TransientOptions opt, Waveform first, const CheckedRun& run,
                        double agreement_v, TransientConvergence* out) {
   *out = TransientConvergence{};
   out->reltols.push_back(opt.reltol);
   out->tmaxes.push_back(opt.effective_tmax());
   Waveform kept = std::move(first);
-  while (opt.reltol / 10 >= TransientConvergence::kReltolFloor * (1 - 1e-9)) {
-    opt.reltol /= 10;
-    opt.tmax = opt.effective_tmax() / 2;  // the step limit may bind rather than the tolerance
+  while (std::optional<TransientOptions> next = tightened(opt)) {
+    opt = *next;
     StatusOr<Waveform> tighter = run(opt);
     if (!tighter) return kept;  // it did not finish (max_steps): the last run stands
     out->reltols.push_back(opt.reltol);
@@ -55,6 +70,29 @@ Waveform converge_runs(TransientOptions opt, Waveform first, const CheckedRun& r
     }
   }
   return kept;
+}
+
+StatusOr<Waveform> converge_runs_two_at_once(const TransientOptions& opt, const CheckedRun& run,
+                                             double agreement_v, TransientConvergence* out) {
+  const std::optional<TransientOptions> second = tightened(opt);
+  std::optional<StatusOr<Waveform>> first, ahead;
+  if (second)
+    tbb::parallel_invoke([&] { first.emplace(run(opt)); }, [&] { ahead.emplace(run(*second)); });
+  else
+    first.emplace(run(opt));
+  if (!*first) return first->status();
+  // converge_runs asks for `second` first: it gets the run made ahead; later ones run then.
+  return converge_runs(
+      opt, std::move(**first),
+      [&](const TransientOptions& o) -> StatusOr<Waveform> {
+        if (ahead && o.reltol == second->reltol && o.tmax == second->tmax) {
+          StatusOr<Waveform> w = std::move(*ahead);
+          ahead.reset();
+          return w;
+        }
+        return run(o);
+      },
+      agreement_v, out);
 }
 
 StatusOr<Waveform> converge_transient(Circuit& circuit, TransientOptions opt,

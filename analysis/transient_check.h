@@ -59,6 +59,14 @@ using CheckedRun = std::function<StatusOr<Waveform>(const TransientOptions&)>;
 Waveform converge_runs(TransientOptions opt, Waveform first, const CheckedRun& run,
                        double agreement_v, TransientConvergence* out);
 
+// The first run and the tighter one converge_runs would ask next, on two threads at once (oneTBB:
+// inside an arena of one they run one after the other), then converge_runs from there: the same
+// runs and the same answer as run(opt) followed by converge_runs, in about the time of the
+// tighter run alone. `run` must be safe to call from two threads at once (the port model's
+// runs only read the circuit and the model). Errors: the first run's.
+StatusOr<Waveform> converge_runs_two_at_once(const TransientOptions& opt, const CheckedRun& run,
+                                             double agreement_v, TransientConvergence* out);
+
 // converge_runs on the transient, at kAgreementV; *stats becomes the kept run's.
 StatusOr<Waveform> converge_transient(Circuit& circuit, TransientOptions opt,
                                       const std::vector<Probe>& probes, Waveform first,

@@ -882,6 +882,12 @@ StatusOr<Waveform> PortMarch::run(PortModelStats* stats_out) {
 
 StatusOr<Waveform> run_port_model(Circuit& circuit, const PortModel& model,
                                   const TransientOptions& opt, PortModelStats* stats) {
+  for (const auto& e : circuit.elements()) e->bind_time(opt.tstep, opt.tstop);
+  return run_port_model_bound(circuit, model, opt, stats);
+}
+
+StatusOr<Waveform> run_port_model_bound(const Circuit& circuit, const PortModel& model,
+                                        const TransientOptions& opt, PortModelStats* stats) {
   if (Status s = opt.validate(); !s.ok()) return s;
   if (opt.uic || !opt.node_ic.empty())
     return Status::Error(
@@ -900,7 +906,6 @@ StatusOr<Waveform> run_port_model(Circuit& circuit, const PortModel& model,
   for (const std::string& name : model.port_elements)
     if (!circuit.find_element(name))
       return Status::Error("port model: built from another circuit (element " + name + ")");
-  for (const auto& e : circuit.elements()) e->bind_time(opt.tstep, opt.tstop);
   PortModelStats st;
   StatusOr<Waveform> w = PortMarch(circuit, model, opt).run(&st);
   if (w.ok() && stats) {

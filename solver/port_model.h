@@ -168,4 +168,11 @@ StatusOr<PortModel> build_port_model(const std::vector<Card>& cards, const Circu
 StatusOr<Waveform> run_port_model(Circuit& circuit, const PortModel& model,
                                   const TransientOptions& opt, PortModelStats* stats = nullptr);
 
+// The same on a circuit whose sources are already bound to opt's tstep and tstop
+// (Element::bind_time, as run_port_model does first): it only reads the circuit and the model,
+// so several runs (other options) may go at once on one circuit and model.
+StatusOr<Waveform> run_port_model_bound(const Circuit& circuit, const PortModel& model,
+                                        const TransientOptions& opt,
+                                        PortModelStats* stats = nullptr);
+
 }  // namespace isolink
