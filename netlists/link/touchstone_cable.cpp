@@ -90,26 +90,39 @@ SeriesEntry fit_series_diagonal(const std::vector<double>& freqs, const std::vec
   return best;
 }
 
-// The lowest points (up to 5) over which the cable is electrically short: |(gamma l)^2| =
-// |Z Y_shunt| at most 0.15, where the pi section corrected to second order (below) is within a
-// few tenths of a percent of a line's. At least the first point.
-int short_line_points(const std::vector<double>& freqs, const std::vector<Eigen::MatrixXcd>& y) {
-  const int n = static_cast<int>(y[0].rows()), h = n / 2;
-  int k = 0;
-  while (k < 5 && k < static_cast<int>(freqs.size())) {
-    const Eigen::MatrixXcd z = (-y[k].block(0, h, h, h)).inverse();
-    const Eigen::MatrixXcd shunt = y[k].block(0, 0, h, h) + y[k].block(0, h, h, h) +
-                                   y[k].block(h, h, h, h) + y[k].block(h, 0, h, h);
-    if (k > 0 && !((z * shunt).cwiseAbs().maxCoeff() <= 0.15)) break;
-    ++k;
+// One point's pi section (2 x 2 single-ended, 1 x 1 differential): the series impedance
+// -(Y_tx,rx)^-1 and each end's shunt Y_end + Y_tx,rx, corrected to second order for a line's
+// distribution (below).
+struct PiSection {
+  Eigen::MatrixXcd z, ya, yb;
+};
+
+PiSection pi_section(const Eigen::MatrixXcd& y) {
+  const int h = static_cast<int>(y.rows()) / 2;
+  const Eigen::MatrixXcd z_pi = (-y.block(0, h, h, h)).inverse();
+  const Eigen::MatrixXcd a = y.block(0, 0, h, h) + y.block(0, h, h, h);
+  const Eigen::MatrixXcd b = y.block(h, h, h, h) + y.block(h, 0, h, h);
+  const Eigen::MatrixXcd z = z_pi - z_pi * (a + b) * z_pi / 6.0;
+  return {z, a + a * z * a / 6.0, b + b * z * b / 6.0};
+}
+
+// The pi sections of the lowest points (up to 5) over which the cable is electrically short:
+// |(gamma l)^2| = |Z Y_shunt| at most 0.15, where the section corrected to second order is within
+// a few tenths of a percent of a line's. At least the first point.
+std::vector<PiSection> short_line_sections(const std::vector<Eigen::MatrixXcd>& y) {
+  std::vector<PiSection> out;
+  while (out.size() < 5 && out.size() < y.size()) {
+    PiSection p = pi_section(y[out.size()]);
+    if (!out.empty() && !((p.z * (p.ya + p.yb)).cwiseAbs().maxCoeff() <= 0.15)) break;
+    out.push_back(std::move(p));
   }
-  return k;
+  return out;
 }
 
 }  // namespace
 
 // Below the band (contract: touchstone_cable.h). At the lowest points over which the cable is
-// electrically short (short_line_points): the series impedance Z = -(Y_tx,rx)^-1 (2 x 2
+// electrically short (short_line_sections): the series impedance Z = -(Y_tx,rx)^-1 (2 x 2
 // single-ended, 1 x 1 differential) and each end's shunt admittance Y_a = Y_end + Y_tx,rx,
 // corrected to second order for a line's distribution (Z_pi = Z + Z Y Z / 6, Y_a = Y / 2 - Y Z Y /
 // 24 for a uniform line of series Z and shunt Y: Z = Z_pi - Z_pi Y Z_pi / 6, Y / 2 = Y_a + Y_a Z
@@ -127,18 +140,9 @@ int short_line_points(const std::vector<double>& freqs, const std::vector<Eigen:
 Status extend_below_band(std::vector<double>& freqs, std::vector<Eigen::MatrixXcd>& y,
                          Eigen::MatrixXd* r_dc) {
   const int n = static_cast<int>(y[0].rows()), h = n / 2;
-  const int k = short_line_points(freqs, y);
+  const std::vector<PiSection> sections = short_line_sections(y);
+  const int k = static_cast<int>(sections.size());
   const std::vector<double> low(freqs.begin(), freqs.begin() + k);
-  std::vector<Eigen::MatrixXcd> zs, ya, yb;
-  for (int q = 0; q < k; ++q) {
-    const Eigen::MatrixXcd z_pi = (-y[q].block(0, h, h, h)).inverse();
-    const Eigen::MatrixXcd a = y[q].block(0, 0, h, h) + y[q].block(0, h, h, h);
-    const Eigen::MatrixXcd b = y[q].block(h, h, h, h) + y[q].block(h, 0, h, h);
-    const Eigen::MatrixXcd z = z_pi - z_pi * (a + b) * z_pi / 6.0;
-    zs.push_back(z);
-    ya.push_back(a + a * z * a / 6.0);
-    yb.push_back(b + b * z * b / 6.0);
-  }
   std::vector<std::vector<SeriesEntry>> series(h, std::vector<SeriesEntry>(h));
   Eigen::MatrixXd r(h, h), c1(h, h), c2(h, h);
   for (int i = 0; i < h; ++i)
@@ -147,9 +151,9 @@ Status extend_below_band(std::vector<double>& freqs, std::vector<Eigen::MatrixXc
       std::vector<double> va, vb;
       for (int q = 0; q < k; ++q) {
         const double w = 2 * std::numbers::pi * low[q];
-        zij.push_back(zs[q](i, j));
-        va.push_back(ya[q](i, j).imag() / w);
-        vb.push_back(yb[q](i, j).imag() / w);
+        zij.push_back(sections[q].z(i, j));
+        va.push_back(sections[q].ya(i, j).imag() / w);
+        vb.push_back(sections[q].yb(i, j).imag() / w);
       }
       if (i == j)
         series[i][j] = fit_series_diagonal(low, zij);
