@@ -57,10 +57,13 @@ StatusOr<Engine> parse_engine(const std::string& text) {
 // What the self-check (transient_check.h) did; `agreement`: its absolute allowance, in words.
 std::string tightening_text(const TransientConvergence& c, const char* agreement) {
   return fmt::format(
-      "checked by tightening: reltol {:g} -> {:g} and largest step {:g} -> {:g} s in {} runs; the "
-      "kept run is {:.3g} m from the run before it (V or A, the probe nearest its allowance){}",
-      c.reltols.front(), c.reltols.back(), c.tmaxes.front(), c.tmaxes.back(), c.reltols.size(),
-      1e3 * c.deviations.back(),
+      "checked by tightening: reltol {:g} -> {:g}{} in {} runs; the kept run is {:.3g} m from the "
+      "run before it (V or A, the probe nearest its allowance){}",
+      c.reltols.front(), c.reltols.back(),
+      c.tmaxes.front() == c.tmaxes.back()
+          ? ""
+          : fmt::format(" and largest step {:g} -> {:g} s", c.tmaxes.front(), c.tmaxes.back()),
+      c.reltols.size(), 1e3 * c.deviations.back(),
       c.agreed ? fmt::format(", within its allowance of {:.3g} m ({} or 0.1 % of the probe's "
                              "peak): converged to about that, as the error shrinks at least "
                              "twofold per round",
@@ -84,9 +87,11 @@ std::string engine_accuracy(const SimulationResult& r) {
     return fmt::format(
         "port model: the linear network's transfer (port impedances, sources to ports and "
         "probes) within {:.1e} of each pair's peak (check {:.0e}{}; an edge's response within "
-        "{:.2g} of its amplitude times the pair's peak gain); time steps under the transient's "
-        "truncation-error control (trtol x reltol = {:.2g} of each port voltage's, charge's and "
-        "probe's peak), the port currents linear over a step, charge conserved{}",
+        "{:.2g} of its amplitude times the pair's peak gain); the port currents linear over a "
+        "step, the steps under the transient's truncation-error control and the currents' bend "
+        "(trtol x reltol = {:.2g} of the largest port voltage's peak and of each charge's), rows "
+        "inside a step as the probes' linear interpolation needs (the same of each probe's "
+        "peak), charge conserved{}",
         r.port.model.error, r.port.model.tol,
         r.port.model.relaxed
             ? fmt::format(", relaxed from {:.0e}: the search could add no direction",
@@ -556,7 +561,7 @@ Status run_port(const Netlist& netlist, const EngineRun& run, SimulationResult& 
           if (w) stats[o.reltol] = st;
           return w;
         },
-        TransientConvergence::kPortAgreementV, &conv);
+        TransientConvergence::kPortAgreementV, &conv, Tighten::Reltol);
     if (wave) {
       port_opt.reltol = conv.reltols.back();
       result.port = stats[port_opt.reltol];

@@ -37,29 +37,29 @@ std::pair<double, double> worst_column(const Waveform& coarse, const Waveform& f
 
 namespace {
 
-// The options of the run after one at `opt` (a tenth of the reltol, half the largest step: the
-// step limit may bind rather than the tolerance); none below kReltolFloor.
-std::optional<TransientOptions> tightened(TransientOptions opt) {
+// The options of the run after one at `opt` (a tenth of the reltol; for the transient half the
+// largest step too: the step limit may bind rather than the tolerance); none below kReltolFloor.
+std::optional<TransientOptions> tightened(TransientOptions opt, Tighten how) {
   if (!(opt.reltol / 10 >= TransientConvergence::kReltolFloor * (1 - 1e-9))) return std::nullopt;
   opt.reltol /= 10;
-  opt.tmax = opt.effective_tmax() / 2;
+  if (how == Tighten::ReltolAndTmax) opt.tmax = opt.effective_tmax() / 2;
   return opt;
 }
 
 }  // namespace
 
 Waveform converge_runs(TransientOptions opt, Waveform first, const CheckedRun& run,
-                       double agreement_v, TransientConvergence* out) {
+                       double agreement_v, TransientConvergence* out, Tighten how) {
   *out = TransientConvergence{};
   out->reltols.push_back(opt.reltol);
   out->tmaxes.push_back(opt.effective_tmax());
   Waveform kept = std::move(first);
-  while (std::optional<TransientOptions> next = tightened(opt)) {
+  while (std::optional<TransientOptions> next = tightened(opt, how)) {
     opt = *next;
     StatusOr<Waveform> tighter = run(opt);
     if (!tighter) return kept;  // it did not finish (max_steps): the last run stands
     out->reltols.push_back(opt.reltol);
-    out->tmaxes.push_back(opt.tmax);
+    out->tmaxes.push_back(opt.effective_tmax());
     const auto [dev, allowed] = worst_column(kept, *tighter, agreement_v);
     out->deviations.push_back(dev);
     out->allowed.push_back(allowed);
@@ -73,8 +73,9 @@ Waveform converge_runs(TransientOptions opt, Waveform first, const CheckedRun& r
 }
 
 StatusOr<Waveform> converge_runs_two_at_once(const TransientOptions& opt, const CheckedRun& run,
-                                             double agreement_v, TransientConvergence* out) {
-  const std::optional<TransientOptions> second = tightened(opt);
+                                             double agreement_v, TransientConvergence* out,
+                                             Tighten how) {
+  const std::optional<TransientOptions> second = tightened(opt, how);
   std::optional<StatusOr<Waveform>> first, ahead;
   if (second)
     tbb::parallel_invoke([&] { first.emplace(run(opt)); }, [&] { ahead.emplace(run(*second)); });
@@ -92,7 +93,7 @@ StatusOr<Waveform> converge_runs_two_at_once(const TransientOptions& opt, const 
         }
         return run(o);
       },
-      agreement_v, out);
+      agreement_v, out, how);
 }
 
 StatusOr<Waveform> converge_transient(Circuit& circuit, TransientOptions opt,

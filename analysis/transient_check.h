@@ -49,6 +49,9 @@ double max_deviation(const Waveform& coarse, const Waveform& fine, size_t k = 0)
 // One run of a time-stepping engine at the given options (the caller keeps its statistics when
 // it succeeds: the last run to succeed is the one kept).
 using CheckedRun = std::function<StatusOr<Waveform>(const TransientOptions&)>;
+// What each tighter run changes: the reltol (a tenth) and, for the transient, the largest step
+// (half); the port model's modes are exact between its steps, its largest step no accuracy knob.
+enum class Tighten { ReltolAndTmax, Reltol };
 
 // The tightening for any time-stepping engine: `first` is the run at opt.reltol. Runs `run` at
 // a tenth of the reltol and half the largest step, again and again, until two successive runs
@@ -57,7 +60,8 @@ using CheckedRun = std::function<StatusOr<Waveform>(const TransientOptions&)>;
 // run that fails (max_steps, the memory limit) ends the tightening with the run before it kept
 // and out->agreed false.
 Waveform converge_runs(TransientOptions opt, Waveform first, const CheckedRun& run,
-                       double agreement_v, TransientConvergence* out);
+                       double agreement_v, TransientConvergence* out,
+                       Tighten how = Tighten::ReltolAndTmax);
 
 // The first run and the tighter one converge_runs would ask next, on two threads at once (oneTBB:
 // inside an arena of one they run one after the other), then converge_runs from there: the same
@@ -65,7 +69,8 @@ Waveform converge_runs(TransientOptions opt, Waveform first, const CheckedRun& r
 // tighter run alone. `run` must be safe to call from two threads at once (the port model's
 // runs only read the circuit and the model). Errors: the first run's.
 StatusOr<Waveform> converge_runs_two_at_once(const TransientOptions& opt, const CheckedRun& run,
-                                             double agreement_v, TransientConvergence* out);
+                                             double agreement_v, TransientConvergence* out,
+                                             Tighten how = Tighten::ReltolAndTmax);
 
 // converge_runs on the transient, at kAgreementV; *stats becomes the kept run's.
 StatusOr<Waveform> converge_transient(Circuit& circuit, TransientOptions opt,

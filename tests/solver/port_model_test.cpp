@@ -79,7 +79,9 @@ Runs both(const std::vector<Card>& cards, const std::vector<std::string>& texts,
   EXPECT_TRUE(m.ok()) << m.status().message();
   if (!m) return r;
   TransientOptions po = opt;
-  po.reltol = PortModelOptions{}.default_reltol;  // as analysis/simulate.cpp runs it
+  // The run analysis/simulate.cpp keeps at its defaults: its self-check's second, at a tenth of
+  // default_reltol, when it agrees with the first.
+  po.reltol = PortModelOptions{}.default_reltol / 10;
   StatusOr<Waveform> w = run_port_model(c, *m, po, &r.stats);
   EXPECT_TRUE(w.ok()) << w.status().message();
   if (w) r.port = std::move(*w);
@@ -131,25 +133,79 @@ TEST(PortModel, ClipperFollowsItsKneeOnASlowRamp) {
   const std::vector<Probe> ps = probes(c, {"v(in)", "v(out)"});
   StatusOr<PortModel> m = build_port_model(cards, c, ps, 1e-3, {});
   ASSERT_TRUE(m.ok()) << m.status().message();
-  TransientOptions opt{.tstep = 10e-6, .tstop = 1e-3};
-  StatusOr<Waveform> w = run_port_model(c, *m, opt);
-  ASSERT_TRUE(w.ok()) << w.status().message();
-  ASSERT_GT(w->samples(), 50u);
-  double worst = 0;
-  for (size_t k = 0; k < w->samples(); ++k) {
-    const double vin = w->columns[0][k];
-    const double vd = std::fabs(vin) < 1e-12 ? 0.0 : [&] {
-      double a = -1, b = std::max(vin, 0.0) + 1e-9;
-      auto f = [&](double x) {
-        return (vin - x) / 1e3 - 1e-14 * (std::exp(x / kVt) - 1) - kGmin * x;
-      };
-      for (int i = 0; i < 200; ++i) ((f(0.5 * (a + b)) > 0) ? a : b) = 0.5 * (a + b);
-      return 0.5 * (a + b);
-    }();
-    worst = std::max(worst, std::fabs(w->columns[1][k] - vd));
+  // The rows at the steps' ends solve the diode; those inside a step (the march's steps grow to
+  // tstop / 50 here) take its current as a straight line over the step, within the step
+  // control's trtol reltol |v|: 7e-5 V at reltol 1e-3, 7e-6 V at 1e-4.
+  for (const double reltol : {1e-3, 1e-4}) {
+    TransientOptions opt{.tstep = 10e-6, .tstop = 1e-3, .reltol = reltol};
+    StatusOr<Waveform> w = run_port_model(c, *m, opt);
+    ASSERT_TRUE(w.ok()) << w.status().message();
+    ASSERT_GT(w->samples(), 100u);  // at least one row each TSTEP
+    double worst = 0;
+    for (size_t k = 0; k < w->samples(); ++k) {
+      const double vin = w->columns[0][k];
+      const double vd = std::fabs(vin) < 1e-12 ? 0.0 : [&] {
+        double a = -1, b = std::max(vin, 0.0) + 1e-9;
+        auto f = [&](double x) {
+          return (vin - x) / 1e3 - 1e-14 * (std::exp(x / kVt) - 1) - kGmin * x;
+        };
+        for (int i = 0; i < 200; ++i) ((f(0.5 * (a + b)) > 0) ? a : b) = 0.5 * (a + b);
+        return 0.5 * (a + b);
+      }();
+      worst = std::max(worst, std::fabs(w->columns[1][k] - vd));
+    }
+    EXPECT_LT(worst, reltol / 10) << reltol;
+    EXPECT_NEAR(w->columns[1].back(), 0.6929, 1e-3);
   }
-  EXPECT_LT(worst, 1e-5);
-  EXPECT_NEAR(w->columns[1].back(), 0.6929, 1e-3);
+}
+
+// Method step 5, the rows inside the steps: a series RLC rung by a 1 ns ramp, beside a diode
+// held at a constant forward bias by a DC source of its own. The port's voltage never moves, so
+// the steps grow to tstop / 50 (40 ns, a fifth of the ringing's period) and nearly every row is
+// one the modes were marched to inside a step. Against the closed form of the ramp response
+// (R(t) the step response's integral): every row exact to the model's check, the rows at most
+// TSTEP apart, and the straight line between rows within a few times trtol reltol |v|peak.
+TEST(PortModel, RowsInsideStepsFollowARingingRlcClosedForm) {
+  const double r = 10, l = 1e-6, cap = 1e-9, t0 = 10e-9, tr = 1e-9;
+  const std::vector<Card> cards = {
+      card("v1", {"in", "0"}, {call("pwl", {0, 0, t0, 0, t0 + tr, 1})}),
+      card("r1", {"in", "a"}, {num(r)}), card("l1", {"a", "out"}, {num(l)}),
+      card("c1", {"out", "0"}, {num(cap)}), card("v2", {"b", "0"}, {num(1)}),
+      card("r2", {"b", "k"}, {num(1e3)}), diode("d1", {"k", "0"}, model({{"is", 1e-14}}))};
+  Circuit c;
+  ASSERT_EQ(build(c, cards), "");
+  const TransientOptions opt{.tstep = 10e-9, .tstop = 2e-6, .reltol = 1e-3};
+  StatusOr<PortModel> m = build_port_model(cards, c, probes(c, {"v(out)"}), opt.tstop, {});
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  PortModelStats stats;
+  StatusOr<Waveform> w = run_port_model(c, *m, opt, &stats);
+  ASSERT_TRUE(w.ok()) << w.status().message();
+  const double alpha = r / (2 * l), w0 = 1 / std::sqrt(l * cap);
+  const double wd = std::sqrt(w0 * w0 - alpha * alpha), n2 = alpha * alpha + wd * wd;
+  auto integral = [&](double t) {  // of the unit step response 1 - e^-at (cos + a/wd sin)
+    if (t <= 0) return 0.0;
+    const double e = std::exp(-alpha * t), co = std::cos(wd * t), si = std::sin(wd * t);
+    const double ic = (alpha - e * (alpha * co - wd * si)) / n2;
+    const double is = (wd - e * (alpha * si + wd * co)) / n2;
+    return t - ic - alpha / wd * is;
+  };
+  auto exact = [&](double t) { return (integral(t - t0) - integral(t - t0 - tr)) / tr; };
+  const std::vector<double>& v = w->columns[0];
+  double peak = 0, worst_row = 0, worst_line = 0, widest = 0;
+  for (size_t k = 0; k < w->samples(); ++k) {
+    peak = std::max(peak, std::fabs(v[k]));
+    worst_row = std::max(worst_row, std::fabs(v[k] - exact(w->time[k])));
+    if (k == 0) continue;
+    const double dt = w->time[k] - w->time[k - 1], mid = w->time[k - 1] + dt / 2;
+    widest = std::max(widest, dt);
+    worst_line = std::max(worst_line, std::fabs(0.5 * (v[k - 1] + v[k]) - exact(mid)));
+  }
+  EXPECT_GT(peak, 1.5);                       // it rings: 1.6 V overshoot of a 1 V step
+  EXPECT_LT(stats.accepted * 5, static_cast<long>(w->samples()));  // rows inside the steps
+  EXPECT_LE(widest, opt.tstep * (1 + 1e-9));  // TSTEP's rows at least
+  EXPECT_LT(worst_row, 2e-5 * peak);          // the model's check: 2e-6 of the pair's peak
+  const double tol = opt.trtol * opt.reltol * peak;  // the rows' interpolation allowance
+  EXPECT_LT(worst_line, 3 * tol) << tol;
 }
 
 // A rectifier diode with series resistance, junction capacitance and transit time (charge
