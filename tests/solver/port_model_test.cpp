@@ -169,9 +169,12 @@ TEST(PortModel, RowsInsideStepsFollowARingingRlcClosedForm) {
   const double r = 10, l = 1e-6, cap = 1e-9, t0 = 10e-9, tr = 1e-9;
   const std::vector<Card> cards = {
       card("v1", {"in", "0"}, {call("pwl", {0, 0, t0, 0, t0 + tr, 1})}),
-      card("r1", {"in", "a"}, {num(r)}), card("l1", {"a", "out"}, {num(l)}),
-      card("c1", {"out", "0"}, {num(cap)}), card("v2", {"b", "0"}, {num(1)}),
-      card("r2", {"b", "k"}, {num(1e3)}), diode("d1", {"k", "0"}, model({{"is", 1e-14}}))};
+      card("r1", {"in", "a"}, {num(r)}),
+      card("l1", {"a", "out"}, {num(l)}),
+      card("c1", {"out", "0"}, {num(cap)}),
+      card("v2", {"b", "0"}, {num(1)}),
+      card("r2", {"b", "k"}, {num(1e3)}),
+      diode("d1", {"k", "0"}, model({{"is", 1e-14}}))};
   Circuit c;
   ASSERT_EQ(build(c, cards), "");
   const TransientOptions opt{.tstep = 10e-9, .tstop = 2e-6, .reltol = 1e-3};
@@ -200,10 +203,10 @@ TEST(PortModel, RowsInsideStepsFollowARingingRlcClosedForm) {
     widest = std::max(widest, dt);
     worst_line = std::max(worst_line, std::fabs(0.5 * (v[k - 1] + v[k]) - exact(mid)));
   }
-  EXPECT_GT(peak, 1.5);                       // it rings: 1.6 V overshoot of a 1 V step
+  EXPECT_GT(peak, 1.5);  // it rings: 1.6 V overshoot of a 1 V step
   EXPECT_LT(stats.accepted * 5, static_cast<long>(w->samples()));  // rows inside the steps
-  EXPECT_LE(widest, opt.tstep * (1 + 1e-9));  // TSTEP's rows at least
-  EXPECT_LT(worst_row, 2e-5 * peak);          // the model's check: 2e-6 of the pair's peak
+  EXPECT_LE(widest, opt.tstep * (1 + 1e-9));                       // TSTEP's rows at least
+  EXPECT_LT(worst_row, 2e-5 * peak);                 // the model's check: 2e-6 of the pair's peak
   const double tol = opt.trtol * opt.reltol * peak;  // the rows' interpolation allowance
   EXPECT_LT(worst_line, 3 * tol) << tol;
 }
