@@ -443,6 +443,8 @@ class PortMarch {
   Eigen::VectorXd offset_;           // per output
   Eigen::ArrayXd scratch_r_, scratch_i_;
   Eigen::ArrayXd in_xr_, in_xi_, in_wr_, in_wi_, in_nr_, in_ni_;  // probes_inside's march
+  Eigen::ArrayXd in_dwr_, in_dwi_;
+  std::vector<double> inner_u_, inner_d_;
   // in.u and in.d of state s (its u and d).
   void modal_inputs(const PortState& s, Eigen::ArrayXd& sur, Eigen::ArrayXd& sui,
                     Eigen::ArrayXd& sdr, Eigen::ArrayXd& sdi) const;
@@ -647,12 +649,15 @@ void PortMarch::probes_inside(const PortState& s0, const PortState& s1, double h
   const Eigen::ArrayXd& d0i = euler ? s1.sdi : s0.sdi;
   in_xr_ = s0.xr, in_xi_ = s0.xi;
   in_wr_ = s0.sur + d0r, in_wi_ = s0.sui + d0i;
+  in_dwr_ = s1.sur + s1.sdr - in_wr_, in_dwi_ = s1.sui + s1.sdi - in_wi_;  // w(h) - w(0)
   rows_.resize(static_cast<size_t>(n - 1) * ny_);
-  std::vector<double> u(ns_), d(np_);
+  std::vector<double>& u = inner_u_;
+  std::vector<double>& d = inner_d_;
+  u.resize(ns_), d.resize(np_);
   for (int k = 1; k < n; ++k) {
     const double f = static_cast<double>(k) / n;
-    in_nr_ = (1 - f) * (s0.sur + d0r) + f * (s1.sur + s1.sdr);
-    in_ni_ = (1 - f) * (s0.sui + d0i) + f * (s1.sui + s1.sdi);
+    in_nr_ = (s0.sur + d0r) + f * in_dwr_;
+    in_ni_ = (s0.sui + d0i) + f * in_dwi_;
     scratch_r_ = c.er * in_xr_ - c.ei * in_xi_ + c.ar * in_wr_ - c.ai * in_wi_ + c.br * in_nr_ -
                  c.bi * in_ni_;
     in_xi_ = c.er * in_xi_ + c.ei * in_xr_ + c.ar * in_wi_ + c.ai * in_wr_ + c.br * in_ni_ +
@@ -664,14 +669,13 @@ void PortMarch::probes_inside(const PortState& s0, const PortState& s1, double h
     // The port currents' direct share at their values in between (an Euler step's modes take
     // the end value over the step; the instant's own current is nearer the line).
     for (int m = 0; m < np_; ++m) d[m] = s0.d[m] + f * (s1.d[m] - s0.d[m]);
-    const auto rows = Eigen::seqN(0, ny_);
     Eigen::Map<Eigen::VectorXd> y(rows_.data() + static_cast<size_t>(k - 1) * ny_, ny_);
-    y.noalias() = out_re_(rows, Eigen::all) * in_xr_.matrix();
-    y.noalias() -= out_im_(rows, Eigen::all) * in_xi_.matrix();
+    y.noalias() = out_re_.topRows(ny_) * in_xr_.matrix();
+    y.noalias() -= out_im_.topRows(ny_) * in_xi_.matrix();
     y.noalias() +=
-        direct_(rows, Eigen::seqN(0, ns_)) * Eigen::Map<const Eigen::VectorXd>(u.data(), ns_);
+        direct_.topLeftCorner(ny_, ns_) * Eigen::Map<const Eigen::VectorXd>(u.data(), ns_);
     y.noalias() +=
-        direct_(rows, Eigen::seqN(ns_, np_)) * Eigen::Map<const Eigen::VectorXd>(d.data(), np_);
+        direct_.block(0, ns_, ny_, np_) * Eigen::Map<const Eigen::VectorXd>(d.data(), np_);
     y += offset_.head(ny_);
   }
 }
@@ -819,11 +823,10 @@ Status PortMarch::advance(double h, bool euler, bool* converged) {
   std::vector<double>& v_oc = v_oc_;
   std::vector<double>& v = v_;
   {
-    const auto rows = Eigen::seqN(ny_, np_);
     Eigen::Map<Eigen::VectorXd> voc(v_oc.data(), np_);
-    voc.noalias() = out_re_(rows, Eigen::all) * s1.xr.matrix();
-    voc.noalias() -= out_im_(rows, Eigen::all) * s1.xi.matrix();
-    voc.noalias() += direct_(rows, Eigen::seqN(0, ns_)) * u1;
+    voc.noalias() = out_re_.middleRows(ny_, np_) * s1.xr.matrix();
+    voc.noalias() -= out_im_.middleRows(ny_, np_) * s1.xi.matrix();
+    voc.noalias() += direct_.block(ny_, 0, np_, ns_) * u1;
     voc += offset_.segment(ny_, np_);
   }
   // The first iterate: the last point moved along the last step's slope.
@@ -848,12 +851,11 @@ Status PortMarch::advance(double h, bool euler, bool* converged) {
   s1.xi += bdr * s1.sdi + bdi * s1.sdr;
   s1.y.resize(ny_);
   if (ny_ > 0) {
-    const auto rows = Eigen::seqN(0, ny_);
     Eigen::Map<Eigen::VectorXd> y1(s1.y.data(), ny_);
-    y1.noalias() = out_re_(rows, Eigen::all) * s1.xr.matrix();
-    y1.noalias() -= out_im_(rows, Eigen::all) * s1.xi.matrix();
-    y1.noalias() += direct_(rows, Eigen::seqN(0, ns_)) * u1;
-    y1.noalias() += direct_(rows, Eigen::seqN(ns_, np_)) * d1;
+    y1.noalias() = out_re_.topRows(ny_) * s1.xr.matrix();
+    y1.noalias() -= out_im_.topRows(ny_) * s1.xi.matrix();
+    y1.noalias() += direct_.topLeftCorner(ny_, ns_) * u1;
+    y1.noalias() += direct_.block(0, ns_, ny_, np_) * d1;
     y1 += offset_.head(ny_);
   }
   for (int p = 0; p < ny_; ++p) {
