@@ -317,8 +317,11 @@ namespace {
 // linear in t from w0 to w1, x1 = e x0 + a w0 + b w1; for an input constant at w1, x1 = e x0 +
 // be w1. With z = p h: e = e^z, be = h (e^z - 1) / z, b = h (e^z - 1 - z) / z^2, a = be - b.
 // Complex coefficients are held as real and imaginary arrays (the march's products vectorise).
-struct StepCoefs {
+// The modes' own (mode_coefs) serve the rows inside a step too (method step 5: its sub-steps).
+struct ModeCoefs {
   Eigen::ArrayXd er, ei, ar, ai, br, bi, ber, bei;
+};
+struct StepCoefs : ModeCoefs {
   Eigen::MatrixXd z_trap, z_euler;  // port voltages per unit of end port current
 };
 
@@ -350,11 +353,22 @@ struct PortState {
   }
 };
 
-// The modes' coefficients for a sub-step of an accepted step (method step 5): the StepCoefs'
-// e, a and b without the port impedances.
-struct InnerCoefs {
-  Eigen::ArrayXd er, ei, ar, ai, br, bi;
-};
+ModeCoefs mode_coefs(const std::vector<Cplx>& poles, double h) {
+  const int q = static_cast<int>(poles.size());
+  ModeCoefs c;
+  for (auto* v : {&c.er, &c.ei, &c.ar, &c.ai, &c.br, &c.bi, &c.ber, &c.bei}) v->resize(q);
+  for (int i = 0; i < q; ++i) {
+    const Cplx z = poles[i] * h;
+    Cplx p1, p2;
+    phi12(z, &p1, &p2);
+    const Cplx e = std::exp(z), be = h * p1, b = h * p2, a = be - b;
+    c.er[i] = e.real(), c.ei[i] = e.imag();
+    c.ar[i] = a.real(), c.ai[i] = a.imag();
+    c.br[i] = b.real(), c.bi[i] = b.imag();
+    c.ber[i] = be.real(), c.bei[i] = be.imag();
+  }
+  return c;
+}
 
 // The largest step (method step 4): the user's TMAX; else, where every source is piecewise
 // linear (its corners breakpoints, so the modes take it exactly) and no switch is controlled,
@@ -396,7 +410,7 @@ class PortMarch {
   double current_shape_ratio(const PortState& s1, double h);
   // The rows strictly inside the accepted step of h from s0 to s1 (method step 5).
   Status record_inside(const PortState& s0, const PortState& s1, double h, bool euler);
-  const InnerCoefs& inner_coefs(double delta);
+  const ModeCoefs& inner_coefs(double delta);
   // The probes (model outputs) at the n - 1 points inside the step that split it into n equal
   // parts, marched from s0 with the step's input (linear in t), into rows_ (n - 1 rows of ny_).
   void probes_inside(const PortState& s0, const PortState& s1, double h, bool euler, int n);
@@ -420,7 +434,7 @@ class PortMarch {
   std::vector<double> control_sign_;
   std::vector<const Element*> port_el_;
   std::map<double, StepCoefs> cache_;
-  std::map<double, InnerCoefs> inner_cache_;
+  std::map<double, ModeCoefs> inner_cache_;
   PortState cur_, next_;
   std::array<PortState, 3> hist_;  // points since the last breakpoint, oldest first
   int hist_count_ = 0;
@@ -506,21 +520,7 @@ const StepCoefs& PortMarch::coefs(double h) {
   if (it != cache_.end()) return it->second;
   if (cache_.size() > 256) cache_.clear();
   StepCoefs c;
-  for (auto* v : {&c.er, &c.ei, &c.ar, &c.ai, &c.br, &c.bi, &c.ber, &c.bei}) v->resize(q_);
-  std::vector<Cplx> b(q_), be(q_);
-  for (int i = 0; i < q_; ++i) {
-    const Cplx z = m_.poles[i] * h;
-    Cplx p1, p2;
-    phi12(z, &p1, &p2);
-    const Cplx e = std::exp(z);
-    be[i] = h * p1;
-    b[i] = h * p2;
-    const Cplx a = be[i] - b[i];
-    c.er[i] = e.real(), c.ei[i] = e.imag();
-    c.ar[i] = a.real(), c.ai[i] = a.imag();
-    c.br[i] = b[i].real(), c.bi[i] = b[i].imag();
-    c.ber[i] = be[i].real(), c.bei[i] = be[i].imag();
-  }
+  static_cast<ModeCoefs&>(c) = mode_coefs(m_.poles, h);
   c.z_trap.setZero(np_, np_);
   c.z_euler.setZero(np_, np_);
   for (int mo = 0; mo < np_; ++mo)
@@ -530,8 +530,8 @@ const StepCoefs& PortMarch::coefs(double h) {
       Cplx st = 0, se = 0;
       for (int i = 0; i < q_; ++i) {
         const Cplx oi = out[i] * in[i];
-        st += oi * b[i];
-        se += oi * be[i];
+        st += oi * Cplx(c.br[i], c.bi[i]);
+        se += oi * Cplx(c.ber[i], c.bei[i]);
       }
       const double dir = m_.direct[ns_ + mi][ny_ + mo];
       c.z_trap(mo, mi) = st.real() + dir;
@@ -623,27 +623,16 @@ void PortMarch::record(const PortState& s) {
     w_.columns[c.column].push_back(c.sign * (s.d[c.port] + pm_.port_shunt[c.port] * s.v[c.port]));
 }
 
-const InnerCoefs& PortMarch::inner_coefs(double delta) {
+const ModeCoefs& PortMarch::inner_coefs(double delta) {
   auto it = inner_cache_.find(delta);
   if (it != inner_cache_.end()) return it->second;
   if (inner_cache_.size() > 64) inner_cache_.clear();
-  InnerCoefs c;
-  for (auto* v : {&c.er, &c.ei, &c.ar, &c.ai, &c.br, &c.bi}) v->resize(q_);
-  for (int i = 0; i < q_; ++i) {
-    const Cplx z = m_.poles[i] * delta;
-    Cplx p1, p2;
-    phi12(z, &p1, &p2);
-    const Cplx e = std::exp(z), b = delta * p2, a = delta * p1 - b;
-    c.er[i] = e.real(), c.ei[i] = e.imag();
-    c.ar[i] = a.real(), c.ai[i] = a.imag();
-    c.br[i] = b.real(), c.bi[i] = b.imag();
-  }
-  return inner_cache_.emplace(delta, std::move(c)).first->second;
+  return inner_cache_.emplace(delta, mode_coefs(m_.poles, delta)).first->second;
 }
 
 void PortMarch::probes_inside(const PortState& s0, const PortState& s1, double h, bool euler,
                               int n) {
-  const InnerCoefs& c = inner_coefs(h / n);
+  const ModeCoefs& c = inner_coefs(h / n);
   // The step's modal input, linear in t: w(0) = in.u0 + in.d0 (Euler: in.d1), w(h) = in.u1 + in.d1.
   const Eigen::ArrayXd& d0r = euler ? s1.sdr : s0.sdr;
   const Eigen::ArrayXd& d0i = euler ? s1.sdi : s0.sdi;
