@@ -37,8 +37,8 @@ class HessenbergTransfer {
   // sigma C singular or the system not finite. q = 0 is allowed: H = 0.
   Status set(const Eigen::MatrixXd& g, const Eigen::MatrixXd& c, const Eigen::MatrixXd& b,
              const Eigen::MatrixXd& l, double sigma);
-  // H(s) as an nk x np matrix (element (k, p): source k to probe p). Not thread-safe (a work
-  // array is reused between calls).
+  // H(s) as an nk x np matrix (element (k, p): source k to probe p). Thread-safe: the work
+  // arrays are each thread's own (kept between calls, so that repeated calls allocate nothing).
   Eigen::MatrixXcd at(std::complex<double> s) const;
 
  private:
@@ -52,10 +52,6 @@ class HessenbergTransfer {
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> t_;  // q x q, Hessenberg
   Eigen::MatrixXd lq_;                                                        // np x q: L Q
   Eigen::MatrixXd qab_;                                                       // q x nk: Q' A^-1 B
-  mutable std::vector<double> re_, im_;  // the shifted matrix, row-major, real and imaginary
-  mutable std::vector<double> xr_, xi_;  // the solution, q per source or probe
-  mutable std::vector<std::complex<double>> mult_;  // at_by_probes: the elimination's multipliers
-  mutable std::vector<char> swapped_;               // and its row swaps
 };
 
 }  // namespace isolink
