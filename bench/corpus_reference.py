@@ -21,6 +21,10 @@ MODE:
   0.25 ns steps at most (two tolerances that agree: the full transient at 1e-6 does not finish in
   minutes on these links; the port model's linear network is checked against the exact AC
   solution, its check printed by isolink), and both runs' deviations from it are printed.
+- `nonlinear-time`: the timing of `nonlinear-speed` without its reference (which takes hours
+  on the 20-100 m links): isolink at its defaults best of 3 (each run's wall time with process
+  start), ngspice at its defaults once, one link after the other; also the port model's size
+  and its build time as isolink prints them. No deviation, no limit.
 For specs FIRST..FIRST+COUNT-1 of the random link corpus (tools/link_corpus.py, drawn with SEED:
 links none of the examples are), the exported netlist (down direction) through that run and the
 reference, twice: `--engine transient --reltol 1e-6` with trapezoidal and with Gear-2 steps (two
@@ -40,7 +44,7 @@ import time
 here = os.path.dirname(os.path.abspath(__file__))
 args = sys.argv[1:]
 mode = args.pop(0) if args else ""
-if mode not in ("defaults", "nonlinear", "nonlinear-speed"):
+if mode not in ("defaults", "nonlinear", "nonlinear-speed", "nonlinear-time"):
     sys.exit(__doc__)
 isolink = os.path.abspath(args[0] if len(args) > 0 else os.path.join(here, "..", "build", "cli",
                                                                      "isolink"))
@@ -91,9 +95,10 @@ def sim(cir, out, *args):
     span = [] if tstop == "full" else ["--tstop", tstop]
     r = subprocess.run([isolink, "sim", cir, "-p", "v(rxp,rxn)", "-o", out, *span, *args],
                        capture_output=True, text=True)
+    seconds = time.monotonic() - start  # the run alone, not the reading of its rows below
     if r.returncode != 0:
         sys.exit("isolink sim %s %s: %s" % (cir, " ".join(args), r.stderr.strip()))
-    return load(out), time.monotonic() - start, r.stderr
+    return load(out), seconds, r.stderr
 
 
 def ngspice(cir, out):
@@ -111,6 +116,22 @@ def ngspice(cir, out):
     seconds = time.monotonic() - start
     rows = [l.split() for l in open(out) if l.strip()]
     return ([float(r[0]) for r in rows], [float(r[1]) for r in rows]), seconds
+
+
+def time_row(i, cir, length, iso):
+    """nonlinear-time: one table row (isolink best of 3, ngspice once)."""
+    runs = [sim(cir, cir + ".d.csv") for _ in range(3)]
+    err = runs[0][2]
+    unknowns = int(err.split(" unknowns")[0].split()[-1])
+    model = err.split("; model ")[1].split(" s")[0] if "; model " in err else "-"
+    modes = err.split(" modes (order ")[0].split()[-1] if " modes (order " in err else "-"
+    order = err.split(" modes (order ")[1].split(",")[0] if " modes (order " in err else "-"
+    steps = err.split(" steps accepted")[0].split()[-1] if " steps accepted" in err else "-"
+    best = min(r[1] for r in runs)
+    _, t_ng = ngspice(cir, cir + ".ng.txt")
+    print("| link_%03d | %s | %s | %d | %s / %s | %s | %s | %.2f | %.2f | %.1f |"
+          % (i, length, " / ".join(iso), unknowns, modes, order, model, steps, best, t_ng,
+             t_ng / best), flush=True)
 
 
 def speed_row(i, cir, length, iso):
@@ -132,7 +153,11 @@ with tempfile.TemporaryDirectory() as work:
     subprocess.run([sys.executable, os.path.join(here, "..", "tools", "link_corpus.py"), "--seed",
                     str(seed), "--first", str(first), "--count", str(count), "--out", work],
                    check=True)
-    if mode == "nonlinear-speed":
+    if mode == "nonlinear-time":
+        print("| spec | length (m) | tx / rx isolation | unknowns | modes / order | model s | "
+              "steps (kept run) | isolink s | ngspice s | ngspice / isolink |")
+        print("|---|---|---|---|---|---|---|---|---|---|")
+    elif mode == "nonlinear-speed":
         print("| spec | length (m) | tx / rx isolation | unknowns | isolink s | ngspice s | ngspice / "
               "isolink | isolink - reference (mV) | ngspice - reference (mV) | reference 1e-6 - 1e-7 "
               "(mV) | reference s |")
@@ -158,6 +183,9 @@ with tempfile.TemporaryDirectory() as work:
         cir = os.path.join(work, "link_%03d.cir" % i)
         subprocess.run([isolink, "export-spice", spec, "--direction", "down", "-o", cir],
                        check=True, capture_output=True)
+        if mode == "nonlinear-time":
+            time_row(i, cir, length, iso)
+            continue
         if mode == "nonlinear-speed":
             dev = speed_row(i, cir, length, iso)
             worst_all = max(worst_all, dev)
@@ -184,6 +212,8 @@ with tempfile.TemporaryDirectory() as work:
         print("| link_%03d | %s | %s | %d | %.1f | %s, %s | %.1f | %.1f | %.2f | %.2f |"
               % (i, length, " / ".join(iso) or "?", unknowns, t_d, engine, reltol, t_trap, t_gear,
                  ref_spread * 1e3, dev * 1e3), flush=True)
+    if mode == "nonlinear-time":
+        sys.exit(0)
     print("worst: %.2f mV over the links above (limit %g mV)%s" % (
         worst_all * 1e3, LIMIT_MV, "; FAIL " + ", ".join(failures) if failures else ""))
     sys.exit(1 if failures else 0)

@@ -11,7 +11,8 @@
 //    gathers, for every source k: its DC solution G^-1 e_k (so the model's DC gain is exact), and
 //    at each expansion point s0 = j 2 pi f the Krylov vectors A^-1 e_k, (A^-1 C) A^-1 e_k, ...
 //    (`moments` of them; A = G + s0 C), real and imaginary parts added separately so that the
-//    moments at s0 and its conjugate both match. Vectors already in the span are dropped.
+//    moments at s0 and its conjugate both match. Vectors already in the span are dropped
+//    (orthogonalised one by one against all before them; `Basis` in the .cpp says how).
 // 2. The projected system Gr = V'GV, Cr = V'CV, br = V'e, lr = l V is diagonalised through
 //    M = (Gr + sigma Cr)^-1 Cr = W diag(lambda) W^-1 (sigma real, where Gr + sigma Cr is
 //    regular, so singular G or C are fine): a mode with lambda = 0 is instantaneous and joins the
