@@ -419,6 +419,11 @@ class PortMarch {
   double inner_deviation(const PortState& s0, const PortState& s1, int n) const;
   double euler_start_ratio(const PortState& s1) const;
   void update_tolerances(const PortState& s);
+  // Port m's element current in state s: the current d the model takes plus the shunt's
+  // give-back g_s v.
+  double element_current(const PortState& s, int m) const {
+    return s.d[m] + pm_.port_shunt[m] * s.v[m];
+  }
   void record(const PortState& s);
   Status newton_failed(double t, double h) const;
 
@@ -619,8 +624,8 @@ void PortMarch::record(const PortState& s) {
   if (s.t < opt_.tstart - tiny_) return;
   w_.time.push_back(s.t);
   for (int p = 0; p < ny_; ++p) w_.columns[pm_.probe_column[p]].push_back(s.y[p]);
-  for (const PortModel::PortCurrentProbe& c : pm_.port_current_probes)  // d + g_s v: the port's
-    w_.columns[c.column].push_back(c.sign * (s.d[c.port] + pm_.port_shunt[c.port] * s.v[c.port]));
+  for (const PortModel::PortCurrentProbe& c : pm_.port_current_probes)
+    w_.columns[c.column].push_back(c.sign * element_current(s, c.port));
 }
 
 const ModeCoefs& PortMarch::inner_coefs(double delta) {
@@ -714,12 +719,9 @@ Status PortMarch::record_inside(const PortState& s0, const PortState& s1, double
     w_.time.push_back(t);
     for (int p = 0; p < ny_; ++p)
       w_.columns[pm_.probe_column[p]].push_back(rows_[static_cast<size_t>(k - 1) * ny_ + p]);
-    for (const PortModel::PortCurrentProbe& c : pm_.port_current_probes) {
-      auto at = [&](const PortState& s) {
-        return s.d[c.port] + pm_.port_shunt[c.port] * s.v[c.port];
-      };
-      w_.columns[c.column].push_back(c.sign * ((1 - f) * at(s0) + f * at(s1)));
-    }
+    for (const PortModel::PortCurrentProbe& c : pm_.port_current_probes)
+      w_.columns[c.column].push_back(
+          c.sign * ((1 - f) * element_current(s0, c.port) + f * element_current(s1, c.port)));
   }
   return Status::Ok();
 }

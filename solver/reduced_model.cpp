@@ -519,7 +519,6 @@ double Reducer::error_at(size_t f) const {
 // link's port model (order up to 667, 13 models, 48-133 frequencies) a fifth of its time.
 void Reducer::measure() {
   model_.stats.error = 0;
-  errors_.resize(freqs_.size());
   measure_range(0);
   for (size_t f = 0; f < freqs_.size(); ++f) {
     const double e = errors_[f];
