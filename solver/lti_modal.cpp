@@ -16,21 +16,13 @@
 #include <utility>
 #include <vector>
 
+#include "base/wide_simd.h"
 #include "solver/lti.h"
 #include "solver/lti_internal.h"
 
 namespace isolink {
 
-// The march's hot loops built twice on x86-64 by GCC, for AVX2 with FMA and for the baseline, the
-// loader picking one for the machine (function multiversioning; other compilers and machines
-// build the baseline alone): the same binary runs anywhere and uses four lanes where it can. The
-// two may differ in the last bits (a fused multiply-add rounds once): a run is the same on every
-// machine of one kind, and within rounding across kinds.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define ISOLINK_WIDE_SIMD __attribute__((target_clones("arch=x86-64-v3", "default")))
-#else
-#define ISOLINK_WIDE_SIMD
-#endif
+// The march's hot loops: ISOLINK_WIDE_SIMD (base/wide_simd.h).
 
 using lti_internal::coarsest_grid_step;
 using lti_internal::Phi;

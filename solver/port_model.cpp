@@ -11,6 +11,7 @@
 #include <optional>
 #include <utility>
 
+#include "base/wide_simd.h"
 #include "solver/elements/source_function.h"
 #include "solver/mna.h"
 #include "solver/mna_system.h"
@@ -454,16 +455,25 @@ class PortMarch {
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
   Eigen::VectorXd f_, dv_;
   std::vector<double> dd_, v_oc_, v_, bend_;
-  // The model as real matrices (complex ones split): inputs (sources, then ports) by column,
-  // outputs (probes, then port voltages) by row.
+  // The model as real matrices (complex ones split): inputs (sources, then ports) and outputs
+  // (probes, then port voltages) by column, each a contiguous array over the modes.
   Eigen::MatrixXd in_re_, in_im_;    // modes x inputs
-  Eigen::MatrixXd out_re_, out_im_;  // outputs x modes
+  Eigen::MatrixXd out_re_, out_im_;  // modes x outputs
   Eigen::MatrixXd direct_;           // outputs x inputs
   Eigen::VectorXd offset_;           // per output
   Eigen::ArrayXd scratch_r_, scratch_i_;
   Eigen::ArrayXd in_xr_, in_xi_, in_wr_, in_wi_, in_nr_, in_ni_;  // probes_inside's march
   Eigen::ArrayXd in_dwr_, in_dwi_;
   std::vector<double> inner_u_, inner_d_;
+  // Output o's modal part, Re sum_i out_i x_i (the march's hot products written out here, not as
+  // Eigen's matrix-vector products, which are compiled once for the baseline: inlined into the
+  // ISOLINK_WIDE_SIMD callers they use their four lanes).
+  double modal_output(int o, const Eigen::ArrayXd& xr, const Eigen::ArrayXd& xi) const {
+    return out_re_.col(o).dot(xr.matrix()) - out_im_.col(o).dot(xi.matrix());
+  }
+  // re + j im = the inputs from..from + count - 1 weighted by w.
+  void weighted_inputs(int from, int count, const double* w, Eigen::ArrayXd& re,
+                       Eigen::ArrayXd& im) const;
   // in.u and in.d of state s (its u and d).
   void modal_inputs(const PortState& s, Eigen::ArrayXd& sur, Eigen::ArrayXd& sui,
                     Eigen::ArrayXd& sdr, Eigen::ArrayXd& sdi) const;
@@ -495,10 +505,10 @@ PortMarch::PortMarch(const Circuit& circuit, const PortModel& pm, const Transien
   for (int k = 0; k < nin; ++k)
     for (int i = 0; i < q_; ++i)
       in_re_(i, k) = m_.input[k][i].real(), in_im_(i, k) = m_.input[k][i].imag();
-  out_re_.resize(nout, q_), out_im_.resize(nout, q_);
+  out_re_.resize(q_, nout), out_im_.resize(q_, nout);
   for (int o = 0; o < nout; ++o)
     for (int i = 0; i < q_; ++i)
-      out_re_(o, i) = m_.output[o][i].real(), out_im_(o, i) = m_.output[o][i].imag();
+      out_re_(i, o) = m_.output[o][i].real(), out_im_(i, o) = m_.output[o][i].imag();
   direct_.resize(nout, nin);
   for (int k = 0; k < nin; ++k)
     for (int o = 0; o < nout; ++o) direct_(o, k) = m_.direct[k][o];
@@ -546,11 +556,38 @@ const StepCoefs& PortMarch::coefs(double h) {
   return cache_.emplace(h, std::move(c)).first->second;
 }
 
+// Two inputs a pass over the modes (half the loads and stores of one at a time).
+ISOLINK_WIDE_SIMD void PortMarch::weighted_inputs(int from, int count, const double* w,
+                                                  Eigen::ArrayXd& re, Eigen::ArrayXd& im) const {
+  re.resize(q_), im.resize(q_);
+  double* rr = re.data();
+  double* ri = im.data();
+  const size_t q = static_cast<size_t>(q_);
+  int k = 0;
+  if (count % 2 == 1) {
+    const double* ar = in_re_.data() + (from + k) * q;
+    const double* ai = in_im_.data() + (from + k) * q;
+    for (size_t i = 0; i < q; ++i) rr[i] = ar[i] * w[k], ri[i] = ai[i] * w[k];
+    ++k;
+  } else {
+    for (size_t i = 0; i < q; ++i) rr[i] = 0.0, ri[i] = 0.0;
+  }
+  for (; k + 1 < count; k += 2) {
+    const double* ar = in_re_.data() + (from + k) * q;
+    const double* ai = in_im_.data() + (from + k) * q;
+    const double *br = ar + q, *bi = ai + q;
+    const double wa = w[k], wb = w[k + 1];
+    for (size_t i = 0; i < q; ++i) {
+      rr[i] += ar[i] * wa + br[i] * wb;
+      ri[i] += ai[i] * wa + bi[i] * wb;
+    }
+  }
+}
+
 void PortMarch::modal_inputs(const PortState& s, Eigen::ArrayXd& sur, Eigen::ArrayXd& sui,
                              Eigen::ArrayXd& sdr, Eigen::ArrayXd& sdi) const {
-  const Eigen::Map<const Eigen::VectorXd> u(s.u.data(), ns_), d(s.d.data(), np_);
-  sur = (in_re_.leftCols(ns_) * u).array(), sui = (in_im_.leftCols(ns_) * u).array();
-  sdr = (in_re_.rightCols(np_) * d).array(), sdi = (in_im_.rightCols(np_) * d).array();
+  weighted_inputs(0, ns_, s.u.data(), sur, sui);
+  weighted_inputs(ns_, np_, s.d.data(), sdr, sdi);
 }
 
 Status PortMarch::initial_state() {
@@ -578,7 +615,8 @@ Status PortMarch::initial_state() {
     s.xr[i] = xm.real(), s.xi[i] = xm.imag();
   }
   // The model's outputs in that steady state against the circuit's operating point.
-  const Eigen::VectorXd modal = out_re_ * s.xr.matrix() - out_im_ * s.xi.matrix();
+  const Eigen::VectorXd modal =
+      out_re_.transpose() * s.xr.matrix() - out_im_.transpose() * s.xi.matrix();
   double mismatch = 0, allowed = 0;
   s.y.resize(ny_);
   for (int o = 0; o < ny_ + np_; ++o) {
@@ -635,8 +673,8 @@ const ModeCoefs& PortMarch::inner_coefs(double delta) {
   return inner_cache_.emplace(delta, mode_coefs(m_.poles, delta)).first->second;
 }
 
-void PortMarch::probes_inside(const PortState& s0, const PortState& s1, double h, bool euler,
-                              int n) {
+ISOLINK_WIDE_SIMD void PortMarch::probes_inside(const PortState& s0, const PortState& s1, double h,
+                                                bool euler, int n) {
   const ModeCoefs& c = inner_coefs(h / n);
   // The step's modal input, linear in t: w(0) = in.u0 + in.d0 (Euler: in.d1), w(h) = in.u1 + in.d1.
   const Eigen::ArrayXd& d0r = euler ? s1.sdr : s0.sdr;
@@ -664,8 +702,7 @@ void PortMarch::probes_inside(const PortState& s0, const PortState& s1, double h
     // the end value over the step; the instant's own current is nearer the line).
     for (int m = 0; m < np_; ++m) d[m] = s0.d[m] + f * (s1.d[m] - s0.d[m]);
     Eigen::Map<Eigen::VectorXd> y(rows_.data() + static_cast<size_t>(k - 1) * ny_, ny_);
-    y.noalias() = out_re_.topRows(ny_) * in_xr_.matrix();
-    y.noalias() -= out_im_.topRows(ny_) * in_xi_.matrix();
+    for (int p = 0; p < ny_; ++p) y[p] = modal_output(p, in_xr_, in_xi_);
     y.noalias() +=
         direct_.topLeftCorner(ny_, ns_) * Eigen::Map<const Eigen::VectorXd>(u.data(), ns_);
     y.noalias() +=
@@ -728,8 +765,8 @@ Status PortMarch::record_inside(const PortState& s0, const PortState& s1, double
 
 // Newton on the port voltages: v = v_oc + Z_h d(v), d the port current with its charge's
 // current by the step's formula; v in: the first iterate, out: the solution (into next_ too).
-bool PortMarch::newton(const StepCoefs& c, double h, bool euler, const std::vector<double>& v_oc,
-                       std::vector<double>& v) {
+ISOLINK_WIDE_SIMD bool PortMarch::newton(const StepCoefs& c, double h, bool euler,
+                                         const std::vector<double>& v_oc, std::vector<double>& v) {
   const Eigen::MatrixXd& z = euler ? c.z_euler : c.z_trap;
   const double a0 = euler ? 1.0 / h : 2.0 / h;
   const NewtonTolerances& tol = opt_.newton;
@@ -791,7 +828,7 @@ bool PortMarch::newton(const StepCoefs& c, double h, bool euler, const std::vect
   return false;
 }
 
-Status PortMarch::advance(double h, bool euler, bool* converged) {
+ISOLINK_WIDE_SIMD Status PortMarch::advance(double h, bool euler, bool* converged) {
   const StepCoefs& c = coefs(h);
   const PortState& s0 = cur_;
   PortState& s1 = next_;
@@ -799,8 +836,7 @@ Status PortMarch::advance(double h, bool euler, bool* converged) {
   s1.u.resize(ns_);
   for (int k = 0; k < ns_; ++k) s1.u[k] = sources_[k]->value(s1.t);
   const Eigen::Map<const Eigen::VectorXd> u1(s1.u.data(), ns_);
-  s1.sur.matrix().noalias() = in_re_.leftCols(ns_) * u1;
-  s1.sui.matrix().noalias() = in_im_.leftCols(ns_) * u1;
+  weighted_inputs(0, ns_, s1.u.data(), s1.sur, s1.sui);
   // x1 = e x0 + a (su0 [+ sd0]) + b su1, complex products in real arrays.
   Eigen::ArrayXd& wr = scratch_r_;
   Eigen::ArrayXd& wi = scratch_i_;
@@ -815,8 +851,7 @@ Status PortMarch::advance(double h, bool euler, bool* converged) {
   std::vector<double>& v = v_;
   {
     Eigen::Map<Eigen::VectorXd> voc(v_oc.data(), np_);
-    voc.noalias() = out_re_.middleRows(ny_, np_) * s1.xr.matrix();
-    voc.noalias() -= out_im_.middleRows(ny_, np_) * s1.xi.matrix();
+    for (int m = 0; m < np_; ++m) voc[m] = modal_output(ny_ + m, s1.xr, s1.xi);
     voc.noalias() += direct_.block(ny_, 0, np_, ns_) * u1;
     voc += offset_.segment(ny_, np_);
   }
@@ -834,8 +869,7 @@ Status PortMarch::advance(double h, bool euler, bool* converged) {
     return Status::Ok();
   }
   const Eigen::Map<const Eigen::VectorXd> d1(s1.d.data(), np_);
-  s1.sdr.matrix().noalias() = in_re_.rightCols(np_) * d1;
-  s1.sdi.matrix().noalias() = in_im_.rightCols(np_) * d1;
+  weighted_inputs(ns_, np_, s1.d.data(), s1.sdr, s1.sdi);
   const Eigen::ArrayXd& bdr = euler ? c.ber : c.br;
   const Eigen::ArrayXd& bdi = euler ? c.bei : c.bi;
   s1.xr += bdr * s1.sdr - bdi * s1.sdi;
@@ -843,8 +877,7 @@ Status PortMarch::advance(double h, bool euler, bool* converged) {
   s1.y.resize(ny_);
   if (ny_ > 0) {
     Eigen::Map<Eigen::VectorXd> y1(s1.y.data(), ny_);
-    y1.noalias() = out_re_.topRows(ny_) * s1.xr.matrix();
-    y1.noalias() -= out_im_.topRows(ny_) * s1.xi.matrix();
+    for (int p = 0; p < ny_; ++p) y1[p] = modal_output(p, s1.xr, s1.xi);
     y1.noalias() += direct_.topLeftCorner(ny_, ns_) * u1;
     y1.noalias() += direct_.block(0, ns_, ny_, np_) * d1;
     y1 += offset_.head(ny_);

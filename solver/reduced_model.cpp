@@ -12,6 +12,7 @@
 #include <numbers>
 
 #include "solver/ac.h"
+#include "solver/dense_lapack.h"
 #include "solver/hessenberg_transfer.h"
 
 namespace isolink {
@@ -99,14 +100,17 @@ struct Basis {
     const int q0 = q;
     const Eigen::VectorXd norm0 = x.colwise().norm().transpose();
     if (q0 > 0) {
-      // In column slices on every core (Eigen's products run on one).
-      const Eigen::Index cols = x.cols(), slice = std::max<Eigen::Index>(8, (cols + 7) / 8);
-      tbb::parallel_for(Eigen::Index{0}, (cols + slice - 1) / slice, [&](Eigen::Index s) {
-        auto xs = x.middleCols(s * slice, std::min(slice, cols - s * slice));
+      // In slices of kSlice columns on every core (the products run on one each); the slices do
+      // not depend on the core count, so neither does the rounding.
+      constexpr Eigen::Index kSlice = 32;
+      const Eigen::Index cols = x.cols();
+      tbb::parallel_for(Eigen::Index{0}, (cols + kSlice - 1) / kSlice, [&](Eigen::Index s) {
+        auto xs = x.middleCols(s * kSlice, std::min(kSlice, cols - s * kSlice));
         const auto old = v.leftCols(q0);
+        Eigen::MatrixXd h(q0, xs.cols());
         for (int pass = 0; pass < 2; ++pass) {
-          const Eigen::MatrixXd h = old.transpose() * xs;
-          xs.noalias() -= old * h;
+          dense_multiply(true, 1.0, old, xs, 0.0, h);    // h = old' xs
+          dense_multiply(false, -1.0, old, h, 1.0, xs);  // xs -= old h
         }
       });
     }
@@ -131,8 +135,8 @@ struct Basis {
     const auto basis = v.middleCols(from, to - from);
     Eigen::VectorXd h(to - from);
     for (int pass = 0; pass < 3; ++pass) {
-      h.noalias() = basis.transpose() * *x;
-      x->noalias() -= basis * h;
+      dense_multiply(true, 1.0, basis, *x, 0.0, h);
+      dense_multiply(false, -1.0, basis, h, 1.0, *x);
       const double left = x->norm();
       const bool enough = pass >= 1 && left > 0.5 * norm;
       norm = left;
@@ -545,10 +549,10 @@ void Reducer::project() {
   cr_.conservativeResize(q, q);
   const auto v = basis_.v.leftCols(q);
   const auto added = basis_.v.middleCols(q0, q - q0);
-  gr_.rightCols(q - q0) = v.transpose() * basis_.gv.middleCols(q0, q - q0);
-  cr_.rightCols(q - q0) = v.transpose() * basis_.cv.middleCols(q0, q - q0);
-  gr_.bottomLeftCorner(q - q0, q0) = added.transpose() * basis_.gv.leftCols(q0);
-  cr_.bottomLeftCorner(q - q0, q0) = added.transpose() * basis_.cv.leftCols(q0);
+  dense_multiply(true, 1.0, v, basis_.gv.middleCols(q0, q - q0), 0.0, gr_.rightCols(q - q0));
+  dense_multiply(true, 1.0, v, basis_.cv.middleCols(q0, q - q0), 0.0, cr_.rightCols(q - q0));
+  dense_multiply(true, 1.0, added, basis_.gv.leftCols(q0), 0.0, gr_.bottomLeftCorner(q - q0, q0));
+  dense_multiply(true, 1.0, added, basis_.cv.leftCols(q0), 0.0, cr_.bottomLeftCorner(q - q0, q0));
 }
 
 // Brings Gr and Cr up to the basis (project()) and gives the projected inputs Br = V'B (q x nk,
@@ -635,43 +639,33 @@ StatusOr<bool> Reducer::accept() {
 // The reduced pencil's eigen-decomposition as poles and residues in `mod`: direct terms for the
 // instantaneous modes, right-half-plane poles dropped (and counted).
 Status Reducer::modal_form(ReducedModel* mod) {
-  const int q = basis_.q;
   Eigen::MatrixXd br, lr;
   project_ports(&br, &lr);
   const double sigma = this->sigma();
   StatusOr<ShiftInvert> si = shift_invert(gr_, cr_, br, sigma);
   if (!si) return si.status();
-  const Eigen::MatrixXd& ab = si->ab;
-  Eigen::EigenSolver<Eigen::MatrixXd> es(si->m);
-  if (es.info() != Eigen::Success)
-    return Status::Error("reduced model: the eigenvalue problem did not converge");
-  const Eigen::VectorXcd lambda = es.eigenvalues();
-  const Eigen::MatrixXcd w = es.eigenvectors();
-  Eigen::PartialPivLU<Eigen::MatrixXcd> wlu(w);
-  const Eigen::MatrixXcd d = wlu.solve(ab.cast<Cplx>());  // q x nk
-  const Eigen::MatrixXcd cw = lr.cast<Cplx>() * w;        // np x q
-  if (!d.allFinite() || !cw.allFinite())
-    return Status::Error("reduced model: the eigenvectors are singular");
-  double lmax = 0;
-  for (int i = 0; i < q; ++i) lmax = std::max(lmax, std::abs(lambda[i]));
   // Instantaneous: lambda = 0, or a mode so fast (|lambda| under 1e-6 / (2 pi f_max): a time
   // constant of 0.05 fs, a pole over 2e16 rad/s) that its share 1 / (1 + (s - sigma) lambda)
-  // is constant within 1e-6 over the whole band. The zero eigenvalues of a singular Cr come
-  // out at about 1e-12 of the largest, of either sign: on V -> L -> R at +-1e-19 s against
-  // 9e-8 s, one was a pole at -8.9e18 rad/s and the other a right-half-plane pole, dropped,
-  // and v(in) lost its direct term (error 1).
+  // is constant within 1e-6 over the whole band: the direct terms. The zero eigenvalues of a
+  // singular Cr come out at about 1e-12 of the largest, of either sign: on V -> L -> R at +-1e-19
+  // s against 9e-8 s, one was a pole at -8.9e18 rad/s and the other a right-half-plane pole,
+  // dropped, and v(in) lost its direct term (error 1).
   const double instant = 1e-6 / (2 * std::numbers::pi * opt_.f_max);
-  for (int i = 0; i < q; ++i) {
-    if (std::abs(lambda[i]) <= std::max(1e-14 * lmax, instant)) {
-      ++mod->stats.direct_modes;
-      for (size_t k = 0; k < nk_; ++k)
-        for (size_t p = 0; p < np_; ++p) mod->direct[k][p] += (cw(p, i) * d(i, k)).real();
-      continue;
-    }
+  StatusOr<ModalSplit> split = modal_split(si->m, si->ab, lr, 1e-14, instant);
+  if (!split) return Status::Error("reduced model: " + split.status().message());
+  mod->stats.direct_modes += split->rest_count;
+  for (size_t k = 0; k < nk_; ++k)
+    for (size_t p = 0; p < np_; ++p) mod->direct[k][p] += split->rest(p, k);
+  const Eigen::VectorXcd& lambda = split->values;
+  const Eigen::MatrixXcd& d = split->inputs;    // modes x nk
+  const Eigen::MatrixXcd& cw = split->outputs;  // np x modes
+  const int modes_in = static_cast<int>(lambda.size());
+  for (int i = 0; i < modes_in; ++i) {
     const Cplx pole = sigma - 1.0 / lambda[i];
     // A complex pole's conjugate (the next eigenvalue: a real matrix's come in exact pairs,
     // with conjugate vectors) is carried by it: one mode, output doubled, real part taken.
-    const bool paired = lambda[i].imag() != 0 && i + 1 < q && lambda[i + 1] == std::conj(lambda[i]);
+    const bool paired =
+        lambda[i].imag() != 0 && i + 1 < modes_in && lambda[i + 1] == std::conj(lambda[i]);
     const int modes = paired ? 2 : 1;
     if (paired) ++i;
     const int at = paired ? i - 1 : i;

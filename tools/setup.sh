@@ -12,6 +12,7 @@ PACKAGES=(
   build-essential cmake ccache pkg-config python3
   libeigen3-dev libsuitesparse-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libfmt-dev
   libopenimageio-dev openimageio-tools libtbb-dev fonts-dejavu-core
+  libopenblas-dev  # LAPACK and BLAS for the reduced model's dense algebra (solver/dense_lapack.h)
   openmpi-bin libopenmpi-dev
   libceres-dev  # isolink compare's fit (analysis/compare_fit.cpp)
   libgtest-dev libgmock-dev libbenchmark-dev ngspice
