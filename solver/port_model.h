@@ -91,7 +91,9 @@ namespace isolink {
 
 struct PortModelOptions {
   // The reltol the engine's caller runs it at when the user gave none (analysis/simulate.cpp),
-  // then checks at a tenth of it: the transient's 1e-3. XXX figures
+  // the transient's 1e-3; the run is then checked at a tenth of it (transient_check.h, both at
+  // once) and the tighter kept when the two agree within 3 mV. On the corpus's nonlinear links
+  // the kept run was 0.10-1.06 mV from a converged reference (bench/README.md).
   double default_reltol = 1e-3;
   // S, the conductance across every diode's port in the linear network (given back by the
   // port's current): bounds each port's self-impedance by 1 / port_shunt. Its give-back, -g_s v,
@@ -116,6 +118,11 @@ struct PortModelOptions {
   // 3.4-16 s, the peaks within 0.4 mV. A lossless ladder of equal sections does not reduce: the
   // 50 m clamp hop (436 unknowns) reaches full order through 23 expansion points in 2.5 s where
   // the full basis takes 0.8 s (500 was the bound before: bench/README.md).
+  // Five expansion points a search step, not three: on the corpus's 44-100 m TVS links (order
+  // 850-970) each step's model costs O(q^3), and fewer steps took their models 7-16 % faster
+  // (019: 5.4 -> 4.4 s), the waveforms within 0.015 mV; 11-32 m links the same within 4 %.
+  // Four moments a point were faster on two of ten long links and slower on eight; two kept
+  // link 019's model past 9 minutes (stopped there; bench/README.md, "Dense linear algebra").
   ReducedModelOptions reduced = [] {
     ReducedModelOptions r;
     r.tol = 2e-6;
@@ -123,6 +130,7 @@ struct PortModelOptions {
     r.full_order_at_most = 150;
     r.difference_scale = true;
     r.stall_tol = 1e-4;
+    r.batch = 5;
     return r;
   }();
   // When the first model fails its check, the other is tried on a network of at most this many
