@@ -9,9 +9,9 @@
 // or AVX2 with FMA), where Eigen's products are compiled for the x86-64 baseline (SSE2). On one
 // core of the development machine (bench/dense_lapack_bench, bench/README.md "Dense linear
 // algebra"), on matrices shaped like a long link's model: the modal form (eigen-decomposition and
-// the inputs' solve) at order 667 in 98 ms against Eigen's 624, at order 970 in 291 against
-// 2,020; the Hessenberg form at order 667 in 40 ms against 108, at 970 in 135 against 411; one
-// pass of 96 Krylov vectors against a basis of 600 in 5.6 ms against 25.9.
+// the inputs' solve) at order 667 in 98 ms against Eigen's 468, at order 970 in 273 against
+// 1,465; the Hessenberg form at order 667 in 29 ms against 75, at 970 in 79 against 218; one
+// pass of 96 Krylov vectors against a basis of 600 in 7.7 ms against 19.6: 2.5-5.4x.
 //
 // Threads: OpenBLAS runs on one thread here (set once, at the first call, for the whole process):
 // the callers already run on every core (a sweep's points, the basis's column slices, the check's
