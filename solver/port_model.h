@@ -121,8 +121,8 @@ struct PortModelOptions {
   // Five expansion points a search step, not three: on the corpus's 44-100 m TVS links (order
   // 850-970) each step's model costs O(q^3), and fewer steps took their models 7-16 % faster
   // (019: 5.4 -> 4.4 s), the waveforms within 0.015 mV; 11-32 m links the same within 4 %.
-  // Four moments a point were faster on two of ten long links and slower on eight; two kept
-  // link 019's model past 9 minutes (stopped there; bench/README.md, "Dense linear algebra").
+  // Four moments a point were faster on two of ten long links and slower on eight; with two,
+  // link 019's run went past 9 minutes (bench/README.md, "Dense linear algebra").
   ReducedModelOptions reduced = [] {
     ReducedModelOptions r;
     r.tol = 2e-6;
