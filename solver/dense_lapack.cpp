@@ -65,10 +65,6 @@ Status check_square(const Eigen::MatrixXd& m, const char* what) {
   return Status::Ok();
 }
 
-}  // namespace
-
-namespace {
-
 // The real Schur form m = z s z' (dgees) with eigenvalues wr + i wi.
 struct Schur {
   Eigen::MatrixXd s, z;
@@ -123,7 +119,7 @@ StatusOr<Eigen::MatrixXcd> block_eigenvectors(const double* t, int n, int ldt,
 }
 
 // Moves the eigenvalues `chosen` marks to the leading block of f (dtrsen).
-Status reorder(Schur* f, std::vector<int> chosen) {
+Status reorder(Schur* f, const std::vector<int>& chosen) {
   const int n = static_cast<int>(f->s.rows());
   int m = 0, info = 0, liwork = 1, iwork = 0;
   double s = 0, sep = 0;
@@ -236,6 +232,7 @@ void apply_reflections(const Eigen::MatrixXd& reflectors, const Eigen::VectorXd&
   lwork = static_cast<int>(work.size());
   dormhr_(side, trans, &rows, &cols, &ilo, &q, reflectors.data(), &q, tau.data(), c->data(), &rows,
           work.data(), &lwork, &info, 1, 1);
+  assert(info == 0);  // only an argument error, which the sizes above rule out
 }
 
 }  // namespace

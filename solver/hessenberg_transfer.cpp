@@ -13,7 +13,7 @@ namespace {
 // One thread's work arrays for HessenbergTransfer::at.
 struct Work {
   std::vector<double> re, im;                 // the shifted matrix, row-major, real and imaginary
-  std::vector<double> xr, xi;                 // the solution, q per source or probe
+  std::vector<double> xr, xi;                 // at_by_sources: the solution, q per source
   std::vector<std::complex<double>> mult;     // at_by_probes: the elimination's multipliers
   std::vector<char> swapped;                  // and its row swaps
   std::vector<std::complex<double>> c, u, w;  // at_by_probes: the probes' rows, U's block, w
