@@ -235,6 +235,15 @@ Status KluSolver::analyze(const MnaPattern& pattern, Ordering ordering) {
     if (!m.symbolic) return Status::Error("KLU symbolic analysis (nested dissection) failed");
     return Status::Ok();
   }
+  if (ordering == Ordering::Colamd) {
+    const int kept = m.common.ordering;
+    m.common.ordering = 1;  // COLAMD
+    m.symbolic = klu_analyze(m.n, m.ap.data(), m.ai.data(), &m.common);
+    m.common.ordering = kept;
+    m.ordering = "colamd";
+    if (!m.symbolic) return Status::Error("KLU symbolic analysis (COLAMD) failed");
+    return Status::Ok();
+  }
   m.symbolic = klu_analyze(m.n, m.ap.data(), m.ai.data(), &m.common);
   m.ordering = "amd";
   if (!m.symbolic) return Status::Error("KLU symbolic analysis failed");

@@ -98,16 +98,17 @@ struct MnaSystem {
     return s;
   }
 
-  // Factors G (the DC matrix) into dc_klu. It has its own KluSolver with KLU's default ordering:
-  // at DC the inductor branches have no diagonal and KLU pivots away from a fill-reducing order,
-  // so this matrix says nothing about which ordering suits the transient matrices; the transient
-  // KluSolver decides on its first (transient) factorization instead. The rows of `held` unknowns
-  // and of the inductors the circuit opened at DC (Circuit::dc_open_branches) are replaced by
-  // unknown = value; dc() puts the values in the right-hand side.
+  // Factors G (the DC matrix) into dc_klu. It has its own KluSolver, ordered by COLAMD: at DC the
+  // inductor branches have no diagonal and KLU pivots away from a symmetric fill-reducing order
+  // (klu_solver.h), so this matrix says nothing about which ordering suits the transient
+  // matrices; the transient KluSolver decides on its first (transient) factorization instead. The
+  // rows of `held` unknowns and of the inductors the circuit opened at DC
+  // (Circuit::dc_open_branches) are replaced by unknown = value; dc() puts the values in the
+  // right-hand side.
   Status factor_dc(const Circuit& circuit, KluSolver& dc_klu,
                    const std::vector<std::pair<int, double>>& held = {}) const {
     const std::vector<double> values = dc_values(circuit, held, nullptr);
-    if (Status s = dc_klu.analyze(pattern, KluSolver::Ordering::Amd); !s.ok()) return s;
+    if (Status s = dc_klu.analyze(pattern, KluSolver::Ordering::Colamd); !s.ok()) return s;
     return name_singular(circuit, dc_klu, dc_klu.factor(0.0, values.data()));
   }
 

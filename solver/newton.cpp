@@ -157,7 +157,7 @@ class DcNewton {
     newton_.tolerances().max_iterations = 100;
   }
   Status analyze(const MnaSystem& sys) {
-    return klu_.analyze(sys.pattern, KluSolver::Ordering::Amd);
+    return klu_.analyze(sys.pattern, KluSolver::Ordering::Colamd);
   }
 
   // Newton at conductance gshunt to ground and sources scaled by `scale`, from x (in place);
