@@ -3,12 +3,14 @@
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
 #include <numbers>
 
 #include "solver/ac.h"
@@ -220,10 +222,23 @@ class Reducer {
 
  private:
   void assemble_pencil(bool passive_form);
+  struct CheckRows {
+    bool transposed = false;
+    std::vector<std::array<AcAnalysis::Vector, 2>> node_rows;  // per probe
+    std::vector<std::vector<int>> source_rows;                 // per source: its nonzeros
+  };
+  struct ExactPoint {
+    std::vector<std::vector<Cplx>> h;            // [k][p]
+    std::vector<std::vector<double>> node_peak;  // [k][p]: max(|H_ka|, |H_kb|)
+  };
   Status add_checks(const std::vector<double>& fs);
+  CheckRows check_rows() const;
+  Status exact_at(AcAnalysis& ac, const CheckRows& rows, double f, ExactPoint* out) const;
   Status start_checks();
   void seed_basis();
   StatusOr<bool> expand_at(double f);
+  Status expand_at_all(const std::vector<double>& fs);
+  Status krylov_block(AcAnalysis& ac, double f, Eigen::MatrixXd* out) const;
   Status expand_at_first_points();
   double error_at(size_t f) const;
   void measure(bool failing_first = false);
@@ -249,6 +264,7 @@ class Reducer {
 
   const Circuit& circuit_;
   AcAnalysis& ac_;
+  std::unique_ptr<AcAnalysis> ac_second_;  // add_checks's second core
   const std::vector<std::vector<double>>& excitations_;
   const std::vector<std::vector<double>>& dc_solutions_;
   const std::vector<Probe>& probes_;
@@ -345,70 +361,105 @@ void Reducer::assemble_pencil(bool passive_form) {
 // The exact transfer at check frequencies `fs` (appended to the grid), and each (k, p)'s scale
 // grown to the peak |H|. H_kp = l_p' A^-1 e_k takes one solve per source, or one transposed
 // solve per probe, z_p = A^-T l_p and H_kp = z_p' e_k: whichever is fewer (an edge response
-// drives two sources and reads one probe).
+// drives two sources and reads one probe). The frequencies go in two halves on two cores, each
+// with its own sparse LU (the second AcAnalysis made on the first call); each half's values
+// depend on the split alone, not on the cores.
 Status Reducer::add_checks(const std::vector<double>& fs) {
-  const bool transposed = np_ < nk_;
-  // When transposed, per probe: with difference_scale, a row e_u per probe node (u = 0:
-  // ground, no row), H_kp the difference of the two nodes' transfers and node_scale_ the larger;
-  // without it, one row l_p (one solve per probe, as the LTI engine's checks need).
-  std::vector<std::array<AcAnalysis::Vector, 2>> node_rows;
-  std::vector<std::vector<int>> source_rows;  // the unknowns where e_k is not 0
-  if (transposed) {
-    for (size_t p = 0; p < np_; ++p) {
-      std::array<AcAnalysis::Vector, 2>& rows = node_rows.emplace_back();
-      const int a = probes_[p].a, b = probes_[p].b;
-      if (!opt_.difference_scale) {
-        rows[0].assign(static_cast<size_t>(n_) + 1, 0.0);
-        rows[0][a] += 1.0;
-        rows[0][b] -= 1.0;
-        rows[0][0] = 0.0;
-        continue;
+  const CheckRows rows = check_rows();
+  std::vector<ExactPoint> points(fs.size());
+  const size_t half = fs.size() / 2;
+  if (half > 0 && !ac_second_) {
+    StatusOr<AcAnalysis> second = AcAnalysis::create(circuit_);
+    if (!second) return second.status();
+    ac_second_ = std::make_unique<AcAnalysis>(std::move(*second));
+    if (Status s = ac_second_->factor(std::sqrt(opt_.f_min * opt_.f_max)); !s.ok()) return s;
+  }
+  Status first_status = Status::Ok(), second_status = Status::Ok();
+  auto run = [&](AcAnalysis& ac, size_t from, size_t to, Status* status) {
+    for (size_t i = from; i < to && status->ok(); ++i)
+      *status = exact_at(ac, rows, fs[i], &points[i]);
+  };
+  tbb::parallel_invoke([&] { run(ac_, half, fs.size(), &first_status); },
+                       [&] {
+                         if (half > 0) run(*ac_second_, 0, half, &second_status);
+                       });
+  if (!second_status.ok()) return second_status;
+  if (!first_status.ok()) return first_status;
+  for (size_t i = 0; i < fs.size(); ++i) {
+    ++st_.factorizations;
+    freqs_.push_back(fs[i]);
+    for (size_t k = 0; k < nk_; ++k)
+      for (size_t p = 0; p < np_; ++p) {
+        scale_[k][p] = std::max(scale_[k][p], std::abs(points[i].h[k][p]));
+        node_scale_[k][p] = std::max(node_scale_[k][p], points[i].node_peak[k][p]);
       }
-      for (int side = 0; side < 2; ++side) {
-        const int u = side == 0 ? a : b;
-        if (u == 0) continue;
-        rows[side].assign(static_cast<size_t>(n_) + 1, 0.0);
-        rows[side][u] = 1.0;
-      }
+    exact_.push_back(std::move(points[i].h));
+  }
+  return Status::Ok();
+}
+
+// The right-hand sides of add_checks's solves (transposed: per probe; else per source).
+Reducer::CheckRows Reducer::check_rows() const {
+  CheckRows r;
+  r.transposed = np_ < nk_;
+  if (!r.transposed) return r;
+  // Per probe: with difference_scale, a row e_u per probe node (u = 0: ground, no row), H_kp the
+  // difference of the two nodes' transfers and node_scale_ the larger; without it, one row l_p
+  // (one solve per probe, as the LTI engine's checks need).
+  for (size_t p = 0; p < np_; ++p) {
+    std::array<AcAnalysis::Vector, 2>& rows = r.node_rows.emplace_back();
+    const int a = probes_[p].a, b = probes_[p].b;
+    if (!opt_.difference_scale) {
+      rows[0].assign(static_cast<size_t>(n_) + 1, 0.0);
+      rows[0][a] += 1.0;
+      rows[0][b] -= 1.0;
+      rows[0][0] = 0.0;
+      continue;
     }
-    for (size_t k = 0; k < nk_; ++k) {
-      std::vector<int>& rows = source_rows.emplace_back();
-      for (int i = 1; i <= n_; ++i)
-        if (excitations_[k][i] != 0) rows.push_back(i);
+    for (int side = 0; side < 2; ++side) {
+      const int u = side == 0 ? a : b;
+      if (u == 0) continue;
+      rows[side].assign(static_cast<size_t>(n_) + 1, 0.0);
+      rows[side][u] = 1.0;
     }
   }
-  for (double f : fs) {
-    if (Status s = ac_.factor(f); !s.ok()) return s;
-    ++st_.factorizations;
-    freqs_.push_back(f);
-    exact_.emplace_back(nk_, std::vector<Cplx>(np_));
-    std::vector<std::vector<Cplx>>& h = exact_.back();
-    // Per source and probe: the transfers to the probe's nodes a and b (0 for ground).
-    auto take = [&](size_t k, size_t p, Cplx at_a, Cplx at_b) {
-      h[k][p] = at_a - at_b;
-      scale_[k][p] = std::max(scale_[k][p], std::abs(h[k][p]));
-      node_scale_[k][p] = std::max({node_scale_[k][p], std::abs(at_a), std::abs(at_b)});
-    };
-    if (transposed) {
-      for (size_t p = 0; p < np_; ++p) {
-        std::array<std::vector<Cplx>, 2> at;  // [side][k]
-        for (int side = 0; side < 2; ++side) {
-          at[side].assign(nk_, 0.0);
-          if (node_rows[p][side].empty()) continue;
-          const AcAnalysis::Vector z = ac_.solve_transposed(node_rows[p][side]);
-          for (size_t k = 0; k < nk_; ++k)
-            for (int i : source_rows[k]) at[side][k] += z[i] * excitations_[k][i];
-        }
-        for (size_t k = 0; k < nk_; ++k) take(k, p, at[0][k], at[1][k]);
+  for (size_t k = 0; k < nk_; ++k) {
+    std::vector<int>& nz = r.source_rows.emplace_back();
+    for (int i = 1; i <= n_; ++i)
+      if (excitations_[k][i] != 0) nz.push_back(i);
+  }
+  return r;
+}
+
+// The exact transfer at f through `ac` (factored there), and per pair the larger node transfer.
+Status Reducer::exact_at(AcAnalysis& ac, const CheckRows& rows, double f, ExactPoint* out) const {
+  if (Status s = ac.factor(f); !s.ok()) return s;
+  out->h.assign(nk_, std::vector<Cplx>(np_));
+  out->node_peak.assign(nk_, std::vector<double>(np_, 0.0));
+  // Per source and probe: the transfers to the probe's nodes a and b (0 for ground).
+  auto take = [&](size_t k, size_t p, Cplx at_a, Cplx at_b) {
+    out->h[k][p] = at_a - at_b;
+    out->node_peak[k][p] = std::max(std::abs(at_a), std::abs(at_b));
+  };
+  if (rows.transposed) {
+    for (size_t p = 0; p < np_; ++p) {
+      std::array<std::vector<Cplx>, 2> at;  // [side][k]
+      for (int side = 0; side < 2; ++side) {
+        at[side].assign(nk_, 0.0);
+        if (rows.node_rows[p][side].empty()) continue;
+        const AcAnalysis::Vector z = ac.solve_transposed(rows.node_rows[p][side]);
+        for (size_t k = 0; k < nk_; ++k)
+          for (int i : rows.source_rows[k]) at[side][k] += z[i] * excitations_[k][i];
       }
-    } else {
-      for (size_t k = 0; k < nk_; ++k) {
-        AcAnalysis::Vector b(excitations_[k].begin(), excitations_[k].end());
-        b[0] = 0.0;
-        const AcAnalysis::Vector x = ac_.solve_factored(b);
-        for (size_t p = 0; p < np_; ++p)
-          take(k, p, probes_[p].a ? x[probes_[p].a] : 0.0, probes_[p].b ? x[probes_[p].b] : 0.0);
-      }
+      for (size_t k = 0; k < nk_; ++k) take(k, p, at[0][k], at[1][k]);
+    }
+  } else {
+    for (size_t k = 0; k < nk_; ++k) {
+      AcAnalysis::Vector b(excitations_[k].begin(), excitations_[k].end());
+      b[0] = 0.0;
+      const AcAnalysis::Vector x = ac.solve_factored(b);
+      for (size_t p = 0; p < np_; ++p)
+        take(k, p, probes_[p].a ? x[probes_[p].a] : 0.0, probes_[p].b ? x[probes_[p].b] : 0.0);
     }
   }
   return Status::Ok();
@@ -460,34 +511,69 @@ void Reducer::seed_basis() {
 
 // Adds the Krylov vectors at j 2 pi f; false when none was new.
 StatusOr<bool> Reducer::expand_at(double f) {
-  const int n = n_;
-  if (Status s = ac_.factor(f); !s.ok()) return s;
+  Eigen::MatrixXd block;
+  if (Status s = krylov_block(ac_, f, &block); !s.ok()) return s;
   ++st_.factorizations;
-  // The point's vectors, real and imaginary parts, in the order they are added.
-  Eigen::MatrixXd block(n, 2 * opt_.moments * static_cast<Eigen::Index>(nk_));
+  ++st_.expansion_points;
+  return basis_.add_block(std::move(block), g_, c_) > 0;
+}
+
+// expand_at for each of fs in turn, their Krylov vectors computed two points at a time (the
+// second through add_checks's second AC solver). Each point's vectors depend on the point and
+// the solver it went to, the split fixed by fs's order: not on the cores.
+Status Reducer::expand_at_all(const std::vector<double>& fs) {
+  std::vector<Eigen::MatrixXd> blocks(fs.size());
+  std::vector<Status> status(fs.size(), Status::Ok());
+  for (size_t i = 0; i < fs.size(); i += 2) {
+    if (i + 1 < fs.size() && ac_second_) {
+      tbb::parallel_invoke(
+          [&] { status[i] = krylov_block(ac_, fs[i], &blocks[i]); },
+          [&] { status[i + 1] = krylov_block(*ac_second_, fs[i + 1], &blocks[i + 1]); });
+    } else {
+      for (size_t j = i; j < std::min(i + 2, fs.size()); ++j)
+        status[j] = krylov_block(ac_, fs[j], &blocks[j]);
+    }
+  }
+  for (size_t i = 0; i < fs.size(); ++i) {
+    if (!status[i].ok()) return status[i];
+    ++st_.factorizations;
+    ++st_.expansion_points;
+    basis_.add_block(std::move(blocks[i]), g_, c_);
+    used_.push_back(fs[i]);
+  }
+  return Status::Ok();
+}
+
+// The point's Krylov vectors, real and imaginary parts, in the order they are added: per source,
+// A^-1 e_k, (A^-1 C) A^-1 e_k, ... (opt_.moments of them), A = G + j 2 pi f C factored in `ac`.
+Status Reducer::krylov_block(AcAnalysis& ac, double f, Eigen::MatrixXd* out) const {
+  const int n = n_;
+  if (Status s = ac.factor(f); !s.ok()) return s;
+  Eigen::MatrixXd& block = *out;
+  block.resize(n, 2 * opt_.moments * static_cast<Eigen::Index>(nk_));
   Eigen::Index cols = 0;
+  Eigen::VectorXd cr(n), ci(n);
   for (size_t k = 0; k < nk_; ++k) {
     AcAnalysis::Vector b(excitations_[k].begin(), excitations_[k].end());
     b[0] = 0.0;
     for (int m = 0; m < opt_.moments; ++m) {
-      AcAnalysis::Vector x = ac_.solve_factored(b);
+      AcAnalysis::Vector x = ac.solve_factored(b);
       Eigen::VectorXd re(n), im(n);
       for (int i = 0; i < n; ++i) re[i] = x[i + 1].real(), im[i] = x[i + 1].imag();
       const double norm = std::sqrt(re.squaredNorm() + im.squaredNorm());
       if (!(norm > 0) || !std::isfinite(norm)) break;
       block.col(cols++) = re;
       block.col(cols++) = im;
-      // Next moment: A^-1 C x (normalised; only the direction matters).
-      Eigen::VectorXcd xc(n);
-      for (int i = 0; i < n; ++i) xc[i] = x[i + 1] / norm;
-      Eigen::VectorXcd cx = c_.cast<Cplx>() * xc;  // the circuit's own C x: undo row_sign
-      for (int i = 0; i < n; ++i) cx[i] *= row_sign_[i];
+      // Next moment: A^-1 C x (normalised; only the direction matters), the circuit's own C x
+      // (row_sign undone).
+      cr.noalias() = c_ * re;
+      ci.noalias() = c_ * im;
       b.assign(n + 1, 0.0);
-      for (int i = 0; i < n; ++i) b[i + 1] = cx[i];
+      for (int i = 0; i < n; ++i) b[i + 1] = Cplx(cr[i], ci[i]) * (row_sign_[i] / norm);
     }
   }
-  ++st_.expansion_points;
-  return basis_.add_block(block.leftCols(cols), g_, c_) > 0;
+  block.conservativeResize(Eigen::NoChange, cols);
+  return Status::Ok();
 }
 
 // The first expansion points: f_min, f_max / 10 and the caller's start points in the band.
@@ -823,15 +909,14 @@ Status Reducer::expand_where_worst() {
     }
     if (static_cast<int>(used_.size()) >= opt_.max_points) break;
   }
-  for (int taken = 1; taken < opt_.batch && grew;) {
-    const auto next = std::find_if(peaks.begin(), peaks.end(),
-                                   [&](const auto& pk) { return !is_used(pk.second); });
-    if (next == peaks.end() || static_cast<int>(used_.size()) >= opt_.max_points) break;
-    StatusOr<bool> added = expand_at(next->second);
-    if (!added) return added.status();
-    used_.push_back(next->second);
-    ++taken;
+  std::vector<double> more;  // the batch's other points: the next-worst peaks not yet used
+  for (const auto& pk : peaks) {
+    if (!grew || 1 + static_cast<int>(more.size()) >= opt_.batch ||
+        static_cast<int>(used_.size() + more.size()) >= opt_.max_points)
+      break;
+    if (!is_used(pk.second)) more.push_back(pk.second);
   }
+  if (Status s = expand_at_all(more); !s.ok()) return s;
   if (!grew && relax()) return Status::Ok();
   if (!grew)
     return Status::Error(fmt::format(
