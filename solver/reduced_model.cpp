@@ -90,8 +90,8 @@ using Cplx = std::complex<double>;
 //    everything should that cancel more than half of it (after step 2 it does not: a guard).
 // Vector by vector (steps 2 and 4 on each in turn, with a third pass against the whole basis
 // when a vector cancelled to a thousandth, the criterion of Daniel, Gragg, Kaufman and Stewart)
-// built models of the same order within 1 % that pass the same check on the corpus's 44-100 m
-// nonlinear links (033: 972 and 972, 019: 972 and 978, 000: 902 and 904), but made about 250 of
+// built models of orders within 2 % of these that pass the same check on the corpus's 44-100 m
+// nonlinear links (033: 972 and 973, 019: 972 and 992, 000: 902 and 904), but made about 250 of
 // those third passes per model, each reading the basis two or three times: 0.6 s of link 033's
 // 4.3 s model, with the passes of steps 1 and 3 on all 108 vectors another 0.3 s.
 struct Basis {
