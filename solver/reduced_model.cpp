@@ -263,7 +263,8 @@ class Reducer {
 
   const Circuit& circuit_;
   AcAnalysis& ac_;
-  std::unique_ptr<AcAnalysis> ac_second_;  // add_checks's second core
+  // The second core's sparse LU (add_checks, expand_at_all), made by start_checks.
+  std::unique_ptr<AcAnalysis> ac_second_;
   const std::vector<std::vector<double>>& excitations_;
   const std::vector<std::vector<double>>& dc_solutions_;
   const std::vector<Probe>& probes_;
@@ -286,7 +287,8 @@ class Reducer {
   std::vector<double> errors_;  // the last model's error at each check frequency
   std::vector<double> freqs_;   // the check frequencies
   std::vector<std::vector<std::vector<Cplx>>> exact_;  // [check][k][p]
-  std::vector<std::vector<double>> scale_;             // [k][p]: peak |H| with DC
+  CheckRows check_rows_;                    // add_checks's right-hand sides (start_checks)
+  std::vector<std::vector<double>> scale_;  // [k][p]: peak |H| with DC
   // [k][p]: the peak over the grid and DC of max(|H_ka|, |H_kb|), probe p = v(a, b): what its
   // nodes carry (opt_.difference_scale).
   std::vector<std::vector<double>> node_scale_;
@@ -361,18 +363,12 @@ void Reducer::assemble_pencil(bool passive_form) {
 // grown to the peak |H|. H_kp = l_p' A^-1 e_k takes one solve per source, or one transposed
 // solve per probe, z_p = A^-T l_p and H_kp = z_p' e_k: whichever is fewer (an edge response
 // drives two sources and reads one probe). The frequencies go in two halves on two cores, each
-// with its own sparse LU (the second AcAnalysis made on the first call); each half's values
+// with its own sparse LU (ac_ and ac_second_); each half's values
 // depend on the split alone, not on the cores.
 Status Reducer::add_checks(const std::vector<double>& fs) {
-  const CheckRows rows = check_rows();
+  const CheckRows& rows = check_rows_;
   std::vector<ExactPoint> points(fs.size());
   const size_t half = fs.size() / 2;
-  if (half > 0 && !ac_second_) {
-    StatusOr<AcAnalysis> second = AcAnalysis::create(circuit_);
-    if (!second) return second.status();
-    ac_second_ = std::make_unique<AcAnalysis>(std::move(*second));
-    if (Status s = ac_second_->factor(std::sqrt(opt_.f_min * opt_.f_max)); !s.ok()) return s;
-  }
   Status first_status = Status::Ok(), second_status = Status::Ok();
   auto run = [&](AcAnalysis& ac, size_t from, size_t to, Status* status) {
     for (size_t i = from; i < to && status->ok(); ++i)
@@ -467,9 +463,15 @@ Status Reducer::exact_at(AcAnalysis& ac, const CheckRows& rows, double f, ExactP
 // Pivots from the middle of the band first: the refactorizations below reuse them, and the
 // ones a 1 kHz matrix would choose (its 1e-12 S ties on floating nodes) fill in badly. Then the
 // check grid: opt.check_points frequencies, log-spaced over the band.
+// The second core's AC solver starts from the same pivots.
 Status Reducer::start_checks() {
-  if (Status s = ac_.factor(std::sqrt(opt_.f_min * opt_.f_max)); !s.ok()) return s;
+  StatusOr<AcAnalysis> second = AcAnalysis::create(circuit_);
+  if (!second) return second.status();
+  ac_second_ = std::make_unique<AcAnalysis>(std::move(*second));
+  for (AcAnalysis* ac : {&ac_, ac_second_.get()})
+    if (Status s = ac->factor(std::sqrt(opt_.f_min * opt_.f_max)); !s.ok()) return s;
   ++st_.factorizations;
+  check_rows_ = check_rows();
   std::vector<double> fs(opt_.check_points);
   for (int i = 0; i < opt_.check_points; ++i)
     fs[i] = opt_.f_min *
@@ -524,7 +526,7 @@ Status Reducer::expand_at_all(const std::vector<double>& fs) {
   std::vector<Eigen::MatrixXd> blocks(fs.size());
   std::vector<Status> status(fs.size(), Status::Ok());
   for (size_t i = 0; i < fs.size(); i += 2) {
-    if (i + 1 < fs.size() && ac_second_) {
+    if (i + 1 < fs.size()) {
       tbb::parallel_invoke(
           [&] { status[i] = krylov_block(ac_, fs[i], &blocks[i]); },
           [&] { status[i + 1] = krylov_block(*ac_second_, fs[i + 1], &blocks[i + 1]); });
