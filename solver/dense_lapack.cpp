@@ -36,6 +36,9 @@ void dtrevc3_(const char* side, const char* howmny, int* select, const int* n, c
               const int* ldt, double* vl, const int* ldvl, double* vr, const int* ldvr,
               const int* mm, int* m, double* work, const int* lwork, int* info,
               std::size_t side_len, std::size_t howmny_len);
+void dhseqr_(const char* job, const char* compz, const int* n, const int* ilo, const int* ihi,
+             double* h, const int* ldh, double* wr, double* wi, double* z, const int* ldz,
+             double* work, const int* lwork, int* info, std::size_t job_len, std::size_t compz_len);
 void dgehrd_(const int* n, const int* ilo, const int* ihi, double* a, const int* lda, double* tau,
              double* work, const int* lwork, int* info);
 void dormhr_(const char* side, const char* trans, const int* m, const int* n, const int* ilo,
@@ -88,6 +91,26 @@ StatusOr<Schur> real_schur(const Eigen::MatrixXd& m) {
   return f;
 }
 
+// The real Schur form of an upper Hessenberg h (dhseqr alone: dgees would reduce it again).
+StatusOr<Schur> hessenberg_schur(const Eigen::MatrixXd& h) {
+  const int n = static_cast<int>(h.rows()), ilo = 1;
+  Schur f{h, Eigen::MatrixXd(n, n), Eigen::VectorXd(n), Eigen::VectorXd(n)};
+  f.s.triangularView<Eigen::StrictlyLower>().setZero();
+  for (int j = 0; j + 1 < n; ++j) f.s(j + 1, j) = h(j + 1, j);
+  int lwork = -1, info = 0;
+  double size = 0;
+  dhseqr_("S", "I", &n, &ilo, &n, f.s.data(), &n, f.wr.data(), f.wi.data(), f.z.data(), &n, &size,
+          &lwork, &info, 1, 1);
+  std::vector<double> work(static_cast<std::size_t>(std::max(static_cast<int>(size), n)));
+  lwork = static_cast<int>(work.size());
+  dhseqr_("S", "I", &n, &ilo, &n, f.s.data(), &n, f.wr.data(), f.wi.data(), f.z.data(), &n,
+          work.data(), &lwork, &info, 1, 1);
+  if (info != 0)
+    return Status::Error("eigen-decomposition: the QR iteration did not converge (LAPACK dhseqr " +
+                         std::to_string(info) + ")");
+  return f;
+}
+
 // The eigenvectors of the quasi-triangular n x n block at t (leading dimension ldt), as complex
 // columns (dtrevc3's real and imaginary column pairs joined).
 StatusOr<Eigen::MatrixXcd> block_eigenvectors(const double* t, int n, int ldt,
@@ -135,7 +158,8 @@ Status reorder(Schur* f, const std::vector<int>& chosen) {
 }  // namespace
 
 StatusOr<ModalSplit> modal_split(const Eigen::MatrixXd& m, const Eigen::MatrixXd& b,
-                                 const Eigen::MatrixXd& l, double relative, double absolute) {
+                                 const Eigen::MatrixXd& l, double relative, double absolute,
+                                 MatrixShape shape) {
   if (Status s = check_square(m, "eigen-decomposition"); !s.ok()) return s;
   if (b.rows() != m.rows() || l.cols() != m.rows())
     return Status::Error("eigen-decomposition: the sizes do not agree");
@@ -144,7 +168,7 @@ StatusOr<ModalSplit> modal_split(const Eigen::MatrixXd& m, const Eigen::MatrixXd
   ModalSplit out;
   out.rest.setZero(l.rows(), b.cols());
   if (q == 0) return out;
-  StatusOr<Schur> f = real_schur(m);
+  StatusOr<Schur> f = shape == MatrixShape::Hessenberg ? hessenberg_schur(m) : real_schur(m);
   if (!f) return f.status();
   double largest = 0;
   for (int j = 0; j < q; ++j)

@@ -41,9 +41,9 @@ namespace isolink {
 // `bound`), l P b with P the projector on their invariant subspace along the modes': what those add
 // where |z| bound is small.
 //
-// Method: the real Schur form m = Z S Z' (dgees), the rest's eigenvalues moved to its leading
-// block (dtrsen), the two blocks decoupled by the Sylvester equation S11 X - X S22 = -S12
-// (dtrsyl), and the eigenvectors of the modes' block alone (dtrevc3). A cluster of equal
+// Method: the real Schur form m = Z S Z' (dgees; dhseqr for a Hessenberg m), the rest's eigenvalues
+// moved to its leading block (dtrsen), the two blocks decoupled by the Sylvester equation S11 X - X
+// S22 = -S12 (dtrsyl), and the eigenvectors of the modes' block alone (dtrevc3). A cluster of equal
 // eigenvalues has no well-conditioned eigenvectors (LAPACK's come out parallel: on a 3-unknown
 // RC with a probe on the source's current, the two zero eigenvalues' vectors agreed to 1e-266 and
 // the model was 1 off), so the rest, where such clusters sit (a singular C: nodes without
@@ -62,8 +62,12 @@ struct ModalSplit {
 
 // Error: m not square or not finite, the sizes not agreeing, the QR iteration not converging, the
 // reordering failing (eigenvalues too close to swap) or the modes' eigenvectors singular.
+// m's shape: General, or Hessenberg (its entries under the subdiagonal taken as zero; the Schur
+// form then starts from m itself: no second reduction, a fifth of the work at order 970).
+enum class MatrixShape { General, Hessenberg };
 StatusOr<ModalSplit> modal_split(const Eigen::MatrixXd& m, const Eigen::MatrixXd& b,
-                                 const Eigen::MatrixXd& l, double relative, double absolute);
+                                 const Eigen::MatrixXd& l, double relative, double absolute,
+                                 MatrixShape shape = MatrixShape::General);
 
 // m = Q H Q' with H upper Hessenberg and Q orthogonal, Q kept as LAPACK's reflections.
 class DenseHessenberg {

@@ -58,6 +58,11 @@ Status HessenbergTransfer::set(const Eigen::MatrixXd& g, const Eigen::MatrixXd& 
   return Status::Ok();
 }
 
+StatusOr<ModalSplit> HessenbergTransfer::modes(double relative, double absolute) const {
+  const Eigen::MatrixXd t = t_;
+  return modal_split(t, qab_, lq_, relative, absolute, MatrixShape::Hessenberg);
+}
+
 Eigen::MatrixXcd HessenbergTransfer::at(std::complex<double> s) const {
   if (q_ == 0) return Eigen::MatrixXcd::Zero(qab_.cols(), lq_.rows());
   return lq_.rows() <= qab_.cols() ? at_by_probes(s.real() - sigma_, s.imag())

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "base/status.h"
+#include "solver/dense_lapack.h"
 
 namespace isolink {
 
@@ -40,6 +41,10 @@ class HessenbergTransfer {
   // H(s) as an nk x np matrix (element (k, p): source k to probe p). Thread-safe: the work
   // arrays are each thread's own (kept between calls, so that repeated calls allocate nothing).
   Eigen::MatrixXcd at(std::complex<double> s) const;
+  // The system's modes from its Hessenberg form (modal_split of T, Q'A^-1B and LQ: the same
+  // split as of M, A^-1 B and L, without reducing M again): their values are the eigenvalues of
+  // M, poles sigma - 1 / lambda.
+  StatusOr<ModalSplit> modes(double relative, double absolute) const;
 
  private:
   // The two ways through (I + z T), z = s - sigma: one solve per probe with the transposed

@@ -324,6 +324,10 @@ struct ModeCoefs {
 };
 struct StepCoefs : ModeCoefs {
   Eigen::MatrixXd z_trap, z_euler;  // port voltages per unit of end port current
+  // The probes at the step's midpoint in one pass (PortMarch::midpoint_probes): probe p's output
+  // row times the half step's e, a + b / 2 and b / 2 in columns 3p, 3p + 1, 3p + 2 (real and
+  // imaginary parts), made on the first use.
+  Eigen::MatrixXd mid_r, mid_i;
 };
 
 void phi12(Cplx z, Cplx* phi1, Cplx* phi2) {
@@ -415,6 +419,11 @@ class PortMarch {
   // The probes (model outputs) at the n - 1 points inside the step that split it into n equal
   // parts, marched from s0 with the step's input (linear in t), into rows_ (n - 1 rows of ny_).
   void probes_inside(const PortState& s0, const PortState& s1, double h, bool euler, int n);
+  // probes_inside for n = 2 (the one row most steps need, to measure the rows' deviation): the
+  // midpoint's modes are x(h/2) = e x0 + a w0 + b (w0 + w1) / 2 with the half step's
+  // coefficients, so each probe's modal part is three products of the state at the step's ends
+  // with the probe's row folded into them, and no state is marched.
+  void midpoint_probes(const PortState& s0, const PortState& s1, double h, bool euler);
   // Max over the probes and the inner points of |y_k - (y_k-1 + y_k+1) / 2| over the probe's
   // row tolerance: the deviation of the rows' linear interpolation at twice their spacing.
   double inner_deviation(const PortState& s0, const PortState& s1, int n) const;
@@ -492,7 +501,8 @@ PortMarch::PortMarch(const Circuit& circuit, const PortModel& pm, const Transien
       tiny_(opt.tstop * 1e-12),
       control_{.hmax = largest_step(circuit, pm, opt),
                .hmin = std::max(1e-18, opt.tstop * 1e-13),
-               .error_order = 3} {
+               .error_order = 3,
+               .rungs_per_octave = 4} {
   for (const std::string& name : pm.source_names)
     sources_.push_back(circuit.find_element(name)->source_function());
   for (const std::string& name : pm.port_elements) port_el_.push_back(circuit.find_element(name));
@@ -711,6 +721,46 @@ ISOLINK_WIDE_SIMD void PortMarch::probes_inside(const PortState& s0, const PortS
   }
 }
 
+ISOLINK_WIDE_SIMD void PortMarch::midpoint_probes(const PortState& s0, const PortState& s1,
+                                                  double h, bool euler) {
+  StepCoefs& c = const_cast<StepCoefs&>(coefs(h));
+  if (c.mid_r.cols() != 3 * ny_) {
+    const ModeCoefs& half = inner_coefs(0.5 * h);
+    c.mid_r.resize(q_, 3 * ny_), c.mid_i.resize(q_, 3 * ny_);
+    for (int p = 0; p < ny_; ++p)
+      for (int i = 0; i < q_; ++i) {
+        const Cplx out(out_re_(i, p), out_im_(i, p)), b(half.br[i], half.bi[i]);
+        const Cplx f[3] = {out * Cplx(half.er[i], half.ei[i]),
+                           out * (Cplx(half.ar[i], half.ai[i]) + 0.5 * b), out * 0.5 * b};
+        for (int k = 0; k < 3; ++k)
+          c.mid_r(i, 3 * p + k) = f[k].real(), c.mid_i(i, 3 * p + k) = f[k].imag();
+      }
+  }
+  // w0 = in.u0 + in.d0 (Euler: in.d1), w1 = in.u1 + in.d1, as probes_inside.
+  const double* d0r = (euler ? s1.sdr : s0.sdr).data();
+  const double* d0i = (euler ? s1.sdi : s0.sdi).data();
+  const double *x0r = s0.xr.data(), *x0i = s0.xi.data(), *u0r = s0.sur.data(), *u0i = s0.sui.data(),
+               *u1r = s1.sur.data(), *u1i = s1.sui.data(), *d1r = s1.sdr.data(),
+               *d1i = s1.sdi.data();
+  rows_.resize(ny_);
+  const double t = 0.5 * (s0.t + s1.t);
+  std::vector<double>& u = inner_u_;
+  u.resize(ns_);
+  for (int j = 0; j < ns_; ++j) u[j] = sources_[j]->value(t);
+  for (int p = 0; p < ny_; ++p) {
+    const double *er = c.mid_r.col(3 * p).data(), *ei = c.mid_i.col(3 * p).data();
+    const double *ar = er + q_, *ai = ei + q_, *br = ar + q_, *bi = ai + q_;
+    double y = 0.0;
+    for (int i = 0; i < q_; ++i)
+      y += er[i] * x0r[i] - ei[i] * x0i[i] + ar[i] * (u0r[i] + d0r[i]) - ai[i] * (u0i[i] + d0i[i]) +
+           br[i] * (u1r[i] + d1r[i]) - bi[i] * (u1i[i] + d1i[i]);
+    y += offset_[p];
+    for (int j = 0; j < ns_; ++j) y += direct_(p, j) * u[j];
+    for (int m = 0; m < np_; ++m) y += direct_(p, ns_ + m) * 0.5 * (s0.d[m] + s1.d[m]);
+    rows_[p] = y;
+  }
+}
+
 double PortMarch::inner_deviation(const PortState& s0, const PortState& s1, int n) const {
   double worst = 0.0;
   for (int p = 0; p < ny_; ++p) {
@@ -738,7 +788,10 @@ Status PortMarch::record_inside(const PortState& s0, const PortState& s1, double
   const bool print_rows = (s1.t - s0.t) > opt_.tstep * (1 + 1e-9);  // TSTEP's rows needed
   if (ny_ == 0 && !print_rows) return Status::Ok();  // the port currents are lines in between
   if (ny_ > 0) {
-    probes_inside(s0, s1, h, euler, n);
+    if (n == 2)
+      midpoint_probes(s0, s1, h, euler);
+    else
+      probes_inside(s0, s1, h, euler, n);
     double dev = inner_deviation(s0, s1, n);
     if (!print_rows && dev <= 1.0) return Status::Ok();  // the step's ends suffice
     if (dev > 4.0 && n < kMaxParts) {

@@ -50,21 +50,23 @@
 //    formula as the current's shape (trapezoidal: dq/dt at the end = 2 (q1 - q0) / h - dq/dt at
 //    the start; Euler: (q1 - q0) / h): the integral of the charge current over a step is q1 - q0
 //    exactly, so charge is conserved.
-// 4. Step control: the one StepControl (solver/step_control.h), step sizes on its ladder so the
-//    coefficients and Z_h are reused; the larger of two estimates decides: the transient's
-//    truncation term (third divided difference) on the port voltages, against trtol (reltol x
-//    the largest port voltage's peak + vntol), and on the ports' charges, against trtol (reltol x
-//    the charge's peak + chgtol), the Euler start step checked one step late; and the port
-//    currents' departure from a straight line over the step (h^2 d'' / 8 through the step's port
-//    impedances) against the port voltages' tolerance. The probes are not watched: exact given
-//    the port currents, their rows are step 5's. The largest step is TMAX, else (tstop - tstart)
-//    / 50 where every source is piecewise linear and no switch is controlled, else TSTEP's
-//    bound. Newton's failure retries at 1/8 of the step.
+// 4. Step control: the one StepControl (solver/step_control.h), step sizes on its ladder at four
+//    rungs an octave so the coefficients and Z_h are reused (a step costs O(modes x ports), a new
+//    size O(modes x ports^2): the finer ladder's steps are nearer what the error allows); the
+//    larger of two estimates decides: the transient's truncation term (third divided difference) on
+//    the port voltages, against trtol (reltol x the largest port voltage's peak + vntol), and on
+//    the ports' charges, against trtol (reltol x the charge's peak + chgtol), the Euler start step
+//    checked one step late; and the port currents' departure from a straight line over the step
+//    (h^2 d'' / 8 through the step's port impedances) against the port voltages' tolerance. The
+//    probes are not watched: exact given the port currents, their rows are step 5's. The largest
+//    step is TMAX, else (tstop - tstart) / 50 where every source is piecewise linear and no switch
+//    is controlled, else TSTEP's bound. Newton's failure retries at 1/8 of the step.
 // 5. Rows: one at each step's end, and inside a step (the modes marched in 2^j equal parts with
-//    the step's input) at most TSTEP apart and as many more as keep the probes' linear
-//    interpolation between rows within the same tolerance (measured on the rows: the deviation
-//    at twice their spacing, quartered). A port current probe is interpolated linearly inside a
-//    step; a switch's step has no rows inside.
+//    the step's input; the midpoint alone, which most steps need, in one pass: its modes are the
+//    step's end states' with the half step's coefficients) at most TSTEP apart and as many more as
+//    keep the probes' linear interpolation between rows within the same tolerance (measured on the
+//    rows: the deviation at twice their spacing, quartered). A port current probe is interpolated
+//    linearly inside a step; a switch's step has no rows inside.
 //
 // Guarantee: the linear network's response is exact to the model's check (its transfer within
 // tol of each input-output pair's peak at every check frequency; for an input edge, the
@@ -121,6 +123,7 @@ struct PortModelOptions {
   // Five expansion points a search step, not three: on the corpus's 44-100 m TVS links (order
   // 850-970) each step's model costs O(q^3), and fewer steps took their models 7-16 % faster
   // (019: 5.4 -> 4.4 s), the waveforms within 0.015 mV; 11-32 m links the same within 4 %.
+  // Ten in the step after a refinement that failed (ReducedModelOptions::refine_batch).
   // Four moments a point were faster on two of ten long links and slower on eight; with two,
   // link 019's run went past 9 minutes (bench/README.md, "Dense linear algebra").
   ReducedModelOptions reduced = [] {
@@ -131,6 +134,7 @@ struct PortModelOptions {
     r.difference_scale = true;
     r.stall_tol = 1e-4;
     r.batch = 5;
+    r.refine_batch = 10;
     return r;
   }();
   // When the first model fails its check, the other is tried on a network of at most this many

@@ -32,6 +32,7 @@ Status ReducedModelOptions::validate() const {
   if (moments < 1 || moments > 20) return bad("moments", moments, "must be in 1..20");
   if (max_points < 1) return bad("max_points", max_points, "must be positive");
   if (batch < 1) return bad("batch", batch, "must be positive");
+  if (refine_batch < 0) return bad("refine_batch", refine_batch, "must be 0 (batch) or positive");
   if (max_order < 1) return bad("max_order", max_order, "must be positive");
   if (!(horizon > 0) || !std::isfinite(horizon)) return bad("horizon", horizon, "must be positive");
   if (!(edge_time >= 0) || !std::isfinite(edge_time))
@@ -249,7 +250,10 @@ class Reducer {
   double sigma() const;
   Status build();
   StatusOr<bool> accept();
-  Status modal_form(ReducedModel* mod);
+  // The modes from the pencil (Shape::FromPencil), or from the Hessenberg form of the last build
+  // (FromProjection: projected_, which must be the current basis's).
+  enum class Shape { FromPencil, FromProjection };
+  Status modal_form(ReducedModel* mod, Shape from = Shape::FromPencil);
   StatusOr<bool> refine_checks();
   Status expand_where_worst();
   // The search can go no further: the check's tolerance becomes opt_.stall_tol when the error is
@@ -284,6 +288,7 @@ class Reducer {
   HessenbergTransfer projected_;
   bool modal_ = false;
   bool modal_each_step_ = false;
+  bool refined_ = false;        // the last check was a refinement that failed
   std::vector<double> errors_;  // the last model's error at each check frequency
   std::vector<double> freqs_;   // the check frequencies
   std::vector<std::vector<std::vector<Cplx>>> exact_;  // [check][k][p]
@@ -756,7 +761,7 @@ StatusOr<bool> Reducer::accept() {
   if (modal_) return true;
   ReducedModel mod = empty_model(model_.stats);
   if (basis_.q != 0)
-    if (Status s = modal_form(&mod); !s.ok()) return s;
+    if (Status s = modal_form(&mod, Shape::FromProjection); !s.ok()) return s;
   model_ = std::move(mod);
   modal_ = true;
   measure();
@@ -767,12 +772,8 @@ StatusOr<bool> Reducer::accept() {
 
 // The reduced pencil's eigen-decomposition as poles and residues in `mod`: direct terms for the
 // instantaneous modes, right-half-plane poles dropped (and counted).
-Status Reducer::modal_form(ReducedModel* mod) {
-  Eigen::MatrixXd br, lr;
-  project_ports(&br, &lr);
+Status Reducer::modal_form(ReducedModel* mod, Shape from) {
   const double sigma = this->sigma();
-  StatusOr<ShiftInvert> si = shift_invert(gr_, cr_, br, sigma);
-  if (!si) return si.status();
   // Instantaneous: lambda = 0, or a mode so fast (|lambda| under 1e-6 / (2 pi f_max): a time
   // constant of 0.05 fs, a pole over 2e16 rad/s) that its share 1 / (1 + (s - sigma) lambda)
   // is constant within 1e-6 over the whole band: the direct terms. The zero eigenvalues of a
@@ -780,7 +781,14 @@ Status Reducer::modal_form(ReducedModel* mod) {
   // s against 9e-8 s, one was a pole at -8.9e18 rad/s and the other a right-half-plane pole,
   // dropped, and v(in) lost its direct term (error 1).
   const double instant = 1e-6 / (2 * std::numbers::pi * opt_.f_max);
-  StatusOr<ModalSplit> split = modal_split(si->m, si->ab, lr, 1e-14, instant);
+  StatusOr<ModalSplit> split = [&]() -> StatusOr<ModalSplit> {
+    if (from == Shape::FromProjection) return projected_.modes(1e-14, instant);
+    Eigen::MatrixXd br, lr;
+    project_ports(&br, &lr);
+    StatusOr<ShiftInvert> si = shift_invert(gr_, cr_, br, sigma);
+    if (!si) return si.status();
+    return modal_split(si->m, si->ab, lr, 1e-14, instant);
+  }();
   if (!split) return Status::Error("reduced model: " + split.status().message());
   mod->stats.direct_modes += split->rest_count;
   for (size_t k = 0; k < nk_; ++k)
@@ -889,8 +897,10 @@ Status Reducer::expand_where_worst() {
     if (static_cast<int>(used_.size()) >= opt_.max_points) break;
   }
   std::vector<double> more;  // the batch's other points: the next-worst peaks not yet used
+  const int batch = refined_ && opt_.refine_batch > 0 ? opt_.refine_batch : opt_.batch;
+  refined_ = false;
   for (const auto& pk : peaks) {
-    if (!grew || 1 + static_cast<int>(more.size()) >= opt_.batch ||
+    if (!grew || 1 + static_cast<int>(more.size()) >= batch ||
         static_cast<int>(used_.size() + more.size()) >= opt_.max_points)
       break;
     if (!is_used(pk.second)) more.push_back(pk.second);
@@ -915,6 +925,7 @@ StatusOr<ReducedModel> Reducer::run() {
     if (model_.stats.error <= tol_) {
       StatusOr<bool> done = refine_checks();
       if (!done) return done.status();
+      refined_ = !*done;
       if (*done) {
         StatusOr<bool> accepted = accept();
         if (!accepted) return accepted.status();

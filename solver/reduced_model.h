@@ -27,14 +27,16 @@
 //    grid is refined as adaptive quadrature does: the model must also pass at the geometric
 //    midpoint of every check interval (a resonance can hide between check points); an interval
 //    whose midpoint fails joins the grid as two halves, tested again at their own midpoints
-//    once the search has fixed the model there (up to max_check_points). Accepted: every check
-//    point passes and every interval's midpoint passed. The models of the search are measured
-//    without their eigenvectors, through the Hessenberg form of M (solver/hessenberg_transfer.h:
-//    O(q^2) a frequency instead of the O(q^3) eigendecomposition a step); only the one that
-//    passes is diagonalised (step 2) and measured again over the whole grid. Should its modal
-//    form fail where the projection passed (step 4's dropped poles), the search goes on with the
-//    modal form at every step. On the corpus's 72 m transformer link (order 658, 26 steps) this
-//    took the model from 30 s to 10 s, with the same expansion points and the same output.
+//    once the search has fixed the model there (up to max_check_points). The step after a
+//    refinement that failed takes up to `refine_batch` points where that is set. Accepted:
+//    every check point passes and every interval's midpoint passed. The models of the search are
+//    measured without their eigenvectors, through the Hessenberg form of M
+//    (solver/hessenberg_transfer.h: O(q^2) a frequency instead of the O(q^3) eigendecomposition a
+//    step); only the one that passes is diagonalised (step 2, from that Hessenberg form: the Schur
+//    form without a second reduction) and measured again over the whole grid. Should its modal form
+//    fail where the projection passed (step 4's dropped poles), the search goes on with the modal
+//    form at every step. On the corpus's 72 m transformer link (order 658, 26 steps) this took the
+//    model from 30 s to 10 s, with the same expansion points and the same output.
 // 4. A pole in the right half plane is a projection artefact (the circuits here are passive). It
 //    is kept when it is so slow that it cannot grow over `horizon` (Re p horizon < 1e-3), and
 //    dropped otherwise, before the check: a model that needed it fails the check there, and the
@@ -83,6 +85,15 @@ struct ReducedModelOptions {
   // 8 lengths from 11 to 13 m: 1 -> 10 points and 69 ms per model, 2 -> 59.5 ms, 3 -> 58.5 ms
   // (10-11 points), 4 -> 60 ms (11 points: more vectors than the model needs).
   int batch = 3;
+  // Expansion points in the step after a refinement that failed (0: `batch`). Its failing
+  // midpoints are resonances between passing points, which one expansion point seldom fixes for
+  // another: the port model takes 10 (twice its batch; on the corpus's 44-100 m nonlinear links
+  // 8-11 % off their models, one O(q^3) build fewer per refinement round, orders within 1 %;
+  // every failing midpoint at once gained no more). Not the default: a fitted Touchstone cable's
+  // LTI search (tests/analysis/touchstone_export_test.cpp, Capchoke5m) then stalled at 3.6e-5,
+  // its error growing as the points went in, as it did when the search measured first where the
+  // last model failed.
+  int refine_batch = 0;
   // Basis size before giving up; lower on large circuits, where the basis (three dense
   // unknowns x order arrays, grown by doubling) would pass 384 MB (32,000 unknowns: order 524).
   int max_order = 1200;

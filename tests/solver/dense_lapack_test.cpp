@@ -1,6 +1,7 @@
 // The dense LAPACK / BLAS layer (solver/dense_lapack.h) against Eigen's own dense algebra: the
 // modal split's transfer against a dense LU solve of l (I + z m)^-1 b, with and without a cluster
-// of zero eigenvalues; the Hessenberg form's Q H Q' against m; the product on blocks; the solve.
+// of zero eigenvalues, and from the Hessenberg form; the Hessenberg form's Q H Q' against m; the
+// product on blocks; the solve.
 #include "solver/dense_lapack.h"
 
 #include <gtest/gtest.h>
@@ -107,6 +108,30 @@ TEST(ModalSplit, DoubleZeroEigenvalueOfAnRcIsExact) {
   ASSERT_EQ(split->values.size(), 1);
   EXPECT_NEAR(split->values[0].real(), 2 * a, 1e-12 * a);
   EXPECT_LT(worst_split_error(m, in, out, *split), 1e-12);
+}
+
+// The split of m's Hessenberg form H = Q' m Q with Q'b and lQ (what the reduced model's search
+// holds when a model passes) is the split of m: the same transfer, the same rest. Its entries
+// under the subdiagonal are garbage here (dgehrd's reflections), which the split must not read.
+TEST(ModalSplit, FromTheHessenbergFormIsTheSplitOfTheMatrix) {
+  for (const int c_rank : {40, 6}) {
+    std::mt19937 rng(17 + c_rank);
+    const Eigen::MatrixXd m = shift_inverted(40, c_rank, &rng);
+    const Eigen::MatrixXd b = random_matrix(40, 3, &rng), l = random_matrix(5, 40, &rng);
+    StatusOr<DenseHessenberg> h = dense_hessenberg(m);
+    ASSERT_TRUE(h.ok());
+    Eigen::MatrixXd qb = b, lq = l;
+    h->apply_q_transposed(&qb);
+    h->apply_q(&lq);
+    Eigen::MatrixXd t = h->h();
+    for (int j = 0; j < 40; ++j)
+      for (int i = j + 2; i < 40; ++i) t(i, j) = 1e3 * (i + j);
+    StatusOr<ModalSplit> split = modal_split(t, qb, lq, 1e-14, 0.0, MatrixShape::Hessenberg);
+    ASSERT_TRUE(split.ok()) << split.status().message();
+    EXPECT_EQ(split->rest_count, 40 - c_rank);
+    EXPECT_EQ(split->values.size(), c_rank);
+    EXPECT_LT(worst_split_error(m, b, l, *split), 1e-10) << "rank of C " << c_rank;
+  }
 }
 
 TEST(ModalSplit, AbsoluteBoundMovesSmallEigenvaluesToTheRest) {

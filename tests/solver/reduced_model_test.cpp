@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <random>
 
@@ -127,6 +128,31 @@ TEST(ReducedModel, BatchedStepsPassTheSameCheckInFewerSteps) {
   EXPECT_EQ(c1.model.stats.steps, c1.model.stats.expansion_points - 1);
   EXPECT_LE(c3.model.stats.steps * 10, c1.model.stats.steps * 6);
   EXPECT_LE(c3.model.stats.order, c1.model.stats.order + 8);
+}
+
+// More points in the step after a refinement that failed (refine_batch): the same check passed
+// in fewer builds, as good between the check frequencies. With a coarse first grid (16 points)
+// the ladder's modes near its cutoff fail the refinement's midpoints several at a time: 9 builds
+// for 15 points at batch 2, 7 for 16 with refine_batch 12.
+TEST(ReducedModel, RefineBatchPassesTheSameCheckInFewerSteps) {
+  auto b = ladder();
+  ReducedModelOptions plain, wide;
+  plain.check_points = wide.check_points = 16;
+  plain.batch = wide.batch = 2;
+  wide.refine_batch = 12;
+  const Checked p = reduce_and_check(*b, plain), w = reduce_and_check(*b, wide);
+  EXPECT_LE(p.model.stats.error, 2e-5);
+  EXPECT_LE(w.model.stats.error, 2e-5);
+  // Between the check frequencies as good as the plain search (both 4.7e-4 off: 16 points then
+  // two levels of refinement leave a mode near the cutoff under-sampled).
+  EXPECT_LT(w.worst, 1.5 * p.worst + 1e-5);
+  std::printf("steps %d / %d, points %d / %d, order %d / %d\n", p.model.stats.steps,
+              w.model.stats.steps, p.model.stats.expansion_points, w.model.stats.expansion_points,
+              p.model.stats.order, w.model.stats.order);
+  EXPECT_LT(w.model.stats.steps, p.model.stats.steps);
+  ReducedModelOptions bad;
+  bad.refine_batch = -1;
+  EXPECT_FALSE(bad.validate().ok());
 }
 
 // Started from a model's own expansion points (what isolink compare's fit does with the design's
