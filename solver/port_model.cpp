@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "base/wide_simd.h"
+#include "solver/dense_lapack.h"
 #include "solver/elements/source_function.h"
 #include "solver/mna.h"
 #include "solver/mna_system.h"
@@ -449,6 +450,8 @@ class PortMarch {
   std::vector<double> control_sign_;
   std::vector<const Element*> port_el_;
   std::map<double, StepCoefs> cache_;
+  double last_h_ = -1.0;  // coefs()'s last step size and its entry
+  const StepCoefs* last_coefs_ = nullptr;
   std::map<double, ModeCoefs> inner_cache_;
   PortState cur_, next_;
   std::array<PortState, 3> hist_;  // points since the last breakpoint, oldest first
@@ -469,7 +472,8 @@ class PortMarch {
   Eigen::MatrixXd in_re_, in_im_;    // modes x inputs
   Eigen::MatrixXd out_re_, out_im_;  // modes x outputs
   Eigen::MatrixXd direct_;           // outputs x inputs
-  Eigen::VectorXd offset_;           // per output
+  Eigen::MatrixXd ports_in_;  // 2 modes x ports: the ports' inputs, real parts over imaginary
+  Eigen::VectorXd offset_;    // per output
   Eigen::ArrayXd scratch_r_, scratch_i_;
   Eigen::ArrayXd in_xr_, in_xi_, in_wr_, in_wi_, in_nr_, in_ni_;  // probes_inside's march
   Eigen::ArrayXd in_dwr_, in_dwi_;
@@ -523,6 +527,9 @@ PortMarch::PortMarch(const Circuit& circuit, const PortModel& pm, const Transien
   for (int k = 0; k < nin; ++k)
     for (int o = 0; o < nout; ++o) direct_(o, k) = m_.direct[k][o];
   offset_ = Eigen::Map<const Eigen::VectorXd>(pm.offset.data(), nout);
+  ports_in_.resize(2 * q_, np_);
+  ports_in_.topRows(q_) = in_re_.middleCols(ns_, np_);
+  ports_in_.bottomRows(q_) = in_im_.middleCols(ns_, np_);
   jac_.resize(np_, np_);
   lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(np_);
   v_oc_.assign(np_, 0.0);
@@ -540,30 +547,37 @@ PortMarch::PortMarch(const Circuit& circuit, const PortModel& pm, const Transien
   probe_peak_.assign(ny_, 0.0);
 }
 
+// Z_h(mo, mi) = Re sum_i out_mo,i b_i in_mi,i + direct: with the ports' outputs times b as the
+// real matrix [Re; -Im] (2q x np) and their inputs as [Re; Im] (ports_in_, 2q x np), one real
+// product for both formulas' b (trapezoidal b, Euler be).
 const StepCoefs& PortMarch::coefs(double h) {
+  if (h == last_h_) return *last_coefs_;
   auto it = cache_.find(h);
-  if (it != cache_.end()) return it->second;
-  if (cache_.size() > 256) cache_.clear();
-  StepCoefs c;
-  static_cast<ModeCoefs&>(c) = mode_coefs(m_.poles, h);
-  c.z_trap.setZero(np_, np_);
-  c.z_euler.setZero(np_, np_);
-  for (int mo = 0; mo < np_; ++mo)
-    for (int mi = 0; mi < np_; ++mi) {
-      const auto& out = m_.output[ny_ + mo];
-      const auto& in = m_.input[ns_ + mi];
-      Cplx st = 0, se = 0;
-      for (int i = 0; i < q_; ++i) {
-        const Cplx oi = out[i] * in[i];
-        st += oi * Cplx(c.br[i], c.bi[i]);
-        se += oi * Cplx(c.ber[i], c.bei[i]);
+  if (it == cache_.end()) {
+    if (cache_.size() > 256) cache_.clear();
+    StepCoefs c;
+    static_cast<ModeCoefs&>(c) = mode_coefs(m_.poles, h);
+    Eigen::MatrixXd ob(2 * q_, 2 * np_);  // columns: trapezoidal per port, then Euler
+    for (int f = 0; f < 2; ++f) {
+      const Eigen::ArrayXd& br = f == 0 ? c.br : c.ber;
+      const Eigen::ArrayXd& bi = f == 0 ? c.bi : c.bei;
+      for (int mo = 0; mo < np_; ++mo) {
+        const auto ore = out_re_.col(ny_ + mo).array(), oim = out_im_.col(ny_ + mo).array();
+        ob.col(f * np_ + mo).head(q_) = ore * br - oim * bi;
+        ob.col(f * np_ + mo).tail(q_) = -(ore * bi + oim * br);
       }
-      const double dir = m_.direct[ns_ + mi][ny_ + mo];
-      c.z_trap(mo, mi) = st.real() + dir;
-      c.z_euler(mo, mi) = se.real() + dir;
     }
-  ++stats_.step_sizes;
-  return cache_.emplace(h, std::move(c)).first->second;
+    Eigen::MatrixXd z(2 * np_, np_);
+    dense_multiply(true, 1.0, ob, ports_in_, 0.0, z);
+    const Eigen::MatrixXd dir = direct_.block(ny_, ns_, np_, np_);
+    c.z_trap = z.topRows(np_) + dir;
+    c.z_euler = z.bottomRows(np_) + dir;
+    ++stats_.step_sizes;
+    it = cache_.emplace(h, std::move(c)).first;
+  }
+  last_h_ = h;
+  last_coefs_ = &it->second;
+  return it->second;
 }
 
 // Two inputs a pass over the modes (half the loads and stores of one at a time).

@@ -32,11 +32,14 @@
 //    every check point passes and every interval's midpoint passed. The models of the search are
 //    measured without their eigenvectors, through the Hessenberg form of M
 //    (solver/hessenberg_transfer.h: O(q^2) a frequency instead of the O(q^3) eigendecomposition a
-//    step); only the one that passes is diagonalised (step 2, from that Hessenberg form: the Schur
-//    form without a second reduction) and measured again over the whole grid. Should its modal form
-//    fail where the projection passed (step 4's dropped poles), the search goes on with the modal
-//    form at every step. On the corpus's 72 m transformer link (order 658, 26 steps) this took the
-//    model from 30 s to 10 s, with the same expansion points and the same output.
+//    step); only the one that passes is diagonalised and measured again over the whole grid.
+//    Should its modal form fail where the projection passed (step 4's dropped poles), the search
+//    goes on with the modal form at every step. On the corpus's 72 m transformer link (order 658,
+//    26 steps) this took the model from 30 s to 10 s, with the same expansion points and the same
+//    output. A model likely to pass is diagonalised at once instead (small ones, whose grid
+//    evaluation would cost more, and one after a refinement that failed at one or two midpoints,
+//    usually the last: four of five on the corpus's 44-100 m links). Every modal form is taken
+//    from the Hessenberg form (the Schur form of T: M is not reduced twice, nor Q formed).
 // 4. A pole in the right half plane is a projection artefact (the circuits here are passive). It
 //    is kept when it is so slow that it cannot grow over `horizon` (Re p horizon < 1e-3), and
 //    dropped otherwise, before the check: a model that needed it fails the check there, and the
