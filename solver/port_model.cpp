@@ -505,8 +505,7 @@ PortMarch::PortMarch(const Circuit& circuit, const PortModel& pm, const Transien
       tiny_(opt.tstop * 1e-12),
       control_{.hmax = largest_step(circuit, pm, opt),
                .hmin = std::max(1e-18, opt.tstop * 1e-13),
-               .error_order = 3,
-               .rungs_per_octave = 4} {
+               .error_order = 3} {
   for (const std::string& name : pm.source_names)
     sources_.push_back(circuit.find_element(name)->source_function());
   for (const std::string& name : pm.port_elements) port_el_.push_back(circuit.find_element(name));

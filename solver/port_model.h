@@ -50,17 +50,16 @@
 //    formula as the current's shape (trapezoidal: dq/dt at the end = 2 (q1 - q0) / h - dq/dt at
 //    the start; Euler: (q1 - q0) / h): the integral of the charge current over a step is q1 - q0
 //    exactly, so charge is conserved.
-// 4. Step control: the one StepControl (solver/step_control.h), step sizes on its ladder at four
-//    rungs an octave so the coefficients and Z_h are reused (a step costs O(modes x ports), a new
-//    size O(modes x ports^2): the finer ladder's steps are nearer what the error allows); the
-//    larger of two estimates decides: the transient's truncation term (third divided difference) on
-//    the port voltages, against trtol (reltol x the largest port voltage's peak + vntol), and on
-//    the ports' charges, against trtol (reltol x the charge's peak + chgtol), the Euler start step
-//    checked one step late; and the port currents' departure from a straight line over the step
-//    (h^2 d'' / 8 through the step's port impedances) against the port voltages' tolerance. The
-//    probes are not watched: exact given the port currents, their rows are step 5's. The largest
-//    step is TMAX, else (tstop - tstart) / 50 where every source is piecewise linear and no switch
-//    is controlled, else TSTEP's bound. Newton's failure retries at 1/8 of the step.
+// 4. Step control: the one StepControl (solver/step_control.h), step sizes on its ladder so the
+//    coefficients and Z_h are reused; the larger of two estimates decides: the transient's
+//    truncation term (third divided difference) on the port voltages, against trtol (reltol x the
+//    largest port voltage's peak + vntol), and on the ports' charges, against trtol (reltol x the
+//    charge's peak + chgtol), the Euler start step checked one step late; and the port currents'
+//    departure from a straight line over the step (h^2 d'' / 8 through the step's port impedances)
+//    against the port voltages' tolerance. The probes are not watched: exact given the port
+//    currents, their rows are step 5's. The largest step is TMAX, else (tstop - tstart) / 50 where
+//    every source is piecewise linear and no switch is controlled, else TSTEP's bound. Newton's
+//    failure retries at 1/8 of the step.
 // 5. Rows: one at each step's end, and inside a step (the modes marched in 2^j equal parts with
 //    the step's input; the midpoint alone, which most steps need, in one pass: its modes are the
 //    step's end states' with the half step's coefficients) at most TSTEP apart and as many more as

@@ -8,12 +8,7 @@
 //   else h = control.grow(step, ratio);                // already a rung
 //
 // Steps are rungs hmax / 2^k so that a step size comes back often and its factorization is reused
-// (KluSolver caches them by the matrix key). A step is the largest rung under the size the error
-// asks for, on average 0.72 of it with a rung per octave (the mean of 2^-u, u uniform in [0, 1)):
-// an engine whose cost per new step size is small against its steps takes rungs_per_octave 4
-// (0.92 of it; the port model: its step coefficients are O(modes x ports^2), a step O(modes x
-// ports), and on the corpus's 5-7 m TVS links it took 15-21 % fewer steps, rejected ones
-// included). error_order is the power of h the controlled error
+// (KluSolver caches them by the matrix key). error_order is the power of h the controlled error
 // grows with: 3 for the local truncation error of a second-order method (the transient: the
 // trapezoidal rule and Gear-2), 2 for that error per unit time (the LTI march), 2 also for the
 // backward-Euler start step's error. A step's error ratio r then asks for the step scaled by
@@ -34,23 +29,15 @@ struct StepControl {
   double hmax = 0.0;    // s, the top rung (> 0)
   double hmin = 0.0;    // s, the floor: the engines give up below it (grow never goes under it)
   int error_order = 3;  // 2 or 3, see above
-  int rungs_per_octave = 1;  // 1, 2 or 4: the rungs are hmax 2^(-k / rungs_per_octave)
 
-  // The largest rung hmax 2^(-k / rungs_per_octave) not above h (up to rounding: log2 is taken
-  // with 1e-9 slack); hmax for h >= hmax. An h of 0 (or below hmax 2^-1074) makes log2 infinite,
-  // whose conversion to int is undefined behaviour (UBSan: negation of INT_MIN): k is clamped to
-  // 1100, so the result is 0 or a subnormal, below any hmin, and the caller's step-size floor
-  // reports.
+  // The largest rung hmax / 2^k not above h (up to rounding: log2 is taken with 1e-9 slack);
+  // hmax for h >= hmax. An h of 0 (or below hmax 2^-1074) makes log2 infinite, whose conversion
+  // to int is undefined behaviour (UBSan: negation of INT_MIN): k is clamped to 1100, so the
+  // result is 0 or a subnormal, below any hmin, and the caller's step-size floor reports.
   double ladder(double h) const {
     if (h >= hmax) return hmax;
-    const int r = rungs_per_octave;
-    const double k = std::ceil(r * std::log2(hmax / h) - 1e-9);
-    if (r == 1) return std::ldexp(hmax, k < 1100 ? -static_cast<int>(k) : -1100);
-    if (!(k < 1100.0 * r)) return 0.0;
-    const int ki = static_cast<int>(k);
-    static const double kFraction[4] = {1.0, 0.8408964152537145, 0.7071067811865476,
-                                        0.5946035575013605};
-    return std::ldexp(hmax * kFraction[(ki % r) * (4 / r)], -(ki / r));
+    const double k = std::ceil(std::log2(hmax / h) - 1e-9);
+    return std::ldexp(hmax, k < 1100 ? -static_cast<int>(k) : -1100);
   }
 
   // The retry size after a step of `step` was rejected with error / tolerance `ratio` (> 1):

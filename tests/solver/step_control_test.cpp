@@ -145,30 +145,6 @@ TEST(StepControl, LadderGivesTheLargestRungNotAboveTheStep) {
   EXPECT_EQ(control.ladder(1e-9 / 1024 * 1.5), 1e-9 / 1024);
 }
 
-// Four rungs per octave (the port model's ladder): hmax 2^(-k/4), the largest not above h, exact
-// rungs to themselves, and the octaves' rungs those of one rung per octave.
-TEST(StepControl, QuarterOctaveLadderGivesTheLargestRungNotAboveTheStep) {
-  const StepControl quarter{.hmax = 1.0, .hmin = 1e-21, .error_order = 3, .rungs_per_octave = 4};
-  const StepControl half{.hmax = 1.0, .hmin = 1e-21, .error_order = 3, .rungs_per_octave = 2};
-  EXPECT_EQ(quarter.ladder(5.0), 1.0);
-  EXPECT_EQ(quarter.ladder(0.9), std::pow(2.0, -0.25));   // 0.841 <= 0.9 < 1
-  EXPECT_EQ(quarter.ladder(0.8), std::pow(2.0, -0.5));    // 0.707 <= 0.8 < 0.841
-  EXPECT_EQ(quarter.ladder(0.65), std::pow(2.0, -0.75));  // 0.595 <= 0.65 < 0.707
-  EXPECT_EQ(quarter.ladder(0.55), 0.5);
-  EXPECT_EQ(half.ladder(0.8), std::pow(2.0, -0.5));
-  EXPECT_EQ(half.ladder(0.65), 0.5);
-  for (int k = 0; k < 80; ++k) {
-    const double rung = quarter.ladder(std::pow(2.0, -k / 4.0));
-    EXPECT_NEAR(rung, std::pow(2.0, -k / 4.0), 1e-15 * rung) << "k " << k;
-    EXPECT_EQ(quarter.ladder(rung), rung) << "k " << k;
-    EXPECT_LT(quarter.ladder(0.999 * rung), rung) << "k " << k;
-    EXPECT_GE(quarter.ladder(0.999 * rung), 0.84 * rung) << "k " << k;
-  }
-  EXPECT_EQ(quarter.ladder(std::ldexp(1.0, -40)), std::ldexp(1.0, -40));
-  // Growth lands on the finer rungs: 0.9 ratio^(-1/3) = 1.8 from 0.5 is 0.9: rung 0.841.
-  EXPECT_EQ(quarter.grow(0.5, 1.0 / 8), std::pow(2.0, -0.25));
-}
-
 // h = 0 (or a subnormal h) made log2 infinite and its conversion to int undefined (UBSan): the
 // rung exponent is clamped at 1100, which gives 0 or a subnormal, below any floor.
 TEST(StepControl, LadderClampsAZeroOrSubnormalStepBelowTheFloor) {
