@@ -395,7 +395,8 @@ class PortMarch {
 
  private:
   Status initial_state();
-  const StepCoefs& coefs(double h);
+  // The step's coefficients, cached per step size (midpoint_probes adds its own to the entry).
+  StepCoefs& coefs(double h);
   // Port m at voltage v, its control (a switch's) at vc[port_control[m]].
   PortEval eval(int m, double v, const std::vector<double>& vc) const {
     const int c = pm_.port_control[m];
@@ -451,7 +452,7 @@ class PortMarch {
   std::vector<const Element*> port_el_;
   std::map<double, StepCoefs> cache_;
   double last_h_ = -1.0;  // coefs()'s last step size and its entry
-  const StepCoefs* last_coefs_ = nullptr;
+  StepCoefs* last_coefs_ = nullptr;
   std::map<double, ModeCoefs> inner_cache_;
   PortState cur_, next_;
   std::array<PortState, 3> hist_;  // points since the last breakpoint, oldest first
@@ -472,8 +473,7 @@ class PortMarch {
   Eigen::MatrixXd in_re_, in_im_;    // modes x inputs
   Eigen::MatrixXd out_re_, out_im_;  // modes x outputs
   Eigen::MatrixXd direct_;           // outputs x inputs
-  Eigen::MatrixXd ports_in_;  // 2 modes x ports: the ports' inputs, real parts over imaginary
-  Eigen::VectorXd offset_;    // per output
+  Eigen::VectorXd offset_;           // per output
   Eigen::ArrayXd scratch_r_, scratch_i_;
   Eigen::ArrayXd in_xr_, in_xi_, in_wr_, in_wi_, in_nr_, in_ni_;  // probes_inside's march
   Eigen::ArrayXd in_dwr_, in_dwi_;
@@ -526,9 +526,6 @@ PortMarch::PortMarch(const Circuit& circuit, const PortModel& pm, const Transien
   for (int k = 0; k < nin; ++k)
     for (int o = 0; o < nout; ++o) direct_(o, k) = m_.direct[k][o];
   offset_ = Eigen::Map<const Eigen::VectorXd>(pm.offset.data(), nout);
-  ports_in_.resize(2 * q_, np_);
-  ports_in_.topRows(q_) = in_re_.middleCols(ns_, np_);
-  ports_in_.bottomRows(q_) = in_im_.middleCols(ns_, np_);
   jac_.resize(np_, np_);
   lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(np_);
   v_oc_.assign(np_, 0.0);
@@ -546,10 +543,10 @@ PortMarch::PortMarch(const Circuit& circuit, const PortModel& pm, const Transien
   probe_peak_.assign(ny_, 0.0);
 }
 
-// Z_h(mo, mi) = Re sum_i out_mo,i b_i in_mi,i + direct: with the ports' outputs times b as the
-// real matrix [Re; -Im] (2q x np) and their inputs as [Re; Im] (ports_in_, 2q x np), one real
-// product for both formulas' b (trapezoidal b, Euler be).
-const StepCoefs& PortMarch::coefs(double h) {
+// Z_h(mo, mi) = Re sum_i out_mo,i b_i in_mi,i + direct: with the ports' outputs times b split
+// into Re and -Im (q x np each, both formulas' b side by side: trapezoidal b, Euler be), two real
+// products with the ports' inputs' real and imaginary parts.
+StepCoefs& PortMarch::coefs(double h) {
   if (h == last_h_) return *last_coefs_;
   auto it = cache_.find(h);
   if (it == cache_.end()) {
@@ -567,7 +564,8 @@ const StepCoefs& PortMarch::coefs(double h) {
       }
     }
     Eigen::MatrixXd z(2 * np_, np_);
-    dense_multiply(true, 1.0, ob, ports_in_, 0.0, z);
+    dense_multiply(true, 1.0, ob.topRows(q_), in_re_.middleCols(ns_, np_), 0.0, z);
+    dense_multiply(true, 1.0, ob.bottomRows(q_), in_im_.middleCols(ns_, np_), 1.0, z);
     const Eigen::MatrixXd dir = direct_.block(ny_, ns_, np_, np_);
     c.z_trap = z.topRows(np_) + dir;
     c.z_euler = z.bottomRows(np_) + dir;
@@ -736,7 +734,7 @@ ISOLINK_WIDE_SIMD void PortMarch::probes_inside(const PortState& s0, const PortS
 
 ISOLINK_WIDE_SIMD void PortMarch::midpoint_probes(const PortState& s0, const PortState& s1,
                                                   double h, bool euler) {
-  StepCoefs& c = const_cast<StepCoefs&>(coefs(h));
+  StepCoefs& c = coefs(h);
   if (c.mid_r.cols() != 3 * ny_) {
     const ModeCoefs& half = inner_coefs(0.5 * h);
     c.mid_r.resize(q_, 3 * ny_), c.mid_i.resize(q_, 3 * ny_);
