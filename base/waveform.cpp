@@ -1,8 +1,13 @@
 #include "base/waveform.h"
 
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
 #include <charconv>
 #include <cstdio>
+#include <string>
+#include <vector>
 
 #include "base/csv.h"
 #include "base/file_io.h"
@@ -57,34 +62,69 @@ Waveform Waveform::resampled(double dt) const {
   return out;
 }
 
+namespace {
+
+// Rows [begin, end) as CSV text: std::to_chars with a precision writes exactly what printf's
+// %.12g / %.9g would (C locale), several times faster.
+std::string csv_rows(const Waveform& w, size_t begin, size_t end) {
+  std::string text;
+  text.reserve((end - begin) * (20 + 17 * w.columns.size()));
+  char cell[64];
+  auto put = [&](double v, int precision) {
+    const auto r =
+        std::to_chars(cell, cell + sizeof cell, v, std::chars_format::general, precision);
+    text.append(cell, r.ptr);
+  };
+  for (size_t i = begin; i < end; ++i) {
+    put(w.time[i], 12);
+    for (const auto& c : w.columns) {
+      text += ',';
+      put(c[i], 9);
+    }
+    text += '\n';
+  }
+  return text;
+}
+
+}  // namespace
+
+// The rows are formatted in blocks on every core and written in order (oneTBB's pipeline, at most
+// a few blocks in memory at once): formatting was 7 % of a nonlinear link's run (323,000 rows,
+// 43 ms on one core).
 Status write_waveform_csv(const Waveform& w, const std::string& path) {
   StatusOr<OutputFile> f = OutputFile::open(path);
   if (!f) return f.status();
   std::vector<std::string> header{"time"};
   header.insert(header.end(), w.names.begin(), w.names.end());
-  std::string line = csv_row(header);
-  if (Status s = f->write(line); !s.ok()) return s;
-  // std::to_chars with a precision writes exactly what printf's %.12g / %.9g would (C locale),
-  // several times faster; rows are written in blocks.
-  char cell[64];
-  auto put = [&](double v, int precision) {
-    const auto r =
-        std::to_chars(cell, cell + sizeof cell, v, std::chars_format::general, precision);
-    line.append(cell, r.ptr);
-  };
-  line.clear();
-  for (size_t i = 0; i < w.time.size(); ++i) {
-    put(w.time[i], 12);
-    for (const auto& c : w.columns) {
-      line += ',';
-      put(c[i], 9);
-    }
-    line += '\n';
-    if (line.size() >= (1 << 16) || i + 1 == w.time.size()) {
-      if (Status s = f->write(line); !s.ok()) return s;
-      line.clear();
-    }
-  }
+  if (Status s = f->write(csv_row(header)); !s.ok()) return s;
+  constexpr size_t kBlockRows = 8192;
+  const size_t rows = w.time.size();
+  size_t next = 0;
+  Status written = Status::Ok();
+  const size_t tokens =
+      2 * static_cast<size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
+  tbb::parallel_pipeline(tokens,
+                         tbb::make_filter<void, size_t>(tbb::filter_mode::serial_in_order,
+                                                        [&](tbb::flow_control& fc) -> size_t {
+                                                          if (next >= rows) {
+                                                            fc.stop();
+                                                            return 0;
+                                                          }
+                                                          const size_t begin = next;
+                                                          next = std::min(rows, next + kBlockRows);
+                                                          return begin;
+                                                        }) &
+                             tbb::make_filter<size_t, std::string>(
+                                 tbb::filter_mode::parallel,
+                                 [&](size_t begin) {
+                                   return csv_rows(w, begin, std::min(rows, begin + kBlockRows));
+                                 }) &
+                             tbb::make_filter<std::string, void>(tbb::filter_mode::serial_in_order,
+                                                                 [&](const std::string& text) {
+                                                                   if (written.ok())
+                                                                     written = f->write(text);
+                                                                 }));
+  if (!written.ok()) return written;
   return f->commit();
 }
 

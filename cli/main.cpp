@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "cli/commands.h"
+#include "solver/dense_lapack.h"
 
 int main(int argc, char** argv) {
   // Every sweep point, edge response and model allocates and frees the same large arrays (MBs):
@@ -13,6 +14,7 @@ int main(int argc, char** argv) {
   // faster (bench/README.md). Peak memory is unchanged; only freed memory is kept for reuse.
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
   mallopt(M_TRIM_THRESHOLD, 512 << 20);
+  isolink::stop_blas_worker_threads();
   CLI::App app{"isolink: signal integrity of BMS daisy-chain links (BQ7961x, BQ79600, BQ79606A)"};
   app.require_subcommand(1);
   int exit_code = 0;

@@ -1,5 +1,7 @@
 #include "solver/dense_lapack.h"
 
+#include <dlfcn.h>
+
 #include <algorithm>
 #include <cassert>
 #include <complex>
@@ -57,10 +59,24 @@ namespace isolink {
 namespace {
 
 // OpenBLAS on one thread (the header says why), once per process.
-void one_thread() {
+void one_blas_thread() {
   static std::once_flag once;
   std::call_once(once, [] { openblas_set_num_threads(1); });
 }
+
+}  // namespace
+
+void stop_blas_worker_threads() {
+  one_blas_thread();
+  // The worker threads OpenBLAS started when it loaded spin (sched_yield) for 2^28 cycles, about
+  // 0.1 s, before they sleep; stopped here they give that core back to the program's own threads
+  // (the port model's two runs: 1-2 % of a 5 m link's wall time on two cores). Looked up, not
+  // linked: OpenBLAS's serial build has no thread server to stop.
+  using Shutdown = int (*)();
+  if (auto stop = reinterpret_cast<Shutdown>(dlsym(RTLD_DEFAULT, "blas_thread_shutdown_"))) stop();
+}
+
+namespace {
 
 Status check_square(const Eigen::MatrixXd& m, const char* what) {
   if (m.rows() != m.cols()) return Status::Error(std::string(what) + ": the matrix is not square");
@@ -163,7 +179,7 @@ StatusOr<ModalSplit> modal_split(const Eigen::MatrixXd& m, const Eigen::MatrixXd
   if (Status s = check_square(m, "eigen-decomposition"); !s.ok()) return s;
   if (b.rows() != m.rows() || l.cols() != m.rows())
     return Status::Error("eigen-decomposition: the sizes do not agree");
-  one_thread();
+  one_blas_thread();
   const int q = static_cast<int>(m.rows());
   ModalSplit out;
   out.rest.setZero(l.rows(), b.cols());
@@ -219,7 +235,7 @@ StatusOr<ModalSplit> modal_split(const Eigen::MatrixXd& m, const Eigen::MatrixXd
 
 StatusOr<DenseHessenberg> dense_hessenberg(const Eigen::MatrixXd& m) {
   if (Status s = check_square(m, "Hessenberg reduction"); !s.ok()) return s;
-  one_thread();
+  one_blas_thread();
   const int n = static_cast<int>(m.rows()), ilo = 1;
   DenseHessenberg d;
   d.reflectors_ = m;
@@ -277,7 +293,7 @@ void multiply_with(Gemm gemm, bool transpose_a, Scalar alpha, const Scalar* a, E
                    const Scalar* b, Eigen::Index ldb, Scalar beta, Scalar* c, Eigen::Index ldc,
                    int m, int n, int k) {
   if (m == 0 || n == 0) return;
-  one_thread();
+  one_blas_thread();
   const int la = static_cast<int>(std::max<Eigen::Index>(1, lda)),
             lb = static_cast<int>(std::max<Eigen::Index>(1, ldb)),
             lc = static_cast<int>(std::max<Eigen::Index>(1, ldc));
@@ -318,7 +334,7 @@ StatusOr<Matrix> solve_with(Gesv gesv, Matrix a, Matrix b) {
     return Status::Error("dense solve: the sizes do not agree");
   const int n = static_cast<int>(a.rows()), nrhs = static_cast<int>(b.cols());
   if (n == 0 || nrhs == 0) return b;
-  one_thread();
+  one_blas_thread();
   std::vector<int> pivots(static_cast<std::size_t>(n));
   int info = 0;
   gesv(&n, &nrhs, a.data(), &n, pivots.data(), b.data(), &n, &info);

@@ -35,6 +35,12 @@
 
 namespace isolink {
 
+// OpenBLAS on one thread from here on and its idle worker threads stopped, which otherwise spin
+// for their first 0.1 s, taking a core from the program's own threads. For a program, first
+// thing in main(), while no other thread uses BLAS (not from a module loaded into someone else's
+// process: Python's numpy may be using those threads).
+void stop_blas_worker_threads();
+
 // The transfer l (I + z m)^-1 b of a real q x q matrix m split by m's eigenvalues: the modes
 // (eigenvalues over bound = max(relative x the largest |eigenvalue|, absolute) in magnitude), each
 // a term outputs.col(i) inputs.row(i) / (1 + z values[i]), and the rest (eigenvalues of at most

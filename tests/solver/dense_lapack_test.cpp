@@ -4,11 +4,14 @@
 // product on blocks; the solve.
 #include "solver/dense_lapack.h"
 
+#include <dlfcn.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <complex>
+#include <filesystem>
 #include <random>
+#include <thread>
 #include <vector>
 
 namespace isolink {
@@ -223,6 +226,37 @@ TEST(DenseSolve, SolvesAndRefusesASingularMatrix) {
   singular.row(4).setZero();
   EXPECT_FALSE(dense_solve(singular, b).ok());
   EXPECT_FALSE(dense_solve(a, b.topRows(5)).ok());
+}
+
+// The threads of this process, from /proc.
+int thread_count() {
+  int n = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator("/proc/self/task")) ++n;
+  return n;
+}
+
+// OpenBLAS's threaded build starts one worker per further core when it loads; stopped, the
+// process has fewer threads, and BLAS and LAPACK still answer (on one thread), the second stop
+// harmless.
+TEST(BlasThreads, StoppedWorkersLeaveBlasWorking) {
+  const int before = thread_count();
+  stop_blas_worker_threads();
+  const int after = thread_count();
+  if (std::thread::hardware_concurrency() > 1 && dlsym(RTLD_DEFAULT, "blas_thread_shutdown_"))
+    EXPECT_LT(after, before);
+  else
+    EXPECT_EQ(after, before);
+  stop_blas_worker_threads();
+  EXPECT_EQ(thread_count(), after);
+  std::mt19937 rng(8);
+  const Eigen::MatrixXd a = random_matrix(300, 200, &rng), b = random_matrix(300, 90, &rng);
+  Eigen::MatrixXd c = Eigen::MatrixXd::Zero(200, 90);
+  dense_multiply(true, 1.0, a, b, 0.0, c);
+  EXPECT_LT((c - a.transpose() * b).cwiseAbs().maxCoeff(), 1e-11);
+  const Eigen::MatrixXd m = random_matrix(40, 40, &rng);
+  StatusOr<Eigen::MatrixXd> x = dense_solve(m, b.topRows(40));
+  ASSERT_TRUE(x.ok());
+  EXPECT_LT((m * *x - b.topRows(40)).cwiseAbs().maxCoeff(), 1e-9);
 }
 
 }  // namespace
