@@ -44,8 +44,9 @@
 //    the end value on the first step after a breakpoint (backward Euler). Each mode is integrated
 //    exactly for such inputs: x1 = e^(ph) x0 + a(h) in.w0 + b(h) in.w1. The end port voltages
 //    are then v1 = v_oc + Z_h d1 with Z_h the model's step impedance (np x np, cached per step
-//    size), and Newton's iteration (SPICE's pnjlim limiting, the transient's tolerances) solves
-//    v1 = v_oc + Z_h d(v1) on the np port voltages alone, a dense np x np system. The junction
+//    size), and Newton's iteration (SPICE's pnjlim limiting, the transient's tolerances on an
+//    iterate's residual and on the update from it) solves v1 = v_oc + Z_h d(v1) on the np port
+//    voltages alone, a dense np x np system. The junction
 //    and diffusion charges q(v) are integrated as the transient integrates them, by the same
 //    formula as the current's shape (trapezoidal: dq/dt at the end = 2 (q1 - q0) / h - dq/dt at
 //    the start; Euler: (q1 - q0) / h): the integral of the charge current over a step is q1 - q0
