@@ -326,10 +326,12 @@ struct ModeCoefs {
 };
 struct StepCoefs : ModeCoefs {
   Eigen::MatrixXd z_trap, z_euler;  // port voltages per unit of end port current
-  // The probes at the step's midpoint in one pass (PortMarch::midpoint_probes): probe p's output
-  // row times the half step's e, a + b / 2 and b / 2 in columns 3p, 3p + 1, 3p + 2 (real and
-  // imaginary parts), made on the first use.
-  Eigen::MatrixXd mid_r, mid_i;
+  // The probes at the points that split the step into n = 2, 4 or 8 equal parts, in one pass each
+  // (PortMarch::folded_rows): for the point at f = k / n and probe p, the probe's output row
+  // times the coefficients of a step of f h, e, a + (1 - f) b and f b, in columns
+  // 3 (ny (k - 1) + p) + 0, 1, 2 (real and imaginary parts), made on the first use. folds[j]
+  // for n = 2^(j + 1).
+  std::array<Eigen::MatrixXd, 3> fold_r, fold_i;
 };
 
 void phi12(Cplx z, Cplx* phi1, Cplx* phi2) {
@@ -396,7 +398,7 @@ class PortMarch {
 
  private:
   Status initial_state();
-  // The step's coefficients, cached per step size (midpoint_probes adds its own to the entry).
+  // The step's coefficients, cached per step size (folded_rows adds its own to the entry).
   StepCoefs& coefs(double h);
   // Port m at voltage v, its control (a switch's) at vc[port_control[m]].
   PortEval eval(int m, double v, const std::vector<double>& vc) const {
@@ -422,11 +424,19 @@ class PortMarch {
   // The probes (model outputs) at the n - 1 points inside the step that split it into n equal
   // parts, marched from s0 with the step's input (linear in t), into rows_ (n - 1 rows of ny_).
   void probes_inside(const PortState& s0, const PortState& s1, double h, bool euler, int n);
-  // probes_inside for n = 2 (the one row most steps need, to measure the rows' deviation): the
-  // midpoint's modes are x(h/2) = e x0 + a w0 + b (w0 + w1) / 2 with the half step's
-  // coefficients, so each probe's modal part is three products of the state at the step's ends
-  // with the probe's row folded into them, and no state is marched.
-  void midpoint_probes(const PortState& s0, const PortState& s1, double h, bool euler);
+  // probes_inside for n = 2, 4 or 8 (the rows most steps need) without marching the modes: at
+  // f = k / n the modes are x(f h) = e x0 + a w0 + b w(f h), w(f h) = (1 - f) w0 + f w1, with
+  // the coefficients of a step of f h, so each probe's modal part is three products of the
+  // states at the step's ends with the probe's row folded into them (StepCoefs::fold_r).
+  void folded_rows(const PortState& s0, const PortState& s1, double h, bool euler, int n);
+  // probes_inside where n allows the folded rows, else the march.
+  void rows_inside(const PortState& s0, const PortState& s1, double h, bool euler, int n) {
+    if (n <= kMaxFoldedParts)
+      folded_rows(s0, s1, h, euler, n);
+    else
+      probes_inside(s0, s1, h, euler, n);
+  }
+  static constexpr int kMaxFoldedParts = 8;
   // Max over the probes and the inner points of |y_k - (y_k-1 + y_k+1) / 2| over the probe's
   // row tolerance: the deviation of the rows' linear interpolation at twice their spacing.
   double inner_deviation(const PortState& s0, const PortState& s1, int n) const;
@@ -749,20 +759,25 @@ ISOLINK_WIDE_SIMD void PortMarch::probes_inside(const PortState& s0, const PortS
   }
 }
 
-ISOLINK_WIDE_SIMD void PortMarch::midpoint_probes(const PortState& s0, const PortState& s1,
-                                                  double h, bool euler) {
+ISOLINK_WIDE_SIMD void PortMarch::folded_rows(const PortState& s0, const PortState& s1, double h,
+                                              bool euler, int n) {
   StepCoefs& c = coefs(h);
-  if (c.mid_r.cols() != 3 * ny_) {
-    const ModeCoefs& half = inner_coefs(0.5 * h);
-    c.mid_r.resize(q_, 3 * ny_), c.mid_i.resize(q_, 3 * ny_);
-    for (int p = 0; p < ny_; ++p)
-      for (int i = 0; i < q_; ++i) {
-        const Cplx out(out_re_(i, p), out_im_(i, p)), b(half.br[i], half.bi[i]);
-        const Cplx f[3] = {out * Cplx(half.er[i], half.ei[i]),
-                           out * (Cplx(half.ar[i], half.ai[i]) + 0.5 * b), out * 0.5 * b};
-        for (int k = 0; k < 3; ++k)
-          c.mid_r(i, 3 * p + k) = f[k].real(), c.mid_i(i, 3 * p + k) = f[k].imag();
-      }
+  const int fold = n == 2 ? 0 : n == 4 ? 1 : 2;
+  Eigen::MatrixXd &fr = c.fold_r[fold], &fi = c.fold_i[fold];
+  if (fr.cols() != 3 * ny_ * (n - 1)) {
+    fr.resize(q_, 3 * ny_ * (n - 1)), fi.resize(q_, 3 * ny_ * (n - 1));
+    for (int k = 1; k < n; ++k) {
+      const double f = static_cast<double>(k) / n;
+      const ModeCoefs sub = mode_coefs(m_.poles, f * h);
+      for (int p = 0; p < ny_; ++p)
+        for (int i = 0; i < q_; ++i) {
+          const Cplx out(out_re_(i, p), out_im_(i, p)), b(sub.br[i], sub.bi[i]);
+          const Cplx w[3] = {out * Cplx(sub.er[i], sub.ei[i]),
+                             out * (Cplx(sub.ar[i], sub.ai[i]) + (1 - f) * b), out * f * b};
+          const int col = 3 * (ny_ * (k - 1) + p);
+          for (int j = 0; j < 3; ++j) fr(i, col + j) = w[j].real(), fi(i, col + j) = w[j].imag();
+        }
+    }
   }
   // w0 = in.u0 + in.d0 (Euler: in.d1), w1 = in.u1 + in.d1, as probes_inside.
   const double* d0r = (euler ? s1.sdr : s0.sdr).data();
@@ -770,22 +785,26 @@ ISOLINK_WIDE_SIMD void PortMarch::midpoint_probes(const PortState& s0, const Por
   const double *x0r = s0.xr.data(), *x0i = s0.xi.data(), *u0r = s0.sur.data(), *u0i = s0.sui.data(),
                *u1r = s1.sur.data(), *u1i = s1.sui.data(), *d1r = s1.sdr.data(),
                *d1i = s1.sdi.data();
-  rows_.resize(ny_);
-  const double t = 0.5 * (s0.t + s1.t);
+  rows_.resize(static_cast<size_t>(n - 1) * ny_);
   std::vector<double>& u = inner_u_;
   u.resize(ns_);
-  for (int j = 0; j < ns_; ++j) u[j] = sources_[j]->value(t);
-  for (int p = 0; p < ny_; ++p) {
-    const double *er = c.mid_r.col(3 * p).data(), *ei = c.mid_i.col(3 * p).data();
-    const double *ar = er + q_, *ai = ei + q_, *br = ar + q_, *bi = ai + q_;
-    double y = 0.0;
-    for (int i = 0; i < q_; ++i)
-      y += er[i] * x0r[i] - ei[i] * x0i[i] + ar[i] * (u0r[i] + d0r[i]) - ai[i] * (u0i[i] + d0i[i]) +
-           br[i] * (u1r[i] + d1r[i]) - bi[i] * (u1i[i] + d1i[i]);
-    y += offset_[p];
-    for (int j = 0; j < ns_; ++j) y += direct_(p, j) * u[j];
-    for (int m = 0; m < np_; ++m) y += direct_(p, ns_ + m) * 0.5 * (s0.d[m] + s1.d[m]);
-    rows_[p] = y;
+  for (int k = 1; k < n; ++k) {
+    const double f = static_cast<double>(k) / n;
+    const double t = s0.t + f * (s1.t - s0.t);
+    for (int j = 0; j < ns_; ++j) u[j] = sources_[j]->value(t);
+    for (int p = 0; p < ny_; ++p) {
+      const int col = 3 * (ny_ * (k - 1) + p);
+      const double *er = fr.col(col).data(), *ei = fi.col(col).data();
+      const double *ar = er + q_, *ai = ei + q_, *br = ar + q_, *bi = ai + q_;
+      double y = 0.0;
+      for (int i = 0; i < q_; ++i)
+        y += er[i] * x0r[i] - ei[i] * x0i[i] + ar[i] * (u0r[i] + d0r[i]) -
+             ai[i] * (u0i[i] + d0i[i]) + br[i] * (u1r[i] + d1r[i]) - bi[i] * (u1i[i] + d1i[i]);
+      y += offset_[p];
+      for (int j = 0; j < ns_; ++j) y += direct_(p, j) * u[j];
+      for (int m = 0; m < np_; ++m) y += direct_(p, ns_ + m) * ((1 - f) * s0.d[m] + f * s1.d[m]);
+      rows_[static_cast<size_t>(k - 1) * ny_ + p] = y;
+    }
   }
 }
 
@@ -816,16 +835,13 @@ Status PortMarch::record_inside(const PortState& s0, const PortState& s1, double
   const bool print_rows = (s1.t - s0.t) > opt_.tstep * (1 + 1e-9);  // TSTEP's rows needed
   if (ny_ == 0 && !print_rows) return Status::Ok();  // the port currents are lines in between
   if (ny_ > 0) {
-    if (n == 2)
-      midpoint_probes(s0, s1, h, euler);
-    else
-      probes_inside(s0, s1, h, euler, n);
+    rows_inside(s0, s1, h, euler, n);
     double dev = inner_deviation(s0, s1, n);
     if (!print_rows && dev <= 1.0) return Status::Ok();  // the step's ends suffice
     if (dev > 4.0 && n < kMaxParts) {
       // Quartered per halving of the spacing: n' = n sqrt(dev / 4), a power of two.
       while (n < kMaxParts && dev > 4.0) n *= 2, dev /= 4;
-      probes_inside(s0, s1, h, euler, n);
+      rows_inside(s0, s1, h, euler, n);
     }
   }
   if (w_.time.size() + n > static_cast<size_t>(opt_.max_steps))

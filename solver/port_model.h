@@ -61,9 +61,10 @@
 //    currents, their rows are step 5's. The largest step is TMAX, else (tstop - tstart) / 50 where
 //    every source is piecewise linear and no switch is controlled, else TSTEP's bound. Newton's
 //    failure retries at 1/8 of the step.
-// 5. Rows: one at each step's end, and inside a step (the modes marched in 2^j equal parts with
-//    the step's input; the midpoint alone, which most steps need, in one pass: its modes are the
-//    step's end states' with the half step's coefficients) at most TSTEP apart and as many more as
+// 5. Rows: one at each step's end, and inside a step (the modes in 2^j equal parts with the
+//    step's input; up to 8 parts, which nearly every step needs, each row in one pass over the
+//    step's end states with the coefficients of its own fraction of the step, more parts
+//    marched) at most TSTEP apart and as many more as
 //    keep the probes' linear interpolation between rows within the same tolerance (measured on the
 //    rows: the deviation at twice their spacing, quartered). A port current probe is interpolated
 //    linearly inside a step; a switch's step has no rows inside.
