@@ -7,7 +7,6 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <map>
 #include <optional>
 #include <utility>
@@ -329,7 +328,7 @@ struct StepCoefs : ModeCoefs {
   // The probes at the points that split the step into n = 2, 4 or 8 equal parts, in one pass each
   // (PortMarch::folded_rows): for the point at f = k / n and probe p, the probe's output row
   // times the coefficients of a step of f h, e, a + (1 - f) b and f b, in columns
-  // 3 (ny (k - 1) + p) + 0, 1, 2 (real and imaginary parts), made on the first use. folds[j]
+  // 3 (ny (k - 1) + p) + 0, 1, 2 (real and imaginary parts), made on the first use. fold_r[j]
   // for n = 2^(j + 1).
   std::array<Eigen::MatrixXd, 3> fold_r, fold_i;
 };
