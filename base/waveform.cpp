@@ -100,30 +100,26 @@ Status write_waveform_csv(const Waveform& w, const std::string& path) {
   constexpr size_t kBlockRows = 8192;
   const size_t rows = w.time.size();
   size_t next = 0;
+  auto next_block = [&](tbb::flow_control& fc) -> size_t {  // its first row
+    if (next >= rows) fc.stop();
+    const size_t begin = next;
+    next = std::min(rows, next + kBlockRows);
+    return begin;
+  };
+  auto format_block = [&](size_t begin) {
+    return csv_rows(w, begin, std::min(rows, begin + kBlockRows));
+  };
   Status written = Status::Ok();
+  auto write_block = [&](const std::string& text) {
+    if (written.ok()) written = f->write(text);
+  };
   const size_t tokens =
       2 * static_cast<size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
-  tbb::parallel_pipeline(tokens,
-                         tbb::make_filter<void, size_t>(tbb::filter_mode::serial_in_order,
-                                                        [&](tbb::flow_control& fc) -> size_t {
-                                                          if (next >= rows) {
-                                                            fc.stop();
-                                                            return 0;
-                                                          }
-                                                          const size_t begin = next;
-                                                          next = std::min(rows, next + kBlockRows);
-                                                          return begin;
-                                                        }) &
-                             tbb::make_filter<size_t, std::string>(
-                                 tbb::filter_mode::parallel,
-                                 [&](size_t begin) {
-                                   return csv_rows(w, begin, std::min(rows, begin + kBlockRows));
-                                 }) &
-                             tbb::make_filter<std::string, void>(tbb::filter_mode::serial_in_order,
-                                                                 [&](const std::string& text) {
-                                                                   if (written.ok())
-                                                                     written = f->write(text);
-                                                                 }));
+  tbb::parallel_pipeline(
+      tokens,
+      tbb::make_filter<void, size_t>(tbb::filter_mode::serial_in_order, next_block) &
+          tbb::make_filter<size_t, std::string>(tbb::filter_mode::parallel, format_block) &
+          tbb::make_filter<std::string, void>(tbb::filter_mode::serial_in_order, write_block));
   if (!written.ok()) return written;
   return f->commit();
 }

@@ -436,6 +436,13 @@ class PortMarch {
       probes_inside(s0, s1, h, euler, n);
   }
   static constexpr int kMaxFoldedParts = 8;
+  // StepCoefs::fold_r / fold_i for n parts of a step of h, into c.
+  void make_fold(StepCoefs& c, double h, int n) const;
+  // Adds to y (ny_ values) what a row at f h inside the step from s0 to s1 has besides its
+  // modes: the constant offset, the sources' direct share at that instant and the port
+  // currents' at their values on the line between the step's ends (an Euler step's modes take
+  // the end value over the step; the instant's own current is nearer the line).
+  void add_direct_share(const PortState& s0, const PortState& s1, double f, double* y);
   // Max over the probes and the inner points of |y_k - (y_k-1 + y_k+1) / 2| over the probe's
   // row tolerance: the deviation of the rows' linear interpolation at twice their spacing.
   double inner_deviation(const PortState& s0, const PortState& s1, int n) const;
@@ -730,9 +737,6 @@ ISOLINK_WIDE_SIMD void PortMarch::probes_inside(const PortState& s0, const PortS
   in_wr_ = s0.sur + d0r, in_wi_ = s0.sui + d0i;
   in_dwr_ = s1.sur + s1.sdr - in_wr_, in_dwi_ = s1.sui + s1.sdi - in_wi_;  // w(h) - w(0)
   rows_.resize(static_cast<size_t>(n - 1) * ny_);
-  std::vector<double>& u = inner_u_;
-  std::vector<double>& d = inner_d_;
-  u.resize(ns_), d.resize(np_);
   for (int k = 1; k < n; ++k) {
     const double f = static_cast<double>(k) / n;
     in_nr_ = (s0.sur + d0r) + f * in_dwr_;
@@ -743,18 +747,42 @@ ISOLINK_WIDE_SIMD void PortMarch::probes_inside(const PortState& s0, const PortS
              c.bi * in_nr_;
     in_xr_.swap(scratch_r_);
     in_wr_.swap(in_nr_), in_wi_.swap(in_ni_);
-    const double t = s0.t + f * (s1.t - s0.t);
-    for (int j = 0; j < ns_; ++j) u[j] = sources_[j]->value(t);
-    // The port currents' direct share at their values in between (an Euler step's modes take
-    // the end value over the step; the instant's own current is nearer the line).
-    for (int m = 0; m < np_; ++m) d[m] = s0.d[m] + f * (s1.d[m] - s0.d[m]);
-    Eigen::Map<Eigen::VectorXd> y(rows_.data() + static_cast<size_t>(k - 1) * ny_, ny_);
+    double* y = rows_.data() + static_cast<size_t>(k - 1) * ny_;
     for (int p = 0; p < ny_; ++p) y[p] = modal_output(p, in_xr_, in_xi_);
-    y.noalias() +=
-        direct_.topLeftCorner(ny_, ns_) * Eigen::Map<const Eigen::VectorXd>(u.data(), ns_);
-    y.noalias() +=
-        direct_.block(0, ns_, ny_, np_) * Eigen::Map<const Eigen::VectorXd>(d.data(), np_);
-    y += offset_.head(ny_);
+    add_direct_share(s0, s1, f, y);
+  }
+}
+
+void PortMarch::add_direct_share(const PortState& s0, const PortState& s1, double f, double* y) {
+  std::vector<double>& u = inner_u_;
+  std::vector<double>& d = inner_d_;
+  u.resize(ns_), d.resize(np_);
+  const double t = s0.t + f * (s1.t - s0.t);
+  for (int j = 0; j < ns_; ++j) u[j] = sources_[j]->value(t);
+  for (int m = 0; m < np_; ++m) d[m] = (1 - f) * s0.d[m] + f * s1.d[m];
+  Eigen::Map<Eigen::VectorXd> out(y, ny_);
+  out.noalias() +=
+      direct_.topLeftCorner(ny_, ns_) * Eigen::Map<const Eigen::VectorXd>(u.data(), ns_);
+  out.noalias() +=
+      direct_.block(0, ns_, ny_, np_) * Eigen::Map<const Eigen::VectorXd>(d.data(), np_);
+  out += offset_.head(ny_);
+}
+
+void PortMarch::make_fold(StepCoefs& c, double h, int n) const {
+  const int fold = n == 2 ? 0 : n == 4 ? 1 : 2;
+  Eigen::MatrixXd &fr = c.fold_r[fold], &fi = c.fold_i[fold];
+  fr.resize(q_, 3 * ny_ * (n - 1)), fi.resize(q_, 3 * ny_ * (n - 1));
+  for (int k = 1; k < n; ++k) {
+    const double f = static_cast<double>(k) / n;
+    const ModeCoefs sub = mode_coefs(m_.poles, f * h);
+    for (int p = 0; p < ny_; ++p)
+      for (int i = 0; i < q_; ++i) {
+        const Cplx out(out_re_(i, p), out_im_(i, p)), b(sub.br[i], sub.bi[i]);
+        const Cplx w[3] = {out * Cplx(sub.er[i], sub.ei[i]),
+                           out * (Cplx(sub.ar[i], sub.ai[i]) + (1 - f) * b), out * f * b};
+        const int col = 3 * (ny_ * (k - 1) + p);
+        for (int j = 0; j < 3; ++j) fr(i, col + j) = w[j].real(), fi(i, col + j) = w[j].imag();
+      }
   }
 }
 
@@ -762,22 +790,8 @@ ISOLINK_WIDE_SIMD void PortMarch::folded_rows(const PortState& s0, const PortSta
                                               bool euler, int n) {
   StepCoefs& c = coefs(h);
   const int fold = n == 2 ? 0 : n == 4 ? 1 : 2;
-  Eigen::MatrixXd &fr = c.fold_r[fold], &fi = c.fold_i[fold];
-  if (fr.cols() != 3 * ny_ * (n - 1)) {
-    fr.resize(q_, 3 * ny_ * (n - 1)), fi.resize(q_, 3 * ny_ * (n - 1));
-    for (int k = 1; k < n; ++k) {
-      const double f = static_cast<double>(k) / n;
-      const ModeCoefs sub = mode_coefs(m_.poles, f * h);
-      for (int p = 0; p < ny_; ++p)
-        for (int i = 0; i < q_; ++i) {
-          const Cplx out(out_re_(i, p), out_im_(i, p)), b(sub.br[i], sub.bi[i]);
-          const Cplx w[3] = {out * Cplx(sub.er[i], sub.ei[i]),
-                             out * (Cplx(sub.ar[i], sub.ai[i]) + (1 - f) * b), out * f * b};
-          const int col = 3 * (ny_ * (k - 1) + p);
-          for (int j = 0; j < 3; ++j) fr(i, col + j) = w[j].real(), fi(i, col + j) = w[j].imag();
-        }
-    }
-  }
+  if (c.fold_r[fold].cols() != 3 * ny_ * (n - 1)) make_fold(c, h, n);
+  const Eigen::MatrixXd &fr = c.fold_r[fold], &fi = c.fold_i[fold];
   // w0 = in.u0 + in.d0 (Euler: in.d1), w1 = in.u1 + in.d1, as probes_inside.
   const double* d0r = (euler ? s1.sdr : s0.sdr).data();
   const double* d0i = (euler ? s1.sdi : s0.sdi).data();
@@ -785,25 +799,19 @@ ISOLINK_WIDE_SIMD void PortMarch::folded_rows(const PortState& s0, const PortSta
                *u1r = s1.sur.data(), *u1i = s1.sui.data(), *d1r = s1.sdr.data(),
                *d1i = s1.sdi.data();
   rows_.resize(static_cast<size_t>(n - 1) * ny_);
-  std::vector<double>& u = inner_u_;
-  u.resize(ns_);
   for (int k = 1; k < n; ++k) {
-    const double f = static_cast<double>(k) / n;
-    const double t = s0.t + f * (s1.t - s0.t);
-    for (int j = 0; j < ns_; ++j) u[j] = sources_[j]->value(t);
+    double* y = rows_.data() + static_cast<size_t>(k - 1) * ny_;
     for (int p = 0; p < ny_; ++p) {
       const int col = 3 * (ny_ * (k - 1) + p);
       const double *er = fr.col(col).data(), *ei = fi.col(col).data();
       const double *ar = er + q_, *ai = ei + q_, *br = ar + q_, *bi = ai + q_;
-      double y = 0.0;
+      double sum = 0.0;
       for (int i = 0; i < q_; ++i)
-        y += er[i] * x0r[i] - ei[i] * x0i[i] + ar[i] * (u0r[i] + d0r[i]) -
-             ai[i] * (u0i[i] + d0i[i]) + br[i] * (u1r[i] + d1r[i]) - bi[i] * (u1i[i] + d1i[i]);
-      y += offset_[p];
-      for (int j = 0; j < ns_; ++j) y += direct_(p, j) * u[j];
-      for (int m = 0; m < np_; ++m) y += direct_(p, ns_ + m) * ((1 - f) * s0.d[m] + f * s1.d[m]);
-      rows_[static_cast<size_t>(k - 1) * ny_ + p] = y;
+        sum += er[i] * x0r[i] - ei[i] * x0i[i] + ar[i] * (u0r[i] + d0r[i]) -
+               ai[i] * (u0i[i] + d0i[i]) + br[i] * (u1r[i] + d1r[i]) - bi[i] * (u1i[i] + d1i[i]);
+      y[p] = sum;
     }
+    add_direct_share(s0, s1, static_cast<double>(k) / n, y);
   }
 }
 

@@ -934,7 +934,6 @@ StatusOr<ReducedModel> Reducer::run() {
     if (model_.stats.error <= tol_) {
       StatusOr<bool> done = refine_checks();
       if (!done) return done.status();
-
       if (*done) {
         StatusOr<bool> accepted = accept();
         if (!accepted) return accepted.status();
